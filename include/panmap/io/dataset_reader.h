@@ -1,0 +1,92 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "panmap/core/frame.h"
+#include "panmap/core/pose.h"
+
+namespace panmap {
+
+/// One frame read from a dataset folder, colour already registered to the depth camera.
+struct DatasetFrame {
+  RgbdFrame rgbd;  ///< decoded images, intrinsics, utime, frame id
+  /// The source's colour file bytes when they can travel unchanged (JPEG, not resampled).
+  std::vector<uint8_t> color_jpeg;
+  /// The source's depth file bytes when they can travel unchanged (16-bit PNG).
+  std::vector<uint8_t> depth_png;
+  /// T_W_C when the dataset has a valid pose for this frame.
+  std::optional<Eigen::Isometry3d> T_W_C;
+  std::string pose_problem;  ///< why T_W_C is empty (file and reason)
+  std::string color_stem;    ///< colour file name without extension: the key of its masks
+  int color_source_width = 0;   ///< colour image size in the dataset, before registration
+  int color_source_height = 0;
+  /// Per depth pixel, the colour-image pixel it sees (empty when colour is already registered).
+  Image<float> color_map_u;
+  Image<float> color_map_v;
+};
+
+/// Which folder layout a dataset has.
+enum class DatasetLayout { kAuto, kSevenScenes, kScanNet, kTum };
+
+/// How ScanNet colour is registered to the depth camera.
+enum class ColorRegistration {
+  kReproject,  ///< per pixel through depth and the colour-to-depth extrinsics
+  kResize,     ///< resize the colour image to the depth size (common practice, ignores baseline)
+};
+
+/// Reader options; defaults suit the datasets' documented conventions.
+struct DatasetOptions {
+  DatasetLayout layout = DatasetLayout::kAuto;
+  /// Replaces the dataset's intrinsics (fx, fy, cx, cy of the depth camera) when set.
+  std::optional<Eigen::Vector4d> intrinsics;
+  double frame_rate_hz = 30.0;  ///< time base for datasets without timestamps
+  ColorRegistration registration = ColorRegistration::kReproject;
+  double tum_max_dt_s = 0.02;   ///< TUM: max |t_rgb - t_depth| and |t_pose - t_depth|
+  /// Largest |R^T R - I| entry accepted in a pose file (datasets store rounded matrices).
+  double pose_tolerance = 1e-3;
+  /// Throws Error naming the bad option.
+  void check() const;
+};
+
+/// A dataset folder as a sequence of frames.
+class DatasetReader {
+ public:
+  virtual ~DatasetReader() = default;
+  /// Short layout name: "7scenes", "scannet" or "tum".
+  virtual std::string layoutName() const = 0;
+  /// Number of frames (depth images) found.
+  virtual size_t size() const = 0;
+  /// Reads frame i (0-based, in time order). Throws Error naming the file at fault.
+  virtual DatasetFrame read(size_t index) const = 0;
+  /// Where the dataset's poses come from.
+  virtual PoseSource poseSource() const { return PoseSource::kGroundTruth; }
+  /// True when invalid poses are a documented property of the layout (ScanNet writes -inf
+  /// rows for frames its reconstruction lost), so skipping them is the default.
+  virtual bool invalidPosesExpected() const { return false; }
+  /// Frames the reader dropped while indexing (e.g. TUM depth without a matching colour).
+  virtual size_t unmatchedFrames() const { return 0; }
+};
+
+/// Opens a dataset folder. Throws Error naming the folder or file when it is missing or does
+/// not look like the layout.
+std::unique_ptr<DatasetReader> openDataset(const std::string& directory,
+                                           const DatasetOptions& options);
+
+/// Brings a label image at the colour image's resolution into the depth camera (nearest
+/// neighbour through the frame's colour map). Throws Error when sizes disagree.
+LabelImage registerLabelsToDepth(const LabelImage& labels_color, const DatasetFrame& frame,
+                                 const std::string& what);
+
+/// Name of a layout.
+const char* datasetLayoutName(DatasetLayout layout);
+
+/// Parses "auto", "7scenes", "scannet" or "tum"; throws Error otherwise.
+DatasetLayout parseDatasetLayout(const std::string& name);
+
+}  // namespace panmap

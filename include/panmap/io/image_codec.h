@@ -1,0 +1,53 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "panmap/core/image.h"
+
+namespace panmap {
+
+/// Bytes of a whole file; throws Error("cannot read <path>") when it cannot be read.
+std::vector<uint8_t> readFileBytes(const std::string& path);
+
+/// Writes bytes to a file, replacing it; throws Error naming the path on failure.
+void writeFileBytes(const std::string& path, const std::vector<uint8_t>& bytes);
+
+/// JPEG file bytes of a colour image.
+/// @param quality 1..100
+std::vector<uint8_t> encodeJpeg(const ColorImage& image, int quality = 90);
+
+/// 8-bit RGB PNG file bytes of a colour image.
+std::vector<uint8_t> encodePng(const ColorImage& image);
+
+/// 16-bit greyscale PNG file bytes of a depth image (lossless).
+std::vector<uint8_t> encodeDepthPng(const DepthImage& image);
+
+/// 8-bit RGB PNG of a label image in the COCO panoptic encoding id = R + 256 G + 65536 B.
+/// Throws Error for labels outside [0, 2^24).
+std::vector<uint8_t> encodeLabelPng(const LabelImage& image);
+
+/// True when JPEG bytes start with SOI and end with EOI (a truncated file does not; libjpeg
+/// would otherwise decode it with a grey tail and only a warning).
+bool isCompleteJpeg(const uint8_t* data, size_t size);
+
+/// Decodes a JPEG or 8-bit PNG into RGB. Throws Error naming `what` when the bytes are not a
+/// complete image of that kind.
+ColorImage decodeColor(const uint8_t* data, size_t size, const std::string& what);
+
+/// Decodes a 16-bit single-channel PNG. Throws Error naming `what` otherwise (an 8-bit PNG
+/// is refused: it cannot hold millimetre depth).
+DepthImage decodeDepthPng(const uint8_t* data, size_t size, const std::string& what);
+
+/// Decodes a label PNG: 8-bit RGB in the COCO panoptic encoding, or 8/16-bit greyscale ids.
+LabelImage decodeLabelPng(const uint8_t* data, size_t size, const std::string& what);
+
+/// Reads and decodes a colour image file (JPEG or PNG).
+ColorImage readColorFile(const std::string& path);
+
+/// Reads and decodes a 16-bit depth PNG file.
+DepthImage readDepthFile(const std::string& path);
+
+}  // namespace panmap

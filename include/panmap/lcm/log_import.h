@@ -1,0 +1,53 @@
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <string>
+
+#include "panmap/core/pose.h"
+#include "panmap/io/dataset_reader.h"
+#include "panmap/lcm/conversions.h"
+
+namespace panmap {
+
+/// Options of panmap-import.
+struct ImportOptions {
+  DatasetOptions dataset;
+  ImageEncoding encoding;          ///< JPEG colour + PNG depth unless --raw
+  std::string mask_dir;            ///< COCO panoptic PNGs; "" for no PANOPTIC channel
+  std::string mask_json;           ///< COCO panoptic JSON; "" for per-frame JSON files
+  std::string label_table;         ///< segmenter -> panmap classes; "" = NYU40 identity
+  /// What to do with a frame whose pose is invalid: skip it (counted) or stop with an error.
+  /// kAuto skips where the layout documents invalid poses (ScanNet) and stops elsewhere.
+  enum class InvalidPose { kAuto, kSkip, kError } invalid_pose = InvalidPose::kAuto;
+  PoseSource pose_source = PoseSource::kGroundTruth;  ///< recorded in every pose message
+  size_t max_frames = 0;           ///< 0 = all
+  std::string channel_rgbd = "CAMERA_RGBD";
+  std::string channel_pose = "CAMERA_POSE";
+  std::string channel_panoptic = "PANOPTIC";
+};
+
+/// What an import wrote and skipped.
+struct ImportStats {
+  std::string layout;
+  size_t frames_found = 0;
+  size_t frames_written = 0;
+  size_t poses_written = 0;
+  size_t panoptic_written = 0;
+  size_t skipped_invalid_pose = 0;
+  size_t frames_without_mask = 0;
+  size_t unknown_category_segments = 0;
+  size_t unmatched_frames = 0;     ///< e.g. TUM depth without colour in time
+  size_t bytes_written = 0;
+  std::string first_skip_reason;
+};
+
+/// Reads a dataset folder and writes an LCM log with CAMERA_RGBD, CAMERA_POSE and (with
+/// masks) PANOPTIC events, all stamped with the frame's utime. Throws Error naming the file
+/// at fault; a partial log is removed on failure.
+/// @param progress called after each frame with (frames done, frames total)
+ImportStats importDataset(const std::string& dataset_dir, const std::string& log_path,
+                          const ImportOptions& options,
+                          const std::function<void(size_t, size_t)>& progress = {});
+
+}  // namespace panmap

@@ -1,0 +1,155 @@
+#include "panmap/io/coco_panoptic_reader.h"
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "panmap/core/error.h"
+#include "panmap/io/image_codec.h"
+#include "panmap/io/text_files.h"
+
+namespace panmap {
+namespace {
+
+using nlohmann::json;
+
+json readJson(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot read " + path);
+  try {
+    return json::parse(in);
+  } catch (const json::exception& e) {
+    throw Error(path + ": malformed JSON (" + std::string(e.what()) + ")");
+  }
+}
+
+std::string stemOf(const std::string& file_name) {
+  return std::filesystem::path(file_name).stem().string();
+}
+
+// segments_info entries -> segments with panmap classes. Unknown categories keep class 0.
+std::vector<PanopticSegment> parseSegments(const json& info, const LabelTable& table,
+                                           const std::string& what, size_t* unknown) {
+  if (!info.is_array()) throw Error(what + ": segments_info must be a list");
+  std::vector<PanopticSegment> segments;
+  std::set<int32_t> ids;
+  for (const json& s : info) {
+    if (!s.is_object() || !s.contains("id") || !s.contains("category_id") ||
+        !s["id"].is_number_integer() || !s["category_id"].is_number_integer()) {
+      throw Error(what + ": a segments_info entry lacks integer id/category_id");
+    }
+    PanopticSegment seg;
+    seg.id = s["id"].get<int32_t>();
+    seg.source_category = s["category_id"].get<int32_t>();
+    if (seg.id <= 0) throw Error(what + ": segment id " + std::to_string(seg.id) + " is not > 0");
+    if (!ids.insert(seg.id).second) {
+      throw Error(what + ": segment id " + std::to_string(seg.id) + " appears twice");
+    }
+    const auto entry = table.lookup(seg.source_category);
+    if (entry) {
+      seg.category = entry->panmap_class;
+      seg.is_thing = entry->is_thing;
+    } else {
+      seg.category = 0;
+      ++*unknown;
+    }
+    if (s.contains("isthing")) seg.is_thing = s["isthing"].get<int>() != 0;
+    if (s.contains("score")) {
+      const double score = s["score"].get<double>();
+      if (!(score >= 0.0 && score <= 1.0)) {
+        throw Error(what + ": score of segment " + std::to_string(seg.id) + " not in [0, 1]");
+      }
+      seg.score = static_cast<float>(score);
+    }
+    segments.push_back(seg);
+  }
+  return segments;
+}
+
+}  // namespace
+
+CocoPanopticReader::CocoPanopticReader(const std::string& mask_dir, const std::string& json_path,
+                                       LabelTable table)
+    : mask_dir_(mask_dir), table_(std::move(table)) {
+  if (!isDirectory(mask_dir)) throw Error("mask folder " + mask_dir + " does not exist");
+  if (!json_path.empty()) {
+    const json root = readJson(json_path);
+    if (!root.is_object() || !root.contains("annotations") || !root["annotations"].is_array()) {
+      throw Error(json_path + ": not a COCO panoptic file (no annotations list)");
+    }
+    std::map<long long, std::string> image_names;  // image_id -> image file stem
+    if (root.contains("images") && root["images"].is_array()) {
+      for (const json& im : root["images"]) {
+        if (im.contains("id") && im.contains("file_name")) {
+          image_names[im["id"].get<long long>()] = stemOf(im["file_name"].get<std::string>());
+        }
+      }
+    }
+    size_t unknown = 0;
+    for (const json& a : root["annotations"]) {
+      if (!a.contains("file_name") || !a.contains("segments_info")) {
+        throw Error(json_path + ": an annotation lacks file_name or segments_info");
+      }
+      const std::string png = a["file_name"].get<std::string>();
+      Entry entry;
+      entry.png_path = mask_dir + "/" + png;
+      entry.segments = parseSegments(a["segments_info"], table_, json_path + " (" + png + ")",
+                                     &unknown);
+      std::string key = stemOf(png);
+      if (a.contains("image_id") && a["image_id"].is_number_integer()) {
+        const auto it = image_names.find(a["image_id"].get<long long>());
+        if (it != image_names.end()) key = it->second;
+      }
+      entries_[key] = entry;
+    }
+  } else {
+    std::error_code ec;
+    for (const auto& f : std::filesystem::directory_iterator(mask_dir, ec)) {
+      if (f.path().extension() != ".png") continue;
+      const std::string stem = f.path().stem().string();
+      const std::string json_file = mask_dir + "/" + stem + ".json";
+      if (!isRegularFile(json_file)) continue;
+      entries_[stem] = Entry{f.path().string(), json_file, {}};
+    }
+  }
+  if (entries_.empty()) {
+    throw Error("mask folder " + mask_dir + " has no masks (PNG + JSON) in COCO panoptic format");
+  }
+}
+
+bool CocoPanopticReader::has(const std::string& color_stem) const {
+  return entries_.count(color_stem) > 0;
+}
+
+PanopticFrame CocoPanopticReader::read(const std::string& color_stem) {
+  const auto it = entries_.find(color_stem);
+  if (it == entries_.end()) throw Error("no panoptic mask for colour image " + color_stem);
+  const Entry& entry = it->second;
+  PanopticFrame frame;
+  size_t unknown = 0;
+  if (!entry.json_path.empty()) {
+    const json root = readJson(entry.json_path);
+    const json& info = root.is_object() && root.contains("segments_info") ? root["segments_info"] : root;
+    frame.segments = parseSegments(info, table_, entry.json_path, &unknown);
+  } else {
+    frame.segments = entry.segments;
+    for (const auto& s : frame.segments) unknown += table_.lookup(s.source_category) ? 0 : 1;
+  }
+  const auto bytes = readFileBytes(entry.png_path);
+  frame.segment_ids = decodeLabelPng(bytes.data(), bytes.size(), entry.png_path);
+  // Pixels of ids without a segments_info entry are unsegmented (COCO: id 0 is void).
+  std::set<int32_t> known;
+  for (const auto& s : frame.segments) known.insert(s.id);
+  for (size_t i = 0; i < frame.segment_ids.size(); ++i) {
+    int32_t& id = frame.segment_ids.data()[i];
+    if (id != 0 && !known.count(id)) id = 0;
+  }
+  ++stats_.frames_with_masks;
+  stats_.segments += frame.segments.size();
+  stats_.unknown_category_segments += unknown;
+  return frame;
+}
+
+}  // namespace panmap

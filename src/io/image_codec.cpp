@@ -1,0 +1,163 @@
+#include "panmap/io/image_codec.h"
+
+#include <fstream>
+#include <iterator>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "panmap/core/error.h"
+#include "panmap/io/opencv_image.h"
+
+namespace panmap {
+
+std::vector<uint8_t> readFileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("cannot read " + path);
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw Error("cannot read " + path);
+  return bytes;
+}
+
+void writeFileBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  if (!out) throw Error("cannot write " + path);
+}
+
+std::vector<uint8_t> encodeJpeg(const ColorImage& image, int quality) {
+  cv::Mat bgr;
+  cv::cvtColor(asMat(image), bgr, cv::COLOR_RGB2BGR);
+  std::vector<uint8_t> bytes;
+  if (!cv::imencode(".jpg", bgr, bytes, {cv::IMWRITE_JPEG_QUALITY, quality})) {
+    throw Error("JPEG encoding failed");
+  }
+  return bytes;
+}
+
+std::vector<uint8_t> encodePng(const ColorImage& image) {
+  cv::Mat bgr;
+  cv::cvtColor(asMat(image), bgr, cv::COLOR_RGB2BGR);
+  std::vector<uint8_t> bytes;
+  if (!cv::imencode(".png", bgr, bytes, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+    throw Error("PNG encoding failed");
+  }
+  return bytes;
+}
+
+std::vector<uint8_t> encodeDepthPng(const DepthImage& image) {
+  std::vector<uint8_t> bytes;
+  if (!cv::imencode(".png", asMat(image), bytes, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+    throw Error("depth PNG encoding failed");
+  }
+  return bytes;
+}
+
+std::vector<uint8_t> encodeLabelPng(const LabelImage& image) {
+  cv::Mat bgr(image.height(), image.width(), CV_8UC3);
+  for (int v = 0; v < image.height(); ++v) {
+    const int32_t* src = image.row(v);
+    auto* dst = bgr.ptr<cv::Vec3b>(v);
+    for (int u = 0; u < image.width(); ++u) {
+      const int32_t id = src[u];
+      if (id < 0 || id >= (1 << 24)) throw Error("label " + std::to_string(id) + " outside [0, 2^24)");
+      dst[u] = cv::Vec3b(static_cast<uint8_t>(id >> 16), static_cast<uint8_t>((id >> 8) & 255),
+                         static_cast<uint8_t>(id & 255));
+    }
+  }
+  std::vector<uint8_t> bytes;
+  if (!cv::imencode(".png", bgr, bytes, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+    throw Error("label PNG encoding failed");
+  }
+  return bytes;
+}
+
+bool isCompleteJpeg(const uint8_t* data, size_t size) {
+  if (size < 4 || data[0] != 0xFF || data[1] != 0xD8) return false;
+  // EOI ends the stream; some writers pad a few bytes after it.
+  const size_t tail = size > 64 ? size - 64 : 2;
+  for (size_t i = size - 2; i + 1 > tail; --i) {
+    if (data[i] == 0xFF && data[i + 1] == 0xD9) return true;
+  }
+  return false;
+}
+
+namespace {
+
+bool isPng(const uint8_t* data, size_t size) {
+  static const uint8_t kMagic[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  return size >= 8 && std::equal(kMagic, kMagic + 8, data);
+}
+
+cv::Mat decodeUnchanged(const uint8_t* data, size_t size, const std::string& what) {
+  if (size == 0) throw Error(what + ": empty image data");
+  const cv::Mat buffer(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data));
+  cv::Mat mat = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
+  if (mat.empty()) throw Error(what + ": not a decodable image (corrupt or truncated)");
+  return mat;
+}
+
+}  // namespace
+
+ColorImage decodeColor(const uint8_t* data, size_t size, const std::string& what) {
+  const bool png = isPng(data, size);
+  if (!png && !isCompleteJpeg(data, size)) {
+    throw Error(what + ": truncated or not a JPEG/PNG image");
+  }
+  cv::Mat mat = decodeUnchanged(data, size, what);
+  if (mat.depth() != CV_8U) throw Error(what + ": colour image must have 8 bits per channel");
+  cv::Mat rgb;
+  switch (mat.channels()) {
+    case 1:
+      cv::cvtColor(mat, rgb, cv::COLOR_GRAY2RGB);
+      break;
+    case 3:
+      cv::cvtColor(mat, rgb, cv::COLOR_BGR2RGB);
+      break;
+    case 4:
+      cv::cvtColor(mat, rgb, cv::COLOR_BGRA2RGB);
+      break;
+    default:
+      throw Error(what + ": unsupported channel count " + std::to_string(mat.channels()));
+  }
+  return colorFromMat(rgb);
+}
+
+DepthImage decodeDepthPng(const uint8_t* data, size_t size, const std::string& what) {
+  if (!isPng(data, size)) throw Error(what + ": depth must be a 16-bit PNG");
+  const cv::Mat mat = decodeUnchanged(data, size, what);
+  if (mat.type() != CV_16UC1) {
+    throw Error(what + ": depth PNG must be 16-bit single channel");
+  }
+  return depthFromMat(mat);
+}
+
+LabelImage decodeLabelPng(const uint8_t* data, size_t size, const std::string& what) {
+  if (!isPng(data, size)) throw Error(what + ": labels must be a PNG");
+  const cv::Mat mat = decodeUnchanged(data, size, what);
+  LabelImage labels(mat.cols, mat.rows);
+  if (mat.type() == CV_8UC3) {
+    for (int v = 0; v < mat.rows; ++v) {
+      const auto* src = mat.ptr<cv::Vec3b>(v);  // B G R
+      int32_t* dst = labels.row(v);
+      for (int u = 0; u < mat.cols; ++u) dst[u] = src[u][2] + 256 * src[u][1] + 65536 * src[u][0];
+    }
+  } else if (mat.type() == CV_16UC1 || mat.type() == CV_8UC1) {
+    mat.convertTo(asMat(labels), CV_32S);
+  } else {
+    throw Error(what + ": label PNG must be 8-bit RGB (COCO panoptic) or greyscale");
+  }
+  return labels;
+}
+
+ColorImage readColorFile(const std::string& path) {
+  const auto bytes = readFileBytes(path);
+  return decodeColor(bytes.data(), bytes.size(), path);
+}
+
+DepthImage readDepthFile(const std::string& path) {
+  const auto bytes = readFileBytes(path);
+  return decodeDepthPng(bytes.data(), bytes.size(), path);
+}
+
+}  // namespace panmap

@@ -1,0 +1,222 @@
+// TUM RGB-D layout: rgb.txt and depth.txt ("timestamp file" lines), groundtruth.txt
+// ("timestamp tx ty tz qx qy qz qw"), depth PNGs in units of 1/5000 m. Each depth image is
+// paired with the colour image nearest in time (within tum_max_dt_s) and the ground-truth
+// pose interpolated between its neighbours (or the nearest one within tum_max_dt_s).
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "panmap/core/error.h"
+#include "panmap/io/image_codec.h"
+#include "panmap/io/internal/readers.h"
+#include "panmap/io/text_files.h"
+
+namespace panmap {
+namespace internal {
+namespace {
+
+struct Stamped {
+  double t = 0.0;
+  std::string file;
+};
+
+std::vector<Stamped> readFileList(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot read " + path);
+  std::vector<Stamped> out;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    Stamped s;
+    if (!(fields >> s.t >> s.file)) {
+      throw Error(path + ":" + std::to_string(line_no) + ": expected 'timestamp file'");
+    }
+    out.push_back(s);
+  }
+  std::sort(out.begin(), out.end(), [](const Stamped& a, const Stamped& b) { return a.t < b.t; });
+  return out;
+}
+
+struct GroundTruth {
+  double t = 0.0;
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+};
+
+std::vector<GroundTruth> readGroundTruth(const std::string& path, double tolerance) {
+  std::vector<GroundTruth> out;
+  std::ifstream in(path);
+  if (!in) return out;  // a TUM folder without ground truth yields frames without poses
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double v[8];
+    for (double& x : v) {
+      std::string token;
+      if (!(fields >> token)) {
+        throw Error(path + ":" + std::to_string(line_no) + ": expected 't tx ty tz qx qy qz qw'");
+      }
+      x = std::strtod(token.c_str(), nullptr);
+    }
+    const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+    bool finite = true;
+    for (double x : v) finite = finite && std::isfinite(x);
+    if (!finite || std::abs(q.norm() - 1.0) > std::max(tolerance, 1e-3)) {
+      throw Error(path + ":" + std::to_string(line_no) + ": invalid pose (non-finite or "
+                  "non-unit quaternion)");
+    }
+    GroundTruth gt;
+    gt.t = v[0];
+    gt.T_W_C.linear() = q.normalized().toRotationMatrix();
+    gt.T_W_C.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+    out.push_back(gt);
+  }
+  std::sort(out.begin(), out.end(),
+            [](const GroundTruth& a, const GroundTruth& b) { return a.t < b.t; });
+  return out;
+}
+
+// Index of the entry nearest to t in a time-sorted list, or -1 if farther than max_dt.
+template <typename T>
+long nearest(const std::vector<T>& list, double t, double max_dt) {
+  auto it = std::lower_bound(list.begin(), list.end(), t,
+                             [](const T& e, double value) { return e.t < value; });
+  long best = -1;
+  double best_dt = max_dt;
+  for (auto c : {it, it == list.begin() ? it : it - 1}) {
+    if (c == list.end()) continue;
+    const double dt = std::abs(c->t - t);
+    if (dt <= best_dt) {
+      best_dt = dt;
+      best = c - list.begin();
+    }
+  }
+  return best;
+}
+
+class TumReader : public DatasetReader {
+ public:
+  TumReader(const std::string& dir, const DatasetOptions& options) : dir_(dir), options_(options) {
+    const auto rgb = readFileList(dir + "/rgb.txt");
+    const auto depth = readFileList(dir + "/depth.txt");
+    if (depth.empty()) throw Error(dir + "/depth.txt: no depth images listed");
+    for (const Stamped& d : depth) {
+      const long c = nearest(rgb, d.t, options.tum_max_dt_s);
+      if (c < 0) {
+        ++unmatched_;
+        continue;
+      }
+      pairs_.push_back({d, rgb[static_cast<size_t>(c)]});
+    }
+    if (pairs_.empty()) {
+      throw Error(dir + ": no depth image has a colour image within " +
+                  std::to_string(options.tum_max_dt_s) + " s");
+    }
+    ground_truth_ = readGroundTruth(dir + "/groundtruth.txt", options.pose_tolerance);
+
+    if (options.intrinsics) {
+      const Eigen::Vector4d& k = *options.intrinsics;
+      camera_ = PinholeCamera{k(0), k(1), k(2), k(3), 0, 0};
+    } else if (isRegularFile(dir + "/camera-intrinsics.txt")) {
+      const Eigen::MatrixXd K = readMatrixFile(dir + "/camera-intrinsics.txt", 3, 3);
+      camera_ = PinholeCamera{K(0, 0), K(1, 1), K(0, 2), K(1, 2), 0, 0};
+    } else if (dir.find("freiburg1") != std::string::npos) {
+      camera_ = PinholeCamera{517.3, 516.5, 318.6, 255.3, 0, 0};  // TUM's published fr1 values
+    } else if (dir.find("freiburg2") != std::string::npos) {
+      camera_ = PinholeCamera{520.9, 521.0, 325.1, 249.7, 0, 0};
+    } else if (dir.find("freiburg3") != std::string::npos) {
+      camera_ = PinholeCamera{535.4, 539.2, 320.1, 247.6, 0, 0};
+    } else {
+      throw Error(dir + "/camera-intrinsics.txt: intrinsics file missing and the folder name "
+                  "names no freiburg camera (pass --intrinsics fx,fy,cx,cy)");
+    }
+    const DepthImage first = readDepthFile(dir + "/" + pairs_.front().depth.file);
+    camera_.width = first.width();
+    camera_.height = first.height();
+    std::string why;
+    if (!camera_.isValid(&why)) throw Error(dir + ": intrinsics: " + why);
+  }
+
+  std::string layoutName() const override { return "tum"; }
+  size_t size() const override { return pairs_.size(); }
+  size_t unmatchedFrames() const override { return unmatched_; }
+
+  DatasetFrame read(size_t index) const override {
+    const Pair& p = pairs_.at(index);
+    DatasetFrame frame;
+    const std::string depth_path = dir_ + "/" + p.depth.file;
+    frame.depth_png = readFileBytes(depth_path);
+    frame.rgbd.depth = decodeDepthPng(frame.depth_png.data(), frame.depth_png.size(), depth_path);
+    checkImageSize(depth_path, "depth", frame.rgbd.depth.width(), frame.rgbd.depth.height(),
+                   camera_.width, camera_.height);
+    const std::string color_path = dir_ + "/" + p.color.file;
+    const std::vector<uint8_t> color_bytes = readFileBytes(color_path);
+    frame.rgbd.color = decodeColor(color_bytes.data(), color_bytes.size(), color_path);
+    checkImageSize(color_path, "colour", frame.rgbd.color.width(), frame.rgbd.color.height(),
+                   camera_.width, camera_.height);
+    if (isCompleteJpeg(color_bytes.data(), color_bytes.size())) frame.color_jpeg = color_bytes;
+    frame.color_stem = fileStem(color_path);
+    frame.color_source_width = camera_.width;
+    frame.color_source_height = camera_.height;
+
+    frame.rgbd.utime = static_cast<int64_t>(std::llround(p.depth.t * 1e6));
+    frame.rgbd.frame_id = static_cast<int64_t>(index);
+    frame.rgbd.camera_name = "tum";
+    frame.rgbd.camera = camera_;
+    frame.rgbd.depth_scale_m = 1.0 / 5000.0;
+    frame.T_W_C = poseAt(p.depth.t, &frame.pose_problem);
+    return frame;
+  }
+
+ private:
+  struct Pair {
+    Stamped depth;
+    Stamped color;
+  };
+
+  std::optional<Eigen::Isometry3d> poseAt(double t, std::string* problem) const {
+    const auto& gt = ground_truth_;
+    auto it = std::lower_bound(gt.begin(), gt.end(), t,
+                               [](const GroundTruth& e, double value) { return e.t < value; });
+    // Interpolate between bracketing samples no more than 2 tolerances apart.
+    if (it != gt.end() && it != gt.begin()) {
+      const GroundTruth& b = *it;
+      const GroundTruth& a = *(it - 1);
+      if (b.t - a.t <= 2.0 * options_.tum_max_dt_s + 1e-9) {
+        const double s = (b.t > a.t) ? (t - a.t) / (b.t - a.t) : 0.0;
+        return interpolatePose(a.T_W_C, b.T_W_C, s);
+      }
+    }
+    const long i = nearest(gt, t, options_.tum_max_dt_s);
+    if (i >= 0) return gt[static_cast<size_t>(i)].T_W_C;
+    std::ostringstream msg;
+    msg.precision(6);
+    msg << std::fixed << dir_ << "/groundtruth.txt: no pose within " << options_.tum_max_dt_s
+        << " s of depth time " << t;
+    *problem = msg.str();
+    return std::nullopt;
+  }
+
+  std::string dir_;
+  DatasetOptions options_;
+  PinholeCamera camera_;
+  std::vector<Pair> pairs_;
+  std::vector<GroundTruth> ground_truth_;
+  size_t unmatched_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<DatasetReader> makeTumReader(const std::string& dir,
+                                             const DatasetOptions& options) {
+  return std::make_unique<TumReader>(dir, options);
+}
+
+}  // namespace internal
+}  // namespace panmap

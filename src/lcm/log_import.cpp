@@ -1,0 +1,132 @@
+#include "panmap/lcm/log_import.h"
+
+#include <cstdio>
+#include <memory>
+#include <optional>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "panmap/core/error.h"
+#include "panmap/io/coco_panoptic_reader.h"
+#include "panmap/io/text_files.h"
+
+namespace panmap {
+namespace {
+
+// Appends encoded messages to an LCM log opened for writing.
+class LogWriter {
+ public:
+  explicit LogWriter(const std::string& path) : path_(path), log_(path, "w") {
+    if (!log_.good()) throw Error("cannot write log " + path);
+  }
+
+  template <typename Msg>
+  void write(const std::string& channel, int64_t utime, const Msg& msg) {
+    const int size = msg.getEncodedSize();
+    buffer_.resize(static_cast<size_t>(size));
+    if (msg.encode(buffer_.data(), 0, size) != size) throw Error("cannot encode " + channel);
+    lcm::LogEvent event;
+    event.eventnum = next_event_++;
+    event.timestamp = utime;
+    event.channel = channel;
+    event.datalen = size;
+    event.data = buffer_.data();
+    if (log_.writeEvent(&event) != 0) throw Error("cannot write to log " + path_);
+    bytes_ += static_cast<size_t>(size);
+  }
+
+  size_t bytes() const { return bytes_; }
+
+ private:
+  std::string path_;
+  lcm::LogFile log_;
+  std::vector<uint8_t> buffer_;
+  int64_t next_event_ = 0;
+  size_t bytes_ = 0;
+};
+
+}  // namespace
+
+ImportStats importDataset(const std::string& dataset_dir, const std::string& log_path,
+                          const ImportOptions& options,
+                          const std::function<void(size_t, size_t)>& progress) {
+  const std::unique_ptr<DatasetReader> reader = openDataset(dataset_dir, options.dataset);
+  std::optional<CocoPanopticReader> masks;
+  if (!options.mask_dir.empty()) {
+    masks.emplace(options.mask_dir, options.mask_json,
+                  options.label_table.empty() ? LabelTable::nyu40Identity()
+                                              : LabelTable::load(options.label_table));
+  }
+  bool skip_invalid = reader->invalidPosesExpected();
+  if (options.invalid_pose == ImportOptions::InvalidPose::kSkip) skip_invalid = true;
+  if (options.invalid_pose == ImportOptions::InvalidPose::kError) skip_invalid = false;
+
+  ImportStats stats;
+  stats.layout = reader->layoutName();
+  stats.frames_found = reader->size();
+  stats.unmatched_frames = reader->unmatchedFrames();
+  const size_t total = options.max_frames ? std::min(options.max_frames, reader->size())
+                                          : reader->size();
+
+  // Write beside the target and rename at the end: a failed import leaves no partial log.
+  const std::string partial = log_path + ".partial";
+  try {
+    LogWriter writer(partial);
+    int64_t last_utime = INT64_MIN;
+    for (size_t i = 0; i < total; ++i) {
+      const DatasetFrame frame = reader->read(i);
+      if (!frame.T_W_C) {
+        if (!skip_invalid) throw Error(frame.pose_problem);
+        if (stats.first_skip_reason.empty()) stats.first_skip_reason = frame.pose_problem;
+        ++stats.skipped_invalid_pose;
+        if (progress) progress(i + 1, total);
+        continue;
+      }
+      if (frame.rgbd.utime <= last_utime) {
+        throw Error("frame " + std::to_string(frame.rgbd.frame_id) +
+                    ": timestamps are not increasing");
+      }
+      last_utime = frame.rgbd.utime;
+      const int64_t utime = frame.rgbd.utime;
+
+      writer.write(options.channel_rgbd, utime,
+                   toMessage(frame.rgbd, options.encoding, &frame.color_jpeg, &frame.depth_png));
+      ++stats.frames_written;
+
+      StampedPose pose;
+      pose.utime = utime;
+      pose.frame_id = frame.rgbd.frame_id;
+      pose.T_W_C = *frame.T_W_C;
+      pose.source = options.pose_source;
+      writer.write(options.channel_pose, utime, toMessage(pose));
+      ++stats.poses_written;
+
+      if (masks) {
+        if (masks->has(frame.color_stem)) {
+          PanopticFrame panoptic = masks->read(frame.color_stem);
+          panoptic.segment_ids =
+              registerLabelsToDepth(panoptic.segment_ids, frame, "mask of " + frame.color_stem);
+          panoptic.utime = utime;
+          panoptic.frame_id = frame.rgbd.frame_id;
+          writer.write(options.channel_panoptic, utime, toMessage(panoptic, options.encoding));
+          ++stats.panoptic_written;
+        } else {
+          ++stats.frames_without_mask;
+        }
+      }
+      if (progress) progress(i + 1, total);
+    }
+    stats.bytes_written = writer.bytes();
+  } catch (...) {
+    std::remove(partial.c_str());
+    throw;
+  }
+  if (masks) stats.unknown_category_segments = masks->stats().unknown_category_segments;
+  if (std::rename(partial.c_str(), log_path.c_str()) != 0) {
+    std::remove(partial.c_str());
+    throw Error("cannot write log " + log_path);
+  }
+  return stats;
+}
+
+}  // namespace panmap

@@ -1,0 +1,119 @@
+#include "panmap/lcm/log_info.h"
+
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <iomanip>
+#include <map>
+#include <sstream>
+
+#include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
+
+#include "panmap/core/error.h"
+#include "panmap/lcm/message_types.h"
+
+namespace panmap {
+
+double ChannelInfo::rateHz() const {
+  if (count < 2 || last_utime <= first_utime) return 0.0;
+  return static_cast<double>(count - 1) * 1e6 / static_cast<double>(last_utime - first_utime);
+}
+
+bool LogInfo::allDecoded() const {
+  if (truncated) return false;
+  for (const ChannelInfo& c : channels) {
+    if (c.failures > 0) return false;
+  }
+  return true;
+}
+
+LogInfo inspectLog(const std::string& path, bool deep,
+                   const std::function<void(size_t, size_t)>& progress) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
+    throw Error("log " + path + " does not exist");
+  }
+  const auto file_size = static_cast<size_t>(st.st_size);
+  lcm::LogFile log(path, "r");
+  if (!log.good()) throw Error("cannot open log " + path);
+
+  LogInfo info;
+  info.path = path;
+  std::map<std::string, ChannelInfo> channels;
+  while (const lcm::LogEvent* event = log.readNextEvent()) {
+    ++info.events;
+    ChannelInfo& c = channels[event->channel];
+    c.channel = event->channel;
+    const MessageCheck check =
+        checkMessage(event->data, static_cast<size_t>(event->datalen), deep);
+    const int64_t utime = check.ok ? check.utime : event->timestamp;
+    if (c.count == 0) {
+      c.type = check.type;
+      c.first_utime = utime;
+    } else if (c.type != check.type) {
+      c.type.clear();  // mixed types on one channel
+    }
+    c.last_utime = utime;
+    ++c.count;
+    c.bytes += static_cast<size_t>(event->datalen);
+    if (!check.ok) {
+      if (c.failures == 0) c.first_error = "event " + std::to_string(event->eventnum) + ": " + check.error;
+      ++c.failures;
+    }
+    if (progress && info.events % 16 == 0) {
+      progress(static_cast<size_t>(std::ftell(log.getFilePtr())), file_size);
+    }
+  }
+  // readNextEvent stops at the end or at an event it cannot read whole.
+  const long end = std::ftell(log.getFilePtr());
+  info.truncated = end >= 0 && static_cast<size_t>(end) < file_size;
+  for (auto& kv : channels) info.channels.push_back(kv.second);
+  return info;
+}
+
+std::string logInfoToJson(const LogInfo& info) {
+  nlohmann::json root;
+  root["path"] = info.path;
+  root["events"] = info.events;
+  root["truncated"] = info.truncated;
+  root["all_decoded"] = info.allDecoded();
+  nlohmann::json channels = nlohmann::json::array();
+  for (const ChannelInfo& c : info.channels) {
+    channels.push_back({{"channel", c.channel},
+                        {"type", c.type},
+                        {"count", c.count},
+                        {"rate_hz", c.rateHz()},
+                        {"mean_bytes", c.meanBytes()},
+                        {"first_utime", c.first_utime},
+                        {"last_utime", c.last_utime},
+                        {"decode_failures", c.failures},
+                        {"first_error", c.first_error}});
+  }
+  root["channels"] = channels;
+  return root.dump(2);
+}
+
+std::string logInfoToTable(const LogInfo& info) {
+  std::ostringstream out;
+  out << std::left << std::setw(16) << "channel" << std::setw(20) << "type" << std::right
+      << std::setw(8) << "count" << std::setw(10) << "rate_hz" << std::setw(12) << "mean_bytes"
+      << std::setw(18) << "first_utime" << std::setw(18) << "last_utime" << "  decoded\n";
+  for (const ChannelInfo& c : info.channels) {
+    out << std::left << std::setw(16) << c.channel << std::setw(20)
+        << (c.type.empty() ? "?" : c.type) << std::right << std::setw(8) << c.count
+        << std::setw(10) << std::fixed << std::setprecision(2) << c.rateHz() << std::setw(12)
+        << std::setprecision(0) << c.meanBytes() << std::setw(18) << c.first_utime
+        << std::setw(18) << c.last_utime << "  "
+        << (c.failures ? std::to_string(c.count - c.failures) + "/" + std::to_string(c.count)
+                       : std::string("all"))
+        << "\n";
+    if (c.failures) out << "  first failure: " << c.first_error << "\n";
+  }
+  out << info.events << " events";
+  if (info.truncated) out << "; the log ends with a truncated event";
+  out << "\n";
+  return out.str();
+}
+
+}  // namespace panmap
