@@ -21,7 +21,7 @@ double ChannelInfo::rateHz() const {
 }
 
 bool LogInfo::allDecoded() const {
-  if (truncated) return false;
+  if (truncated || skipped_bytes > 0) return false;
   for (const ChannelInfo& c : channels) {
     if (c.failures > 0) return false;
   }
@@ -41,8 +41,18 @@ LogInfo inspectLog(const std::string& path, bool deep,
   LogInfo info;
   info.path = path;
   std::map<std::string, ChannelInfo> channels;
+  // LCM's reader skips leading garbage and stops quietly at a cut or corrupt event, so
+  // account for every byte: each event must start where the previous one ended.
+  size_t previous_end = 0;
   while (const lcm::LogEvent* event = log.readNextEvent()) {
     ++info.events;
+    const long pos = std::ftell(log.getFilePtr());
+    const size_t event_bytes = 28 + event->channel.size() + static_cast<size_t>(event->datalen);
+    if (pos >= 0 && static_cast<size_t>(pos) >= event_bytes) {
+      const size_t start = static_cast<size_t>(pos) - event_bytes;
+      if (start > previous_end) info.skipped_bytes += start - previous_end;
+      previous_end = static_cast<size_t>(pos);
+    }
     ChannelInfo& c = channels[event->channel];
     c.channel = event->channel;
     const MessageCheck check =
@@ -65,9 +75,8 @@ LogInfo inspectLog(const std::string& path, bool deep,
       progress(static_cast<size_t>(std::ftell(log.getFilePtr())), file_size);
     }
   }
-  // readNextEvent stops at the end or at an event it cannot read whole.
-  const long end = std::ftell(log.getFilePtr());
-  info.truncated = end >= 0 && static_cast<size_t>(end) < file_size;
+  info.readable_bytes = previous_end;
+  info.truncated = previous_end < file_size;
   for (auto& kv : channels) info.channels.push_back(kv.second);
   return info;
 }
@@ -77,6 +86,8 @@ std::string logInfoToJson(const LogInfo& info) {
   root["path"] = info.path;
   root["events"] = info.events;
   root["truncated"] = info.truncated;
+  root["skipped_bytes"] = info.skipped_bytes;
+  root["readable_bytes"] = info.readable_bytes;
   root["all_decoded"] = info.allDecoded();
   nlohmann::json channels = nlohmann::json::array();
   for (const ChannelInfo& c : info.channels) {
@@ -111,7 +122,10 @@ std::string logInfoToTable(const LogInfo& info) {
     if (c.failures) out << "  first failure: " << c.first_error << "\n";
   }
   out << info.events << " events";
-  if (info.truncated) out << "; the log ends with a truncated event";
+  if (info.truncated) {
+    out << "; unreadable after byte " << info.readable_bytes << " of " << "the file (truncated or corrupt)";
+  }
+  if (info.skipped_bytes) out << "; " << info.skipped_bytes << " bytes between events are not events";
   out << "\n";
   return out.str();
 }

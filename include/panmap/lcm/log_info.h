@@ -29,9 +29,11 @@ struct ChannelInfo {
 struct LogInfo {
   std::string path;
   size_t events = 0;
-  bool truncated = false;     ///< the file ends inside an event
+  bool truncated = false;     ///< bytes after the last readable event (cut or corrupt)
+  size_t readable_bytes = 0;  ///< bytes up to the end of the last readable event
+  size_t skipped_bytes = 0;   ///< leading garbage LCM's reader skipped to find an event
   std::vector<ChannelInfo> channels;  ///< sorted by channel name
-  /// True when every event decoded and the file is not truncated.
+  /// True when every event decoded and every byte of the file belongs to an event.
   bool allDecoded() const;
 };
 

@@ -1,0 +1,76 @@
+// The command-line tools as a user runs them: exit codes, one-line errors, --help, --json.
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "panmap/io/image_codec.h"
+#include "test_helpers.h"
+
+namespace panmap {
+namespace {
+
+using test::binPath;
+using test::runCommand;
+
+TEST(Cli, HelpExitsZero) {
+  for (const char* tool : {"panmap-import", "panmap-loginfo"}) {
+    const auto r = runCommand(binPath(tool) + " --help");
+    EXPECT_EQ(r.exit_code, 0) << tool;
+    EXPECT_NE(r.output.find("Usage"), std::string::npos) << r.output;
+  }
+}
+
+TEST(Cli, ImportOfAMissingFolderFailsWithOneLine) {
+  test::TempDir dir;
+  const auto r = runCommand(binPath("panmap-import") + " " + dir.path("absent") + " " + dir.path("x.lcmlog"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(test::countLines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find(dir.path("absent")), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path("x.lcmlog")));
+}
+
+TEST(Cli, ImportThenLogInfoJson) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  const auto imp = runCommand(binPath("panmap-import") + " --quiet --max-frames 5 " +
+                              test::dataDir("7scenes-200") + " " + dir.path("s.lcmlog"));
+  ASSERT_EQ(imp.exit_code, 0) << imp.output;
+  EXPECT_NE(imp.output.find("5 frames, 5 poses"), std::string::npos) << imp.output;
+  const auto info = runCommand(binPath("panmap-loginfo") + " --json " + dir.path("s.lcmlog"));
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const auto json = nlohmann::json::parse(info.output);
+  EXPECT_EQ(json["events"], 10);
+  EXPECT_EQ(json["channels"][0]["channel"], "CAMERA_POSE");
+  EXPECT_EQ(json["channels"][0]["decode_failures"], 0);
+  EXPECT_EQ(json["channels"][1]["type"], "rgbd_frame_t");
+
+  // A truncated copy makes loginfo exit non-zero.
+  auto bytes = readFileBytes(dir.path("s.lcmlog"));
+  bytes.resize(bytes.size() - 1000);
+  writeFileBytes(dir.path("cut.lcmlog"), bytes);
+  const auto cut = runCommand(binPath("panmap-loginfo") + " --quiet " + dir.path("cut.lcmlog"));
+  EXPECT_EQ(cut.exit_code, 1);
+  EXPECT_NE(cut.output.find("unreadable after byte"), std::string::npos) << cut.output;
+}
+
+TEST(Cli, ImportNamesTheBadFile) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  namespace fs = std::filesystem;
+  fs::copy_file(test::dataDir("7scenes-200/camera-intrinsics.txt"), dir.path("camera-intrinsics.txt"));
+  for (const char* kind : {".color.jpg", ".depth.png"}) {
+    fs::create_symlink(test::dataDir(std::string("7scenes-200/frame-000000") + kind), dir.path(std::string("frame-000000") + kind));
+  }
+  std::ofstream(dir.path("frame-000000.pose.txt")) << "1 0 0 0\n0 1 0 0\n0 0 1 nan\n0 0 0 1\n";
+  const auto r = runCommand(binPath("panmap-import") + " --quiet " + dir.path() + " " + dir.path("x.lcmlog"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(test::countLines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("frame-000000.pose.txt"), std::string::npos) << r.output;
+  const auto bad_option = runCommand(binPath("panmap-import") + " --layout nope " + dir.path() + " " + dir.path("x.lcmlog"));
+  EXPECT_NE(bad_option.exit_code, 0);
+}
+
+}  // namespace
+}  // namespace panmap

@@ -1,0 +1,266 @@
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "panmap/core/error.h"
+#include "panmap/io/image_codec.h"
+#include "panmap/io/text_files.h"
+#include "panmap/lcm/conversions.h"
+#include "panmap/lcm/log_import.h"
+#include "panmap/lcm/log_info.h"
+#include "test_helpers.h"
+
+namespace panmap {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Every event of a log, in order.
+struct Event {
+  std::string channel;
+  int64_t timestamp;
+  std::vector<uint8_t> data;
+};
+std::vector<Event> readEvents(const std::string& path) {
+  lcm::LogFile log(path, "r");
+  EXPECT_TRUE(log.good());
+  std::vector<Event> events;
+  while (const lcm::LogEvent* e = log.readNextEvent()) {
+    const auto* d = static_cast<const uint8_t*>(e->data);
+    events.push_back({e->channel, e->timestamp, std::vector<uint8_t>(d, d + e->datalen)});
+  }
+  return events;
+}
+
+template <typename Msg>
+Msg decodeEvent(const Event& e) {
+  Msg msg;
+  EXPECT_EQ(msg.decode(e.data.data(), 0, static_cast<int>(e.data.size())), static_cast<int>(e.data.size()));
+  return msg;
+}
+
+// The 7-Scenes log is imported once for all tests of this suite.
+class SevenScenesLog : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (!fs::is_directory(test::dataDir("7scenes-200"))) return;
+    dir_ = new test::TempDir;
+    stats_ = importDataset(test::dataDir("7scenes-200"), dir_->path("7s.lcmlog"), ImportOptions{});
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+  void SetUp() override { PANMAP_REQUIRE_DATA("7scenes-200"); }
+  static std::string logPath() { return dir_->path("7s.lcmlog"); }
+
+  static test::TempDir* dir_;
+  static ImportStats stats_;
+};
+test::TempDir* SevenScenesLog::dir_ = nullptr;
+ImportStats SevenScenesLog::stats_;
+
+TEST_F(SevenScenesLog, EveryFrameAndPoseIsWritten) {
+  EXPECT_EQ(stats_.frames_written, 200u);
+  EXPECT_EQ(stats_.poses_written, 200u);
+  EXPECT_EQ(stats_.panoptic_written, 0u);
+  EXPECT_EQ(stats_.skipped_invalid_pose, 0u);
+  EXPECT_FALSE(fs::exists(logPath() + ".partial"));
+}
+
+TEST_F(SevenScenesLog, DepthIsBitIdenticalAndPosesEqualTheFiles) {
+  const std::vector<Event> events = readEvents(logPath());
+  ASSERT_EQ(events.size(), 400u);
+  size_t frames = 0, poses = 0;
+  int64_t last = -1;
+  for (const Event& e : events) {
+    EXPECT_GE(e.timestamp, last);
+    last = e.timestamp;
+    if (e.channel == "CAMERA_RGBD") {
+      const RgbdFrame f = fromMessage(decodeEvent<rgbd_frame_t>(e));
+      char name[64];
+      std::snprintf(name, sizeof(name), "7scenes-200/frame-%06lld", static_cast<long long>(f.frame_id));
+      const cv::Mat png = cv::imread(test::dataDir(name) + ".depth.png", cv::IMREAD_UNCHANGED);
+      ASSERT_EQ(png.type(), CV_16UC1);
+      ASSERT_EQ(f.depth.width(), png.cols);
+      ASSERT_EQ(f.depth.height(), png.rows);
+      EXPECT_EQ(std::memcmp(png.data, f.depth.data(), f.depth.size() * 2), 0) << name;
+      EXPECT_EQ(f.utime, e.timestamp);
+      EXPECT_EQ(f.utime, std::llround(f.frame_id * 1e6 / 30.0));
+      ++frames;
+    } else if (e.channel == "CAMERA_POSE") {
+      const StampedPose p = fromMessage(decodeEvent<pose_t>(e));
+      char name[64];
+      std::snprintf(name, sizeof(name), "7scenes-200/frame-%06lld.pose.txt", static_cast<long long>(p.frame_id));
+      const Eigen::MatrixXd file = readMatrixFile(test::dataDir(name), 4, 4);
+      // Translation exactly; rotation to the file's own rounding (|R^T R - I| < 3e-4).
+      EXPECT_EQ(p.T_W_C.translation(), Eigen::Vector3d(file.topRightCorner<3, 1>())) << name;
+      EXPECT_LT((p.T_W_C.linear() - file.topLeftCorner<3, 3>()).cwiseAbs().maxCoeff(), 5e-4) << name;
+      EXPECT_EQ(p.source, PoseSource::kGroundTruth);
+      ++poses;
+    }
+  }
+  EXPECT_EQ(frames, 200u);
+  EXPECT_EQ(poses, 200u);
+}
+
+TEST_F(SevenScenesLog, LogInfoDecodesEverything) {
+  const LogInfo info = inspectLog(logPath(), true);
+  EXPECT_TRUE(info.allDecoded());
+  EXPECT_EQ(info.events, 400u);
+  ASSERT_EQ(info.channels.size(), 2u);
+  const ChannelInfo& pose = info.channels[0];
+  const ChannelInfo& rgbd = info.channels[1];
+  EXPECT_EQ(pose.channel, "CAMERA_POSE");
+  EXPECT_EQ(rgbd.type, "rgbd_frame_t");
+  EXPECT_EQ(rgbd.count, 200u);
+  EXPECT_EQ(rgbd.first_utime, 0);
+  EXPECT_EQ(rgbd.last_utime, 19900000);  // frame 597 at 30 Hz
+  EXPECT_NEAR(rgbd.rateHz(), 10.0, 1e-9);  // every third frame of a 30 Hz recording
+  const auto json = nlohmann::json::parse(logInfoToJson(info));
+  EXPECT_EQ(json["channels"][1]["count"], 200);
+  EXPECT_EQ(json["all_decoded"], true);
+}
+
+TEST_F(SevenScenesLog, TruncatedAndCorruptLogsAreReported) {
+  const std::vector<uint8_t> bytes = readFileBytes(logPath());
+  test::TempDir dir;
+  std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + bytes.size() / 2);
+  writeFileBytes(dir.path("cut.lcmlog"), cut);
+  const LogInfo truncated = inspectLog(dir.path("cut.lcmlog"), false);
+  EXPECT_TRUE(truncated.truncated);
+  EXPECT_FALSE(truncated.allDecoded());
+  EXPECT_GT(truncated.events, 100u);
+
+  // Flip a byte inside the first frame's depth PNG: the message decodes, its image does not.
+  std::vector<uint8_t> corrupt = bytes;
+  const auto events = readEvents(logPath());
+  // Event header: sync word, event number, timestamp, channel and data lengths, channel.
+  const size_t header = 4 + 8 + 8 + 4 + 4 + events[0].channel.size();
+  ASSERT_EQ(events[0].channel, "CAMERA_RGBD");
+  for (size_t i = header + events[0].data.size() - 2000; i < header + events[0].data.size() - 1000; ++i) corrupt[i] ^= 0x5A;
+  writeFileBytes(dir.path("corrupt.lcmlog"), corrupt);
+  const LogInfo deep = inspectLog(dir.path("corrupt.lcmlog"), true);
+  EXPECT_FALSE(deep.truncated);
+  EXPECT_EQ(deep.channels[1].failures, 1u);
+  EXPECT_FALSE(deep.channels[1].first_error.empty());
+  EXPECT_THROW(inspectLog(dir.path("missing.lcmlog"), true), Error);
+
+  // Garbage between two events: LCM's reader stops there; loginfo reports the unread rest.
+  std::vector<uint8_t> gap(bytes.begin(), bytes.begin() + header + events[0].data.size());
+  gap.insert(gap.end(), 37, 0xAB);
+  gap.insert(gap.end(), bytes.begin() + header + events[0].data.size(), bytes.end());
+  writeFileBytes(dir.path("gap.lcmlog"), gap);
+  const LogInfo skipped = inspectLog(dir.path("gap.lcmlog"), false);
+  EXPECT_LT(skipped.events, 400u);
+  EXPECT_TRUE(skipped.truncated);
+  EXPECT_FALSE(skipped.allDecoded());
+}
+
+TEST(Import, RawImagesAreExact) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  ImportOptions options;
+  options.max_frames = 3;
+  options.encoding.color = image_t::COMPRESSION_NONE;
+  options.encoding.depth = image_t::COMPRESSION_NONE;
+  importDataset(test::dataDir("7scenes-200"), dir.path("raw.lcmlog"), options);
+  const auto events = readEvents(dir.path("raw.lcmlog"));
+  ASSERT_EQ(events.size(), 6u);
+  const rgbd_frame_t msg = decodeEvent<rgbd_frame_t>(events[2]);
+  EXPECT_EQ(msg.depth.compression, +image_t::COMPRESSION_NONE);
+  EXPECT_EQ(msg.depth.row_stride, 1280);
+  const ColorImage jpeg = readColorFile(test::dataDir("7scenes-200/frame-000003.color.jpg"));
+  EXPECT_EQ(fromMessage(msg).color, jpeg);
+}
+
+TEST(Import, ScanNetSkipsInvalidPosesWithACount) {
+  PANMAP_REQUIRE_DATA("scannet-export-3");
+  test::TempDir dir;
+  const std::string src = test::dataDir("scannet-export-3");
+  for (const char* sub : {"color", "depth", "intrinsic"}) fs::create_directory_symlink(src + "/" + sub, dir.path(sub));
+  fs::create_symlink(src + "/scene0707_00.txt", dir.path("scene0707_00.txt"));
+  fs::create_directory(dir.path("pose"));
+  fs::create_symlink(src + "/pose/0.txt", dir.path("pose/0.txt"));
+  fs::create_symlink(src + "/pose/2.txt", dir.path("pose/2.txt"));
+  std::ofstream(dir.path("pose/1.txt")) << "-inf -inf -inf -inf\n-inf -inf -inf -inf\n"
+                                           "-inf -inf -inf -inf\n-inf -inf -inf -inf\n";
+  const ImportStats s = importDataset(dir.path(), dir.path("s.lcmlog"), ImportOptions{});
+  EXPECT_EQ(s.frames_written, 2u);
+  EXPECT_EQ(s.skipped_invalid_pose, 1u);
+  EXPECT_NE(s.first_skip_reason.find("pose/1.txt"), std::string::npos);
+  const auto events = readEvents(dir.path("s.lcmlog"));
+  ASSERT_EQ(events.size(), 4u);
+  const RgbdFrame f = fromMessage(decodeEvent<rgbd_frame_t>(events[2]));
+  EXPECT_EQ(f.frame_id, 2);  // frame 1 is not in the log
+  EXPECT_EQ(f.color.width(), 640);
+
+  ImportOptions strict;
+  strict.invalid_pose = ImportOptions::InvalidPose::kError;
+  EXPECT_THROW(importDataset(dir.path(), dir.path("t.lcmlog"), strict), Error);
+  EXPECT_FALSE(fs::exists(dir.path("t.lcmlog")));
+  EXPECT_FALSE(fs::exists(dir.path("t.lcmlog.partial")));
+}
+
+TEST(Import, TumStopsOnAMissingPoseUnlessAskedToSkip) {
+  test::TempDir dir;
+  try {
+    importDataset(test::fixtureDir("tum_tiny"), dir.path("t.lcmlog"), ImportOptions{});
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("groundtruth.txt"), std::string::npos) << e.what();
+  }
+  ImportOptions skip;
+  skip.invalid_pose = ImportOptions::InvalidPose::kSkip;
+  const ImportStats s = importDataset(test::fixtureDir("tum_tiny"), dir.path("t.lcmlog"), skip);
+  EXPECT_EQ(s.frames_written, 2u);
+  EXPECT_EQ(s.unmatched_frames, 1u);
+  const auto events = readEvents(dir.path("t.lcmlog"));
+  ASSERT_EQ(events.size(), 4u);
+  EXPECT_EQ(events[0].timestamp, 1005000);  // real timestamps
+  EXPECT_EQ(events[2].timestamp, 1040000);
+  const RgbdFrame f = fromMessage(decodeEvent<rgbd_frame_t>(events[0]));
+  EXPECT_DOUBLE_EQ(f.depth_scale_m, 0.0002);
+  EXPECT_EQ(f.depth(3, 2), 5003);
+}
+
+TEST(Import, PanopticMasksBecomeMessages) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  // A full-size mask for the first frame only: left half wall, a chair box, the rest void.
+  LabelImage mask(640, 480, 0);
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 320; ++u) mask(u, v) = 1;
+  }
+  for (int v = 100; v < 200; ++v) {
+    for (int u = 400; u < 500; ++u) mask(u, v) = 300;
+  }
+  fs::create_directory(dir.path("masks"));
+  writeFileBytes(dir.path("masks/frame-000000.color.png"), encodeLabelPng(mask));
+  std::ofstream(dir.path("masks/frame-000000.color.json"))
+      << R"({"segments_info": [{"id": 1, "category_id": 1}, {"id": 300, "category_id": 62, "score": 0.9}]})";
+  ImportOptions options;
+  options.max_frames = 2;
+  options.mask_dir = dir.path("masks");
+  options.label_table = test::fixtureDir("coco_tiny/labels.tsv");
+  const ImportStats s = importDataset(test::dataDir("7scenes-200"), dir.path("m.lcmlog"), options);
+  EXPECT_EQ(s.panoptic_written, 1u);
+  EXPECT_EQ(s.frames_without_mask, 1u);
+  const auto events = readEvents(dir.path("m.lcmlog"));
+  ASSERT_EQ(events.size(), 5u);
+  EXPECT_EQ(events[2].channel, "PANOPTIC");
+  const PanopticFrame p = fromMessage(decodeEvent<panoptic_t>(events[2]));
+  EXPECT_EQ(p.utime, 0);
+  EXPECT_EQ(p.segment_ids, mask);
+  ASSERT_EQ(p.segments.size(), 2u);
+  EXPECT_EQ(p.segments[1], (PanopticSegment{300, 5, 62, true, 0.9f}));
+  EXPECT_TRUE(inspectLog(dir.path("m.lcmlog"), true).allDecoded());
+}
+
+}  // namespace
+}  // namespace panmap

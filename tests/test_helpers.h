@@ -1,0 +1,87 @@
+#pragma once
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace panmap {
+namespace test {
+
+/// The shared real-data folder (../shared/data beside the checkout).
+inline std::string dataDir(const std::string& sub = "") {
+  return std::string(PANMAP_DATA_DIR) + (sub.empty() ? "" : "/" + sub);
+}
+
+/// Small fixtures committed under tests/fixtures.
+inline std::string fixtureDir(const std::string& sub = "") {
+  return std::string(PANMAP_FIXTURE_DIR) + (sub.empty() ? "" : "/" + sub);
+}
+
+/// A built executable of this build tree.
+inline std::string binPath(const std::string& name) { return std::string(PANMAP_BIN_DIR) + "/" + name; }
+
+/// Skips the current test when a shared data folder is absent (e.g. a checkout without
+/// ../shared); everywhere else the data is there and the test runs.
+#define PANMAP_REQUIRE_DATA(sub)                                                        \
+  do {                                                                                  \
+    if (!std::filesystem::is_directory(::panmap::test::dataDir(sub))) {                 \
+      GTEST_SKIP() << "shared data folder " << ::panmap::test::dataDir(sub) << " absent"; \
+    }                                                                                   \
+  } while (0)
+
+/// A fresh temporary folder, removed with everything in it when this object dies.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "panmap-test-XXXXXX").string();
+    if (!::mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  /// The folder, or a path inside it.
+  std::string path(const std::string& sub = "") const { return sub.empty() ? path_ : path_ + "/" + sub; }
+
+ private:
+  std::string path_;
+};
+
+/// Result of running a command.
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  ///< stdout and stderr together
+};
+
+/// Runs a shell command and captures its output and exit code.
+inline CommandResult runCommand(const std::string& command) {
+  CommandResult result;
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return result;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.output.append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+/// Number of lines in a text.
+inline int countLines(const std::string& text) {
+  int lines = 0;
+  for (char c : text) lines += c == '\n';
+  if (!text.empty() && text.back() != '\n') ++lines;
+  return lines;
+}
+
+}  // namespace test
+}  // namespace panmap
