@@ -1,0 +1,208 @@
+#include "panmap/sim/renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "panmap/core/error.h"
+
+namespace panmap {
+
+void RenderConfig::check() const {
+  if (!(near_m > 0.0f)) throw Error("render near_m must be > 0");
+  if (!(far_m > near_m)) throw Error("render far_m must exceed near_m");
+  if (!(ambient >= 0.0f && ambient <= 1.0f)) throw Error("render ambient must be in [0, 1]");
+  if (!(texture_cell_m > 0.0f)) throw Error("render texture_cell_m must be > 0");
+  if (!(texture_contrast >= 0.0f && texture_contrast <= 1.0f)) {
+    throw Error("render texture_contrast must be in [0, 1]");
+  }
+}
+
+// Per-frame working memory: vertices in the camera frame and the z-buffer.
+struct MeshRenderer::Scratch {
+  std::vector<Eigen::Vector3f> points_C;
+  Image<float> zbuffer;     // z of the nearest surface so far
+  Image<int32_t> face;      // its face index, -1 = none
+};
+
+MeshRenderer::MeshRenderer(const LabelledMesh& mesh, const RenderConfig& config)
+    : mesh_(mesh), config_(config) {
+  config_.check();
+  const std::string problem = mesh.check();
+  if (!problem.empty()) throw Error("renderer: mesh is inconsistent: " + problem);
+  const size_t n = mesh.faces.size();
+  face_normals_W_.resize(n);
+  face_instance_.resize(n, 0);
+  face_semantic_.resize(n, 0);
+  face_color_.resize(n, Rgb8{180, 180, 180});
+  for (size_t f = 0; f < n; ++f) {
+    const Eigen::Vector3i& t = mesh.faces[f];
+    const Eigen::Vector3f e1 = mesh.vertices[t[1]] - mesh.vertices[t[0]];
+    const Eigen::Vector3f e2 = mesh.vertices[t[2]] - mesh.vertices[t[0]];
+    face_normals_W_[f] = e1.cross(e2).normalized();
+    if (!mesh.instance.empty()) face_instance_[f] = mesh.instance[t[0]];
+    if (!mesh.semantic.empty()) face_semantic_[f] = mesh.semantic[t[0]];
+    if (!mesh.colors.empty()) face_color_[f] = mesh.colors[t[0]];
+  }
+}
+
+RenderedView MeshRenderer::render(const PinholeCamera& camera,
+                                  const Eigen::Isometry3d& T_W_C) const {
+  RenderedView view;
+  render(camera, T_W_C, &view);
+  return view;
+}
+
+namespace {
+
+// Draws one triangle given in the camera frame, all corners at z >= near. Setup runs in double
+// so that large triangles projecting far off-screen keep sub-millimetre depth.
+inline void drawTriangle(const PinholeCamera& cam, const Eigen::Vector3f& af,
+                         const Eigen::Vector3f& bf, const Eigen::Vector3f& cf, int32_t face,
+                         Image<float>* zbuffer, Image<int32_t>* faces) {
+  const Eigen::Vector3d a = af.cast<double>(), b = bf.cast<double>(), c = cf.cast<double>();
+  const double ua = cam.fx * a.x() / a.z() + cam.cx, va = cam.fy * a.y() / a.z() + cam.cy;
+  const double ub = cam.fx * b.x() / b.z() + cam.cx, vb = cam.fy * b.y() / b.z() + cam.cy;
+  const double uc = cam.fx * c.x() / c.z() + cam.cx, vc = cam.fy * c.y() / c.z() + cam.cy;
+  // Signed double area; either winding is drawn.
+  const double area = (ub - ua) * (vc - va) - (vb - va) * (uc - ua);
+  if (std::abs(area) < 1e-12 || !std::isfinite(area)) return;
+  const int u0 = std::max(0, static_cast<int>(std::ceil(std::min({ua, ub, uc}))));
+  const int u1 = std::min(cam.width - 1, static_cast<int>(std::floor(std::max({ua, ub, uc}))));
+  const int v0 = std::max(0, static_cast<int>(std::ceil(std::min({va, vb, vc}))));
+  const int v1 = std::min(cam.height - 1, static_cast<int>(std::floor(std::max({va, vb, vc}))));
+  if (u0 > u1 || v0 > v1) return;
+  // 1/z of the triangle's plane n . p = d along the ray ((u - cx) / fx, (v - cy) / fy, 1) is
+  // linear in (u, v): exact perspective-correct depth.
+  const Eigen::Vector3d n = (b - a).cross(c - a);
+  const double d = n.dot(a);
+  if (std::abs(d) < 1e-12) return;  // seen edge-on
+  const double iz_du = n.x() / (cam.fx * d), iz_dv = n.y() / (cam.fy * d);
+  const double iz_0 = (n.z() - n.x() * cam.cx / cam.fx - n.y() * cam.cy / cam.fy) / d;
+  // Edge functions, normalised barycentrics of corners a and b, linear in (u, v).
+  const double inv_area = 1.0 / area;
+  const double wa_du = -(vc - vb) * inv_area, wa_dv = (uc - ub) * inv_area;
+  const double wb_du = -(va - vc) * inv_area, wb_dv = (ua - uc) * inv_area;
+  const double eps = -1e-6;  // closes seams between neighbouring triangles
+  for (int v = v0; v <= v1; ++v) {
+    double wa = ((ub - u0) * (vc - v) - (vb - v) * (uc - u0)) * inv_area;
+    double wb = ((uc - u0) * (va - v) - (vc - v) * (ua - u0)) * inv_area;
+    double iz = iz_0 + iz_du * u0 + iz_dv * v;
+    float* zrow = zbuffer->row(v);
+    int32_t* frow = faces->row(v);
+    for (int u = u0; u <= u1; ++u, wa += wa_du, wb += wb_du, iz += iz_du) {
+      if (wa < eps || wb < eps || 1.0 - wa - wb < eps) continue;
+      const float z = static_cast<float>(1.0 / iz);
+      if (z < zrow[u]) {
+        zrow[u] = z;
+        frow[u] = face;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void MeshRenderer::rasterise(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
+                             Scratch* s) const {
+  const Eigen::Isometry3f T_C_W = T_W_C.inverse().cast<float>();
+  const size_t nv = mesh_.vertices.size();
+  s->points_C.resize(nv);
+  for (size_t i = 0; i < nv; ++i) s->points_C[i] = T_C_W * mesh_.vertices[i];
+  const float near = config_.near_m;
+  const float far = config_.far_m;
+  for (size_t f = 0; f < mesh_.faces.size(); ++f) {
+    const Eigen::Vector3i& t = mesh_.faces[f];
+    const Eigen::Vector3f* p[3] = {&s->points_C[t[0]], &s->points_C[t[1]], &s->points_C[t[2]]};
+    const int in_front = (p[0]->z() >= near) + (p[1]->z() >= near) + (p[2]->z() >= near);
+    if (in_front == 0) continue;
+    if (p[0]->z() > far && p[1]->z() > far && p[2]->z() > far) continue;
+    const auto id = static_cast<int32_t>(f);
+    if (in_front == 3) {
+      drawTriangle(camera, *p[0], *p[1], *p[2], id, &s->zbuffer, &s->face);
+      continue;
+    }
+    // Clip the polygon against z = near (Sutherland-Hodgman, one plane): 3 or 4 corners.
+    Eigen::Vector3f poly[4];
+    int n = 0;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3f& cur = *p[k];
+      const Eigen::Vector3f& nxt = *p[(k + 1) % 3];
+      const bool cur_in = cur.z() >= near, nxt_in = nxt.z() >= near;
+      if (cur_in) poly[n++] = cur;
+      if (cur_in != nxt_in) {
+        const float s_t = (near - cur.z()) / (nxt.z() - cur.z());
+        poly[n++] = cur + s_t * (nxt - cur);
+        poly[n - 1].z() = near;
+      }
+    }
+    for (int k = 1; k + 1 < n; ++k) {
+      drawTriangle(camera, poly[0], poly[k], poly[k + 1], id, &s->zbuffer, &s->face);
+    }
+  }
+}
+
+void MeshRenderer::render(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
+                          RenderedView* view) const {
+  std::string why;
+  if (!camera.isValid(&why)) throw Error("renderer: camera: " + why);
+  thread_local Scratch scratch;
+  const int w = camera.width, h = camera.height;
+  if (scratch.zbuffer.width() != w || scratch.zbuffer.height() != h) {
+    scratch.zbuffer = Image<float>(w, h);
+    scratch.face = Image<int32_t>(w, h);
+  }
+  std::fill(scratch.zbuffer.data(), scratch.zbuffer.data() + scratch.zbuffer.size(),
+            std::numeric_limits<float>::infinity());
+  std::fill(scratch.face.data(), scratch.face.data() + scratch.face.size(), -1);
+  rasterise(camera, T_W_C, &scratch);
+
+  if (view->depth_m.width() != w || view->depth_m.height() != h) {
+    view->depth_m = Image<float>(w, h);
+    view->color = ColorImage(w, h);
+    view->instance = LabelImage(w, h);
+    view->semantic = LabelImage(w, h);
+    view->cos_incidence = Image<float>(w, h);
+  }
+  const Eigen::Matrix3f R_W_C = T_W_C.linear().cast<float>();
+  const Eigen::Vector3f t_W_C = T_W_C.translation().cast<float>();
+  const float two_pi_over_cell = 6.2831853f / config_.texture_cell_m;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const int32_t f = scratch.face(u, v);
+      if (f < 0) {
+        view->depth_m(u, v) = 0.0f;
+        view->color(u, v) = Rgb8{0, 0, 0};
+        view->instance(u, v) = 0;
+        view->semantic(u, v) = 0;
+        view->cos_incidence(u, v) = 0.0f;
+        continue;
+      }
+      const float z = scratch.zbuffer(u, v);
+      const Eigen::Vector3f ray_C((u - static_cast<float>(camera.cx)) / static_cast<float>(camera.fx),
+                                  (v - static_cast<float>(camera.cy)) / static_cast<float>(camera.fy),
+                                  1.0f);
+      const Eigen::Vector3f ray_W = R_W_C * ray_C.normalized();
+      const float cos_i = std::abs(face_normals_W_[f].dot(ray_W));
+      view->depth_m(u, v) = z;
+      view->instance(u, v) = face_instance_[f];
+      view->semantic(u, v) = face_semantic_[f];
+      view->cos_incidence(u, v) = cos_i;
+      // Headlight shading times a 3D sine texture whose phase depends on the instance, so
+      // colour carries surface information a network or a photometric term could use.
+      const Eigen::Vector3f p_W = R_W_C * (ray_C * z) + t_W_C;
+      const float phase = 0.7f * static_cast<float>(face_instance_[f] % 7);
+      const float pattern = std::sin(two_pi_over_cell * p_W.x() + phase) *
+                            std::sin(two_pi_over_cell * p_W.y() + 2.0f * phase) *
+                            std::sin(two_pi_over_cell * p_W.z() + 3.0f * phase);
+      const float shade = (config_.ambient + (1.0f - config_.ambient) * cos_i) *
+                          (1.0f - config_.texture_contrast * (0.5f + 0.5f * pattern));
+      const Rgb8 base = face_color_[f];
+      view->color(u, v) = Rgb8{static_cast<uint8_t>(std::min(255.0f, base.r * shade + 0.5f)),
+                               static_cast<uint8_t>(std::min(255.0f, base.g * shade + 0.5f)),
+                               static_cast<uint8_t>(std::min(255.0f, base.b * shade + 0.5f))};
+    }
+  }
+}
+
+}  // namespace panmap
