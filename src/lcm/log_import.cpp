@@ -4,49 +4,12 @@
 #include <memory>
 #include <optional>
 
-#include <lcm/lcm-cpp.hpp>
-
 #include "panmap/core/error.h"
 #include "panmap/io/coco_panoptic_reader.h"
 #include "panmap/io/text_files.h"
+#include "panmap/lcm/log_writer.h"
 
 namespace panmap {
-namespace {
-
-// Appends encoded messages to an LCM log opened for writing.
-class LogWriter {
- public:
-  explicit LogWriter(const std::string& path) : path_(path), log_(path, "w") {
-    if (!log_.good()) throw Error("cannot write log " + path);
-  }
-
-  template <typename Msg>
-  void write(const std::string& channel, int64_t utime, const Msg& msg) {
-    const int size = msg.getEncodedSize();
-    buffer_.resize(static_cast<size_t>(size));
-    if (msg.encode(buffer_.data(), 0, size) != size) throw Error("cannot encode " + channel);
-    lcm::LogEvent event;
-    event.eventnum = next_event_++;
-    event.timestamp = utime;
-    event.channel = channel;
-    event.datalen = size;
-    event.data = buffer_.data();
-    if (log_.writeEvent(&event) != 0) throw Error("cannot write to log " + path_);
-    bytes_ += static_cast<size_t>(size);
-  }
-
-  size_t bytes() const { return bytes_; }
-
- private:
-  std::string path_;
-  lcm::LogFile log_;
-  std::vector<uint8_t> buffer_;
-  int64_t next_event_ = 0;
-  size_t bytes_ = 0;
-};
-
-}  // namespace
-
 ImportStats importDataset(const std::string& dataset_dir, const std::string& log_path,
                           const ImportOptions& options,
                           const std::function<void(size_t, size_t)>& progress) {

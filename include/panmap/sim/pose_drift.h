@@ -1,0 +1,44 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace panmap {
+
+/// SLAM-like pose error (DESIGN 10): the estimate integrates the true relative motions with a
+/// slowly wandering bias (drift proportional to distance and rotation travelled) plus white
+/// per-frame jitter that does not accumulate.
+struct PoseDriftConfig {
+  std::string preset = "gt";
+  /// Standard deviation of the translation drift bias, metres of error per metre travelled.
+  double translation_drift_per_m = 0.0;
+  /// Standard deviation of the rotation drift bias, degrees per metre travelled.
+  double rotation_drift_deg_per_m = 0.0;
+  /// Standard deviation of the rotation drift bias, degrees per 90 degrees turned.
+  double rotation_drift_deg_per_90deg = 0.0;
+  /// Distance over which the bias decorrelates (it is an Ornstein-Uhlenbeck process), metres.
+  double bias_correlation_m = 5.0;
+  double jitter_translation_m = 0.0;  ///< per-frame white noise, metres (per axis)
+  double jitter_rotation_deg = 0.0;   ///< per-frame white noise, degrees (per axis)
+
+  /// Throws Error naming the bad field.
+  void check() const;
+  /// "gt" (no error), "slam" (ATE RMSE ~3-8 cm over a 2-3 minute room scan) or "slam-hard"
+  /// (about 3x that). Throws Error for other names.
+  static PoseDriftConfig fromPreset(const std::string& name);
+};
+
+/// The drifting estimate of a ground-truth trajectory T_W_C (one pose per frame). The first
+/// pose is exact. Deterministic for a seed.
+std::vector<Eigen::Isometry3d> applyPoseDrift(const std::vector<Eigen::Isometry3d>& T_W_C_gt,
+                                              const PoseDriftConfig& config, uint64_t seed);
+
+/// Absolute trajectory error: RMSE of camera positions, metres, after the rigid alignment
+/// (Umeyama, no scale) of `estimate` onto `reference`. Both must have the same length >= 3.
+double absoluteTrajectoryErrorRmse(const std::vector<Eigen::Isometry3d>& estimate,
+                                   const std::vector<Eigen::Isometry3d>& reference);
+
+}  // namespace panmap

@@ -1,0 +1,442 @@
+#include "panmap/sim/trajectory.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <queue>
+#include <sstream>
+
+#include <nanoflann.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "panmap/core/classes.h"
+#include "panmap/core/error.h"
+#include "panmap/core/random.h"
+
+namespace panmap {
+
+void SurveyConfig::check() const {
+  if (num_frames < 1) throw Error("survey num_frames must be >= 1");
+  if (!(rate_hz > 0)) throw Error("survey rate_hz must be > 0");
+  if (!(speed_mps > 0)) throw Error("survey speed_mps must be > 0");
+  if (!(clearance_m >= 0)) throw Error("survey clearance_m must be >= 0");
+  if (!(min_height_m > 0 && max_height_m >= min_height_m)) {
+    throw Error("survey heights need 0 < min_height_m <= max_height_m");
+  }
+  if (!(max_yaw_rate_dps > 0 && max_pitch_rate_dps > 0)) throw Error("survey rates must be > 0");
+  if (!(grid_m > 0)) throw Error("survey grid_m must be > 0");
+  if (num_waypoints < 2) throw Error("survey num_waypoints must be >= 2");
+  if (!(view_max_m > view_min_m)) throw Error("survey view_max_m must exceed view_min_m");
+}
+
+namespace {
+
+// Occupancy of the camera's height band and the floor, on a 2D grid over the mesh.
+struct FreeSpace {
+  Eigen::Vector2d origin;  // world x, y of cell (0, 0)'s corner
+  double cell = 0.05;
+  cv::Mat safe;            // CV_8U, 1 where the camera may stand
+  cv::Mat clearance_m;     // CV_32F, distance to the nearest obstacle cell, metres
+  double floor_z = 0.0;
+
+  Eigen::Vector2d centre(int i, int j) const {
+    return origin + Eigen::Vector2d((i + 0.5) * cell, (j + 0.5) * cell);
+  }
+};
+
+FreeSpace buildFreeSpace(const LabelledMesh& mesh, const SurveyConfig& config) {
+  FreeSpace fs;
+  fs.cell = config.grid_m;
+  std::vector<float> zs;
+  zs.reserve(mesh.vertices.size());
+  Eigen::Vector2d lo(1e30, 1e30), hi(-1e30, -1e30);
+  for (const auto& v : mesh.vertices) {
+    zs.push_back(v.z());
+    lo = lo.cwiseMin(v.head<2>().cast<double>());
+    hi = hi.cwiseMax(v.head<2>().cast<double>());
+  }
+  if (zs.empty()) throw Error("survey: the mesh has no vertices");
+  std::nth_element(zs.begin(), zs.begin() + zs.size() / 100, zs.end());
+  fs.floor_z = zs[zs.size() / 100];  // robust against a few stray vertices below the floor
+  fs.origin = lo - Eigen::Vector2d::Constant(fs.cell);
+  const int nx = static_cast<int>(std::ceil((hi.x() - lo.x()) / fs.cell)) + 3;
+  const int ny = static_cast<int>(std::ceil((hi.y() - lo.y()) / fs.cell)) + 3;
+  cv::Mat occupied = cv::Mat::zeros(ny, nx, CV_8U);
+  cv::Mat floor = cv::Mat::zeros(ny, nx, CV_8U);
+  const double band_lo = fs.floor_z + config.min_height_m - config.clearance_m;
+  const double band_hi = fs.floor_z + config.max_height_m + config.clearance_m;
+  auto mark = [&](const Eigen::Vector3f& p) {
+    const int i = static_cast<int>((p.x() - fs.origin.x()) / fs.cell);
+    const int j = static_cast<int>((p.y() - fs.origin.y()) / fs.cell);
+    if (i < 0 || j < 0 || i >= nx || j >= ny) return;
+    if (p.z() >= band_lo && p.z() <= band_hi) occupied.at<uint8_t>(j, i) = 1;
+    if (p.z() < fs.floor_z + 0.1) floor.at<uint8_t>(j, i) = 1;
+  };
+  // Sample every triangle densely enough that no cell it crosses is missed.
+  for (const auto& f : mesh.faces) {
+    const Eigen::Vector3f& a = mesh.vertices[f[0]];
+    const Eigen::Vector3f& b = mesh.vertices[f[1]];
+    const Eigen::Vector3f& c = mesh.vertices[f[2]];
+    const float zmin = std::min({a.z(), b.z(), c.z()}), zmax = std::max({a.z(), b.z(), c.z()});
+    if (zmax < band_lo && zmin > fs.floor_z + 0.1) continue;
+    if (zmin > band_hi) continue;
+    const float edge = std::max({(b - a).norm(), (c - a).norm(), (c - b).norm()});
+    const int n = std::max(1, static_cast<int>(std::ceil(edge / (0.5 * fs.cell))));
+    for (int i = 0; i <= n; ++i) {
+      for (int j = 0; i + j <= n; ++j) {
+        const float s = static_cast<float>(i) / n, t = static_cast<float>(j) / n;
+        mark(a + s * (b - a) + t * (c - a));
+      }
+    }
+  }
+  // Inside the room = over the floor; obstacles block the floor beneath them, so close gaps.
+  cv::Mat inside;
+  cv::morphologyEx(floor, inside, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
+  cv::Mat free_cells = (occupied == 0) / 255;
+  cv::distanceTransform(free_cells, fs.clearance_m, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  fs.clearance_m *= fs.cell;
+  const double margin = config.clearance_m + fs.cell;  // the grid hides up to a cell
+  fs.safe = (fs.clearance_m >= margin) & (inside > 0) & (occupied == 0);
+  fs.safe /= 255;
+  // Keep the largest connected free region: the room the camera walks in.
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(fs.safe, labels, stats, centroids, 8);
+  int best = -1, best_area = 0;
+  for (int k = 1; k < n; ++k) {
+    if (stats.at<int>(k, cv::CC_STAT_AREA) > best_area) {
+      best_area = stats.at<int>(k, cv::CC_STAT_AREA);
+      best = k;
+    }
+  }
+  const double area_m2 = best_area * fs.cell * fs.cell;
+  if (best < 0 || area_m2 < 1.0) {
+    std::ostringstream msg;
+    msg << "survey: only " << area_m2 << " m^2 of floor is " << config.clearance_m
+        << " m clear of surfaces at heights " << config.min_height_m << "-" << config.max_height_m
+        << " m; no room to walk";
+    throw Error(msg.str());
+  }
+  fs.safe = (labels == best) / 255;
+  return fs;
+}
+
+using Cell = std::pair<int, int>;  // (i, j) = (column, row)
+
+// Cheapest path on safe cells, preferring open space (cost grows near obstacles).
+std::vector<Cell> shortestPath(const FreeSpace& fs, Cell from, Cell to) {
+  const int nx = fs.safe.cols, ny = fs.safe.rows;
+  std::vector<float> dist(static_cast<size_t>(nx) * ny, 1e30f);
+  std::vector<int> parent(dist.size(), -1);
+  using Item = std::pair<float, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  const int start = from.second * nx + from.first, goal = to.second * nx + to.first;
+  dist[start] = 0.0f;
+  queue.push({0.0f, start});
+  while (!queue.empty()) {
+    const auto [d, idx] = queue.top();
+    queue.pop();
+    if (idx == goal) break;
+    if (d > dist[idx]) continue;
+    const int i = idx % nx, j = idx / nx;
+    for (int dj = -1; dj <= 1; ++dj) {
+      for (int di = -1; di <= 1; ++di) {
+        if (!di && !dj) continue;
+        const int ni = i + di, nj = j + dj;
+        if (ni < 0 || nj < 0 || ni >= nx || nj >= ny || !fs.safe.at<uint8_t>(nj, ni)) continue;
+        const float step = (di && dj) ? 1.41421356f : 1.0f;
+        const float open = fs.clearance_m.at<float>(nj, ni);
+        const float cost = step * (1.0f + 0.5f / std::max(open, 0.05f));
+        const int nidx = nj * nx + ni;
+        if (d + cost < dist[nidx]) {
+          dist[nidx] = d + cost;
+          parent[nidx] = idx;
+          queue.push({d + cost, nidx});
+        }
+      }
+    }
+  }
+  std::vector<Cell> path;
+  if (parent[goal] < 0 && goal != start) return path;
+  for (int idx = goal; idx != -1; idx = parent[idx]) path.push_back({idx % nx, idx / nx});
+  std::reverse(path.begin(), path.end());
+  return path;
+}
+
+// Tour stops spread over the free space by farthest-point sampling.
+std::vector<Cell> chooseWaypoints(const FreeSpace& fs, int count, Rng* rng) {
+  std::vector<Cell> cells;
+  for (int j = 0; j < fs.safe.rows; ++j) {
+    for (int i = 0; i < fs.safe.cols; ++i) {
+      if (fs.safe.at<uint8_t>(j, i)) cells.push_back({i, j});
+    }
+  }
+  std::vector<Cell> stops = {cells[rng->below(cells.size())]};
+  std::vector<double> nearest(cells.size(), 1e30);
+  while (static_cast<int>(stops.size()) < count) {
+    size_t best = 0;
+    for (size_t k = 0; k < cells.size(); ++k) {
+      const double di = cells[k].first - stops.back().first;
+      const double dj = cells[k].second - stops.back().second;
+      nearest[k] = std::min(nearest[k], di * di + dj * dj);
+      if (nearest[k] > nearest[best]) best = k;
+    }
+    if (nearest[best] < 4.0) break;  // the space is smaller than `count` stops
+    stops.push_back(cells[best]);
+  }
+  // Visit order: nearest neighbour from the first stop.
+  std::vector<Cell> tour = {stops.front()};
+  std::vector<bool> used(stops.size(), false);
+  used[0] = true;
+  for (size_t n = 1; n < stops.size(); ++n) {
+    size_t best = 0;
+    double best_d = 1e30;
+    for (size_t k = 0; k < stops.size(); ++k) {
+      if (used[k]) continue;
+      const double di = stops[k].first - tour.back().first, dj = stops[k].second - tour.back().second;
+      if (di * di + dj * dj < best_d) {
+        best_d = di * di + dj * dj;
+        best = k;
+      }
+    }
+    used[best] = true;
+    tour.push_back(stops[best]);
+  }
+  return tour;
+}
+
+// A closed, smoothed loop through the waypoints, as world x, y points.
+std::vector<Eigen::Vector2d> planLoop(const FreeSpace& fs, const std::vector<Cell>& stops) {
+  std::vector<Cell> cells;
+  for (size_t k = 0; k < stops.size(); ++k) {
+    const auto leg = shortestPath(fs, stops[k], stops[(k + 1) % stops.size()]);
+    cells.insert(cells.end(), leg.begin(), leg.empty() ? leg.end() : leg.end() - 1);
+  }
+  std::vector<Eigen::Vector2d> points;
+  for (const Cell& c : cells) points.push_back(fs.centre(c.first, c.second));
+  if (points.size() < 4) throw Error("survey: the free space is too small for a loop");
+  // Moving-average smoothing on the closed loop; a smoothed point must stay on a safe cell.
+  const int half = std::max(1, static_cast<int>(0.4 / fs.cell));
+  for (int pass = 0; pass < 3; ++pass) {
+    std::vector<Eigen::Vector2d> smooth(points.size());
+    const int n = static_cast<int>(points.size());
+    for (int k = 0; k < n; ++k) {
+      Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+      for (int d = -half; d <= half; ++d) sum += points[static_cast<size_t>(((k + d) % n + n) % n)];
+      smooth[k] = sum / (2 * half + 1);
+      const int i = static_cast<int>((smooth[k].x() - fs.origin.x()) / fs.cell);
+      const int j = static_cast<int>((smooth[k].y() - fs.origin.y()) / fs.cell);
+      if (i < 0 || j < 0 || i >= fs.safe.cols || j >= fs.safe.rows || !fs.safe.at<uint8_t>(j, i)) {
+        smooth[k] = points[k];
+      }
+    }
+    points = smooth;
+  }
+  return points;
+}
+
+struct Target {
+  Eigen::Vector3d centre;
+  int looks = 0;
+};
+
+std::vector<Target> objectTargets(const LabelledMesh& mesh) {
+  std::map<int32_t, std::pair<Eigen::Vector3d, int>> sums;
+  for (size_t v = 0; v < mesh.vertices.size() && !mesh.instance.empty(); ++v) {
+    const int32_t id = mesh.instance[v];
+    const int32_t cls = mesh.semantic.empty() ? 0 : mesh.semantic[v];
+    if (id <= 0 || isStuffClass(cls)) continue;
+    auto& s = sums[id];
+    s.first += mesh.vertices[v].cast<double>();
+    ++s.second;
+  }
+  std::vector<Target> targets;
+  for (const auto& [id, s] : sums) {
+    if (s.second >= 20) targets.push_back({s.first / s.second, 0});
+  }
+  return targets;
+}
+
+double wrapAngle(double a) {
+  while (a > M_PI) a -= 2 * M_PI;
+  while (a < -M_PI) a += 2 * M_PI;
+  return a;
+}
+
+}  // namespace
+
+std::vector<TimedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& config,
+                                  uint64_t seed) {
+  config.check();
+  Rng rng(hashSeed(seed, 0x5u));
+  const FreeSpace fs = buildFreeSpace(mesh, config);
+  const std::vector<Eigen::Vector2d> loop = planLoop(fs, chooseWaypoints(fs, config.num_waypoints, &rng));
+  std::vector<double> arc = {0.0};
+  for (size_t k = 1; k <= loop.size(); ++k) arc.push_back(arc.back() + (loop[k % loop.size()] - loop[k - 1]).norm());
+  const double loop_length = arc.back();
+  std::vector<Target> targets = objectTargets(mesh);
+
+  const double dt = 1.0 / config.rate_hz;
+  const double max_dyaw = config.max_yaw_rate_dps * M_PI / 180.0 * dt;
+  const double max_dpitch = config.max_pitch_rate_dps * M_PI / 180.0 * dt;
+  const double mid = 0.5 * (config.min_height_m + config.max_height_m);
+  const double amp = 0.4 * (config.max_height_m - config.min_height_m);
+  const double phase = rng.uniform(0.0, 2 * M_PI);
+  std::vector<TimedPose> out;
+  double yaw = 0.0, pitch = -0.2, look_timer = 1e9;
+  int target = -1;
+  size_t seg = 0;
+  for (int k = 0; k < config.num_frames; ++k) {
+    const double t = k * dt;
+    const double s = std::fmod(t * config.speed_mps, loop_length);
+    if (s < arc[seg]) seg = 0;
+    while (seg + 1 < arc.size() - 1 && arc[seg + 1] <= s) ++seg;
+    const Eigen::Vector2d& a = loop[seg];
+    const Eigen::Vector2d& b = loop[(seg + 1) % loop.size()];
+    const double frac = (s - arc[seg]) / std::max(1e-9, arc[seg + 1] - arc[seg]);
+    const Eigen::Vector2d xy = a + frac * (b - a);
+    const Eigen::Vector2d heading = (b - a).normalized();
+    const double z = fs.floor_z + mid + amp * std::sin(2 * M_PI * t / 20.0 + phase);
+    const Eigen::Vector3d eye(xy.x(), xy.y(), z);
+
+    // Pick what to look at: an object at a comfortable distance, not too far off the walking
+    // direction, looked at least recently; keep it for at least min_look_s.
+    look_timer += dt;
+    auto suitable = [&](const Target& tg, double* score) {
+      const Eigen::Vector3d d = tg.centre - eye;
+      const double range = d.head<2>().norm();
+      const double off = std::abs(wrapAngle(std::atan2(d.y(), d.x()) - std::atan2(heading.y(), heading.x())));
+      if (range < config.view_min_m * 0.5 || range > config.view_max_m * 1.5 || off > 0.6 * M_PI) return false;
+      *score = -tg.looks - 0.3 * std::abs(range - 0.5 * (config.view_min_m + config.view_max_m)) -
+               0.5 * off + 0.01 * rng.uniform();
+      return true;
+    };
+    double dummy = 0.0;
+    if (target < 0 || look_timer >= config.min_look_s || !suitable(targets[target], &dummy)) {
+      if (look_timer >= config.min_look_s || target < 0) {
+        int best = -1;
+        double best_score = -1e30, score = 0.0;
+        for (size_t i = 0; i < targets.size(); ++i) {
+          if (suitable(targets[i], &score) && score > best_score) {
+            best_score = score;
+            best = static_cast<int>(i);
+          }
+        }
+        if (best != target && best >= 0) {
+          target = best;
+          ++targets[best].looks;
+          look_timer = 0.0;
+        } else if (best < 0) {
+          target = -1;
+        }
+      }
+    }
+    double want_yaw = std::atan2(heading.y(), heading.x());
+    double want_pitch = -0.25;
+    if (target >= 0) {
+      const Eigen::Vector3d d = targets[target].centre - eye;
+      want_yaw = std::atan2(d.y(), d.x());
+      want_pitch = std::clamp(std::atan2(d.z(), d.head<2>().norm()), -0.9, 0.25);
+    }
+    if (k == 0) {
+      yaw = want_yaw;
+      pitch = want_pitch;
+    } else {
+      yaw = wrapAngle(yaw + std::clamp(wrapAngle(want_yaw - yaw), -max_dyaw, max_dyaw));
+      pitch += std::clamp(want_pitch - pitch, -max_dpitch, max_dpitch);
+    }
+    const Eigen::Vector3d forward(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw),
+                                  std::sin(pitch));
+    const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+    TimedPose pose;
+    pose.utime = static_cast<int64_t>(std::llround(t * 1e6));
+    pose.T_W_C.linear().col(0) = right;
+    pose.T_W_C.linear().col(1) = forward.cross(right);
+    pose.T_W_C.linear().col(2) = forward;
+    pose.T_W_C.translation() = eye;
+    out.push_back(pose);
+  }
+  return out;
+}
+
+namespace {
+
+// nanoflann adaptor over mesh vertices.
+struct VertexCloud {
+  const std::vector<Eigen::Vector3f>* points;
+  size_t kdtree_get_point_count() const { return points->size(); }
+  float kdtree_get_pt(size_t i, size_t dim) const { return (*points)[i][static_cast<int>(dim)]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const { return false; }
+};
+
+}  // namespace
+
+double minClearance(const std::vector<TimedPose>& trajectory, const LabelledMesh& mesh) {
+  if (mesh.vertices.empty()) return std::numeric_limits<double>::infinity();
+  VertexCloud cloud{&mesh.vertices};
+  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, VertexCloud>,
+                                                   VertexCloud, 3>;
+  Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  tree.buildIndex();
+  double best = std::numeric_limits<double>::infinity();
+  for (const TimedPose& p : trajectory) {
+    const Eigen::Vector3f q = p.T_W_C.translation().cast<float>();
+    uint32_t index = 0;
+    float dist2 = 0.0f;
+    tree.knnSearch(q.data(), 1, &index, &dist2);
+    best = std::min(best, std::sqrt(static_cast<double>(dist2)));
+  }
+  return best;
+}
+
+std::vector<TimedPose> readTumTrajectory(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot read trajectory " + path);
+  std::vector<TimedPose> out;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double v[8];
+    for (double& x : v) {
+      if (!(fields >> x)) {
+        throw Error(path + ":" + std::to_string(line_no) + ": expected 't tx ty tz qx qy qz qw'");
+      }
+    }
+    const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+    if (!std::isfinite(q.norm()) || std::abs(q.norm() - 1.0) > 1e-3) {
+      throw Error(path + ":" + std::to_string(line_no) + ": quaternion is not unit length");
+    }
+    TimedPose pose;
+    pose.utime = static_cast<int64_t>(std::llround(v[0] * 1e6));
+    pose.T_W_C.linear() = q.normalized().toRotationMatrix();
+    pose.T_W_C.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+    if (!pose.T_W_C.matrix().allFinite()) {
+      throw Error(path + ":" + std::to_string(line_no) + ": non-finite pose");
+    }
+    out.push_back(pose);
+  }
+  if (out.empty()) throw Error("trajectory " + path + " has no poses");
+  return out;
+}
+
+void writeTumTrajectory(const std::string& path, const std::vector<TimedPose>& trajectory) {
+  std::ofstream out(path);
+  if (!out) throw Error("cannot write trajectory " + path);
+  out << "# timestamp tx ty tz qx qy qz qw\n";
+  char buffer[256];
+  for (const TimedPose& p : trajectory) {
+    const Eigen::Quaterniond q(p.T_W_C.linear());
+    const Eigen::Vector3d t = p.T_W_C.translation();
+    std::snprintf(buffer, sizeof(buffer), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n",
+                  p.utime * 1e-6, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+    out << buffer;
+  }
+  if (!out) throw Error("cannot write trajectory " + path);
+}
+
+}  // namespace panmap
