@@ -233,7 +233,14 @@ std::vector<Eigen::Vector2d> planLoop(const FreeSpace& fs, const std::vector<Cel
     }
     points = smooth;
   }
-  return points;
+  // Smoothing can stack points; zero-length segments would have no heading.
+  std::vector<Eigen::Vector2d> distinct;
+  for (const Eigen::Vector2d& p : points) {
+    if (distinct.empty() || (p - distinct.back()).norm() > 1e-4) distinct.push_back(p);
+  }
+  while (distinct.size() > 1 && (distinct.front() - distinct.back()).norm() <= 1e-4) distinct.pop_back();
+  if (distinct.size() < 4) throw Error("survey: the free space is too small for a loop");
+  return distinct;
 }
 
 struct Target {
@@ -247,7 +254,8 @@ std::vector<Target> objectTargets(const LabelledMesh& mesh) {
     const int32_t id = mesh.instance[v];
     const int32_t cls = mesh.semantic.empty() ? 0 : mesh.semantic[v];
     if (id <= 0 || isStuffClass(cls)) continue;
-    auto& s = sums[id];
+    // Eigen vectors are not zero-initialised: start each sum explicitly.
+    auto& s = sums.try_emplace(id, Eigen::Vector3d::Zero(), 0).first->second;
     s.first += mesh.vertices[v].cast<double>();
     ++s.second;
   }
@@ -339,6 +347,10 @@ std::vector<TimedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& 
       want_yaw = std::atan2(d.y(), d.x());
       want_pitch = std::clamp(std::atan2(d.z(), d.head<2>().norm()), -0.9, 0.25);
     }
+    if (!std::isfinite(want_yaw) || !std::isfinite(want_pitch)) {
+      want_yaw = yaw;  // keep looking where we look; never let a NaN into the trajectory
+      want_pitch = pitch;
+    }
     if (k == 0) {
       yaw = want_yaw;
       pitch = want_pitch;
@@ -355,6 +367,9 @@ std::vector<TimedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& 
     pose.T_W_C.linear().col(1) = forward.cross(right);
     pose.T_W_C.linear().col(2) = forward;
     pose.T_W_C.translation() = eye;
+    if (!pose.T_W_C.matrix().allFinite()) {
+      throw Error("survey: non-finite pose at frame " + std::to_string(k) + " (planner bug)");
+    }
     out.push_back(pose);
   }
   return out;

@@ -1,0 +1,252 @@
+// panmap-synth: renders a labelled mesh (a procedural room or a ScanNet scene's ground truth)
+// along a camera trajectory into an LCM log with RGB-D frames, drifting poses and simulated
+// panoptic masks, plus the ground truth to evaluate against.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "panmap/core/error.h"
+#include "panmap/core/progress.h"
+#include "panmap/io/image_codec.h"
+#include "panmap/io/ply.h"
+#include "panmap/io/scannet_ground_truth.h"
+#include "panmap/lcm/channels.h"
+#include "panmap/lcm/conversions.h"
+#include "panmap/lcm/log_writer.h"
+#include "panmap/sim/procedural_room.h"
+#include "panmap/sim/sequence.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// The one file in `dir` whose name ends with `suffix`.
+std::string findOne(const std::string& dir, const std::string& suffix) {
+  std::string found;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+        name.find(".labels.") == std::string::npos) {
+      if (!found.empty()) throw panmap::Error(dir + ": more than one *" + suffix);
+      found = e.path().string();
+    }
+  }
+  if (found.empty()) throw panmap::Error(dir + ": no *" + suffix + " file");
+  return found;
+}
+
+json masksJson(const panmap::SegmenterNoiseConfig& c) {
+  return {{"preset", c.preset},
+          {"window_frames", c.window_frames},
+          {"miss_probability_small", c.miss_probability_small},
+          {"miss_probability_large", c.miss_probability_large},
+          {"miss_small_px", c.miss_small_px},
+          {"miss_large_px", c.miss_large_px},
+          {"miss_probability_occluded", c.miss_probability_occluded},
+          {"boundary_mean_px", c.boundary_mean_px},
+          {"boundary_grid_px", c.boundary_grid_px},
+          {"confusion_probability", c.confusion_probability},
+          {"confusion_groups", c.confusion_groups},
+          {"merge_probability", c.merge_probability},
+          {"split_probability", c.split_probability},
+          {"split_min_extent_m", c.split_min_extent_m},
+          {"false_positives_per_frame", c.false_positives_per_frame},
+          {"sample_scores", c.sample_scores},
+          {"true_score_beta", {c.true_score_alpha, c.true_score_beta}},
+          {"wrong_score_beta", {c.wrong_score_alpha, c.wrong_score_beta}}};
+}
+
+json posesJson(const panmap::PoseDriftConfig& c) {
+  return {{"preset", c.preset},
+          {"translation_drift_per_m", c.translation_drift_per_m},
+          {"rotation_drift_deg_per_m", c.rotation_drift_deg_per_m},
+          {"rotation_drift_deg_per_90deg", c.rotation_drift_deg_per_90deg},
+          {"bias_correlation_m", c.bias_correlation_m},
+          {"jitter_translation_m", c.jitter_translation_m},
+          {"jitter_rotation_deg", c.jitter_rotation_deg}};
+}
+
+json depthJson(const panmap::DepthNoiseConfig& c) {
+  return {{"enabled", c.enabled},
+          {"axial_sigma_m", "a + b (z - z0)^2"},
+          {"axial_sigma_a_m", c.axial_sigma_a_m},
+          {"axial_sigma_b_m", c.axial_sigma_b_m},
+          {"axial_z0_m", c.axial_z0_m},
+          {"lateral_sigma_px", c.lateral_sigma_px},
+          {"quantization_m", c.quantization_m},
+          {"range_m", {c.min_range_m, c.max_range_m}},
+          {"grazing_dropout_deg", {c.grazing_start_deg, c.grazing_full_deg}},
+          {"edge_ratio", c.edge_ratio},
+          {"edge_dropout", c.edge_dropout}};
+}
+
+// False-colour PNGs of one frame, for looking at what the sequence contains.
+void writePreview(const std::string& out_dir, const panmap::SynthFrame& f) {
+  fs::create_directories(out_dir + "/preview");
+  char stem[64];
+  std::snprintf(stem, sizeof(stem), "%s/preview/%06lld", out_dir.c_str(),
+                static_cast<long long>(f.rgbd.frame_id));
+  panmap::writeFileBytes(std::string(stem) + "_color.png", panmap::encodePng(f.rgbd.color));
+  panmap::ColorImage depth(f.rgbd.depth.width(), f.rgbd.depth.height());
+  panmap::ColorImage masks(depth.width(), depth.height());
+  for (size_t i = 0; i < depth.size(); ++i) {
+    const auto g = static_cast<uint8_t>(std::min(255.0, f.rgbd.depth.data()[i] * 255.0 / 6000.0));
+    depth.data()[i] = panmap::Rgb8{g, g, g};
+    const uint32_t id = static_cast<uint32_t>(f.panoptic.segment_ids.data()[i]);
+    const uint32_t h = id ? id * 2654435761u : 0u;
+    masks.data()[i] = panmap::Rgb8{static_cast<uint8_t>(h >> 24), static_cast<uint8_t>(h >> 16),
+                                   static_cast<uint8_t>(h >> 8)};
+  }
+  panmap::writeFileBytes(std::string(stem) + "_depth.png", panmap::encodePng(depth));
+  panmap::writeFileBytes(std::string(stem) + "_masks.png", panmap::encodePng(masks));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Render a labelled mesh along a camera trajectory into an LCM log (CAMERA_RGBD, "
+      "CAMERA_POSE, PANOPTIC) with sensor noise, segmenter errors and SLAM-like pose drift, "
+      "and write the ground truth beside it:\n  OUT/sequence.lcmlog, OUT/gt/mesh.ply, "
+      "OUT/gt/instances.txt, OUT/gt/trajectory_gt.txt, OUT/gt/trajectory_input.txt, "
+      "OUT/info.json"};
+  int64_t room_seed = -1;
+  std::string scannet_dir, scannet_labels = "../shared/data/scannet-meta/scannetv2-labels.combined.tsv";
+  std::string trajectory_file, masks = "m2f", poses = "slam", out_dir;
+  int frames = 300;
+  uint64_t seed = 1;
+  bool quiet = false, no_depth_noise = false;
+  int preview_every = 0;
+  auto* source = app.add_option_group("source", "ground-truth mesh (one of)");
+  source->add_option("--room", room_seed, "procedural room with this seed");
+  source->add_option("--scannet", scannet_dir,
+                     "ScanNet scene folder (<scene>_vh_clean_2.ply, .aggregation.json, "
+                     "_vh_clean_2.0.010000.segs.json)");
+  source->require_option(1);
+  app.add_option("--scannet-labels", scannet_labels, "ScanNet label table (tsv)")
+      ->capture_default_str();
+  app.add_option("--trajectory", trajectory_file, "TUM trajectory to follow instead of a survey");
+  app.add_option("--frames", frames, "frames to render (30 Hz)")->capture_default_str()
+      ->check(CLI::Range(1, 1000000));
+  app.add_option("--masks", masks, "segmenter noise preset: clean, m2f, hard")
+      ->capture_default_str()->check(CLI::IsMember({"clean", "m2f", "hard"}));
+  app.add_option("--poses", poses, "pose preset: gt, slam, slam-hard")
+      ->capture_default_str()->check(CLI::IsMember({"gt", "slam", "slam-hard"}));
+  app.add_option("--seed", seed, "seed of trajectory, noise, masks and drift")->capture_default_str();
+  app.add_flag("--no-depth-noise", no_depth_noise, "exact depth (quantised to 1 mm)");
+  app.add_option("--out", out_dir, "output folder")->required();
+  app.add_option("--preview-every", preview_every,
+                 "write colour, depth and mask PNGs of every Nth frame into OUT/preview (0 = none)");
+  app.add_flag("-q,--quiet", quiet, "no progress line");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    const auto start = std::chrono::steady_clock::now();
+    panmap::LabelledMesh mesh;
+    json source_json;
+    if (room_seed >= 0) {
+      const panmap::ProceduralRoom room = panmap::generateRoom(static_cast<uint64_t>(room_seed));
+      mesh = room.mesh;
+      source_json = {{"type", "procedural_room"}, {"room_seed", room_seed}};
+    } else {
+      const auto table = panmap::ScanNetLabelTable::load(scannet_labels);
+      const auto gt = panmap::loadScanNetGroundTruth(
+          findOne(scannet_dir, "_vh_clean_2.ply"), findOne(scannet_dir, ".aggregation.json"),
+          findOne(scannet_dir, "_vh_clean_2.0.010000.segs.json"), table);
+      mesh = gt.mesh;
+      source_json = {{"type", "scannet"}, {"dir", scannet_dir}, {"unknown_labels", gt.unknown_labels}};
+    }
+
+    panmap::SynthConfig config;
+    config.seed = seed;
+    config.masks = panmap::SegmenterNoiseConfig::fromPreset(masks);
+    config.poses = panmap::PoseDriftConfig::fromPreset(poses);
+    config.depth.enabled = !no_depth_noise;
+    std::vector<panmap::TimedPose> trajectory;
+    panmap::SurveyConfig survey;
+    survey.num_frames = frames;
+    if (!trajectory_file.empty()) {
+      trajectory = panmap::readTumTrajectory(trajectory_file);
+      if (static_cast<int>(trajectory.size()) > frames) trajectory.resize(static_cast<size_t>(frames));
+    } else {
+      trajectory = panmap::planSurvey(mesh, survey, seed);
+    }
+
+    fs::create_directories(out_dir + "/gt");
+    panmap::SequenceSynthesizer synth(mesh, trajectory, config);
+    panmap::LogWriter log(out_dir + "/sequence.lcmlog");
+    const panmap::ImageEncoding encoding;
+    const auto pose_source = poses == "gt" ? panmap::PoseSource::kGroundTruth : panmap::PoseSource::kSlam;
+    panmap::ProgressLine progress("synth", "frames", !quiet);
+    for (size_t k = 0; k < synth.size(); ++k) {
+      const panmap::SynthFrame f = synth.frame(k);
+      const int64_t utime = f.rgbd.utime;
+      log.write(panmap::kChannelRgbd, utime, panmap::toMessage(f.rgbd, encoding));
+      panmap::StampedPose pose;
+      pose.utime = utime;
+      pose.frame_id = f.rgbd.frame_id;
+      pose.T_W_C = f.input_pose.T_W_C;
+      pose.source = pose_source;
+      log.write(panmap::kChannelPose, utime, panmap::toMessage(pose));
+      log.write(panmap::kChannelPanoptic, utime, panmap::toMessage(f.panoptic, encoding));
+      if (preview_every > 0 && k % static_cast<size_t>(preview_every) == 0) writePreview(out_dir, f);
+      progress.update(k + 1, synth.size());
+    }
+    progress.finish();
+
+    panmap::writePly(out_dir + "/gt/mesh.ply", mesh);
+    panmap::writeScanNetInstanceFile(out_dir + "/gt/instances.txt", mesh);
+    panmap::writeTumTrajectory(out_dir + "/gt/trajectory_gt.txt", synth.groundTruthTrajectory());
+    panmap::writeTumTrajectory(out_dir + "/gt/trajectory_input.txt", synth.inputTrajectory());
+
+    std::vector<Eigen::Isometry3d> gt_poses, input_poses;
+    for (const auto& p : synth.groundTruthTrajectory()) gt_poses.push_back(p.T_W_C);
+    for (const auto& p : synth.inputTrajectory()) input_poses.push_back(p.T_W_C);
+    const double ate = gt_poses.size() >= 3 ? panmap::absoluteTrajectoryErrorRmse(input_poses, gt_poses) : 0.0;
+    const panmap::CoverageStats cov = synth.coverage();
+    const panmap::SegmenterNoiseStats& seg = synth.segmenterStats();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const json info = {
+        {"seed", seed},
+        {"source", source_json},
+        {"frames", synth.size()},
+        {"camera", {{"fx", config.camera.fx}, {"fy", config.camera.fy}, {"cx", config.camera.cx},
+                    {"cy", config.camera.cy}, {"width", config.camera.width},
+                    {"height", config.camera.height}, {"depth_scale_m", config.depth_scale_m}}},
+        {"mesh", {{"vertices", mesh.numVertices()}, {"faces", mesh.numFaces()},
+                  {"instances", synth.instances().size()}}},
+        {"trajectory", {{"source", trajectory_file.empty() ? "survey" : trajectory_file},
+                        {"min_clearance_m", panmap::minClearance(synth.groundTruthTrajectory(), mesh)}}},
+        {"masks", masksJson(config.masks)},
+        {"poses", posesJson(config.poses)},
+        {"depth_noise", depthJson(config.depth)},
+        {"coverage", {{"thing_instances", cov.thing_instances}, {"seen_once", cov.seen_once},
+                      {"seen_from_3_views", cov.seen_from_3_views},
+                      {"fraction_seen_from_3_views", cov.fractionSeenFrom3Views()}}},
+        {"measured", {{"input_ate_rmse_m", ate},
+                      {"miss_rate", seg.missRate()},
+                      {"small_miss_rate", seg.smallMissRate()},
+                      {"large_miss_rate", seg.largeMissRate()},
+                      {"confusion_rate", seg.confusionRate()},
+                      {"merge_rate", seg.mergeRate()},
+                      {"split_rate", seg.splitRate()},
+                      {"false_positives_per_frame", seg.falsePositivesPerFrame()},
+                      {"mean_boundary_error_px", seg.meanBoundaryErrorPx()}}},
+        {"log_bytes", log.bytes()},
+        {"seconds", seconds}};
+    std::ofstream(out_dir + "/info.json") << info.dump(2) << "\n";
+    std::printf("wrote %s: %zu frames, %.1f MB; input ATE %.3f m; %d/%d objects seen from >= 3 "
+                "views; %.1f s\n",
+                (out_dir + "/sequence.lcmlog").c_str(), synth.size(), log.bytes() / 1e6, ate,
+                cov.seen_from_3_views, cov.thing_instances, seconds);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "panmap-synth: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,126 @@
+#include "panmap/sim/sequence.h"
+
+#include <cmath>
+
+#include "panmap/core/classes.h"
+#include "panmap/core/error.h"
+#include "panmap/core/random.h"
+
+namespace panmap {
+
+void SynthConfig::check() const {
+  std::string why;
+  if (!camera.isValid(&why)) throw Error("synth camera: " + why);
+  if (!(depth_scale_m > 0)) throw Error("synth depth_scale_m must be > 0");
+  render.check();
+  depth.check();
+  masks.check();
+  poses.check();
+  if (min_view_px < 1) throw Error("synth min_view_px must be >= 1");
+  if (!(distinct_view_deg > 0)) throw Error("synth distinct_view_deg must be > 0");
+}
+
+namespace {
+
+std::vector<TimedPose> drift(const std::vector<TimedPose>& gt, const PoseDriftConfig& config,
+                             uint64_t seed) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (const TimedPose& p : gt) poses.push_back(p.T_W_C);
+  const std::vector<Eigen::Isometry3d> drifted = applyPoseDrift(poses, config, seed);
+  std::vector<TimedPose> out = gt;
+  for (size_t k = 0; k < out.size(); ++k) out[k].T_W_C = drifted[k];
+  return out;
+}
+
+}  // namespace
+
+SequenceSynthesizer::SequenceSynthesizer(const LabelledMesh& mesh, std::vector<TimedPose> T_W_C_gt,
+                                         const SynthConfig& config)
+    : config_(config),
+      renderer_(mesh, config.render),
+      segmenter_(config.masks, hashSeed(config.seed, 0x3A5Cu)),
+      gt_(std::move(T_W_C_gt)) {
+  config_.check();
+  if (gt_.empty()) throw Error("synth: the trajectory has no poses");
+  input_ = drift(gt_, config.poses, hashSeed(config.seed, 0xD41Fu));
+  // Per instance: majority class, bounding box, centroid.
+  std::map<int32_t, std::map<int32_t, int>> class_votes;
+  std::map<int32_t, Eigen::AlignedBox3f> boxes;
+  std::map<int32_t, std::pair<Eigen::Vector3d, int>> sums;
+  for (size_t v = 0; v < mesh.vertices.size() && !mesh.instance.empty(); ++v) {
+    const int32_t id = mesh.instance[v];
+    if (id <= 0) continue;
+    ++class_votes[id][mesh.semantic.empty() ? 0 : mesh.semantic[v]];
+    boxes[id].extend(mesh.vertices[v]);
+    // Eigen vectors are not zero-initialised: start each sum explicitly.
+    auto& sum = sums.try_emplace(id, Eigen::Vector3d::Zero(), 0).first->second;
+    sum.first += mesh.vertices[v].cast<double>();
+    ++sum.second;
+  }
+  for (const auto& [id, votes] : class_votes) {
+    int32_t best = 0, best_count = -1;
+    for (const auto& [cls, count] : votes) {
+      if (count > best_count) best = cls, best_count = count;
+    }
+    InstanceInfo info;
+    info.semantic = best;
+    info.extent_m = boxes[id].sizes().maxCoeff();
+    info.is_stuff = isStuffClass(best);
+    infos_[id] = info;
+    centroids_[id] = sums[id].first / sums[id].second;
+  }
+}
+
+SynthFrame SequenceSynthesizer::frame(size_t k) {
+  if (k >= gt_.size()) throw Error("synth: frame " + std::to_string(k) + " beyond the trajectory");
+  SynthFrame out;
+  out.gt_pose = gt_[k];
+  out.input_pose = input_[k];
+  renderer_.render(config_.camera, gt_[k].T_W_C, &view_);
+  out.rgbd.utime = gt_[k].utime;
+  out.rgbd.frame_id = static_cast<int64_t>(k);
+  out.rgbd.camera_name = "panmap-synth";
+  out.rgbd.camera = config_.camera;
+  out.rgbd.depth_scale_m = config_.depth_scale_m;
+  out.rgbd.depth = simulateDepth(view_, config_.depth, hashSeed(config_.seed, k, 0xDE9u),
+                                 config_.depth_scale_m);
+  out.rgbd.color = view_.color;
+  out.gt_instance = view_.instance;
+  out.panoptic = segmenter_.segment(view_.instance, view_.semantic, static_cast<int>(k), infos_);
+  out.panoptic.utime = out.rgbd.utime;
+  out.panoptic.frame_id = out.rgbd.frame_id;
+
+  // Coverage: an instance's viewing direction joins its distinct views when it is far enough
+  // from every direction it was seen from before.
+  std::map<int32_t, int> pixels;
+  for (size_t i = 0; i < view_.instance.size(); ++i) {
+    const int32_t id = view_.instance.data()[i];
+    if (id > 0) ++pixels[id];
+  }
+  const double cos_distinct = std::cos(config_.distinct_view_deg * M_PI / 180.0);
+  for (const auto& [id, count] : pixels) {
+    const auto info = infos_.find(id);
+    if (count < config_.min_view_px || info == infos_.end() || info->second.is_stuff) continue;
+    const Eigen::Vector3d dir = (gt_[k].T_W_C.translation() - centroids_[id]).normalized();
+    auto& seen = views_[id];
+    bool distinct = true;
+    for (const Eigen::Vector3d& d : seen) distinct = distinct && d.dot(dir) < cos_distinct;
+    if (distinct) seen.push_back(dir);
+  }
+  return out;
+}
+
+CoverageStats SequenceSynthesizer::coverage() const {
+  CoverageStats stats;
+  for (const auto& [id, info] : infos_) {
+    if (info.is_stuff) continue;
+    ++stats.thing_instances;
+    const auto it = views_.find(id);
+    if (it == views_.end()) continue;
+    ++stats.seen_once;
+    if (it->second.size() >= 3) ++stats.seen_from_3_views;
+  }
+  return stats;
+}
+
+}  // namespace panmap

@@ -1,0 +1,138 @@
+#include <cmath>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "panmap/core/error.h"
+#include "panmap/sim/procedural_room.h"
+#include "panmap/sim/sequence.h"
+#include "panmap/sim/trajectory.h"
+#include "test_helpers.h"
+
+namespace panmap {
+namespace {
+
+// Exact distance from a point to a triangle (Ericson, Real-Time Collision Detection 5.1.5).
+double pointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                             const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return (p - a).norm();
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return (p - b).norm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return (p - c).norm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
+  }
+  const double denom = 1.0 / (va + vb + vc);
+  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
+}
+
+class SurveyOfRoom : public ::testing::TestWithParam<int> {};
+
+TEST_P(SurveyOfRoom, StaysClearSmoothAndAtHeadHeight) {
+  const ProceduralRoom room = generateRoom(static_cast<uint64_t>(GetParam()));
+  SurveyConfig config;
+  config.num_frames = 1800;
+  const std::vector<TimedPose> traj = planSurvey(room.mesh, config, 7);
+  ASSERT_EQ(traj.size(), 1800u);
+  const double dt = 1.0 / config.rate_hz;
+  double max_turn = 0.0, max_step = 0.0;
+  for (size_t k = 0; k < traj.size(); ++k) {
+    const Eigen::Isometry3d& T = traj[k].T_W_C;
+    ASSERT_TRUE(T.matrix().allFinite()) << k;
+    EXPECT_EQ(traj[k].utime, std::llround(k * dt * 1e6));
+    EXPECT_GE(T.translation().z(), config.min_height_m - 1e-9);
+    EXPECT_LE(T.translation().z(), config.max_height_m + 1e-9);
+    // Optical frame: x right, level (no roll), y pointing down-ish.
+    EXPECT_NEAR(T.linear().col(0).z(), 0.0, 1e-9);
+    EXPECT_GT(T.linear().col(1).z(), 0.0 - 1.0);
+    if (k > 0) {
+      const Eigen::Isometry3d& P = traj[k - 1].T_W_C;
+      max_step = std::max(max_step, (T.translation() - P.translation()).head<2>().norm());
+      max_turn = std::max(max_turn, std::acos(std::clamp(T.linear().col(2).dot(P.linear().col(2)), -1.0, 1.0)));
+    }
+  }
+  EXPECT_LE(max_step, config.speed_mps * dt * 1.01);
+  const double max_rate = (config.max_yaw_rate_dps + config.max_pitch_rate_dps) * M_PI / 180.0 * dt;
+  EXPECT_LE(max_turn, max_rate + 1e-9);
+  // Exact clearance against every triangle, for every 30th pose.
+  double clearance = 1e9;
+  std::vector<TimedPose> sampled;
+  for (size_t k = 0; k < traj.size(); k += 30) {
+    sampled.push_back(traj[k]);
+    const Eigen::Vector3d p = traj[k].T_W_C.translation();
+    for (const Eigen::Vector3i& f : room.mesh.faces) {
+      clearance = std::min(clearance, pointTriangleDistance(p, room.mesh.vertices[f[0]].cast<double>(),
+                                                            room.mesh.vertices[f[1]].cast<double>(),
+                                                            room.mesh.vertices[f[2]].cast<double>()));
+    }
+  }
+  EXPECT_GE(clearance, config.clearance_m);
+  EXPECT_GE(minClearance(sampled, room.mesh), clearance - 1e-6);  // vertices are never nearer than faces
+  // Same seed, same trajectory.
+  const auto again = planSurvey(room.mesh, config, 7);
+  EXPECT_EQ(again.back().T_W_C.matrix(), traj.back().T_W_C.matrix());
+}
+
+TEST_P(SurveyOfRoom, MostObjectsAreSeenFromThreeViewpoints) {
+  const ProceduralRoom room = generateRoom(static_cast<uint64_t>(GetParam()));
+  SurveyConfig survey;
+  survey.num_frames = 3600;  // a 2-minute scan
+  SynthConfig config;
+  config.camera = PinholeCamera{131.25, 131.25, 79.375, 59.375, 160, 120};  // 640x480 / 4
+  config.min_view_px = 200 / 16;
+  config.masks = SegmenterNoiseConfig::fromPreset("clean");
+  config.depth.enabled = false;
+  SequenceSynthesizer synth(room.mesh, planSurvey(room.mesh, survey, 7), config);
+  for (size_t k = 0; k < synth.size(); k += 6) synth.frame(k);
+  const CoverageStats coverage = synth.coverage();
+  EXPECT_GT(coverage.thing_instances, 10);
+  EXPECT_GE(coverage.fractionSeenFrom3Views(), 0.6)
+      << coverage.seen_from_3_views << " of " << coverage.thing_instances;
+  RecordProperty("fraction_seen_from_3_views", std::to_string(coverage.fractionSeenFrom3Views()));
+}
+
+INSTANTIATE_TEST_SUITE_P(Seeds, SurveyOfRoom, ::testing::Values(1, 2, 3));
+
+TEST(Survey, NoRoomToWalkIsAClearError) {
+  LabelledMesh mesh;
+  mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  mesh.faces = {{0, 1, 2}};
+  try {
+    planSurvey(mesh, SurveyConfig(), 1);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no room to walk"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Survey, TumRoundTrip) {
+  test::TempDir dir;
+  std::vector<TimedPose> traj(3);
+  for (int k = 0; k < 3; ++k) {
+    traj[k].utime = 1000000 + 33333 * k;
+    traj[k].T_W_C.linear() = Eigen::AngleAxisd(0.3 * k, Eigen::Vector3d(1, 2, 2).normalized()).toRotationMatrix();
+    traj[k].T_W_C.translation() << 0.5 * k, -1.25, 2.0;
+  }
+  writeTumTrajectory(dir.path("t.txt"), traj);
+  const auto back = readTumTrajectory(dir.path("t.txt"));
+  ASSERT_EQ(back.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(back[k].utime, traj[k].utime);
+    EXPECT_LT((back[k].T_W_C.matrix() - traj[k].T_W_C.matrix()).cwiseAbs().maxCoeff(), 1e-8);
+  }
+  std::ofstream(dir.path("bad.txt")) << "0 1 2 3 0 0 0 1\n1 2 3 nan 0 0 0 1\n";
+  EXPECT_THROW(readTumTrajectory(dir.path("bad.txt")), Error);
+}
+
+}  // namespace
+}  // namespace panmap
