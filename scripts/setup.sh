@@ -26,7 +26,8 @@ packages=(
   liblcm-dev liblcm-bin liblcm-java libglib2.0-dev   # LCM (C/C++ library, tools, lcm.jar)
   default-jdk-headless libjchart2d-java               # types jar for lcm-spy, its charts
   libeigen3-dev                                       # geometry
-  libopencv-dev                                       # image codecs, depth segmentation, max-flow
+  libabsl-dev zlib1g-dev                              # block hash map, map file checksums
+  libopencv-dev libopencv-contrib-dev                 # image codecs, depth segmentation, max-flow
   liboctomap-dev octomap-tools                        # occupancy tree for planners
   libceres-dev                                        # pose refinement against the map
   libgtest-dev libgmock-dev libbenchmark-dev          # tests and benchmarks

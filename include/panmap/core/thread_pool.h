@@ -1,0 +1,43 @@
+#pragma once
+
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace panmap {
+
+/// A fixed set of worker threads that run index ranges in parallel. Threads live as long as
+/// the pool, so per-frame work creates no threads.
+class ThreadPool {
+ public:
+  /// @param num_threads total threads working on a range, the caller included (>= 1)
+  explicit ThreadPool(int num_threads);
+  ~ThreadPool();
+  ThreadPool(const ThreadPool&) = delete;
+  ThreadPool& operator=(const ThreadPool&) = delete;
+
+  /// Threads that share a range, the caller included.
+  int size() const { return static_cast<int>(workers_.size()) + 1; }
+
+  /// Calls fn(begin, end, thread) on disjoint chunks covering [0, n) and returns when all are
+  /// done. Chunks are static (thread t gets the t-th slice), so results are deterministic
+  /// as long as fn's effects depend only on its range.
+  void parallelFor(size_t n, const std::function<void(size_t, size_t, int)>& fn);
+
+ private:
+  void workerLoop(int index);
+
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable start_cv_;
+  std::condition_variable done_cv_;
+  const std::function<void(size_t, size_t, int)>* job_ = nullptr;
+  size_t job_size_ = 0;
+  uint64_t generation_ = 0;
+  int pending_ = 0;
+  bool stop_ = false;
+};
+
+}  // namespace panmap

@@ -1,0 +1,65 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "panmap/core/frame.h"
+#include "panmap/core/image.h"
+#include "panmap/core/thread_pool.h"
+#include "panmap/map/tsdf_map.h"
+
+namespace panmap {
+
+/// Parameters of label-TSDF integration.
+struct IntegratorConfig {
+  float truncation_voxels = 4.0f;  ///< truncation distance, voxels
+  float max_weight = 100.0f;       ///< weights saturate here, so the map can still change
+  float min_depth_m = 0.1f;        ///< depth outside [min, max] is ignored, metres
+  float max_depth_m = 5.0f;
+  bool weight_dropoff = true;      ///< behind the surface, weight falls linearly to 0 at -trunc
+  /// Also allocate blocks between camera and surface and record free space there (voxels
+  /// farther than the truncation in front of the surface); off: only the truncation band.
+  bool space_carving = false;
+  /// Voxels within this distance of the surface (voxels) take a vote for their pixel's label.
+  float vote_band_voxels = 1.0f;
+  /// Throws Error naming the bad field.
+  void check() const;
+};
+
+/// What one integration did.
+struct IntegrationStats {
+  size_t blocks_in_view = 0;    ///< blocks near the observed surface
+  size_t blocks_allocated = 0;  ///< of those, new
+  size_t voxels_updated = 0;
+  size_t votes_added = 0;
+  size_t votes_evicted = 0;     ///< votes that pushed out a weaker label (never silent)
+};
+
+/// Projective TSDF integration of depth, colour and per-pixel super-point labels into a
+/// TsdfMap: each voxel near the surface projects into the image and fuses the pixel it hits.
+/// Multi-threaded over blocks; deterministic (every voxel is touched by exactly one thread and
+/// new blocks are allocated in sorted order).
+class ProjectiveIntegrator {
+ public:
+  /// @param pool threads to use (shared with the caller; not owned)
+  ProjectiveIntegrator(const IntegratorConfig& config, ThreadPool* pool);
+
+  /// Integrates one frame seen from T_W_C (camera to world, optical frame).
+  /// @param labels super-point label per pixel (0 = none), or null for geometry only
+  IntegrationStats integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
+                             const LabelImage* labels, TsdfMap* map);
+
+  /// The config in use.
+  const IntegratorConfig& config() const { return config_; }
+
+ private:
+  IntegratorConfig config_;
+  ThreadPool* pool_;
+  Image<float> depth_m_;              // scratch: depth in metres, 0 = invalid
+  std::vector<uint64_t> keys_;        // scratch: block keys seen this frame
+  std::vector<Block*> blocks_;        // scratch: blocks in view
+};
+
+}  // namespace panmap

@@ -1,0 +1,92 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <absl/container/flat_hash_map.h>
+#include <Eigen/Core>
+
+#include "panmap/map/voxel.h"
+
+namespace panmap {
+
+/// Voxels per block side (voxblox-style blocks of 8^3 voxels).
+constexpr int kBlockSide = 8;
+/// Voxels per block.
+constexpr int kBlockVoxels = kBlockSide * kBlockSide * kBlockSide;
+
+/// Integer block coordinates (block corner = index * block size).
+using BlockIndex = Eigen::Vector3i;
+
+/// A cube of kBlockSide^3 voxels, x fastest.
+struct Block {
+  BlockIndex index = BlockIndex::Zero();
+  bool updated = false;  ///< changed since the mesher last looked (cleared by the mesher)
+  Voxel voxels[kBlockVoxels];
+
+  /// Voxel at local coordinates (x, y, z), each in [0, kBlockSide).
+  Voxel& at(int x, int y, int z) { return voxels[x + kBlockSide * (y + kBlockSide * z)]; }
+  /// Voxel at local coordinates (x, y, z), each in [0, kBlockSide).
+  const Voxel& at(int x, int y, int z) const {
+    return voxels[x + kBlockSide * (y + kBlockSide * z)];
+  }
+};
+
+/// Hashed blocks of voxels: the label-TSDF's storage. Blocks are created on demand and never
+/// move in memory, so pointers to them stay valid.
+class TsdfMap {
+ public:
+  /// Map geometry.
+  struct Config {
+    float voxel_size_m = 0.01f;  ///< voxel edge length, metres (the paper: 1 cm)
+    /// Throws Error naming the bad field.
+    void check() const;
+  };
+
+  /// Throws Error when the config is invalid.
+  explicit TsdfMap(const Config& config);
+
+  /// The config the map was built with.
+  const Config& config() const { return config_; }
+  /// Voxel edge length, metres.
+  float voxelSize() const { return config_.voxel_size_m; }
+  /// Block edge length, metres.
+  float blockSize() const { return config_.voxel_size_m * kBlockSide; }
+
+  /// Block containing a world point.
+  BlockIndex blockIndexOf(const Eigen::Vector3f& p_W) const;
+  /// The block at an index, or null when it is not allocated.
+  Block* findBlock(const BlockIndex& index);
+  /// @copydoc findBlock
+  const Block* findBlock(const BlockIndex& index) const;
+  /// The block at an index, allocated (all voxels unobserved) when missing.
+  Block* allocateBlock(const BlockIndex& index);
+  /// The voxel containing a world point, or null when its block is not allocated.
+  const Voxel* findVoxel(const Eigen::Vector3f& p_W) const;
+  /// Centre of voxel (x, y, z) of a block, world frame, metres.
+  Eigen::Vector3f voxelCentre(const BlockIndex& block, int x, int y, int z) const;
+
+  /// Number of allocated blocks.
+  size_t numBlocks() const { return blocks_.size(); }
+  /// Allocated blocks in allocation order (deterministic for a deterministic input).
+  const std::vector<std::unique_ptr<Block>>& blocks() const { return blocks_; }
+  /// Allocated blocks in allocation order, mutable.
+  std::vector<std::unique_ptr<Block>>& blocks() { return blocks_; }
+  /// Bytes used by voxel storage and the index.
+  size_t memoryBytes() const;
+
+  /// Hash key of a block index (21 bits per axis, two's complement).
+  static uint64_t key(const BlockIndex& index) {
+    return (static_cast<uint64_t>(index.x() & 0x1FFFFF) << 42) |
+           (static_cast<uint64_t>(index.y() & 0x1FFFFF) << 21) |
+           static_cast<uint64_t>(index.z() & 0x1FFFFF);
+  }
+
+ private:
+  Config config_;
+  absl::flat_hash_map<uint64_t, Block*> index_;
+  std::vector<std::unique_ptr<Block>> blocks_;
+};
+
+}  // namespace panmap

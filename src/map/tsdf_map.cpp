@@ -1,0 +1,69 @@
+#include "panmap/map/tsdf_map.h"
+
+#include <cmath>
+
+#include "panmap/core/error.h"
+
+namespace panmap {
+
+void TsdfMap::Config::check() const {
+  if (!(voxel_size_m > 0.0f && voxel_size_m < 1.0f)) {
+    throw Error("map voxel_size_m must be in (0, 1) metres");
+  }
+}
+
+TsdfMap::TsdfMap(const Config& config) : config_(config) { config_.check(); }
+
+BlockIndex TsdfMap::blockIndexOf(const Eigen::Vector3f& p_W) const {
+  const float inv = 1.0f / blockSize();
+  return BlockIndex(static_cast<int>(std::floor(p_W.x() * inv)),
+                    static_cast<int>(std::floor(p_W.y() * inv)),
+                    static_cast<int>(std::floor(p_W.z() * inv)));
+}
+
+Block* TsdfMap::findBlock(const BlockIndex& index) {
+  const auto it = index_.find(key(index));
+  return it == index_.end() ? nullptr : it->second;
+}
+
+const Block* TsdfMap::findBlock(const BlockIndex& index) const {
+  const auto it = index_.find(key(index));
+  return it == index_.end() ? nullptr : it->second;
+}
+
+Block* TsdfMap::allocateBlock(const BlockIndex& index) {
+  auto [it, inserted] = index_.try_emplace(key(index), nullptr);
+  if (inserted) {
+    blocks_.push_back(std::make_unique<Block>());
+    blocks_.back()->index = index;
+    it->second = blocks_.back().get();
+  }
+  return it->second;
+}
+
+const Voxel* TsdfMap::findVoxel(const Eigen::Vector3f& p_W) const {
+  const float inv = 1.0f / config_.voxel_size_m;
+  const int gx = static_cast<int>(std::floor(p_W.x() * inv));
+  const int gy = static_cast<int>(std::floor(p_W.y() * inv));
+  const int gz = static_cast<int>(std::floor(p_W.z() * inv));
+  // Floor division by the block side (works for negative coordinates).
+  const BlockIndex b(gx >> 3, gy >> 3, gz >> 3);
+  static_assert(kBlockSide == 8, "shift by 3 assumes 8 voxels per block side");
+  const Block* block = findBlock(b);
+  if (!block) return nullptr;
+  return &block->at(gx & 7, gy & 7, gz & 7);
+}
+
+Eigen::Vector3f TsdfMap::voxelCentre(const BlockIndex& block, int x, int y, int z) const {
+  const float v = config_.voxel_size_m;
+  return Eigen::Vector3f((block.x() * kBlockSide + x + 0.5f) * v,
+                         (block.y() * kBlockSide + y + 0.5f) * v,
+                         (block.z() * kBlockSide + z + 0.5f) * v);
+}
+
+size_t TsdfMap::memoryBytes() const {
+  return blocks_.size() * sizeof(Block) +
+         index_.capacity() * (sizeof(uint64_t) + sizeof(Block*) + 1);
+}
+
+}  // namespace panmap
