@@ -1,0 +1,33 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <vector>
+
+namespace panmap {
+
+/// Super-point labels L_S: integer ids from 1, merged through a union-find so that every id
+/// ever handed out stays resolvable to the super-point it belongs to now.
+class LabelRegistry {
+ public:
+  /// A new label (ids are consecutive from 1).
+  int32_t create();
+  /// The label a (possibly merged-away) label belongs to now; 0 stays 0.
+  int32_t resolve(int32_t label) const;
+  /// Merges two super-points; the smaller (older) root survives. Returns the survivor.
+  int32_t merge(int32_t a, int32_t b);
+  /// Number of labels ever created.
+  int32_t size() const { return static_cast<int32_t>(parent_.size()) - 1; }
+  /// True when a label is its own root (a live super-point).
+  bool isRoot(int32_t label) const { return label > 0 && label < static_cast<int32_t>(parent_.size()) && parent_[label] == label; }
+  /// Parent array (index = label; parent_[0] = 0) for saving.
+  const std::vector<int32_t>& parents() const { return parent_; }
+  /// Restores from a saved parent array (validated: every parent <= its label).
+  void restore(std::vector<int32_t> parents);
+
+ private:
+  // Mutable: resolve() compresses paths (the result never changes, only the speed).
+  mutable std::vector<int32_t> parent_ = {0};
+};
+
+}  // namespace panmap

@@ -1,0 +1,119 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "panmap/core/frame.h"
+#include "panmap/map/tsdf_map.h"
+#include "panmap/segmentation/panoptic_geometric.h"
+#include "panmap/superpoint/label_registry.h"
+
+namespace panmap {
+
+/// Parameters of super-point segmentation (paper III-B) and frame-count instance association.
+struct SuperpointConfig {
+  /// A surface joins the super-point holding at least this share of its sampled points
+  /// (Pi_s(L_S, s_i) / |s_i|); otherwise it starts a new one.
+  float association_min_overlap = 0.2f;
+  /// Super-points holding at least this share of a surface are its L_N(s_i) (Eq. 3).
+  float significant_overlap = 0.2f;
+  /// theta_merge: super-points merge once co-observed in more than this many surfaces.
+  int merge_threshold = 3;
+  /// Merge only semantically consistent super-points (same class or one is background).
+  /// false: spatial-only merging as in Voxblox++ (ablation "w/o III-B").
+  bool semantic_consistency = true;
+  /// Pixels between overlap samples (1 = every pixel).
+  int sample_stride_px = 2;
+  /// A 2D instance joins the global instance covering at least this share of its pixels.
+  float instance_min_overlap = 0.1f;
+  /// Throws Error naming the bad field.
+  void check() const;
+};
+
+/// What the tracker knows about one live super-point.
+struct SuperpointState {
+  std::map<int32_t, double> class_counts;    ///< frames that saw it as each class (0 = background)
+  std::map<int32_t, int> instance_counts;    ///< frames that assigned it to each global instance
+  /// C(L_S) from frame counting: the most frequent class (0 = background / none).
+  int32_t semanticClass() const;
+  /// Its global instance from frame counting (0 = none).
+  int32_t instance() const;
+};
+
+/// The result of associating one frame's surfaces with super-points.
+struct FrameAssociation {
+  LabelImage pixel_labels;               ///< super-point label per pixel, 0 = none
+  std::vector<int32_t> surface_labels;   ///< per surface (index = id - 1)
+  std::vector<int32_t> surface_instances;  ///< global instance per surface, 0 = none
+  int new_labels = 0;
+  int merges = 0;
+};
+
+/// A merge of two super-points, for the record (ids stay resolvable through LabelRegistry).
+struct SuperpointMerge {
+  int32_t kept = 0;
+  int32_t removed = 0;
+  int64_t frame = 0;
+};
+
+/// Semantically consistent super-point segmentation (III-B) with frame-count semantic and
+/// instance labelling (as Voxblox++ / Han et al.), the initial labelling the graph refines.
+class SuperpointTracker {
+ public:
+  /// Throws Error when the config is invalid.
+  explicit SuperpointTracker(const SuperpointConfig& config);
+
+  /// Associates the surfaces of a frame seen from T_W_C with the map's super-points, creates
+  /// new ones, counts co-observations and merges (Eq. 2-3), updates class and instance frame
+  /// counts. Call before integrating the frame with the returned pixel labels.
+  FrameAssociation associate(const FrameSegmentation& segmentation, const RgbdFrame& frame,
+                             const Eigen::Isometry3d& T_W_C, const TsdfMap& map);
+
+  /// Label registry (creation and merges).
+  const LabelRegistry& labels() const { return labels_; }
+  /// State of a live super-point (resolves merged labels); null if unknown.
+  const SuperpointState* state(int32_t label) const;
+  /// All live super-points.
+  const std::map<int32_t, SuperpointState>& states() const { return states_; }
+  /// Every merge so far, in order.
+  const std::vector<SuperpointMerge>& merges() const { return merge_log_; }
+  /// Global instances created so far.
+  int32_t numInstances() const { return next_instance_ - 1; }
+  /// Co-observation counts M(L1, L2) of live super-points (L1 < L2).
+  const std::map<std::pair<int32_t, int32_t>, int>& coObservations() const { return co_observed_; }
+  /// The config in use.
+  const SuperpointConfig& config() const { return config_; }
+
+  /// Full state for saving and restoring a map.
+  struct Snapshot {
+    std::vector<int32_t> parents;
+    std::map<int32_t, SuperpointState> states;
+    std::map<std::pair<int32_t, int32_t>, int> co_observed;
+    std::vector<SuperpointMerge> merges;
+    int32_t next_instance = 1;
+    int64_t frames = 0;
+  };
+  /// Copies the state out.
+  Snapshot snapshot() const;
+  /// Replaces the state (throws Error when inconsistent).
+  void restore(const Snapshot& snapshot);
+
+ private:
+  bool consistent(int32_t a, int32_t b) const;
+  void mergeLabels(int32_t a, int32_t b, FrameAssociation* out);
+  void associateInstances(const FrameSegmentation& segmentation, FrameAssociation* out);
+
+  SuperpointConfig config_;
+  LabelRegistry labels_;
+  std::map<int32_t, SuperpointState> states_;            // by root label
+  std::map<std::pair<int32_t, int32_t>, int> co_observed_;  // M, by root labels (a < b)
+  std::vector<SuperpointMerge> merge_log_;
+  int32_t next_instance_ = 1;
+  int64_t frames_ = 0;
+};
+
+}  // namespace panmap

@@ -1,0 +1,43 @@
+#include "panmap/superpoint/label_registry.h"
+
+#include "panmap/core/error.h"
+
+namespace panmap {
+
+int32_t LabelRegistry::create() {
+  parent_.push_back(static_cast<int32_t>(parent_.size()));
+  return parent_.back();
+}
+
+int32_t LabelRegistry::resolve(int32_t label) const {
+  if (label <= 0 || label >= static_cast<int32_t>(parent_.size())) return 0;
+  int32_t root = label;
+  while (parent_[root] != root) root = parent_[root];
+  while (parent_[label] != root) {  // path compression
+    const int32_t next = parent_[label];
+    parent_[label] = root;
+    label = next;
+  }
+  return root;
+}
+
+int32_t LabelRegistry::merge(int32_t a, int32_t b) {
+  const int32_t ra = resolve(a), rb = resolve(b);
+  if (ra == 0 || rb == 0) throw Error("cannot merge unknown super-point labels");
+  if (ra == rb) return ra;
+  const int32_t keep = std::min(ra, rb), gone = std::max(ra, rb);
+  parent_[gone] = keep;
+  return keep;
+}
+
+void LabelRegistry::restore(std::vector<int32_t> parents) {
+  if (parents.empty() || parents[0] != 0) throw Error("super-point labels: bad parent array");
+  for (size_t i = 1; i < parents.size(); ++i) {
+    if (parents[i] <= 0 || parents[i] > static_cast<int32_t>(i)) {
+      throw Error("super-point labels: parent of " + std::to_string(i) + " is invalid");
+    }
+  }
+  parent_ = std::move(parents);
+}
+
+}  // namespace panmap

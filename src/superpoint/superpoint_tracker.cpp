@@ -1,0 +1,273 @@
+#include "panmap/superpoint/superpoint_tracker.h"
+
+#include <algorithm>
+#include <tuple>
+
+#include "panmap/core/error.h"
+#include "panmap/map/voxel.h"
+
+namespace panmap {
+
+void SuperpointConfig::check() const {
+  if (!(association_min_overlap > 0.0f && association_min_overlap <= 1.0f)) {
+    throw Error("superpoint association_min_overlap must be in (0, 1]");
+  }
+  if (!(significant_overlap > 0.0f && significant_overlap <= 1.0f)) {
+    throw Error("superpoint significant_overlap must be in (0, 1]");
+  }
+  if (merge_threshold < 0) throw Error("superpoint merge_threshold must be >= 0");
+  if (sample_stride_px < 1) throw Error("superpoint sample_stride_px must be >= 1");
+  if (!(instance_min_overlap >= 0.0f && instance_min_overlap <= 1.0f)) {
+    throw Error("superpoint instance_min_overlap must be in [0, 1]");
+  }
+}
+
+int32_t SuperpointState::semanticClass() const {
+  int32_t best = 0;
+  double best_count = 0.0;
+  for (const auto& [cls, count] : class_counts) {
+    if (count > best_count) best = cls, best_count = count;  // ties: the smaller class id
+  }
+  return best;
+}
+
+int32_t SuperpointState::instance() const {
+  int32_t best = 0, best_count = 0;
+  for (const auto& [id, count] : instance_counts) {
+    if (count > best_count) best = id, best_count = count;
+  }
+  return best;
+}
+
+SuperpointTracker::SuperpointTracker(const SuperpointConfig& config) : config_(config) {
+  config_.check();
+}
+
+const SuperpointState* SuperpointTracker::state(int32_t label) const {
+  const auto it = states_.find(labels_.resolve(label));
+  return it == states_.end() ? nullptr : &it->second;
+}
+
+namespace {
+
+// The voxel at a world point, remembering the last block: neighbouring pixels mostly fall in
+// the same block, so most lookups skip the hash map.
+class VoxelLookup {
+ public:
+  explicit VoxelLookup(const TsdfMap& map) : map_(map), inv_voxel_(1.0f / map.voxelSize()) {}
+  const Voxel* find(const Eigen::Vector3f& p_W) {
+    const int gx = static_cast<int>(std::floor(p_W.x() * inv_voxel_));
+    const int gy = static_cast<int>(std::floor(p_W.y() * inv_voxel_));
+    const int gz = static_cast<int>(std::floor(p_W.z() * inv_voxel_));
+    const BlockIndex b(gx >> 3, gy >> 3, gz >> 3);
+    if (!valid_ || b != last_index_) {
+      last_ = map_.findBlock(b);
+      last_index_ = b;
+      valid_ = true;
+    }
+    return last_ ? &last_->at(gx & 7, gy & 7, gz & 7) : nullptr;
+  }
+
+ private:
+  const TsdfMap& map_;
+  float inv_voxel_;
+  const Block* last_ = nullptr;
+  BlockIndex last_index_ = BlockIndex::Zero();
+  bool valid_ = false;
+};
+
+}  // namespace
+
+bool SuperpointTracker::consistent(int32_t a, int32_t b) const {
+  if (!config_.semantic_consistency) return true;
+  const auto ia = states_.find(a), ib = states_.find(b);
+  const int32_t ca = ia == states_.end() ? 0 : ia->second.semanticClass();
+  const int32_t cb = ib == states_.end() ? 0 : ib->second.semanticClass();
+  // Paper III-B: the same class, or at least one is background C_0.
+  return ca == cb || ca == 0 || cb == 0;
+}
+
+void SuperpointTracker::mergeLabels(int32_t a, int32_t b, FrameAssociation* out) {
+  const int32_t ra = labels_.resolve(a), rb = labels_.resolve(b);
+  if (ra == rb) return;
+  const int32_t keep = labels_.merge(ra, rb);
+  const int32_t gone = keep == ra ? rb : ra;
+  SuperpointState& kept = states_[keep];
+  const auto it = states_.find(gone);
+  if (it != states_.end()) {
+    for (const auto& [cls, count] : it->second.class_counts) kept.class_counts[cls] += count;
+    for (const auto& [id, count] : it->second.instance_counts) kept.instance_counts[id] += count;
+    states_.erase(it);
+  }
+  // Co-observations of the removed super-point now belong to the survivor.
+  std::map<std::pair<int32_t, int32_t>, int> moved;
+  for (auto m = co_observed_.begin(); m != co_observed_.end();) {
+    if (m->first.first == gone || m->first.second == gone) {
+      const int32_t other = m->first.first == gone ? m->first.second : m->first.first;
+      if (other != keep) moved[std::minmax(keep, other)] += m->second;
+      m = co_observed_.erase(m);
+    } else {
+      ++m;
+    }
+  }
+  co_observed_.erase(std::minmax(keep, gone));
+  for (const auto& [key, count] : moved) co_observed_[key] += count;
+  merge_log_.push_back({keep, gone, frames_});
+  ++out->merges;
+}
+
+FrameAssociation SuperpointTracker::associate(const FrameSegmentation& segmentation,
+                                              const RgbdFrame& frame,
+                                              const Eigen::Isometry3d& T_W_C, const TsdfMap& map) {
+  ++frames_;
+  const auto& surfaces = segmentation.surface_list;
+  const size_t n = surfaces.size();
+  const int w = frame.camera.width, h = frame.camera.height;
+  if (segmentation.surfaces.width() != w || segmentation.surfaces.height() != h) {
+    throw Error("superpoints: segmentation size differs from the frame's");
+  }
+  FrameAssociation out;
+  out.surface_labels.assign(n, 0);
+  out.surface_instances.assign(n, 0);
+
+  // Pi_s(L_S, s_i): votes of the voxels the surface's points fall in (Eq. 2 per voxel).
+  std::vector<int> samples(n, 0);
+  std::vector<std::map<int32_t, int>> overlap(n);
+  const Eigen::Isometry3f T = T_W_C.cast<float>();
+  const float scale = static_cast<float>(frame.depth_scale_m);
+  const float fx = static_cast<float>(frame.camera.fx), fy = static_cast<float>(frame.camera.fy);
+  const float cx = static_cast<float>(frame.camera.cx), cy = static_cast<float>(frame.camera.cy);
+  VoxelLookup lookup(map);
+  auto resolve = [this](int32_t l) { return labels_.resolve(l); };
+  const int stride = config_.sample_stride_px;
+  for (int v = 0; v < h; v += stride) {
+    for (int u = 0; u < w; u += stride) {
+      const int32_t sid = segmentation.surfaces(u, v);
+      if (sid <= 0 || static_cast<size_t>(sid) > n) continue;
+      const float d = frame.depth(u, v) * scale;
+      if (d <= 0.0f) continue;
+      ++samples[sid - 1];
+      const Voxel* voxel = lookup.find(T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d));
+      if (!voxel) continue;
+      const int32_t label = argmaxLabel(*voxel, resolve);
+      if (label > 0) ++overlap[sid - 1][label];
+    }
+  }
+
+  // Association: best pairs first, one surface per super-point per frame (as Voxblox++).
+  std::vector<std::tuple<int, size_t, int32_t>> pairs;  // (-count, surface, label)
+  for (size_t s = 0; s < n; ++s) {
+    for (const auto& [label, count] : overlap[s]) pairs.emplace_back(-count, s, label);
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::map<int32_t, bool> taken;
+  for (const auto& [neg_count, s, label] : pairs) {
+    if (out.surface_labels[s] != 0 || taken[label]) continue;
+    if (-neg_count < config_.association_min_overlap * samples[s]) continue;
+    out.surface_labels[s] = label;
+    taken[label] = true;
+  }
+  for (size_t s = 0; s < n; ++s) {
+    if (out.surface_labels[s] == 0) {
+      out.surface_labels[s] = labels_.create();
+      states_[out.surface_labels[s]];
+      ++out.new_labels;
+    }
+    // Semantic frame count (background surfaces count for class 0).
+    states_[out.surface_labels[s]].class_counts[surfaces[s].category] += 1.0;
+  }
+
+  // Co-observation M (Eq. 3) of the super-points significantly overlapping each surface, and
+  // merging of spatially connected, semantically consistent ones.
+  for (size_t s = 0; s < n; ++s) {
+    std::vector<int32_t> significant;
+    for (const auto& [label, count] : overlap[s]) {
+      if (count >= config_.significant_overlap * samples[s]) significant.push_back(label);
+    }
+    for (size_t i = 0; i < significant.size(); ++i) {
+      for (size_t j = i + 1; j < significant.size(); ++j) {
+        const int32_t a = labels_.resolve(significant[i]), b = labels_.resolve(significant[j]);
+        if (a == b) continue;
+        int& m = co_observed_[std::minmax(a, b)];
+        ++m;
+        if (m > config_.merge_threshold && consistent(a, b)) mergeLabels(a, b, &out);
+      }
+    }
+  }
+  for (int32_t& label : out.surface_labels) label = labels_.resolve(label);
+
+  associateInstances(segmentation, &out);
+
+  out.pixel_labels = LabelImage(w, h, 0);
+  for (size_t i = 0; i < out.pixel_labels.size(); ++i) {
+    const int32_t sid = segmentation.surfaces.data()[i];
+    if (sid > 0 && static_cast<size_t>(sid) <= n) out.pixel_labels.data()[i] = out.surface_labels[sid - 1];
+  }
+  return out;
+}
+
+void SuperpointTracker::associateInstances(const FrameSegmentation& segmentation,
+                                           FrameAssociation* out) {
+  const auto& surfaces = segmentation.surface_list;
+  // Thing surfaces grouped by their 2D instance o.
+  std::map<int32_t, std::vector<size_t>> by_mask;
+  for (size_t s = 0; s < surfaces.size(); ++s) {
+    if (surfaces[s].is_thing && surfaces[s].panoptic_segment > 0 && surfaces[s].category > 0) {
+      by_mask[surfaces[s].panoptic_segment].push_back(s);
+    }
+  }
+  // Overlap of each 2D instance with the global instances of its super-points.
+  std::vector<std::tuple<int, int32_t, int32_t>> pairs;  // (-pixels, mask, instance)
+  std::map<int32_t, int> mask_pixels;
+  for (const auto& [mask, members] : by_mask) {
+    std::map<int32_t, int> overlap;
+    for (size_t s : members) {
+      mask_pixels[mask] += surfaces[s].num_pixels;
+      const auto it = states_.find(out->surface_labels[s]);
+      const int32_t instance = it == states_.end() ? 0 : it->second.instance();
+      if (instance > 0) overlap[instance] += surfaces[s].num_pixels;
+    }
+    for (const auto& [instance, pixels] : overlap) pairs.emplace_back(-pixels, mask, instance);
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::map<int32_t, int32_t> assigned;  // mask -> global instance
+  std::map<int32_t, bool> used;
+  for (const auto& [neg_pixels, mask, instance] : pairs) {
+    if (assigned.count(mask) || used[instance]) continue;
+    if (-neg_pixels < config_.instance_min_overlap * mask_pixels[mask]) continue;
+    assigned[mask] = instance;
+    used[instance] = true;
+  }
+  for (const auto& [mask, members] : by_mask) {
+    if (!assigned.count(mask)) assigned[mask] = next_instance_++;
+    for (size_t s : members) {
+      states_[out->surface_labels[s]].instance_counts[assigned[mask]] += 1;
+      out->surface_instances[s] = assigned[mask];
+    }
+  }
+}
+
+SuperpointTracker::Snapshot SuperpointTracker::snapshot() const {
+  Snapshot s;
+  s.parents = labels_.parents();
+  s.states = states_;
+  s.co_observed = co_observed_;
+  s.merges = merge_log_;
+  s.next_instance = next_instance_;
+  s.frames = frames_;
+  return s;
+}
+
+void SuperpointTracker::restore(const Snapshot& snapshot) {
+  labels_.restore(snapshot.parents);
+  for (const auto& [label, state] : snapshot.states) {
+    if (!labels_.isRoot(label)) throw Error("super-point state for a non-root label");
+  }
+  states_ = snapshot.states;
+  co_observed_ = snapshot.co_observed;
+  merge_log_ = snapshot.merges;
+  next_instance_ = snapshot.next_instance;
+  frames_ = snapshot.frames;
+}
+
+}  // namespace panmap
