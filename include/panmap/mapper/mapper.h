@@ -1,0 +1,89 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "panmap/core/frame.h"
+#include "panmap/core/thread_pool.h"
+#include "panmap/map/projective_integrator.h"
+#include "panmap/map/tsdf_map.h"
+#include "panmap/segmentation/panoptic_geometric.h"
+#include "panmap/superpoint/superpoint_tracker.h"
+
+namespace panmap {
+
+/// Every parameter of the per-frame pipeline, grouped by component.
+struct MapperConfig {
+  TsdfMap::Config map;
+  IntegratorConfig integrator;
+  DepthSegmentationConfig depth_segmentation;
+  SurfaceFusionConfig fusion;
+  SuperpointConfig superpoints;
+  int num_threads = 2;  ///< threads for integration (segmentation and association use one)
+  /// Throws Error naming the bad field.
+  void check() const;
+};
+
+/// Timings and counts of one integrated frame.
+struct FrameStats {
+  double segmentation_ms = 0.0;  ///< III-A
+  double superpoints_ms = 0.0;   ///< III-B association, merging, frame counting
+  double integration_ms = 0.0;   ///< label-TSDF update
+  double total_ms = 0.0;
+  int surfaces = 0;
+  int new_superpoints = 0;
+  int merges = 0;
+  IntegrationStats integration;
+};
+
+/// The mapping core: takes (RGB-D frame, T_W_C, panoptic segmentation) and keeps a label-TSDF
+/// whose voxels belong to semantically consistent super-points. No middleware inside.
+class Mapper {
+ public:
+  /// Throws Error when the config is invalid.
+  explicit Mapper(const MapperConfig& config);
+
+  /// Integrates one frame. Validates everything first (finite rigid pose, image sizes against
+  /// the intrinsics, panoptic size and ids) and throws Error with a one-line reason on bad
+  /// input, leaving the map untouched.
+  /// @param T_W_C camera-to-world pose of the frame (optical frame)
+  /// @param panoptic the frame's 2D panoptic segmentation, or null (geometry only)
+  FrameStats integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
+                       const PanopticFrame* panoptic);
+
+  /// The label-TSDF.
+  const TsdfMap& map() const { return *map_; }
+  /// Super-points and their frame-count labels.
+  const SuperpointTracker& superpoints() const { return *tracker_; }
+  /// The configuration in use.
+  const MapperConfig& config() const { return config_; }
+  /// Frames integrated so far.
+  int64_t framesIntegrated() const { return frames_; }
+  /// Votes evicted from full voxel slots so far (never silent).
+  uint64_t voteEvictions() const { return vote_evictions_; }
+
+  /// Writes the whole state (config, TSDF, votes, super-points) as a versioned binary file
+  /// with a CRC-32; throws Error naming the file on failure.
+  void save(const std::string& path) const;
+  /// Reads a file written by save(); mapping continues exactly as if never interrupted.
+  /// Throws Error naming the file when it is missing, of another version, or corrupt.
+  static std::unique_ptr<Mapper> load(const std::string& path);
+
+ private:
+  void validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
+                const PanopticFrame* panoptic) const;
+
+  MapperConfig config_;
+  std::unique_ptr<ThreadPool> pool_;
+  std::unique_ptr<TsdfMap> map_;
+  std::unique_ptr<PanopticGeometricSegmenter> segmenter_;
+  std::unique_ptr<SuperpointTracker> tracker_;
+  std::unique_ptr<ProjectiveIntegrator> integrator_;
+  int64_t frames_ = 0;
+  uint64_t vote_evictions_ = 0;
+};
+
+}  // namespace panmap

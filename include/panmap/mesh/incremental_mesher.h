@@ -1,0 +1,59 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <absl/container/flat_hash_map.h>
+
+#include "panmap/core/labelled_mesh.h"
+#include "panmap/core/thread_pool.h"
+#include "panmap/map/tsdf_map.h"
+#include "panmap/mesh/marching_cubes.h"
+
+namespace panmap {
+
+/// Keeps one BlockMesh per block and re-meshes only what changed. A block's cubes read its
+/// voxels and those of its 7 upper neighbours, so a changed block invalidates itself and its
+/// 7 lower neighbours. Labels are not stored: assemble() reads them from the map through a
+/// MeshLabeller, so super-point merges and optimised labels need no re-meshing. The
+/// assembled mesh is identical to marchingCubes() of the same map.
+class IncrementalMesher {
+ public:
+  /// @param pool threads to mesh blocks with (not owned), or null for the calling thread
+  explicit IncrementalMesher(const MarchingCubesConfig& config = {}, ThreadPool* pool = nullptr);
+
+  /// Re-meshes every block whose `updated` flag is set, their lower neighbours, and blocks
+  /// (with their lower neighbours) this mesher has not seen yet; then clears the flags.
+  /// Deterministic whatever the thread count. Returns the number of blocks re-meshed.
+  size_t update(TsdfMap* map);
+
+  /// Re-meshes every allocated block, whatever its flag (flags are left as they are).
+  void rebuild(const TsdfMap& map);
+
+  /// The whole mesh: block meshes in blockIndexLess order, border vertices welded, labels
+  /// read from `map`'s current voxels through `labeller`.
+  LabelledMesh assemble(const TsdfMap& map, const MeshLabeller& labeller = {}) const;
+
+  /// Blocks re-meshed by the last update() or rebuild().
+  size_t lastRemeshedBlocks() const { return last_remeshed_; }
+  /// Blocks re-meshed since construction or clear().
+  uint64_t totalRemeshedBlocks() const { return total_remeshed_; }
+  /// Blocks with a stored mesh (possibly empty).
+  size_t numBlockMeshes() const { return meshes_.size(); }
+  /// Forgets every block mesh: the next update() meshes the whole map.
+  void clear();
+  /// The config in use.
+  const MarchingCubesConfig& config() const { return config_; }
+
+ private:
+  void remesh(const TsdfMap& map, std::vector<const Block*>* blocks);
+
+  MarchingCubesConfig config_;
+  ThreadPool* pool_;
+  absl::flat_hash_map<uint64_t, BlockMesh> meshes_;  // by TsdfMap::key of the block
+  size_t last_remeshed_ = 0;
+  uint64_t total_remeshed_ = 0;
+};
+
+}  // namespace panmap

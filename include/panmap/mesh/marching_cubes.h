@@ -1,0 +1,97 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "panmap/core/image.h"
+#include "panmap/core/labelled_mesh.h"
+#include "panmap/map/tsdf_map.h"
+
+namespace panmap {
+
+/// Parameters of marching cubes over a TsdfMap. A cube joins 8 neighbouring voxel centres.
+struct MarchingCubesConfig {
+  /// A voxel counts as observed when its weight is above this. A cube is meshed only when all
+  /// 8 corners are observed, so no face is invented across unobserved space (e.g. the
+  /// truncation border of a band, or the gap between two scans).
+  float min_weight = 0.0f;
+  /// A sign change along a cube edge is taken as a surface only when the two samples differ
+  /// by less than this many voxels; otherwise the cube is skipped. A true distance field
+  /// changes by at most one voxel per voxel step, a projective one by 1 / cos(incidence), and
+  /// a sample clamped at the truncation only bounds the distance. Set it to the integrator's
+  /// truncation (default 4 voxels): then a clamped sample never pairs with one of the other
+  /// sign (the false "skirts" at depth discontinuities when free space is carved), while
+  /// surfaces seen up to 75 degrees from their normal are still meshed.
+  float max_sdf_jump_voxels = 4.0f;
+  /// Throws Error naming the bad field.
+  void check() const;
+};
+
+/// Per-vertex labels computed when a mesh is assembled, never stored with the geometry: they
+/// change (super-points merge, the optimiser relabels) without the surface changing.
+struct MeshLabeller {
+  /// Super-point label of a voxel (e.g. argmaxLabel with the current merges). Empty: the mesh
+  /// gets no label arrays. A vertex takes the label of the nearer voxel of its edge.
+  std::function<int32_t(const Voxel&)> superpoint;
+  /// NYU40 class of a super-point label; empty: 0 (unlabelled).
+  std::function<int32_t(int32_t)> semantic;
+  /// Instance of a super-point label; empty: 0 (none).
+  std::function<int32_t(int32_t)> instance;
+};
+
+/// The mesh of the cubes whose lower corner lies in one block. Its vertices sit on the block's
+/// edges of the voxel grid, including edges whose lower voxel is in an upper neighbour block
+/// (x, y or z local coordinate 8); assembly welds those with the neighbour's own vertices.
+struct BlockMesh {
+  BlockIndex index = BlockIndex::Zero();  ///< the block the cubes start in
+  std::vector<Eigen::Vector3f> vertices;  ///< world frame, metres
+  std::vector<Rgb8> colors;               ///< interpolated along the edge
+  /// Grid edge of each vertex: axis + 3 * (x + 9 * (y + 9 * z)), (x, y, z) in [0, 8] the edge's
+  /// lower voxel relative to the block.
+  std::vector<uint16_t> edges;
+  /// Nearer voxel of each vertex's edge: (neighbour slot dx + 2 dy + 4 dz) << 9 | voxel index
+  /// within that block. Labels are looked up through it at assembly time.
+  std::vector<uint16_t> sources;
+  std::vector<Eigen::Vector3i> faces;  ///< indices into `vertices`, outward (toward sdf > 0)
+
+  /// Removes everything but the index.
+  void clear();
+};
+
+/// Local edge id of a grid edge (see BlockMesh::edges).
+inline uint16_t blockEdgeId(int x, int y, int z, int axis) {
+  return static_cast<uint16_t>(axis + 3 * (x + 9 * (y + 9 * z)));
+}
+
+/// Marching cubes over the cubes whose lower corner lies in `block` (cubes on its upper
+/// faces read the up to 7 upper neighbour blocks; missing neighbours count as unobserved).
+/// Vertices are welded within the block; faces wind counter-clockwise seen from sdf > 0.
+/// @param mesh receives the result (cleared first)
+void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig& config,
+               BlockMesh* mesh);
+
+/// Concatenates block meshes into one mesh, welding the vertices they share on block
+/// borders (one vertex per edge of the voxel grid), and labels every vertex through
+/// `labeller` from the map's current voxels. Blocks are taken in the given order (sort them
+/// with blockIndexLess for a deterministic mesh). Blocks missing from `map` give label 0.
+LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const BlockMesh*>& blocks,
+                                 const MeshLabeller& labeller = {});
+
+/// Orders block indices by x, then y, then z: the order of every assembled mesh.
+inline bool blockIndexLess(const BlockIndex& a, const BlockIndex& b) {
+  if (a.x() != b.x()) return a.x() < b.x();
+  if (a.y() != b.y()) return a.y() < b.y();
+  return a.z() < b.z();
+}
+
+/// Marching cubes over every allocated block of `map`, from scratch: a watertight mesh for a
+/// closed, fully observed surface, with per-vertex colour and (through `labeller`) labels.
+/// Does not touch the blocks' `updated` flags (IncrementalMesher does).
+LabelledMesh marchingCubes(const TsdfMap& map, const MarchingCubesConfig& config = {},
+                           const MeshLabeller& labeller = {});
+
+}  // namespace panmap

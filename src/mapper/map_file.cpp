@@ -1,0 +1,214 @@
+// Map snapshots: "PANMAP\0\0", format version, payload size, payload, CRC-32 of the payload.
+// The payload holds the config field by field, the counters, every block's voxels and the
+// super-point state, so that load-then-continue equals an uninterrupted run.
+#include <zlib.h>
+
+#include <cstdio>
+
+#include "panmap/core/binary_io.h"
+#include "panmap/io/image_codec.h"
+#include "panmap/mapper/mapper.h"
+
+namespace panmap {
+namespace {
+
+constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
+constexpr uint32_t kVersion = 1;
+
+void putConfig(BinaryWriter* w, const MapperConfig& c) {
+  w->put(c.map.voxel_size_m);
+  w->put(c.integrator.truncation_voxels);
+  w->put(c.integrator.max_weight);
+  w->put(c.integrator.min_depth_m);
+  w->put(c.integrator.max_depth_m);
+  w->put<uint8_t>(c.integrator.weight_dropoff);
+  w->put<uint8_t>(c.integrator.space_carving);
+  w->put(c.integrator.vote_band_voxels);
+  w->put<int32_t>(c.depth_segmentation.normals_window_px);
+  w->put<int32_t>(c.depth_segmentation.min_convexity_window_px);
+  w->put(c.depth_segmentation.min_convexity_threshold);
+  w->put(c.depth_segmentation.depth_discontinuity_ratio);
+  w->put<int32_t>(c.depth_segmentation.min_segment_px);
+  w->put(c.depth_segmentation.max_depth_m);
+  w->put<int32_t>(c.fusion.min_surface_px);
+  w->put(c.fusion.stuff_confidence);
+  w->put<uint8_t>(c.fusion.geometry_only);
+  w->put(c.superpoints.association_min_overlap);
+  w->put(c.superpoints.significant_overlap);
+  w->put<int32_t>(c.superpoints.merge_threshold);
+  w->put<uint8_t>(c.superpoints.semantic_consistency);
+  w->put<int32_t>(c.superpoints.sample_stride_px);
+  w->put(c.superpoints.instance_min_overlap);
+  w->put<int32_t>(c.num_threads);
+}
+
+MapperConfig getConfig(BinaryReader* r) {
+  MapperConfig c;
+  c.map.voxel_size_m = r->get<float>();
+  c.integrator.truncation_voxels = r->get<float>();
+  c.integrator.max_weight = r->get<float>();
+  c.integrator.min_depth_m = r->get<float>();
+  c.integrator.max_depth_m = r->get<float>();
+  c.integrator.weight_dropoff = r->get<uint8_t>() != 0;
+  c.integrator.space_carving = r->get<uint8_t>() != 0;
+  c.integrator.vote_band_voxels = r->get<float>();
+  c.depth_segmentation.normals_window_px = r->get<int32_t>();
+  c.depth_segmentation.min_convexity_window_px = r->get<int32_t>();
+  c.depth_segmentation.min_convexity_threshold = r->get<float>();
+  c.depth_segmentation.depth_discontinuity_ratio = r->get<float>();
+  c.depth_segmentation.min_segment_px = r->get<int32_t>();
+  c.depth_segmentation.max_depth_m = r->get<float>();
+  c.fusion.min_surface_px = r->get<int32_t>();
+  c.fusion.stuff_confidence = r->get<float>();
+  c.fusion.geometry_only = r->get<uint8_t>() != 0;
+  c.superpoints.association_min_overlap = r->get<float>();
+  c.superpoints.significant_overlap = r->get<float>();
+  c.superpoints.merge_threshold = r->get<int32_t>();
+  c.superpoints.semantic_consistency = r->get<uint8_t>() != 0;
+  c.superpoints.sample_stride_px = r->get<int32_t>();
+  c.superpoints.instance_min_overlap = r->get<float>();
+  c.num_threads = r->get<int32_t>();
+  return c;
+}
+
+void putSnapshot(BinaryWriter* w, const SuperpointTracker::Snapshot& s) {
+  w->put<uint64_t>(s.parents.size());
+  w->putBytes(s.parents.data(), s.parents.size() * sizeof(int32_t));
+  w->put<uint64_t>(s.states.size());
+  for (const auto& [label, state] : s.states) {
+    w->put<int32_t>(label);
+    w->put<uint64_t>(state.class_counts.size());
+    for (const auto& [cls, count] : state.class_counts) {
+      w->put<int32_t>(cls);
+      w->put<double>(count);
+    }
+    w->put<uint64_t>(state.instance_counts.size());
+    for (const auto& [id, count] : state.instance_counts) {
+      w->put<int32_t>(id);
+      w->put<int32_t>(count);
+    }
+  }
+  w->put<uint64_t>(s.co_observed.size());
+  for (const auto& [key, count] : s.co_observed) {
+    w->put<int32_t>(key.first);
+    w->put<int32_t>(key.second);
+    w->put<int32_t>(count);
+  }
+  w->put<uint64_t>(s.merges.size());
+  for (const SuperpointMerge& m : s.merges) {
+    w->put<int32_t>(m.kept);
+    w->put<int32_t>(m.removed);
+    w->put<int64_t>(m.frame);
+  }
+  w->put<int32_t>(s.next_instance);
+  w->put<int64_t>(s.frames);
+}
+
+SuperpointTracker::Snapshot getSnapshot(BinaryReader* r) {
+  SuperpointTracker::Snapshot s;
+  s.parents.resize(r->getCount(sizeof(int32_t)));
+  r->getBytes(s.parents.data(), s.parents.size() * sizeof(int32_t));
+  const uint64_t states = r->getCount(20);
+  for (uint64_t i = 0; i < states; ++i) {
+    SuperpointState& state = s.states[r->get<int32_t>()];
+    const uint64_t classes = r->getCount(12);
+    for (uint64_t k = 0; k < classes; ++k) {
+      const int32_t cls = r->get<int32_t>();
+      state.class_counts[cls] = r->get<double>();
+    }
+    const uint64_t instances = r->getCount(8);
+    for (uint64_t k = 0; k < instances; ++k) {
+      const int32_t id = r->get<int32_t>();
+      state.instance_counts[id] = r->get<int32_t>();
+    }
+  }
+  const uint64_t pairs = r->getCount(12);
+  for (uint64_t i = 0; i < pairs; ++i) {
+    const int32_t a = r->get<int32_t>(), b = r->get<int32_t>();
+    s.co_observed[{a, b}] = r->get<int32_t>();
+  }
+  const uint64_t merges = r->getCount(16);
+  for (uint64_t i = 0; i < merges; ++i) {
+    SuperpointMerge m;
+    m.kept = r->get<int32_t>();
+    m.removed = r->get<int32_t>();
+    m.frame = r->get<int64_t>();
+    s.merges.push_back(m);
+  }
+  s.next_instance = r->get<int32_t>();
+  s.frames = r->get<int64_t>();
+  return s;
+}
+
+}  // namespace
+
+void Mapper::save(const std::string& path) const {
+  BinaryWriter payload;
+  putConfig(&payload, config_);
+  payload.put<int64_t>(frames_);
+  payload.put<uint64_t>(vote_evictions_);
+  payload.put<uint64_t>(map_->numBlocks());
+  for (const auto& block : map_->blocks()) {
+    payload.put<int32_t>(block->index.x());
+    payload.put<int32_t>(block->index.y());
+    payload.put<int32_t>(block->index.z());
+    payload.put<uint8_t>(block->updated);
+    payload.putBytes(block->voxels, sizeof(block->voxels));
+  }
+  putSnapshot(&payload, tracker_->snapshot());
+
+  BinaryWriter file;
+  file.putBytes(kMagic, sizeof(kMagic));
+  file.put<uint32_t>(kVersion);
+  file.put<uint64_t>(payload.bytes().size());
+  file.putBytes(payload.bytes().data(), payload.bytes().size());
+  file.put<uint32_t>(static_cast<uint32_t>(
+      crc32(0L, payload.bytes().data(), static_cast<uInt>(payload.bytes().size()))));
+  // Write beside and rename, so a crash never leaves a half-written snapshot in place.
+  const std::string partial = path + ".partial";
+  writeFileBytes(partial, file.bytes());
+  if (std::rename(partial.c_str(), path.c_str()) != 0) {
+    std::remove(partial.c_str());
+    throw Error("cannot write map file " + path);
+  }
+}
+
+std::unique_ptr<Mapper> Mapper::load(const std::string& path) {
+  const std::vector<uint8_t> bytes = readFileBytes(path);
+  BinaryReader header(bytes.data(), bytes.size(), path);
+  char magic[8];
+  header.getBytes(magic, sizeof(magic));
+  if (std::memcmp(magic, kMagic, sizeof(kMagic)) != 0) throw Error(path + ": not a panmap map file");
+  const uint32_t version = header.get<uint32_t>();
+  if (version != kVersion) {
+    throw Error(path + ": map file version " + std::to_string(version) + ", this panmap reads " +
+                std::to_string(kVersion));
+  }
+  const uint64_t size = header.get<uint64_t>();
+  if (size + sizeof(uint32_t) != header.remaining()) throw Error(path + ": truncated map file");
+  const uint8_t* payload = bytes.data() + (bytes.size() - header.remaining());
+  uint32_t stored_crc;
+  std::memcpy(&stored_crc, payload + size, sizeof(stored_crc));
+  if (stored_crc != static_cast<uint32_t>(crc32(0L, payload, static_cast<uInt>(size)))) {
+    throw Error(path + ": checksum mismatch (corrupt map file)");
+  }
+  BinaryReader r(payload, size, path);
+  auto mapper = std::make_unique<Mapper>(getConfig(&r));
+  mapper->frames_ = r.get<int64_t>();
+  mapper->vote_evictions_ = r.get<uint64_t>();
+  const uint64_t blocks = r.getCount(13 + sizeof(Block::voxels));
+  for (uint64_t i = 0; i < blocks; ++i) {
+    BlockIndex index;
+    index.x() = r.get<int32_t>();
+    index.y() = r.get<int32_t>();
+    index.z() = r.get<int32_t>();
+    Block* block = mapper->map_->allocateBlock(index);
+    block->updated = r.get<uint8_t>() != 0;
+    r.getBytes(block->voxels, sizeof(block->voxels));
+  }
+  mapper->tracker_->restore(getSnapshot(&r));
+  if (r.remaining() != 0) throw Error(path + ": unexpected bytes after the map state");
+  return mapper;
+}
+
+}  // namespace panmap

@@ -1,0 +1,75 @@
+#include "panmap/mesh/incremental_mesher.h"
+
+#include <algorithm>
+#include <utility>
+
+namespace panmap {
+
+IncrementalMesher::IncrementalMesher(const MarchingCubesConfig& config, ThreadPool* pool)
+    : config_(config), pool_(pool) {
+  config_.check();
+}
+
+size_t IncrementalMesher::update(TsdfMap* map) {
+  std::vector<const Block*> dirty;
+  for (const auto& block : map->blocks()) {
+    if (!block->updated && meshes_.contains(TsdfMap::key(block->index))) continue;
+    // This block's voxels are read by the cubes of itself and of its 7 lower neighbours.
+    for (int slot = 0; slot < 8; ++slot) {
+      const BlockIndex lower = block->index - BlockIndex(slot & 1, (slot >> 1) & 1, slot >> 2);
+      if (const Block* b = slot == 0 ? block.get() : map->findBlock(lower)) dirty.push_back(b);
+    }
+    block->updated = false;
+  }
+  remesh(*map, &dirty);
+  return last_remeshed_;
+}
+
+void IncrementalMesher::rebuild(const TsdfMap& map) {
+  std::vector<const Block*> all;
+  all.reserve(map.numBlocks());
+  for (const auto& block : map.blocks()) all.push_back(block.get());
+  remesh(map, &all);
+}
+
+void IncrementalMesher::clear() {
+  meshes_.clear();
+  last_remeshed_ = 0;
+  total_remeshed_ = 0;
+}
+
+void IncrementalMesher::remesh(const TsdfMap& map, std::vector<const Block*>* blocks) {
+  // Blocks never move, so their addresses identify them.
+  std::sort(blocks->begin(), blocks->end());
+  blocks->erase(std::unique(blocks->begin(), blocks->end()), blocks->end());
+  // Insert every entry first: no rehash may move a BlockMesh while threads fill them.
+  meshes_.reserve(meshes_.size() + blocks->size());
+  for (const Block* block : *blocks) meshes_.try_emplace(TsdfMap::key(block->index));
+  std::vector<BlockMesh*> targets;
+  targets.reserve(blocks->size());
+  for (const Block* block : *blocks) targets.push_back(&meshes_.at(TsdfMap::key(block->index)));
+  auto work = [&](size_t begin, size_t end, int) {
+    for (size_t i = begin; i < end; ++i) meshBlock(map, *(*blocks)[i], config_, targets[i]);
+  };
+  if (pool_ && blocks->size() > 1) {
+    pool_->parallelFor(blocks->size(), work);
+  } else {
+    work(0, blocks->size(), 0);
+  }
+  last_remeshed_ = blocks->size();
+  total_remeshed_ += blocks->size();
+}
+
+LabelledMesh IncrementalMesher::assemble(const TsdfMap& map, const MeshLabeller& labeller) const {
+  std::vector<const BlockMesh*> sorted;
+  sorted.reserve(meshes_.size());
+  for (const auto& [key, mesh] : meshes_) {
+    if (!mesh.vertices.empty()) sorted.push_back(&mesh);
+  }
+  std::sort(sorted.begin(), sorted.end(), [](const BlockMesh* a, const BlockMesh* b) {
+    return blockIndexLess(a->index, b->index);
+  });
+  return assembleBlockMeshes(map, sorted, labeller);
+}
+
+}  // namespace panmap

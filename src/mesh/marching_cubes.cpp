@@ -1,0 +1,348 @@
+#include "panmap/mesh/marching_cubes.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <utility>
+
+#include <absl/container/flat_hash_map.h>
+
+#include "panmap/core/error.h"
+#include "panmap/mesh/internal/marching_cubes_tables.h"
+
+namespace panmap {
+
+using internal::kMcCornerOffset;
+using internal::kMcEdgeCorners;
+using internal::kMcTriangles;
+
+void MarchingCubesConfig::check() const {
+  if (!(min_weight >= 0.0f) || !std::isfinite(min_weight)) {
+    throw Error("marching cubes min_weight must be finite and >= 0");
+  }
+  if (!(max_sdf_jump_voxels > 0.0f)) {
+    throw Error("marching cubes max_sdf_jump_voxels must be > 0");
+  }
+}
+
+void BlockMesh::clear() {
+  vertices.clear();
+  colors.clear();
+  edges.clear();
+  sources.clear();
+  faces.clear();
+}
+
+namespace {
+
+// A block's cubes read a 9^3 grid of voxels: the block plus one layer of its upper neighbours.
+constexpr int kGrid = kBlockSide + 1;
+constexpr int kGridVoxels = kGrid * kGrid * kGrid;
+constexpr int kEdgeIds = 3 * kGridVoxels;
+static_assert(kEdgeIds <= 65536, "edge ids must fit uint16_t");
+static_assert(kBlockSide == 8, "neighbour slots and sources assume 8 voxels per block side");
+
+constexpr int gridIndex(int x, int y, int z) { return x + kGrid * (y + kGrid * z); }
+
+// Per cube edge: offset of its lower corner and its axis, derived from the corner table.
+struct CubeEdge {
+  int lower[3];
+  int axis;
+  int lower_corner, upper_corner;
+};
+
+std::array<CubeEdge, 12> makeCubeEdges() {
+  std::array<CubeEdge, 12> edges{};
+  for (int e = 0; e < 12; ++e) {
+    int a = kMcEdgeCorners[e][0], b = kMcEdgeCorners[e][1];
+    int axis = 0;
+    while (kMcCornerOffset[a][axis] == kMcCornerOffset[b][axis]) ++axis;
+    if (kMcCornerOffset[a][axis] > kMcCornerOffset[b][axis]) std::swap(a, b);
+    edges[e] =
+        CubeEdge{{kMcCornerOffset[a][0], kMcCornerOffset[a][1], kMcCornerOffset[a][2]}, axis, a, b};
+  }
+  return edges;
+}
+
+const std::array<CubeEdge, 12>& cubeEdges() {
+  static const std::array<CubeEdge, 12> edges = makeCubeEdges();
+  return edges;
+}
+
+// Crossed edges of each case: those whose corners lie on different sides.
+const std::array<uint16_t, 256>& edgeMasks() {
+  static const std::array<uint16_t, 256> masks = [] {
+    std::array<uint16_t, 256> m{};
+    for (int c = 0; c < 256; ++c) {
+      for (int e = 0; e < 12; ++e) {
+        if (((c >> kMcEdgeCorners[e][0]) ^ (c >> kMcEdgeCorners[e][1])) & 1) m[c] |= 1 << e;
+      }
+    }
+    return m;
+  }();
+  return masks;
+}
+
+BlockIndex slotOffset(int slot) { return BlockIndex(slot & 1, (slot >> 1) & 1, (slot >> 2) & 1); }
+
+}  // namespace
+
+void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig& config,
+               BlockMesh* mesh) {
+  mesh->clear();
+  mesh->index = block.index;
+
+  // One hash look-up per neighbour block, none per voxel.
+  const Block* neighbours[8];
+  neighbours[0] = &block;
+  for (int slot = 1; slot < 8; ++slot) {
+    neighbours[slot] = map.findBlock(block.index + slotOffset(slot));
+  }
+
+  float sdf[kGridVoxels];
+  bool observed[kGridVoxels];
+  bool any_inside = false, any_outside = false;
+  for (int z = 0; z < kGrid; ++z) {
+    for (int y = 0; y < kGrid; ++y) {
+      for (int x = 0; x < kGrid; ++x) {
+        const int g = gridIndex(x, y, z);
+        const Block* b = neighbours[(x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2)];
+        if (!b) {
+          sdf[g] = 0.0f;
+          observed[g] = false;
+          continue;
+        }
+        const Voxel& v = b->at(x & 7, y & 7, z & 7);
+        sdf[g] = v.sdf_m;
+        observed[g] = v.weight > config.min_weight;
+        if (observed[g]) (v.sdf_m < 0.0f ? any_inside : any_outside) = true;
+      }
+    }
+  }
+  if (!any_inside || !any_outside) return;  // no observed sign change: nothing to mesh
+
+  const float voxel_m = map.voxelSize();
+  const float max_jump_m = config.max_sdf_jump_voxels * voxel_m;
+  const std::array<CubeEdge, 12>& cube_edges = cubeEdges();
+  const std::array<uint16_t, 256>& edge_masks = edgeMasks();
+  int corner_offset[8];
+  for (int i = 0; i < 8; ++i) {
+    corner_offset[i] =
+        gridIndex(kMcCornerOffset[i][0], kMcCornerOffset[i][1], kMcCornerOffset[i][2]);
+  }
+  constexpr int kAxisStride[3] = {1, kGrid, kGrid * kGrid};
+  const Eigen::Vector3i block_origin = block.index * kBlockSide;
+
+  // Welding within the block: one vertex per grid edge.
+  int32_t edge_vertex[kEdgeIds];
+  std::fill(edge_vertex, edge_vertex + kEdgeIds, -1);
+
+  for (int z = 0; z < kBlockSide; ++z) {
+    for (int y = 0; y < kBlockSide; ++y) {
+      for (int x = 0; x < kBlockSide; ++x) {
+        const int g = gridIndex(x, y, z);
+        int cube = 0;
+        for (int i = 0; i < 8; ++i) cube |= (sdf[g + corner_offset[i]] < 0.0f) << i;
+        if (cube == 0 || cube == 255) continue;
+        bool ok = true;
+        for (int i = 0; i < 8 && ok; ++i) ok = observed[g + corner_offset[i]];
+        if (!ok) continue;
+        const uint16_t crossed = edge_masks[cube];
+        for (int e = 0; e < 12 && ok; ++e) {
+          if (!(crossed >> e & 1)) continue;
+          const CubeEdge& ce = cube_edges[e];
+          ok = std::abs(sdf[g + corner_offset[ce.lower_corner]] -
+                        sdf[g + corner_offset[ce.upper_corner]]) < max_jump_m;
+        }
+        if (!ok) continue;
+
+        int32_t cube_vertex[12];
+        for (int e = 0; e < 12; ++e) {
+          if (!(crossed >> e & 1)) continue;
+          const CubeEdge& ce = cube_edges[e];
+          const int lx = x + ce.lower[0], ly = y + ce.lower[1], lz = z + ce.lower[2];
+          const uint16_t id = blockEdgeId(lx, ly, lz, ce.axis);
+          if (edge_vertex[id] < 0) {
+            const int ga = gridIndex(lx, ly, lz), gb = ga + kAxisStride[ce.axis];
+            const float sa = sdf[ga], sb = sdf[gb];
+            const float t = sa / (sa - sb);  // signs differ, so no division by zero
+            // Computed from global integers only, so neighbour blocks that mesh the same
+            // edge produce bit-identical vertices.
+            const int global[3] = {block_origin.x() + lx, block_origin.y() + ly,
+                                   block_origin.z() + lz};
+            Eigen::Vector3f p;
+            for (int k = 0; k < 3; ++k) {
+              p[k] = (static_cast<float>(global[k]) + 0.5f + (k == ce.axis ? t : 0.0f)) * voxel_m;
+            }
+            const int ax = lx + (ce.axis == 0), ay = ly + (ce.axis == 1), az = lz + (ce.axis == 2);
+            const Rgb8 ca = neighbours[(lx >> 3) | ((ly >> 3) << 1) | ((lz >> 3) << 2)]
+                                ->at(lx & 7, ly & 7, lz & 7)
+                                .color;
+            const Rgb8 cb = neighbours[(ax >> 3) | ((ay >> 3) << 1) | ((az >> 3) << 2)]
+                                ->at(ax & 7, ay & 7, az & 7)
+                                .color;
+            auto mix = [t](uint8_t a, uint8_t b) {
+              return static_cast<uint8_t>(std::lround(a + t * (static_cast<float>(b) - a)));
+            };
+            // The label comes from the voxel whose cell holds the vertex (the nearer one).
+            const bool upper = t >= 0.5f;
+            const int sx = upper ? ax : lx, sy = upper ? ay : ly, sz = upper ? az : lz;
+            const int slot = (sx >> 3) | ((sy >> 3) << 1) | ((sz >> 3) << 2);
+            const int local = (sx & 7) + kBlockSide * ((sy & 7) + kBlockSide * (sz & 7));
+
+            edge_vertex[id] = static_cast<int32_t>(mesh->vertices.size());
+            mesh->vertices.push_back(p);
+            mesh->colors.push_back(Rgb8{mix(ca.r, cb.r), mix(ca.g, cb.g), mix(ca.b, cb.b)});
+            mesh->edges.push_back(id);
+            mesh->sources.push_back(static_cast<uint16_t>(slot << 9 | local));
+          }
+          cube_vertex[e] = edge_vertex[id];
+        }
+        // Bourke's triples wind clockwise seen from outside (sdf > 0): reverse them.
+        const int8_t* tri = kMcTriangles[cube];
+        for (int k = 0; tri[k] >= 0; k += 3) {
+          mesh->faces.emplace_back(cube_vertex[tri[k]], cube_vertex[tri[k + 2]],
+                                   cube_vertex[tri[k + 1]]);
+        }
+      }
+    }
+  }
+}
+
+namespace {
+
+// A grid edge anywhere in the map: its lower voxel's block and its id within that block.
+using EdgeKey = std::pair<uint64_t, uint16_t>;
+
+// Labels one vertex from its source voxel.
+struct VertexLabels {
+  int32_t superpoint = 0, semantic = 0, instance = 0;
+};
+
+VertexLabels labelVertex(const MeshLabeller& labeller, const Block* const* neighbours,
+                         uint16_t source) {
+  VertexLabels labels;
+  const Block* block = neighbours[source >> 9];
+  if (!block) return labels;
+  labels.superpoint = labeller.superpoint(block->voxels[source & 511]);
+  if (labeller.semantic) labels.semantic = labeller.semantic(labels.superpoint);
+  if (labeller.instance) labels.instance = labeller.instance(labels.superpoint);
+  return labels;
+}
+
+}  // namespace
+
+LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const BlockMesh*>& blocks,
+                                 const MeshLabeller& labeller) {
+  LabelledMesh out;
+  const bool labelled = static_cast<bool>(labeller.superpoint);
+  std::vector<size_t> offsets(blocks.size() + 1, 0);
+  size_t num_faces = 0, num_border = 0;
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    offsets[b + 1] = offsets[b] + blocks[b]->vertices.size();
+    num_faces += blocks[b]->faces.size();
+  }
+  std::vector<int32_t> global(offsets.back(), -1);
+  out.vertices.reserve(offsets.back());
+  out.colors.reserve(offsets.back());
+  out.faces.reserve(num_faces);
+
+  const Block* neighbours[8];
+  auto findNeighbours = [&](const BlockIndex& index) {
+    if (!labelled) return;
+    for (int slot = 0; slot < 8; ++slot) neighbours[slot] = map.findBlock(index + slotOffset(slot));
+  };
+  auto emit = [&](const BlockMesh& mesh, size_t i) {
+    const int32_t index = static_cast<int32_t>(out.vertices.size());
+    out.vertices.push_back(mesh.vertices[i]);
+    out.colors.push_back(mesh.colors[i]);
+    if (labelled) {
+      const VertexLabels labels = labelVertex(labeller, neighbours, mesh.sources[i]);
+      out.superpoint.push_back(labels.superpoint);
+      out.semantic.push_back(labels.semantic);
+      out.instance.push_back(labels.instance);
+    }
+    return index;
+  };
+  auto decode = [](uint16_t id, int* x, int* y, int* z) {
+    const int cell = id / 3;
+    *x = cell % kGrid;
+    *y = (cell / kGrid) % kGrid;
+    *z = cell / (kGrid * kGrid);
+  };
+
+  // Pass 1: every block's own vertices (lower voxel inside the block), in block order. Those
+  // on the block's lower faces may be shared with a lower neighbour's border vertices.
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    for (uint16_t id : blocks[b]->edges) {
+      int x, y, z;
+      decode(id, &x, &y, &z);
+      num_border +=
+          (x == 0 || y == 0 || z == 0 || x == kBlockSide || y == kBlockSide || z == kBlockSide);
+    }
+  }
+  absl::flat_hash_map<EdgeKey, int32_t> border;
+  border.reserve(num_border);
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    const BlockMesh& mesh = *blocks[b];
+    findNeighbours(mesh.index);
+    const uint64_t key = TsdfMap::key(mesh.index);
+    for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+      int x, y, z;
+      decode(mesh.edges[i], &x, &y, &z);
+      if (x == kBlockSide || y == kBlockSide || z == kBlockSide) continue;
+      global[offsets[b] + i] = emit(mesh, i);
+      if (x == 0 || y == 0 || z == 0)
+        border.emplace(EdgeKey(key, mesh.edges[i]), global[offsets[b] + i]);
+    }
+  }
+  // Pass 2: border vertices owned by an upper neighbour: weld with the owner's vertex, or
+  // with the first lower block that produced it when the owner's cubes did not.
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    const BlockMesh& mesh = *blocks[b];
+    bool have_neighbours = false;
+    for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+      int x, y, z;
+      decode(mesh.edges[i], &x, &y, &z);
+      if (x < kBlockSide && y < kBlockSide && z < kBlockSide) continue;
+      const BlockIndex owner = mesh.index + BlockIndex(x >> 3, y >> 3, z >> 3);
+      const EdgeKey key(TsdfMap::key(owner), blockEdgeId(x & 7, y & 7, z & 7, mesh.edges[i] % 3));
+      auto [it, inserted] = border.try_emplace(key, -1);
+      if (inserted) {
+        if (!have_neighbours) {
+          findNeighbours(mesh.index);
+          have_neighbours = true;
+        }
+        it->second = emit(mesh, i);
+      }
+      global[offsets[b] + i] = it->second;
+    }
+  }
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    const int32_t* map_to = global.data() + offsets[b];
+    for (const Eigen::Vector3i& f : blocks[b]->faces) {
+      out.faces.emplace_back(map_to[f[0]], map_to[f[1]], map_to[f[2]]);
+    }
+  }
+  return out;
+}
+
+LabelledMesh marchingCubes(const TsdfMap& map, const MarchingCubesConfig& config,
+                           const MeshLabeller& labeller) {
+  config.check();
+  std::vector<const Block*> sorted;
+  sorted.reserve(map.numBlocks());
+  for (const auto& block : map.blocks()) sorted.push_back(block.get());
+  std::sort(sorted.begin(), sorted.end(),
+            [](const Block* a, const Block* b) { return blockIndexLess(a->index, b->index); });
+  std::vector<BlockMesh> meshes(sorted.size());
+  std::vector<const BlockMesh*> pointers;
+  pointers.reserve(sorted.size());
+  for (size_t i = 0; i < sorted.size(); ++i) {
+    meshBlock(map, *sorted[i], config, &meshes[i]);
+    if (!meshes[i].vertices.empty()) pointers.push_back(&meshes[i]);
+  }
+  return assembleBlockMeshes(map, pointers, labeller);
+}
+
+}  // namespace panmap

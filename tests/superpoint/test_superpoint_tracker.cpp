@@ -1,0 +1,157 @@
+#include <gtest/gtest.h>
+
+#include "panmap/core/error.h"
+#include "panmap/map/projective_integrator.h"
+#include "panmap/sim/depth_noise.h"
+#include "panmap/sim/renderer.h"
+#include "panmap/superpoint/superpoint_tracker.h"
+#include "test_meshes.h"
+
+namespace panmap {
+namespace {
+
+// A wall at x = 2 seen head-on; surfaces are drawn by hand so that every step of III-B is
+// under the test's control.
+class WallScene : public ::testing::Test {
+ protected:
+  WallScene() : renderer_(makeWall()), pool_(1), integrator_(IntegratorConfig{}, &pool_) {
+    T_W_C_ = test::lookAt({0, 0, 1}, {2, 0, 1});
+    const RenderedView view = renderer_.render(test::kinectCamera(), T_W_C_);
+    DepthNoiseConfig exact;
+    exact.enabled = false;
+    frame_.camera = test::kinectCamera();
+    frame_.depth = simulateDepth(view, exact, 0);
+  }
+  static LabelledMesh makeWall() {
+    LabelledMesh mesh;
+    test::addQuad(&mesh, {2, -4, -2}, {2, 4, -2}, {2, 4, 4}, {2, -4, 4}, 1, 1, 8);
+    return mesh;
+  }
+  // Surfaces by image column: [0, split) and [split, 640), with categories a and b; split 640
+  // gives one surface of category a.
+  FrameSegmentation columns(int split, int32_t a, int32_t b) const {
+    FrameSegmentation seg;
+    seg.geometric = LabelImage(640, 480, 1);
+    seg.surfaces = LabelImage(640, 480, 0);
+    int count[2] = {0, 0};
+    for (int v = 0; v < 480; ++v) {
+      for (int u = 0; u < 640; ++u) {
+        seg.surfaces(u, v) = u < split ? 1 : 2;
+        ++count[u < split ? 0 : 1];
+      }
+    }
+    seg.surface_list.push_back(Surface{1, 1, a ? 1 : 0, a, a > 3, 0.9f, count[0]});
+    if (split < 640) seg.surface_list.push_back(Surface{2, 1, b ? 2 : 0, b, b > 3, 0.9f, count[1]});
+    return seg;
+  }
+  FrameAssociation step(SuperpointTracker* tracker, TsdfMap* map, const FrameSegmentation& seg) {
+    FrameAssociation a = tracker->associate(seg, frame_, T_W_C_, *map);
+    integrator_.integrate(frame_, T_W_C_, &a.pixel_labels, map);
+    return a;
+  }
+
+  MeshRenderer renderer_;
+  ThreadPool pool_;
+  ProjectiveIntegrator integrator_;
+  Eigen::Isometry3d T_W_C_;
+  RgbdFrame frame_;
+};
+
+TEST_F(WallScene, SurfacesKeepTheirSuperpointAcrossFrames) {
+  TsdfMap map(TsdfMap::Config{0.05f});
+  SuperpointTracker tracker(SuperpointConfig{});
+  const FrameAssociation first = step(&tracker, &map, columns(384, 1, 4));
+  ASSERT_EQ(first.surface_labels.size(), 2u);
+  EXPECT_EQ(first.surface_labels[0], 1);
+  EXPECT_EQ(first.surface_labels[1], 2);
+  EXPECT_EQ(first.new_labels, 2);
+  const FrameAssociation second = step(&tracker, &map, columns(384, 1, 4));
+  EXPECT_EQ(second.new_labels, 0);
+  EXPECT_EQ(second.surface_labels, first.surface_labels);
+  EXPECT_EQ(tracker.state(1)->semanticClass(), 1);
+  EXPECT_EQ(tracker.state(2)->semanticClass(), 4);
+  // Things get a global instance from frame counting; stuff-like class 1 (a <= 3) none.
+  EXPECT_EQ(second.surface_instances[0], 0);
+  EXPECT_EQ(second.surface_instances[1], first.surface_instances[1]);
+  EXPECT_GT(first.surface_instances[1], 0);
+  EXPECT_EQ(tracker.numInstances(), 1);
+}
+
+// The paper's Fig. 4: a surface spanning a wall and a bed (noisy geometric segmentation)
+// co-observes both super-points. Spatial-only merging (Voxblox++) joins them once M exceeds
+// theta_merge; the semantic consistency check keeps them apart. Clean frames in between keep
+// the bed super-point alive (a spanning surface alone would out-vote it within two frames).
+TEST_F(WallScene, SemanticConsistencyPreventsWallBedMerge) {
+  for (bool semantic : {true, false}) {
+    TsdfMap map(TsdfMap::Config{0.05f});
+    SuperpointConfig config;
+    config.semantic_consistency = semantic;
+    SuperpointTracker tracker(config);
+    step(&tracker, &map, columns(384, 1, 4));  // wall (60 %) and bed (40 %)
+    step(&tracker, &map, columns(384, 1, 4));
+    int merges = 0;
+    for (int k = 0; k < 6; ++k) {
+      merges += step(&tracker, &map, columns(384, 1, 4)).merges;
+      merges += step(&tracker, &map, columns(640, 1, 0)).merges;  // spans wall and bed
+    }
+    if (semantic) {
+      EXPECT_EQ(merges, 0);
+      EXPECT_NE(tracker.labels().resolve(1), tracker.labels().resolve(2));
+      EXPECT_EQ(tracker.state(2)->semanticClass(), 4);
+      EXPECT_EQ(tracker.coObservations().at({1, 2}), 6);  // once per spanning frame
+    } else {
+      EXPECT_EQ(merges, 1);
+      EXPECT_EQ(tracker.labels().resolve(2), 1);  // the older id survives
+      ASSERT_EQ(tracker.merges().size(), 1u);
+      EXPECT_EQ(tracker.merges()[0].removed, 2);
+      // M exceeds theta_merge = 3 at the 4th spanning frame, frame 10.
+      EXPECT_EQ(tracker.merges()[0].frame, 10);
+      EXPECT_EQ(tracker.state(2), tracker.state(1));
+    }
+  }
+}
+
+TEST_F(WallScene, SameClassPiecesMergeAndPoolTheirCounts) {
+  TsdfMap map(TsdfMap::Config{0.05f});
+  SuperpointTracker tracker(SuperpointConfig{});
+  // A table top seen in two pieces (e.g. split by an occluder), sometimes whole.
+  step(&tracker, &map, columns(320, 7, 7));
+  step(&tracker, &map, columns(320, 7, 7));
+  int merges = 0;
+  for (int k = 0; k < 4; ++k) {
+    merges += step(&tracker, &map, columns(320, 7, 7)).merges;
+    merges += step(&tracker, &map, columns(640, 7, 0)).merges;
+  }
+  EXPECT_EQ(merges, 1);
+  EXPECT_EQ(tracker.labels().resolve(2), 1);
+  ASSERT_EQ(tracker.merges().size(), 1u);
+  EXPECT_EQ(tracker.merges()[0].frame, 10);
+  const SuperpointState* s = tracker.state(2);
+  ASSERT_NE(s, nullptr);
+  // 6 two-piece frames (12 surface counts) and 4 whole frames: pooled after the merge.
+  EXPECT_EQ(s->class_counts.at(7), 16.0);
+  int instance_frames = 0;
+  for (const auto& [id, count] : s->instance_counts) instance_frames += count;
+  EXPECT_EQ(instance_frames, 16);
+  EXPECT_EQ(s->instance(), 1);
+}
+
+TEST(LabelRegistry, MergesResolveToTheOldestId) {
+  LabelRegistry labels;
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(labels.create(), i + 1);
+  EXPECT_EQ(labels.merge(4, 2), 2);
+  EXPECT_EQ(labels.merge(5, 4), 2);
+  EXPECT_EQ(labels.resolve(5), 2);
+  EXPECT_EQ(labels.resolve(3), 3);
+  EXPECT_EQ(labels.resolve(0), 0);
+  EXPECT_EQ(labels.resolve(99), 0);
+  EXPECT_FALSE(labels.isRoot(4));
+  EXPECT_THROW(labels.merge(1, 42), Error);
+  LabelRegistry copy;
+  copy.restore(labels.parents());
+  EXPECT_EQ(copy.resolve(5), 2);
+  EXPECT_THROW(copy.restore({0, 2}), Error);
+}
+
+}  // namespace
+}  // namespace panmap
