@@ -14,7 +14,7 @@ void IntegratorConfig::check() const {
   if (!(min_depth_m >= 0.0f && max_depth_m > min_depth_m)) {
     throw Error("integrator needs 0 <= min_depth_m < max_depth_m");
   }
-  if (!(vote_band_voxels >= 0.0f)) throw Error("integrator vote_band_voxels must be >= 0");
+  if (vote_stride_px < 1) throw Error("integrator vote_stride_px must be >= 1");
 }
 
 ProjectiveIntegrator::ProjectiveIntegrator(const IntegratorConfig& config, ThreadPool* pool)
@@ -50,6 +50,42 @@ inline float sampleDepth(const Image<float>& depth, float uf, float vf, int u, i
 
 }  // namespace
 
+// Pi_V (Eq. 2's counts): every labelled pixel votes for its label in the voxel its measured
+// point falls in, as in the paper (a vote per point, not per projected voxel: projective
+// distances stretch at grazing angles and would miss the surface voxels there).
+void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isometry3f& T_W_C,
+                                      const LabelImage& labels, TsdfMap* map,
+                                      IntegrationStats* stats) {
+  const PinholeCamera& cam = frame.camera;
+  const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
+  const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
+  const float inv_voxel = 1.0f / map->voxelSize();
+  const int stride = config_.vote_stride_px;
+  Block* block = nullptr;
+  BlockIndex block_index = BlockIndex::Zero();
+  bool have_block = false;
+  for (int v = 0; v < cam.height; v += stride) {
+    for (int u = 0; u < cam.width; u += stride) {
+      const int32_t label = labels(u, v);
+      const float d = depth_m_(u, v);
+      if (label <= 0 || d <= 0.0f) continue;
+      const Eigen::Vector3f p_W = T_W_C * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d);
+      const int gx = static_cast<int>(std::floor(p_W.x() * inv_voxel));
+      const int gy = static_cast<int>(std::floor(p_W.y() * inv_voxel));
+      const int gz = static_cast<int>(std::floor(p_W.z() * inv_voxel));
+      const BlockIndex b(gx >> 3, gy >> 3, gz >> 3);
+      if (!have_block || b != block_index) {  // neighbouring pixels share blocks: skip the hash
+        block = map->findBlock(b);
+        block_index = b;
+        have_block = true;
+      }
+      if (!block) continue;
+      ++stats->votes_added;
+      stats->votes_evicted += addVote(&block->at(gx & 7, gy & 7, gz & 7), label);
+    }
+  }
+}
+
 IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
                                                  const Eigen::Isometry3d& T_W_C,
                                                  const LabelImage* labels, TsdfMap* map) {
@@ -65,7 +101,6 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
   const bool has_color = frame.color.width() == w && frame.color.height() == h;
   const float voxel = map->voxelSize();
   const float trunc = config_.truncation_voxels * voxel;
-  const float vote_band = config_.vote_band_voxels * voxel;
 
   // Depth in metres with the range limits applied once.
   if (depth_m_.width() != w || depth_m_.height() != h) depth_m_ = Image<float>(w, h);
@@ -114,10 +149,10 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
   const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
   const float max_weight = config_.max_weight;
   const bool dropoff = config_.weight_dropoff;
-  std::atomic<size_t> voxels_updated{0}, votes_added{0}, votes_evicted{0};
+  std::atomic<size_t> voxels_updated{0};
 
   pool_->parallelFor(blocks_.size(), [&](size_t begin, size_t end, int) {
-    size_t updated = 0, added = 0, evicted = 0;
+    size_t updated = 0;
     for (size_t b = begin; b < end; ++b) {
       Block& block = *blocks_[b];
       bool changed = false;
@@ -160,25 +195,15 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
             vox.weight = std::min(total, max_weight);
             ++updated;
             changed = true;
-            if (labels && std::abs(sdf) <= vote_band) {
-              const int32_t label = (*labels)(u, v);
-              if (label > 0) {
-                ++added;
-                evicted += addVote(&vox, label);
-              }
-            }
           }
         }
       }
       if (changed) block.updated = true;
     }
     voxels_updated += updated;
-    votes_added += added;
-    votes_evicted += evicted;
   });
   stats.voxels_updated = voxels_updated;
-  stats.votes_added = votes_added;
-  stats.votes_evicted = votes_evicted;
+  if (labels) voteLabels(frame, T_W_Cf, *labels, map, &stats);
   return stats;
 }
 

@@ -23,7 +23,7 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put(c.integrator.max_depth_m);
   w->put<uint8_t>(c.integrator.weight_dropoff);
   w->put<uint8_t>(c.integrator.space_carving);
-  w->put(c.integrator.vote_band_voxels);
+  w->put<int32_t>(c.integrator.vote_stride_px);
   w->put<int32_t>(c.depth_segmentation.normals_window_px);
   w->put<int32_t>(c.depth_segmentation.min_convexity_window_px);
   w->put(c.depth_segmentation.min_convexity_threshold);
@@ -51,7 +51,7 @@ MapperConfig getConfig(BinaryReader* r) {
   c.integrator.max_depth_m = r->get<float>();
   c.integrator.weight_dropoff = r->get<uint8_t>() != 0;
   c.integrator.space_carving = r->get<uint8_t>() != 0;
-  c.integrator.vote_band_voxels = r->get<float>();
+  c.integrator.vote_stride_px = r->get<int32_t>();
   c.depth_segmentation.normals_window_px = r->get<int32_t>();
   c.depth_segmentation.min_convexity_window_px = r->get<int32_t>();
   c.depth_segmentation.min_convexity_threshold = r->get<float>();

@@ -26,6 +26,28 @@ Mapper::Mapper(const MapperConfig& config) : config_(config) {
   segmenter_ = std::make_unique<PanopticGeometricSegmenter>(config_.depth_segmentation, config_.fusion);
   tracker_ = std::make_unique<SuperpointTracker>(config_.superpoints);
   integrator_ = std::make_unique<ProjectiveIntegrator>(config_.integrator, pool_.get());
+  MarchingCubesConfig mesh_config;
+  // A sign change is a surface only between samples closer than the truncation band.
+  mesh_config.max_sdf_jump_voxels = config_.integrator.truncation_voxels;
+  mesher_ = std::make_unique<IncrementalMesher>(mesh_config, pool_.get());
+}
+
+LabelledMesh Mapper::extractMesh() {
+  mesher_->update(map_.get());
+  const SuperpointTracker& tracker = *tracker_;
+  MeshLabeller labeller;
+  labeller.superpoint = [&tracker](const Voxel& voxel) {
+    return argmaxLabel(voxel, [&tracker](int32_t l) { return tracker.labels().resolve(l); });
+  };
+  labeller.semantic = [&tracker](int32_t label) {
+    const SuperpointState* s = tracker.state(label);
+    return s ? s->semanticClass() : 0;
+  };
+  labeller.instance = [&tracker](int32_t label) {
+    const SuperpointState* s = tracker.state(label);
+    return s ? s->instance() : 0;
+  };
+  return mesher_->assemble(*map_, labeller);
 }
 
 void Mapper::validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,

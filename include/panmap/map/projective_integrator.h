@@ -17,13 +17,13 @@ struct IntegratorConfig {
   float truncation_voxels = 4.0f;  ///< truncation distance, voxels
   float max_weight = 100.0f;       ///< weights saturate here, so the map can still change
   float min_depth_m = 0.1f;        ///< depth outside [min, max] is ignored, metres
-  float max_depth_m = 5.0f;
+  float max_depth_m = 3.5f;        // noise grows as z^2: 4 cm sigma at 5 m, the truncation band
   bool weight_dropoff = true;      ///< behind the surface, weight falls linearly to 0 at -trunc
   /// Also allocate blocks between camera and surface and record free space there (voxels
   /// farther than the truncation in front of the surface); off: only the truncation band.
   bool space_carving = false;
-  /// Voxels within this distance of the surface (voxels) take a vote for their pixel's label.
-  float vote_band_voxels = 1.0f;
+  /// Pixels between label votes (1 = every labelled pixel votes in its point's voxel).
+  int vote_stride_px = 1;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -55,6 +55,9 @@ class ProjectiveIntegrator {
   const IntegratorConfig& config() const { return config_; }
 
  private:
+  void voteLabels(const RgbdFrame& frame, const Eigen::Isometry3f& T_W_C, const LabelImage& labels,
+                  TsdfMap* map, IntegrationStats* stats);
+
   IntegratorConfig config_;
   ThreadPool* pool_;
   Image<float> depth_m_;              // scratch: depth in metres, 0 = invalid

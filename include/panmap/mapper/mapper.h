@@ -10,6 +10,7 @@
 #include "panmap/core/thread_pool.h"
 #include "panmap/map/projective_integrator.h"
 #include "panmap/map/tsdf_map.h"
+#include "panmap/mesh/incremental_mesher.h"
 #include "panmap/segmentation/panoptic_geometric.h"
 #include "panmap/superpoint/superpoint_tracker.h"
 
@@ -65,6 +66,11 @@ class Mapper {
   /// Votes evicted from full voxel slots so far (never silent).
   uint64_t voteEvictions() const { return vote_evictions_; }
 
+  /// The labelled mesh of the current map: marching cubes re-run only on changed blocks;
+  /// per vertex the super-point (argmax of its voxel's votes, merges resolved), and the
+  /// super-point's class and instance from frame counting.
+  LabelledMesh extractMesh();
+
   /// Writes the whole state (config, TSDF, votes, super-points) as a versioned binary file
   /// with a CRC-32; throws Error naming the file on failure.
   void save(const std::string& path) const;
@@ -82,6 +88,7 @@ class Mapper {
   std::unique_ptr<PanopticGeometricSegmenter> segmenter_;
   std::unique_ptr<SuperpointTracker> tracker_;
   std::unique_ptr<ProjectiveIntegrator> integrator_;
+  std::unique_ptr<IncrementalMesher> mesher_;
   int64_t frames_ = 0;
   uint64_t vote_evictions_ = 0;
 };

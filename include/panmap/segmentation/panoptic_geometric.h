@@ -14,12 +14,12 @@ namespace panmap {
 /// Geometric segmentation of a depth image into convex patches (paper III-A, after Furrer et
 /// al.'s depth segmentation). Defaults are those of the paper's released code.
 struct DepthSegmentationConfig {
-  int normals_window_px = 13;             ///< neighbourhood for surface normals, pixels (odd)
-  int min_convexity_window_px = 5;        ///< neighbourhood of the concavity test, pixels (odd)
-  float min_convexity_threshold = 0.97f;  ///< concave edge where min convexity falls below
+  int normals_window_px = 13;       ///< neighbourhood for surface normals, pixels (odd, <= 127)
+  int min_convexity_window_px = 5;  ///< neighbourhood of the concavity test, pixels (odd, <= 127)
+  float min_convexity_threshold = 0.97f;    ///< concave edge where min convexity falls below
   float depth_discontinuity_ratio = 0.01f;  ///< edge where |dz| > ratio * z to a neighbour
-  int min_segment_px = 100;               ///< smaller segments are dropped (pixels -> 0)
-  float max_depth_m = 10.0f;              ///< farther depth is treated as invalid
+  int min_segment_px = 100;                 ///< smaller segments are dropped (pixels -> 0)
+  float max_depth_m = 10.0f;                ///< farther depth is treated as invalid
   /// Threads sharing the per-pixel stages (rows split in bands), the caller included. The
   /// result does not depend on it.
   int num_threads = 1;
@@ -43,33 +43,34 @@ struct SurfaceFusionConfig {
 /// One surface s_i of a frame: the pixels of one geometric segment inside one panoptic
 /// segment (or inside no mask: background).
 struct Surface {
-  int32_t id = 0;                  ///< pixel value in FrameSegmentation::surfaces (> 0)
-  int32_t geometric_segment = 0;   ///< its geometric segment id (> 0)
-  int32_t panoptic_segment = 0;    ///< panoptic segment id o_i, 0 = background (no mask)
-  int32_t category = 0;            ///< C(o_i), NYU40 id; 0 = background / unknown class
-  bool is_thing = false;           ///< o_i is a countable object
-  float confidence = 0.0f;         ///< P_o (Eq. 1): score for things, stuff_confidence for stuff
+  int32_t id = 0;                 ///< pixel value in FrameSegmentation::surfaces (> 0)
+  int32_t geometric_segment = 0;  ///< its geometric segment id (> 0)
+  int32_t panoptic_segment = 0;   ///< panoptic segment id o_i, 0 = background (no mask)
+  int32_t category = 0;           ///< C(o_i), NYU40 id; 0 = background / unknown class
+  bool is_thing = false;          ///< o_i is a countable object
+  float confidence = 0.0f;        ///< P_o (Eq. 1): score for things, stuff_confidence for stuff
   int32_t num_pixels = 0;
 };
 
 /// The 2D panoptic-geometric segmentation of one frame.
 struct FrameSegmentation {
-  LabelImage geometric;           ///< geometric segment id per pixel, 0 = edge / invalid / small
-  LabelImage surfaces;            ///< surface id per pixel, 0 = none
+  LabelImage geometric;  ///< geometric segment id per pixel, 0 = edge / invalid / small
+  LabelImage surfaces;   ///< surface id per pixel, 0 = none
   std::vector<Surface> surface_list;  ///< indexed by id - 1
 };
 
 /// Why a pixel is an edge of the geometric segmentation (bit flags of
 /// PanopticGeometricSegmenter::edgeFlags()); 0 = inside a segment candidate.
 enum DepthEdge : uint8_t {
-  kEdgeInvalidDepth = 1,    ///< no depth, or beyond max_depth_m
-  kEdgeNoNormal = 2,        ///< too few valid neighbours for a normal
-  kEdgeDiscontinuity = 4,   ///< an 8-neighbour's depth jumps by more than the ratio
-  kEdgeConcave = 8,         ///< min convexity below the threshold
+  kEdgeInvalidDepth = 1,   ///< no depth, or beyond max_depth_m
+  kEdgeNoNormal = 2,       ///< no normal: holes or depth steps on too many sides
+  kEdgeDiscontinuity = 4,  ///< an 8-neighbour's depth jumps by more than the ratio
+  kEdgeConcave = 8,        ///< min convexity below the threshold
 };
 
 /// Computes geometric segments of the depth image and fuses them with the panoptic masks.
-/// Holds scratch buffers: one instance per thread.
+/// Holds scratch buffers (and DepthSegmentationConfig::num_threads - 1 worker threads): one
+/// instance per calling thread.
 class PanopticGeometricSegmenter {
  public:
   /// Throws Error when a config is invalid.
@@ -83,6 +84,10 @@ class PanopticGeometricSegmenter {
   /// image's size differs from the depth image's (unless geometry_only), when the depth image
   /// does not match the camera, or when a panoptic segment id is not positive or repeated.
   FrameSegmentation segment(const RgbdFrame& frame, const PanopticFrame* panoptic);
+
+  /// The same into `out`, reusing its buffers: once the image size is stable, a frame
+  /// allocates nothing (but inside OpenCV's connected components).
+  void segment(const RgbdFrame& frame, const PanopticFrame* panoptic, FrameSegmentation* out);
 
   /// Unit surface normal at pixel (u, v) of the last segmented frame, camera frame, pointing
   /// toward the camera; zero where the pixel has none.

@@ -1,0 +1,132 @@
+// panmap-mapper: the mapping process. Offline mode (--log) maps every frame of an LCM log as
+// fast as it can and writes the outputs; the live LCM mode arrives with roadmap issue 5.
+#include <sys/resource.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "panmap/core/error.h"
+#include "panmap/core/progress.h"
+#include "panmap/io/image_codec.h"
+#include "panmap/lcm/offline_mapping.h"
+#include "panmap/mesh/mesh_export.h"
+#include "panmap/sim/overview.h"
+
+namespace {
+
+// Peak resident memory of this process, bytes.
+size_t peakRssBytes() {
+  struct rusage usage;
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<size_t>(usage.ru_maxrss) * 1024;
+}
+
+panmap::LabelledMesh recoloured(const panmap::LabelledMesh& mesh,
+                                panmap::Rgb8 (*colour)(int32_t), const std::vector<int32_t>& ids) {
+  panmap::LabelledMesh out = mesh;
+  out.colors.resize(mesh.vertices.size());
+  for (size_t i = 0; i < ids.size(); ++i) out.colors[i] = colour(ids[i]);
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"panmap mapping process. Offline: maps an LCM log (CAMERA_RGBD, CAMERA_POSE, "
+               "PANOPTIC) and writes mesh_{semantic,instance,superpoint}.ply, map.panmap, "
+               "report.json and snapshot PNGs into --out."};
+  std::string log_path, out_dir, load_path;
+  panmap::MapperConfig config;
+  panmap::OfflineOptions options;
+  bool quiet = false, geometry_only = false, spatial_only = false, no_snapshots = false;
+  app.add_option("--log", log_path, "LCM log to map offline")->required();
+  app.add_option("--out", out_dir, "output folder")->required();
+  app.add_option("--voxel-size", config.map.voxel_size_m, "voxel edge, metres")->capture_default_str();
+  app.add_option("--threads", config.num_threads, "integration threads")->capture_default_str();
+  app.add_option("--max-frames", options.max_frames, "stop after N integrated frames (0 = all)");
+  app.add_flag("--geometry-only", geometry_only, "ignore panoptic masks (ablation)");
+  app.add_flag("--spatial-only", spatial_only,
+               "merge super-points without the semantic consistency check (ablation, Voxblox++)");
+  app.add_option("--load", load_path, "resume from a map.panmap snapshot");
+  app.add_option("--channel-rgbd", options.channel_rgbd)->capture_default_str();
+  app.add_option("--channel-pose", options.channel_pose)->capture_default_str();
+  app.add_option("--channel-panoptic", options.channel_panoptic)->capture_default_str();
+  app.add_flag("--no-snapshots", no_snapshots, "skip the overview PNGs");
+  app.add_flag("-q,--quiet", quiet, "no progress line");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    config.fusion.geometry_only = geometry_only;
+    config.superpoints.semantic_consistency = !spatial_only;
+    std::unique_ptr<panmap::Mapper> mapper =
+        load_path.empty() ? std::make_unique<panmap::Mapper>(config) : panmap::Mapper::load(load_path);
+    std::filesystem::create_directories(out_dir);
+    panmap::ProgressLine progress("map", "MiB", !quiet);
+    const panmap::OfflineReport report = panmap::mapLog(
+        log_path, options, mapper.get(),
+        [&](size_t done, size_t total) { progress.update(done >> 20, total >> 20); });
+    progress.finish();
+
+    const panmap::LabelledMesh mesh = mapper->extractMesh();
+    panmap::writeLabelledMeshes(out_dir, mesh);
+    mapper->save(out_dir + "/map.panmap");
+    if (!no_snapshots && !mesh.faces.empty()) {
+      panmap::writeFileBytes(out_dir + "/snapshot_semantic.png",
+                             panmap::encodePng(panmap::renderOverview(
+                                 recoloured(mesh, &panmap::semanticColor, mesh.semantic))));
+      panmap::writeFileBytes(out_dir + "/snapshot_instance.png",
+                             panmap::encodePng(panmap::renderOverview(
+                                 recoloured(mesh, &panmap::idColor, mesh.instance))));
+      panmap::writeFileBytes(out_dir + "/snapshot_superpoint.png",
+                             panmap::encodePng(panmap::renderOverview(
+                                 recoloured(mesh, &panmap::idColor, mesh.superpoint))));
+      panmap::writeFileBytes(out_dir + "/snapshot_color.png",
+                             panmap::encodePng(panmap::renderOverview(mesh)));
+    }
+
+    nlohmann::json timings;
+    for (const auto& [stage, t] : report.timings) timings[stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}};
+    const nlohmann::json json = {
+        {"log", log_path},
+        {"events", report.events},
+        {"frames_integrated", report.frames_integrated},
+        {"frames_total", mapper->framesIntegrated()},
+        {"rejected", report.rejected},
+        {"geometry_only_frames", report.sync.geometry_only},
+        {"unmatched_panoptic", report.sync.unmatched_panoptic},
+        {"timings", timings},
+        {"wall_s", report.wall_s},
+        {"memory", {{"map_bytes", mapper->map().memoryBytes()}, {"peak_rss_bytes", peakRssBytes()},
+                    {"blocks", mapper->map().numBlocks()},
+                    {"voxels", mapper->map().numBlocks() * panmap::kBlockVoxels}}},
+        {"superpoints", mapper->superpoints().states().size()},
+        {"superpoint_merges", mapper->superpoints().merges().size()},
+        {"instances", mapper->superpoints().numInstances()},
+        {"vote_evictions", mapper->voteEvictions()},
+        {"mesh", {{"vertices", mesh.numVertices()}, {"faces", mesh.numFaces()}}},
+        {"config", {{"voxel_size_m", mapper->config().map.voxel_size_m},
+                    {"truncation_voxels", mapper->config().integrator.truncation_voxels},
+                    {"geometry_only", mapper->config().fusion.geometry_only},
+                    {"semantic_consistency", mapper->config().superpoints.semantic_consistency},
+                    {"merge_threshold", mapper->config().superpoints.merge_threshold},
+                    {"threads", mapper->config().num_threads}}}};
+    std::ofstream(out_dir + "/report.json") << json.dump(2) << "\n";
+    std::printf("mapped %lld frames in %.1f s (median %.1f ms/frame): %zu super-points, %d "
+                "instances, %zu mesh vertices; outputs in %s\n",
+                static_cast<long long>(report.frames_integrated), report.wall_s,
+                report.timings.count("total") ? report.timings.at("total").median_ms : 0.0,
+                mapper->superpoints().states().size(), mapper->superpoints().numInstances(),
+                mesh.numVertices(), out_dir.c_str());
+    for (const auto& [reason, count] : report.rejected) {
+      std::printf("  rejected %lld: %s\n", static_cast<long long>(count), reason.c_str());
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "panmap-mapper: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,218 @@
+// The per-frame 2D panoptic-geometric segmentation (paper III-A): depth -> normals -> edges ->
+// connected components -> geometric segments, fused with the panoptic masks into surfaces.
+#include "panmap/segmentation/panoptic_geometric.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "panmap/core/error.h"
+#include "panmap/core/thread_pool.h"
+#include "panmap/segmentation/internal/depth_edges.h"
+#include "panmap/segmentation/internal/depth_geometry.h"
+#include "panmap/segmentation/internal/surface_fusion.h"
+
+namespace panmap {
+
+namespace {
+
+constexpr int kMaxThreads = 64;
+
+// The normal estimator's box sums stay exact up to this window (see depth_normals.cpp).
+constexpr int kMaxWindowPx = 127;
+
+void requireOddWindow(int value_px, const char* field) {
+  if (value_px < 3 || value_px > kMaxWindowPx || value_px % 2 == 0) {
+    throw Error(std::string("DepthSegmentationConfig.") + field +
+                " must be odd and in [3, 127], got " + std::to_string(value_px));
+  }
+}
+
+std::string sizeText(int width, int height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+}  // namespace
+
+void DepthSegmentationConfig::check() const {
+  requireOddWindow(normals_window_px, "normals_window_px");
+  requireOddWindow(min_convexity_window_px, "min_convexity_window_px");
+  if (!(min_convexity_threshold >= -1.0f && min_convexity_threshold <= 1.0f)) {
+    throw Error("DepthSegmentationConfig.min_convexity_threshold must be in [-1, 1], got " +
+                std::to_string(min_convexity_threshold));
+  }
+  if (!(depth_discontinuity_ratio > 0.0f && depth_discontinuity_ratio < 1.0f)) {
+    throw Error("DepthSegmentationConfig.depth_discontinuity_ratio must be in (0, 1), got " +
+                std::to_string(depth_discontinuity_ratio));
+  }
+  if (min_segment_px < 1) {
+    throw Error("DepthSegmentationConfig.min_segment_px must be >= 1, got " +
+                std::to_string(min_segment_px));
+  }
+  if (!(max_depth_m > 0.0f && std::isfinite(max_depth_m))) {
+    throw Error("DepthSegmentationConfig.max_depth_m must be positive and finite, got " +
+                std::to_string(max_depth_m));
+  }
+  if (num_threads < 1 || num_threads > kMaxThreads) {
+    throw Error("DepthSegmentationConfig.num_threads must be in [1, 64], got " +
+                std::to_string(num_threads));
+  }
+}
+
+void SurfaceFusionConfig::check() const {
+  if (min_surface_px < 1) {
+    throw Error("SurfaceFusionConfig.min_surface_px must be >= 1, got " +
+                std::to_string(min_surface_px));
+  }
+  if (!(stuff_confidence >= 0.0f && stuff_confidence <= 1.0f)) {
+    throw Error("SurfaceFusionConfig.stuff_confidence must be in [0, 1], got " +
+                std::to_string(stuff_confidence));
+  }
+}
+
+struct PanopticGeometricSegmenter::Impl {
+  Impl(const DepthSegmentationConfig& depth, const SurfaceFusionConfig& fusion)
+      : depth_config(depth),
+        fusion_config(fusion),
+        pool(depth.num_threads),
+        normal_estimators(depth.num_threads),
+        edge_scratch(depth.num_threads) {}
+
+  void checkInputs(const RgbdFrame& frame, const PanopticFrame* panoptic) const;
+  void geometricSegments(LabelImage* geometric);
+
+  const DepthSegmentationConfig depth_config;
+  const SurfaceFusionConfig fusion_config;
+  ThreadPool pool;
+  std::vector<internal::NormalEstimator> normal_estimators;  ///< one per thread
+  std::vector<internal::EdgeScratch> edge_scratch;           ///< one per thread
+  internal::DepthGeometry geometry;
+  internal::EdgeMaps edges;
+  internal::SurfaceFuser fuser;
+  std::vector<int32_t> component_area_px;
+  std::vector<int32_t> component_to_segment;
+};
+
+void PanopticGeometricSegmenter::Impl::checkInputs(const RgbdFrame& frame,
+                                                   const PanopticFrame* panoptic) const {
+  std::string why;
+  if (!frame.camera.isValid(&why)) throw Error("RgbdFrame.camera: " + why);
+  if (frame.depth.width() != frame.camera.width || frame.depth.height() != frame.camera.height) {
+    throw Error("RgbdFrame.depth is " + sizeText(frame.depth.width(), frame.depth.height()) +
+                ", camera is " + sizeText(frame.camera.width, frame.camera.height));
+  }
+  if (!(frame.depth_scale_m > 0.0 && std::isfinite(frame.depth_scale_m))) {
+    throw Error("RgbdFrame.depth_scale_m must be positive and finite, got " +
+                std::to_string(frame.depth_scale_m));
+  }
+  if (panoptic != nullptr && !fusion_config.geometry_only &&
+      (panoptic->segment_ids.width() != frame.depth.width() ||
+       panoptic->segment_ids.height() != frame.depth.height())) {
+    throw Error("PanopticFrame.segment_ids is " +
+                sizeText(panoptic->segment_ids.width(), panoptic->segment_ids.height()) +
+                ", depth is " + sizeText(frame.depth.width(), frame.depth.height()));
+  }
+}
+
+// Connected components (4-connected) of the non-edge pixels; components smaller than
+// min_segment_px are dropped and the rest numbered from 1 in raster order of their first
+// pixel, so ids do not depend on OpenCV's labelling algorithm or its threads.
+void PanopticGeometricSegmenter::Impl::geometricSegments(LabelImage* geometric) {
+  const int width = geometry.width;
+  const int height = geometry.height;
+  cv::Mat mask(height, width, CV_8UC1, edges.segmentable.data());
+  cv::Mat labels(height, width, CV_32SC1, geometric->data());
+  const int num_labels = cv::connectedComponents(mask, labels, 4, CV_32S);
+  int32_t* label = geometric->data();
+  const size_t n = geometric->size();
+  component_area_px.assign(num_labels, 0);
+  for (size_t i = 0; i < n; ++i) ++component_area_px[label[i]];
+  component_to_segment.assign(num_labels, -1);
+  component_to_segment[0] = 0;
+  int32_t next_id = 0;
+  for (size_t i = 0; i < n; ++i) {
+    int32_t& id = component_to_segment[label[i]];
+    if (id < 0) id = component_area_px[label[i]] >= depth_config.min_segment_px ? ++next_id : 0;
+    label[i] = id;
+  }
+}
+
+PanopticGeometricSegmenter::PanopticGeometricSegmenter(const DepthSegmentationConfig& depth_config,
+                                                       const SurfaceFusionConfig& fusion_config) {
+  depth_config.check();
+  fusion_config.check();
+  impl_ = std::make_unique<Impl>(depth_config, fusion_config);
+}
+
+PanopticGeometricSegmenter::~PanopticGeometricSegmenter() = default;
+
+FrameSegmentation PanopticGeometricSegmenter::segment(const RgbdFrame& frame,
+                                                      const PanopticFrame* panoptic) {
+  FrameSegmentation out;
+  segment(frame, panoptic, &out);
+  return out;
+}
+
+void PanopticGeometricSegmenter::segment(const RgbdFrame& frame, const PanopticFrame* panoptic,
+                                         FrameSegmentation* out) {
+  Impl& impl = *impl_;
+  impl.checkInputs(frame, panoptic);
+  const int width = frame.depth.width();
+  const int height = frame.depth.height();
+  impl.geometry.resize(width, height);
+  impl.edges.resize(width, height);
+
+  // Each stage reads its neighbours' rows of the previous one, so the stages are separate
+  // parallel loops over bands of rows. The lambdas capture two pointers, which std::function
+  // holds without allocating.
+  Impl* const self = &impl;
+  const RgbdFrame* const input = &frame;
+  impl.pool.parallelFor(height, [self, input](size_t v0, size_t v1, int) {
+    internal::backProjectRows(*input, self->depth_config.max_depth_m, static_cast<int>(v0),
+                              static_cast<int>(v1), &self->geometry);
+  });
+  impl.pool.parallelFor(height, [self](size_t v0, size_t v1, int) {
+    internal::markDiscontinuityRows(self->depth_config.depth_discontinuity_ratio,
+                                    static_cast<int>(v0), static_cast<int>(v1), &self->geometry);
+  });
+  impl.pool.parallelFor(height, [self](size_t v0, size_t v1, int thread) {
+    self->normal_estimators[thread].computeRows(self->depth_config.normals_window_px,
+                                                static_cast<int>(v0), static_cast<int>(v1),
+                                                &self->geometry);
+  });
+  impl.pool.parallelFor(height, [self](size_t v0, size_t v1, int thread) {
+    internal::computeEdgeRows(self->geometry, self->depth_config, static_cast<int>(v0),
+                              static_cast<int>(v1), &self->edge_scratch[thread], &self->edges);
+  });
+
+  // Both images are overwritten whole, so buffers of the right size are reused as they are.
+  if (out->geometric.width() != width || out->geometric.height() != height) {
+    out->geometric = LabelImage(width, height);
+  }
+  if (out->surfaces.width() != width || out->surfaces.height() != height) {
+    out->surfaces = LabelImage(width, height);
+  }
+  impl.geometricSegments(&out->geometric);
+  impl.fuser.fuse(panoptic, impl.fusion_config, out);
+}
+
+Eigen::Vector3f PanopticGeometricSegmenter::normal(int u, int v) const {
+  const internal::DepthGeometry& g = impl_->geometry;
+  if (u < 0 || v < 0 || u >= g.width || v >= g.height) {
+    throw Error("normal(" + std::to_string(u) + ", " + std::to_string(v) +
+                "): pixel outside the last frame (" + sizeText(g.width, g.height) + ")");
+  }
+  const size_t i = g.index(u, v);
+  return Eigen::Vector3f(g.nx[i], g.ny[i], g.nz[i]);
+}
+
+const Image<float>& PanopticGeometricSegmenter::minConvexity() const {
+  return impl_->edges.min_convexity;
+}
+
+const Image<uint8_t>& PanopticGeometricSegmenter::edgeFlags() const { return impl_->edges.flags; }
+
+}  // namespace panmap

@@ -1,0 +1,218 @@
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "panmap/core/error.h"
+#include "panmap/io/image_codec.h"
+#include "panmap/mapper/mapper.h"
+#include "panmap/sim/depth_noise.h"
+#include "panmap/sim/renderer.h"
+#include "panmap/sim/segmenter_noise.h"
+#include "test_helpers.h"
+#include "test_meshes.h"
+
+namespace panmap {
+namespace {
+
+// A floor, a wall, and two touching boxes of different classes (cabinet 3 and fridge 24),
+// rendered exactly with ground-truth masks from several poses.
+class BoxScene : public ::testing::Test {
+ protected:
+  BoxScene() : renderer_(makeScene()), segmenter_(SegmenterNoiseConfig::fromPreset("clean"), 1) {
+    infos_[1] = InstanceInfo{2, 6.0f, true};
+    infos_[2] = InstanceInfo{1, 6.0f, true};
+    infos_[3] = InstanceInfo{3, 0.8f, false};
+    infos_[4] = InstanceInfo{24, 1.6f, false};
+  }
+  static LabelledMesh makeScene() {
+    LabelledMesh mesh;
+    test::addQuad(&mesh, {-3, -3, 0}, {3, -3, 0}, {3, 3, 0}, {-3, 3, 0}, 1, 2, 30);   // floor
+    test::addQuad(&mesh, {1.6f, -3, 0}, {1.6f, 3, 0}, {1.6f, 3, 2.5f}, {1.6f, -3, 2.5f}, 2, 1, 30);  // wall
+    test::addBox(&mesh, {0.8f, -0.8f, 0.0f}, {1.4f, 0.0f, 0.9f}, 3, 3, 8);   // cabinet
+    test::addBox(&mesh, {0.8f, 0.0f, 0.0f}, {1.4f, 0.7f, 1.6f}, 4, 24, 8);   // fridge, touching
+    return mesh;
+  }
+  Eigen::Isometry3d pose(int k) const {
+    const double a = -0.6 + 0.12 * k;
+    const Eigen::Vector3d eye(1.1 - 2.2 * std::cos(a), 2.2 * std::sin(a), 1.5);
+    return test::lookAt(eye, {1.1, 0.0, 0.6});
+  }
+  void frameAt(int k, RgbdFrame* frame, PanopticFrame* panoptic) {
+    const RenderedView view = renderer_.render(test::kinectCamera(), pose(k));
+    DepthNoiseConfig exact;
+    exact.enabled = false;
+    frame->camera = test::kinectCamera();
+    frame->utime = k * 33333;
+    frame->frame_id = k;
+    frame->depth = simulateDepth(view, exact, 0);
+    frame->color = view.color;
+    *panoptic = segmenter_.segment(view.instance, view.semantic, k, infos_);
+  }
+  std::unique_ptr<Mapper> run(const MapperConfig& config, int frames) {
+    auto mapper = std::make_unique<Mapper>(config);
+    for (int k = 0; k < frames; ++k) {
+      RgbdFrame frame;
+      PanopticFrame panoptic;
+      frameAt(k, &frame, &panoptic);
+      mapper->integrate(frame, pose(k), &panoptic);
+    }
+    return mapper;
+  }
+  static MapperConfig config() {
+    MapperConfig c;
+    c.map.voxel_size_m = 0.02f;
+    return c;
+  }
+
+  MeshRenderer renderer_;
+  SegmenterNoise segmenter_;
+  std::map<int32_t, InstanceInfo> infos_;
+};
+
+// Majority super-point of the mesh vertices inside a box, and the share of its vertices.
+std::pair<int32_t, double> dominantSuperpoint(const LabelledMesh& mesh, const Eigen::AlignedBox3f& box) {
+  std::map<int32_t, int> counts;
+  int n = 0;
+  for (size_t v = 0; v < mesh.numVertices(); ++v) {
+    if (!box.contains(mesh.vertices[v])) continue;
+    ++counts[mesh.superpoint[v]];
+    ++n;
+  }
+  std::pair<int32_t, int> best{0, 0};
+  for (const auto& [id, c] : counts) {
+    if (c > best.second) best = {id, c};
+  }
+  return {best.first, n ? static_cast<double>(best.second) / n : 0.0};
+}
+
+TEST_F(BoxScene, TouchingBoxesOfDifferentClassesStaySeparate) {
+  auto mapper = run(config(), 10);
+  const LabelledMesh mesh = mapper->extractMesh();
+  // The cameras (1.5 m high) see the cabinet's top and front and the fridge's front.
+  const Eigen::AlignedBox3f cabinet_top(Eigen::Vector3f(0.85f, -0.75f, 0.85f), Eigen::Vector3f(1.35f, -0.1f, 0.95f));
+  const Eigen::AlignedBox3f cabinet_front(Eigen::Vector3f(0.75f, -0.7f, 0.1f), Eigen::Vector3f(0.85f, -0.1f, 0.8f));
+  const Eigen::AlignedBox3f fridge_front(Eigen::Vector3f(0.75f, 0.1f, 0.1f), Eigen::Vector3f(0.85f, 0.6f, 1.5f));
+  const auto top = dominantSuperpoint(mesh, cabinet_top);
+  const auto front = dominantSuperpoint(mesh, cabinet_front);
+  const auto fridge = dominantSuperpoint(mesh, fridge_front);
+  ASSERT_GT(top.first, 0);
+  ASSERT_GT(front.first, 0);
+  ASSERT_GT(fridge.first, 0);
+  EXPECT_GT(top.second, 0.8);
+  EXPECT_GT(fridge.second, 0.8);
+  const SuperpointTracker& sp = mapper->superpoints();
+  // Different classes never share a super-point, even where the boxes touch.
+  EXPECT_NE(front.first, fridge.first);
+  EXPECT_NE(top.first, fridge.first);
+  EXPECT_EQ(sp.state(top.first)->semanticClass(), 3);
+  EXPECT_EQ(sp.state(front.first)->semanticClass(), 3);
+  EXPECT_EQ(sp.state(fridge.first)->semanticClass(), 24);
+  // One object, one instance: the cabinet's faces agree, the fridge differs.
+  EXPECT_EQ(sp.state(top.first)->instance(), sp.state(front.first)->instance());
+  EXPECT_NE(sp.state(top.first)->instance(), sp.state(fridge.first)->instance());
+  // Along the shared side no vertex of the fridge's front carries a cabinet super-point.
+  for (size_t v = 0; v < mesh.numVertices(); ++v) {
+    if (fridge_front.contains(mesh.vertices[v]) && mesh.superpoint[v] > 0) {
+      EXPECT_NE(sp.state(mesh.superpoint[v])->semanticClass(), 3) << v;
+    }
+  }
+}
+
+TEST_F(BoxScene, SameInputGivesBitIdenticalOutput) {
+  auto a = run(config(), 6);
+  auto b = run(config(), 6);
+  test::TempDir dir;
+  a->save(dir.path("a.panmap"));
+  b->save(dir.path("b.panmap"));
+  EXPECT_EQ(readFileBytes(dir.path("a.panmap")), readFileBytes(dir.path("b.panmap")));
+  const LabelledMesh ma = a->extractMesh(), mb = b->extractMesh();
+  EXPECT_EQ(ma.vertices, mb.vertices);
+  EXPECT_EQ(ma.superpoint, mb.superpoint);
+  EXPECT_EQ(ma.instance, mb.instance);
+  // One thread or two: the same map.
+  MapperConfig one = config();
+  one.num_threads = 1;
+  auto c = run(one, 6);
+  c->save(dir.path("c.panmap"));
+  auto bytes_a = readFileBytes(dir.path("a.panmap")), bytes_c = readFileBytes(dir.path("c.panmap"));
+  ASSERT_EQ(bytes_a.size(), bytes_c.size());
+  // The files differ only in the stored thread count (and so the checksum).
+  size_t differing = 0;
+  for (size_t i = 0; i < bytes_a.size(); ++i) differing += bytes_a[i] != bytes_c[i];
+  EXPECT_LE(differing, 8u);
+}
+
+TEST_F(BoxScene, SaveLoadRoundTripAndContinue) {
+  test::TempDir dir;
+  auto full = run(config(), 8);
+  auto half = run(config(), 4);
+  half->save(dir.path("half.panmap"));
+  auto resumed = Mapper::load(dir.path("half.panmap"));
+  resumed->save(dir.path("again.panmap"));
+  EXPECT_EQ(readFileBytes(dir.path("half.panmap")), readFileBytes(dir.path("again.panmap")));
+  for (int k = 4; k < 8; ++k) {
+    RgbdFrame frame;
+    PanopticFrame panoptic;
+    frameAt(k, &frame, &panoptic);
+    resumed->integrate(frame, pose(k), &panoptic);
+  }
+  full->save(dir.path("full.panmap"));
+  resumed->save(dir.path("resumed.panmap"));
+  EXPECT_EQ(readFileBytes(dir.path("full.panmap")), readFileBytes(dir.path("resumed.panmap")));
+  // Corruption is detected, naming the file.
+  auto bytes = readFileBytes(dir.path("full.panmap"));
+  bytes[bytes.size() / 2] ^= 0x40;
+  writeFileBytes(dir.path("bad.panmap"), bytes);
+  try {
+    Mapper::load(dir.path("bad.panmap"));
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.panmap: checksum"), std::string::npos) << e.what();
+  }
+  bytes.resize(100);
+  writeFileBytes(dir.path("short.panmap"), bytes);
+  EXPECT_THROW(Mapper::load(dir.path("short.panmap")), Error);
+  EXPECT_THROW(Mapper::load(dir.path("missing.panmap")), Error);
+}
+
+TEST_F(BoxScene, BadInputIsRefusedAndTheMapIsUnharmed) {
+  auto mapper = run(config(), 3);
+  test::TempDir dir;
+  mapper->save(dir.path("before.panmap"));
+  RgbdFrame frame;
+  PanopticFrame panoptic;
+  frameAt(3, &frame, &panoptic);
+  Eigen::Isometry3d nan_pose = pose(3);
+  nan_pose.translation().x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(mapper->integrate(frame, nan_pose, &panoptic), Error);
+  RgbdFrame small = frame;
+  small.depth = DepthImage(320, 240);
+  try {
+    mapper->integrate(small, pose(3), &panoptic);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("320x240"), std::string::npos) << e.what();
+  }
+  RgbdFrame empty = frame;
+  empty.depth = DepthImage();
+  EXPECT_THROW(mapper->integrate(empty, pose(3), &panoptic), Error);
+  PanopticFrame wrong = panoptic;
+  wrong.segment_ids = LabelImage(10, 10);
+  EXPECT_THROW(mapper->integrate(frame, pose(3), &wrong), Error);
+  PanopticFrame duplicate = panoptic;
+  if (!duplicate.segments.empty()) {
+    duplicate.segments.push_back(duplicate.segments.front());
+    EXPECT_THROW(mapper->integrate(frame, pose(3), &duplicate), Error);
+  }
+  mapper->save(dir.path("after.panmap"));
+  EXPECT_EQ(readFileBytes(dir.path("before.panmap")), readFileBytes(dir.path("after.panmap")));
+  // Unknown classes (0) are simply background.
+  PanopticFrame unknown = panoptic;
+  for (auto& s : unknown.segments) s.category = 0;
+  EXPECT_NO_THROW(mapper->integrate(frame, pose(3), &unknown));
+}
+
+}  // namespace
+}  // namespace panmap
