@@ -23,7 +23,7 @@ struct MapperConfig {
   DepthSegmentationConfig depth_segmentation;
   SurfaceFusionConfig fusion;
   SuperpointConfig superpoints;
-  int num_threads = 2;  ///< threads for integration (segmentation and association use one)
+  int num_threads = 2;  ///< threads for segmentation and integration (association uses one)
   /// Throws Error naming the bad field.
   void check() const;
 };
