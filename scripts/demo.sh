@@ -1,20 +1,23 @@
 #!/usr/bin/env bash
-# The main job on the bundled demo data: set up, build, import the real 7-Scenes sample
-# (../shared/data/7scenes-200) into logs/7scenes-200.lcmlog and check every message with
-# panmap-loginfo. (The mapper processes join this demo as they land: see README.)
-#   scripts/demo.sh [--data DIR]
+# The main job on the bundled demo: set up and build, make the demo logs in logs/ if missing
+# (the real 7-Scenes sample imported; a synthetic room rendered with panmap-synth, seed 1),
+# map the synthetic room offline and print where the outputs are.
+#   scripts/demo.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-data=../shared/data/7scenes-200
-[ "${1:-}" = "--data" ] && data="$2"
 scripts/setup.sh
-[ -d "$data" ] || { echo "demo.sh: dataset folder $data not found" >&2; exit 1; }
 mkdir -p logs
-log=logs/7scenes-200.lcmlog
-if [ ! -f "$log" ]; then
-  build/panmap-import "$data" "$log"
-else
-  echo "demo: $log exists (delete it to import again)"
+data=../shared/data/7scenes-200
+if [ -d "$data" ] && [ ! -f logs/7scenes-200.lcmlog ]; then
+  build/panmap-import "$data" logs/7scenes-200.lcmlog
 fi
-build/panmap-loginfo --quiet "$log"
-echo "demo: replay it with: lcm-logplayer $log   (watch with: scripts/lcm_spy.sh)"
+if [ ! -f logs/room1/sequence.lcmlog ]; then
+  build/panmap-synth --room 1 --frames 300 --masks m2f --poses gt --seed 1 --out logs/room1
+fi
+build/panmap-loginfo --quiet --shallow logs/room1/sequence.lcmlog
+build/panmap-mapper --log logs/room1/sequence.lcmlog --out out/room1
+echo
+echo "demo: outputs in out/room1/: mesh_semantic.ply mesh_instance.ply mesh_superpoint.ply"
+echo "      map.panmap report.json snapshot_{semantic,instance,superpoint,color}.png"
+echo "demo: ground truth of the room in logs/room1/gt/; replay the log with"
+echo "      lcm-logplayer logs/room1/sequence.lcmlog   (watch with scripts/lcm_spy.sh)"
