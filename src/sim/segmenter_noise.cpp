@@ -3,98 +3,40 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <initializer_list>
+#include <cstdint>
 #include <limits>
 #include <map>
+#include <string>
 #include <unordered_map>
 #include <utility>
-
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
+#include "panmap/sim/internal/boundary_warp.h"
+#include "panmap/sim/internal/false_positive_blob.h"
+#include "panmap/sim/internal/segmenter_random.h"
 
 namespace panmap {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-// Part of every hash, so that decisions of different kinds are independent.
-enum Kind : uint64_t {
-  kPhase = 1,
-  kMiss,
-  kConfuse,
-  kConfuseClass,
-  kMerge,
-  kSplit,
-  kSplitAngle,
-  kFalsePositive,
-  kFalsePositiveShape,
-  kBoundary,
-  kScore,
-};
-
-// splitmix64's finaliser: a bijective, well-mixing 64-bit hash.
-uint64_t mix64(uint64_t z) {
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
-uint64_t hashOf(std::initializer_list<uint64_t> keys) {
-  uint64_t h = 0x6a09e667f3bcc909ULL;
-  for (uint64_t k : keys) h = mix64(h ^ mix64(k + 0x9e3779b97f4a7c15ULL));
-  return h;
-}
-
-double toUnit(uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; }
-
-uint64_t key(int64_t v) { return static_cast<uint64_t>(v); }
-
-int64_t floorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
-
-// splitmix64 with our own samplers: std:: distributions differ between standard libraries,
-// and the output must be identical everywhere for a seed.
-class Rng {
- public:
-  explicit Rng(uint64_t seed) : state_(seed) {}
-  uint64_t next() { return mix64(state_ += 0x9e3779b97f4a7c15ULL); }
-  /// Uniform in [0, 1).
-  double uniform() { return toUnit(next()); }
-  /// Standard normal (Box-Muller).
-  double normal() {
-    const double u1 = 1.0 - uniform();  // (0, 1]: log stays finite
-    const double u2 = uniform();
-    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
-  }
-  /// Gamma(shape, 1) by Marsaglia and Tsang (2000); shape < 1 through the boost u^(1/shape).
-  double gamma(double shape) {
-    if (shape < 1.0) return gamma(shape + 1.0) * std::pow(1.0 - uniform(), 1.0 / shape);
-    const double d = shape - 1.0 / 3.0;
-    const double c = 1.0 / std::sqrt(9.0 * d);
-    for (;;) {
-      double x = 0.0;
-      double v = 0.0;
-      do {
-        x = normal();
-        v = 1.0 + c * x;
-      } while (v <= 0.0);
-      v = v * v * v;
-      const double u = 1.0 - uniform();
-      if (std::log(u) < 0.5 * x * x + d - d * v + d * std::log(v)) return d * v;
-    }
-  }
-  /// Beta(a, b) as X / (X + Y) of two Gammas.
-  double beta(double a, double b) {
-    const double x = gamma(a);
-    const double y = gamma(b);
-    return x / (x + y);
-  }
-
- private:
-  uint64_t state_;
-};
+using internal::segmenter::Blob;
+using internal::segmenter::FrameContext;
+using internal::segmenter::hashOf;
+using internal::segmenter::kConfuse;
+using internal::segmenter::kConfuseClass;
+using internal::segmenter::key;
+using internal::segmenter::kFalsePositive;
+using internal::segmenter::kFalsePositiveShape;
+using internal::segmenter::kMerge;
+using internal::segmenter::kMiss;
+using internal::segmenter::kPi;
+using internal::segmenter::kScore;
+using internal::segmenter::kSplit;
+using internal::segmenter::kSplitAngle;
+using internal::segmenter::SegmenterRng;
+using internal::segmenter::toUnit;
+using internal::segmenter::warpLabels;
 
 // One label of the compact image: a thing instance, or all the stuff of one class.
 struct Unit {
@@ -125,121 +67,29 @@ int32_t findRoot(std::vector<Unit>& units, int32_t k) {
   return k;
 }
 
-void checkProbability(double p, const char* field) {
-  if (!(p >= 0.0 && p <= 1.0)) {
-    throw Error(std::string("segmenter noise: ") + field + " = " + std::to_string(p) +
-                " is outside [0, 1]");
+double missProbability(const SegmenterNoiseConfig& c, int64_t px, float occluded) {
+  double p = 0.0;
+  if (px <= c.miss_small_px) {
+    p = c.miss_probability_small;
+  } else if (px >= c.miss_large_px) {
+    p = c.miss_probability_large;
+  } else {
+    const double t =
+        static_cast<double>(px - c.miss_small_px) / (c.miss_large_px - c.miss_small_px);
+    p = c.miss_probability_small + t * (c.miss_probability_large - c.miss_probability_small);
   }
+  if (occluded > c.occluded_threshold) p = std::max(p, c.miss_probability_occluded);
+  return p;
 }
 
-void checkPositive(double v, const char* field) {
-  if (!(v > 0.0 && std::isfinite(v))) {
-    throw Error(std::string("segmenter noise: ") + field + " = " + std::to_string(v) +
-                " must be positive");
-  }
-}
+struct Draft {
+  PanopticSegment segment;
+  SegmentOrigin origin;
+  uint64_t score_key = 0;
+  int64_t px = 0;
+};
 
 }  // namespace
-
-void SegmenterNoiseConfig::check() const {
-  checkPositive(window_frames, "window_frames");
-  checkProbability(miss_probability_small, "miss_probability_small");
-  checkProbability(miss_probability_large, "miss_probability_large");
-  checkProbability(miss_probability_occluded, "miss_probability_occluded");
-  checkProbability(occluded_threshold, "occluded_threshold");
-  if (miss_small_px < 0) throw Error("segmenter noise: miss_small_px must be >= 0");
-  if (miss_large_px <= miss_small_px) {
-    throw Error("segmenter noise: miss_large_px must be larger than miss_small_px");
-  }
-  if (!(boundary_mean_px >= 0.0 && boundary_mean_px <= 100.0)) {
-    throw Error("segmenter noise: boundary_mean_px = " + std::to_string(boundary_mean_px) +
-                " is outside [0, 100]");
-  }
-  if (boundary_grid_px < 2) throw Error("segmenter noise: boundary_grid_px must be >= 2");
-  checkPositive(boundary_period_frames, "boundary_period_frames");
-  checkProbability(confusion_probability, "confusion_probability");
-  for (const auto& group : confusion_groups) {
-    if (group.size() < 2) throw Error("segmenter noise: a confusion_groups entry has < 2 classes");
-    for (int32_t c : group) {
-      if (c < 1 || c > kMaxNyu40Class || isStuffClass(c)) {
-        throw Error("segmenter noise: confusion_groups holds " + std::to_string(c) +
-                    ", not a NYU40 thing class");
-      }
-    }
-  }
-  checkProbability(merge_probability, "merge_probability");
-  if (merge_min_contact_px < 1) throw Error("segmenter noise: merge_min_contact_px must be >= 1");
-  checkProbability(split_probability, "split_probability");
-  if (!(split_min_extent_m >= 0.0f)) {
-    throw Error("segmenter noise: split_min_extent_m must be >= 0");
-  }
-  if (!(false_positives_per_frame >= 0.0 && false_positives_per_frame <= kFalsePositiveSlots)) {
-    throw Error("segmenter noise: false_positives_per_frame = " +
-                std::to_string(false_positives_per_frame) + " is outside [0, " +
-                std::to_string(kFalsePositiveSlots) + "]");
-  }
-  if (false_positive_min_area_px < 1) {
-    throw Error("segmenter noise: false_positive_min_area_px must be >= 1");
-  }
-  if (false_positive_max_area_px < false_positive_min_area_px) {
-    throw Error("segmenter noise: false_positive_max_area_px is below false_positive_min_area_px");
-  }
-  checkPositive(true_score_alpha, "true_score_alpha");
-  checkPositive(true_score_beta, "true_score_beta");
-  checkPositive(wrong_score_alpha, "wrong_score_alpha");
-  checkPositive(wrong_score_beta, "wrong_score_beta");
-  if (stats_min_px < 0) throw Error("segmenter noise: stats_min_px must be >= 0");
-}
-
-SegmenterNoiseConfig SegmenterNoiseConfig::fromPreset(const std::string& name) {
-  SegmenterNoiseConfig c;
-  c.preset = name;
-  if (name == "clean") return c;
-  if (name == "m2f") {
-    // DESIGN 10: what Mask2Former does on ScanNet frames.
-    c.miss_probability_small = 0.4;
-    c.miss_probability_large = 0.1;
-    c.miss_probability_occluded = 0.4;
-    c.boundary_mean_px = 3.0;
-    c.confusion_probability = 0.1;
-    c.merge_probability = 0.2;
-    c.split_probability = 0.1;
-    c.false_positives_per_frame = 0.5;
-    c.sample_scores = true;
-    return c;
-  }
-  if (name == "hard") {
-    // About twice the m2f error rates (small-object misses capped below 1) and 1.5x boundaries.
-    c.miss_probability_small = 0.7;
-    c.miss_probability_large = 0.2;
-    c.miss_probability_occluded = 0.7;
-    c.boundary_mean_px = 4.5;
-    c.confusion_probability = 0.2;
-    c.merge_probability = 0.4;
-    c.split_probability = 0.2;
-    c.false_positives_per_frame = 1.0;
-    c.sample_scores = true;
-    return c;
-  }
-  throw Error("segmenter noise: unknown preset '" + name + "' (clean, m2f, hard)");
-}
-
-namespace {
-double ratio(int64_t a, int64_t b) { return b > 0 ? static_cast<double>(a) / b : 0.0; }
-}  // namespace
-
-double SegmenterNoiseStats::missRate() const { return ratio(missed, things_seen); }
-double SegmenterNoiseStats::smallMissRate() const { return ratio(small_missed, small_seen); }
-double SegmenterNoiseStats::largeMissRate() const { return ratio(large_missed, large_seen); }
-double SegmenterNoiseStats::confusionRate() const { return ratio(confused, confusable_seen); }
-double SegmenterNoiseStats::mergeRate() const { return ratio(merged_pairs, touching_pairs); }
-double SegmenterNoiseStats::splitRate() const { return ratio(split, split_candidates); }
-double SegmenterNoiseStats::falsePositivesPerFrame() const {
-  return ratio(false_positives, frames);
-}
-double SegmenterNoiseStats::meanBoundaryErrorPx() const {
-  return boundary_length_px > 0.0 ? boundary_error_area_px / boundary_length_px : 0.0;
-}
 
 SegmenterNoise::SegmenterNoise(const SegmenterNoiseConfig& config, uint64_t seed)
     : config_(config), seed_(seed), confusable_(kMaxNyu40Class + 1) {
@@ -256,126 +106,6 @@ SegmenterNoise::SegmenterNoise(const SegmenterNoiseConfig& config, uint64_t seed
     list.erase(std::unique(list.begin(), list.end()), list.end());
   }
 }
-
-namespace {
-
-// Everything segment() needs besides the images; keeps the hashing conventions in one place.
-class FrameContext {
- public:
-  FrameContext(const SegmenterNoiseConfig& config, uint64_t seed, int frame)
-      : config_(config), seed_(seed), frame_(frame) {}
-
-  // Index of the time window of (subject, kind) holding this frame. A per-subject phase keeps
-  // the windows of different instances from switching on the same frame.
-  int64_t window(uint64_t subject, Kind kind) const {
-    const int64_t length = config_.window_frames;
-    const int64_t phase = static_cast<int64_t>(hashOf({seed_, kPhase, kind, subject}) %
-                                               static_cast<uint64_t>(length));
-    return floorDiv(frame_ + phase, length);
-  }
-  // A uniform draw constant over the window.
-  double draw(uint64_t subject, Kind kind) const {
-    return toUnit(hashOf({seed_, kind, subject, key(window(subject, kind))}));
-  }
-  uint64_t windowHash(uint64_t subject, Kind kind, Kind sub_kind) const {
-    return hashOf({seed_, sub_kind, subject, key(window(subject, kind))});
-  }
-
- private:
-  const SegmenterNoiseConfig& config_;
-  uint64_t seed_;
-  int frame_;
-};
-
-double missProbability(const SegmenterNoiseConfig& c, int64_t px, float occluded) {
-  double p = 0.0;
-  if (px <= c.miss_small_px) {
-    p = c.miss_probability_small;
-  } else if (px >= c.miss_large_px) {
-    p = c.miss_probability_large;
-  } else {
-    const double t =
-        static_cast<double>(px - c.miss_small_px) / (c.miss_large_px - c.miss_small_px);
-    p = c.miss_probability_small + t * (c.miss_probability_large - c.miss_probability_small);
-  }
-  if (occluded > c.occluded_threshold) p = std::max(p, c.miss_probability_occluded);
-  return p;
-}
-
-// Control points of one displacement field: two standard normals (du, dv) per grid node.
-cv::Mat coarseField(uint64_t seed, int64_t index, int grid_w, int grid_h) {
-  cv::Mat field(grid_h, grid_w, CV_32FC2);
-  Rng rng(hashOf({seed, kBoundary, key(index)}));
-  for (int r = 0; r < grid_h; ++r) {
-    auto* row = field.ptr<cv::Vec2f>(r);
-    for (int c = 0; c < grid_w; ++c) {
-      row[c][0] = static_cast<float>(rng.normal());
-      row[c][1] = static_cast<float>(rng.normal());
-    }
-  }
-  return field;
-}
-
-// Backward-warps the compact label image by a smooth random field (nearest neighbour, so no
-// label is invented): outlines move in blobs of about the grid size, not as per-pixel salt.
-// The field is cos/sin-blended between two independent fields so it drifts smoothly in time with
-// constant variance, and scaled so its mean per-axis displacement is boundary_mean_px, which for
-// an isotropic field is the mean displacement normal to any outline.
-void warpLabels(const SegmenterNoiseConfig& c, uint64_t seed, int frame, int width, int height,
-                const std::vector<int32_t>& in, std::vector<int32_t>& out) {
-  const int grid_w = std::max(2, (width + c.boundary_grid_px - 1) / c.boundary_grid_px);
-  const int grid_h = std::max(2, (height + c.boundary_grid_px - 1) / c.boundary_grid_px);
-  const int64_t period = c.boundary_period_frames;
-  const int64_t index = floorDiv(frame, period);
-  const double theta = 0.5 * kPi * static_cast<double>(frame - index * period) / period;
-  cv::Mat coarse;
-  cv::addWeighted(coarseField(seed, index, grid_w, grid_h), std::cos(theta),
-                  coarseField(seed, index + 1, grid_w, grid_h), std::sin(theta), 0.0, coarse);
-  cv::Mat field;
-  cv::resize(coarse, field, cv::Size(width, height), 0.0, 0.0, cv::INTER_CUBIC);
-  const double mean_abs = cv::norm(field, cv::NORM_L1) / (2.0 * width * height);
-  const float scale = mean_abs > 0.0 ? static_cast<float>(c.boundary_mean_px / mean_abs) : 0.0f;
-  out.resize(in.size());
-  for (int v = 0; v < height; ++v) {
-    const auto* d = field.ptr<cv::Vec2f>(v);
-    int32_t* dst = out.data() + static_cast<size_t>(v) * width;
-    for (int u = 0; u < width; ++u) {
-      const int su = std::min(width - 1, std::max(0, u + cvRound(d[u][0] * scale)));
-      const int sv = std::min(height - 1, std::max(0, v + cvRound(d[u][1] * scale)));
-      dst[u] = in[static_cast<size_t>(sv) * width + su];
-    }
-  }
-}
-
-// A smooth random blob: radius r0 (1 + a2 cos 2(t - p2) + a3 cos 3(t - p3)) in polar angle t,
-// evaluated without trigonometry per pixel.
-struct Blob {
-  double cx = 0.0, cy = 0.0, r0 = 0.0;
-  double c2 = 0.0, s2 = 0.0, c3 = 0.0, s3 = 0.0;  // amplitude * cos / sin of the phases
-  double reach() const { return r0 * (1.0 + std::hypot(c2, s2) + std::hypot(c3, s3)) + 1.0; }
-  bool contains(double u, double v) const {
-    const double x = u - cx;
-    const double y = v - cy;
-    const double rr = x * x + y * y;
-    if (rr < 1e-9) return true;
-    const double r = std::sqrt(rr);
-    const double c = x / r;
-    const double s = y / r;
-    const double cos2 = c * c - s * s, sin2 = 2.0 * c * s;
-    const double cos3 = 4.0 * c * c * c - 3.0 * c, sin3 = 3.0 * s - 4.0 * s * s * s;
-    const double f = 1.0 + c2 * cos2 + s2 * sin2 + c3 * cos3 + s3 * sin3;
-    return r < r0 * f;
-  }
-};
-
-struct Draft {
-  PanopticSegment segment;
-  SegmentOrigin origin;
-  uint64_t score_key = 0;
-  int64_t px = 0;
-};
-
-}  // namespace
 
 PanopticFrame SegmenterNoise::segment(const LabelImage& instances, const LabelImage& semantics,
                                       int frame_index, const std::map<int32_t, InstanceInfo>& infos,
@@ -667,7 +397,7 @@ PanopticFrame SegmenterNoise::segment(const LabelImage& instances, const LabelIm
   for (int slot = 0; slot < SegmenterNoiseConfig::kFalsePositiveSlots; ++slot) {
     const uint64_t subject = key(slot);
     if (slot_probability <= 0.0 || ctx.draw(subject, kFalsePositive) >= slot_probability) continue;
-    Rng rng(ctx.windowHash(subject, kFalsePositive, kFalsePositiveShape));
+    SegmenterRng rng(ctx.windowHash(subject, kFalsePositive, kFalsePositiveShape));
     const double area =
         c.false_positive_min_area_px +
         rng.uniform() * (c.false_positive_max_area_px - c.false_positive_min_area_px);
@@ -730,7 +460,7 @@ PanopticFrame SegmenterNoise::segment(const LabelImage& instances, const LabelIm
     const SegmentOrigin& o = d.origin;
     const bool wrong = o.confused || o.merged || o.split || o.false_positive;
     if (c.sample_scores) {
-      Rng rng(hashOf({seed_, kScore, key(frame_index), d.score_key}));
+      SegmenterRng rng(hashOf({seed_, kScore, key(frame_index), d.score_key}));
       const double score = wrong ? rng.beta(c.wrong_score_alpha, c.wrong_score_beta)
                                  : rng.beta(c.true_score_alpha, c.true_score_beta);
       d.segment.score = static_cast<float>(std::min(1.0, std::max(0.0, score)));
