@@ -50,8 +50,12 @@ void BM_Lookup(benchmark::State& state) {
 }
 using AbslMap = absl::flat_hash_map<uint64_t, int>;
 using StdMap = std::unordered_map<uint64_t, int>;
-BENCHMARK_TEMPLATE(BM_Lookup, AbslMap)->Name("lookup/absl::flat_hash_map")->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(BM_Lookup, StdMap)->Name("lookup/std::unordered_map")->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Lookup, AbslMap)
+    ->Name("lookup/absl::flat_hash_map")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Lookup, StdMap)
+    ->Name("lookup/std::unordered_map")
+    ->Unit(benchmark::kMillisecond);
 
 template <typename Map>
 void BM_Insert(benchmark::State& state) {
@@ -63,8 +67,12 @@ void BM_Insert(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(keys.size()));
 }
-BENCHMARK_TEMPLATE(BM_Insert, AbslMap)->Name("insert/absl::flat_hash_map")->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(BM_Insert, StdMap)->Name("insert/std::unordered_map")->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Insert, AbslMap)
+    ->Name("insert/absl::flat_hash_map")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Insert, StdMap)
+    ->Name("insert/std::unordered_map")
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

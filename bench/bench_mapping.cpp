@@ -21,7 +21,8 @@ int main(int argc, char** argv) {
   panmap::MapperConfig config;
   int frames = 0;
   bool markdown = false;
-  app.add_option("--data", data, "dataset folder (7-Scenes, ScanNet export or TUM)")->capture_default_str();
+  app.add_option("--data", data, "dataset folder (7-Scenes, ScanNet export or TUM)")
+      ->capture_default_str();
   app.add_option("--voxel-size", config.map.voxel_size_m, "metres")->capture_default_str();
   app.add_option("--threads", config.num_threads, "integration threads")->capture_default_str();
   app.add_option("--frames", frames, "frames to map (0 = all)");
@@ -51,17 +52,18 @@ int main(int argc, char** argv) {
     struct rusage usage;
     getrusage(RUSAGE_SELF, &usage);
     const size_t voxels = mapper.map().numBlocks() * panmap::kBlockVoxels;
-    nlohmann::json out = {{"data", data},
-                          {"frames", times["total"].size()},
-                          {"voxel_size_m", config.map.voxel_size_m},
-                          {"threads", config.num_threads},
-                          {"blocks", mapper.map().numBlocks()},
-                          {"voxels", voxels},
-                          {"bytes_per_voxel", static_cast<double>(mapper.map().memoryBytes()) / voxels},
-                          {"map_bytes", mapper.map().memoryBytes()},
-                          {"peak_rss_bytes", static_cast<size_t>(usage.ru_maxrss) * 1024},
-                          {"final_mesh_ms", mesh_ms},
-                          {"mesh_vertices", mesh.numVertices()}};
+    nlohmann::json out = {
+        {"data", data},
+        {"frames", times["total"].size()},
+        {"voxel_size_m", config.map.voxel_size_m},
+        {"threads", config.num_threads},
+        {"blocks", mapper.map().numBlocks()},
+        {"voxels", voxels},
+        {"bytes_per_voxel", static_cast<double>(mapper.map().memoryBytes()) / voxels},
+        {"map_bytes", mapper.map().memoryBytes()},
+        {"peak_rss_bytes", static_cast<size_t>(usage.ru_maxrss) * 1024},
+        {"final_mesh_ms", mesh_ms},
+        {"mesh_vertices", mesh.numVertices()}};
     for (auto& [stage, list] : times) {
       const panmap::StageTiming t = panmap::summariseTimes(list);
       out["stages"][stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}};

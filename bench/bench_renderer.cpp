@@ -101,7 +101,12 @@ void BM_RenderProceduralRoom(benchmark::State& state) {
   }
   state.counters["triangles"] = static_cast<double>(room.mesh.faces.size());
 }
-BENCHMARK(BM_RenderProceduralRoom)->Arg(4)->Arg(1)->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly();
+BENCHMARK(BM_RenderProceduralRoom)
+    ->Arg(4)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->Repetitions(5)
+    ->ReportAggregatesOnly();
 
 }  // namespace
 

@@ -24,15 +24,17 @@ inline std::string fixtureDir(const std::string& sub = "") {
 }
 
 /// A built executable of this build tree.
-inline std::string binPath(const std::string& name) { return std::string(PANMAP_BIN_DIR) + "/" + name; }
+inline std::string binPath(const std::string& name) {
+  return std::string(PANMAP_BIN_DIR) + "/" + name;
+}
 
 /// Skips the current test when a shared data folder is absent (e.g. a checkout without
 /// ../shared); everywhere else the data is there and the test runs.
-#define PANMAP_REQUIRE_DATA(sub)                                                        \
-  do {                                                                                  \
-    if (!std::filesystem::is_directory(::panmap::test::dataDir(sub))) {                 \
+#define PANMAP_REQUIRE_DATA(sub)                                                          \
+  do {                                                                                    \
+    if (!std::filesystem::is_directory(::panmap::test::dataDir(sub))) {                   \
       GTEST_SKIP() << "shared data folder " << ::panmap::test::dataDir(sub) << " absent"; \
-    }                                                                                   \
+    }                                                                                     \
   } while (0)
 
 /// A fresh temporary folder, removed with everything in it when this object dies.
@@ -50,7 +52,9 @@ class TempDir {
   TempDir(const TempDir&) = delete;
   TempDir& operator=(const TempDir&) = delete;
   /// The folder, or a path inside it.
-  std::string path(const std::string& sub = "") const { return sub.empty() ? path_ : path_ + "/" + sub; }
+  std::string path(const std::string& sub = "") const {
+    return sub.empty() ? path_ : path_ + "/" + sub;
+  }
 
  private:
   std::string path_;
@@ -69,7 +73,8 @@ inline CommandResult runCommand(const std::string& command) {
   if (!pipe) return result;
   std::array<char, 4096> buffer;
   size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.output.append(buffer.data(), n);
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    result.output.append(buffer.data(), n);
   const int status = ::pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;

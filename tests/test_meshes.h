@@ -18,7 +18,8 @@ inline void addQuad(LabelledMesh* mesh, const Eigen::Vector3f& a, const Eigen::V
   for (int i = 0; i <= n; ++i) {
     for (int j = 0; j <= n; ++j) {
       const float s = static_cast<float>(i) / n, t = static_cast<float>(j) / n;
-      mesh->vertices.push_back((1 - s) * (1 - t) * a + s * (1 - t) * b + s * t * c + (1 - s) * t * d);
+      mesh->vertices.push_back((1 - s) * (1 - t) * a + s * (1 - t) * b + s * t * c +
+                               (1 - s) * t * d);
       mesh->instance.push_back(instance);
       mesh->semantic.push_back(semantic);
       mesh->colors.push_back(color);

@@ -84,8 +84,9 @@ int main(int argc, char** argv) {
       options.encoding.labels = panmap::image_t::COMPRESSION_NONE;
     }
     panmap::ProgressLine progress("import", "frames", !quiet);
-    const panmap::ImportStats s = panmap::importDataset(
-        dataset_dir, log_path, options, [&](size_t done, size_t total) { progress.update(done, total); });
+    const panmap::ImportStats s =
+        panmap::importDataset(dataset_dir, log_path, options,
+                              [&](size_t done, size_t total) { progress.update(done, total); });
     progress.finish();
     std::printf("wrote %s (%s layout): %zu frames, %zu poses, %zu panoptic, %.1f MB\n",
                 log_path.c_str(), s.layout.c_str(), s.frames_written, s.poses_written,
@@ -98,9 +99,10 @@ int main(int argc, char** argv) {
       std::printf("dropped %zu depth images without a colour image in time\n", s.unmatched_frames);
     }
     if (!options.mask_dir.empty()) {
-      std::printf("%zu frames without a mask; %zu segments of categories unknown to the label "
-                  "table (class 0)\n",
-                  s.frames_without_mask, s.unknown_category_segments);
+      std::printf(
+          "%zu frames without a mask; %zu segments of categories unknown to the label "
+          "table (class 0)\n",
+          s.frames_without_mask, s.unknown_category_segments);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-import: error: %s\n", e.what());

@@ -25,8 +25,8 @@ int main(int argc, char** argv) {
         log_path, !shallow,
         [&](size_t done, size_t total) { progress.update(done >> 20, total >> 20); });
     progress.finish();
-    std::printf("%s\n", json ? panmap::logInfoToJson(info).c_str()
-                             : panmap::logInfoToTable(info).c_str());
+    std::printf("%s\n",
+                json ? panmap::logInfoToJson(info).c_str() : panmap::logInfoToTable(info).c_str());
     if (!info.allDecoded()) {
       std::fprintf(stderr, "panmap-loginfo: %s has messages that do not decode\n",
                    log_path.c_str());

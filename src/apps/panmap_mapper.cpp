@@ -25,8 +25,8 @@ size_t peakRssBytes() {
   return static_cast<size_t>(usage.ru_maxrss) * 1024;
 }
 
-panmap::LabelledMesh recoloured(const panmap::LabelledMesh& mesh,
-                                panmap::Rgb8 (*colour)(int32_t), const std::vector<int32_t>& ids) {
+panmap::LabelledMesh recoloured(const panmap::LabelledMesh& mesh, panmap::Rgb8 (*colour)(int32_t),
+                                const std::vector<int32_t>& ids) {
   panmap::LabelledMesh out = mesh;
   out.colors.resize(mesh.vertices.size());
   for (size_t i = 0; i < ids.size(); ++i) out.colors[i] = colour(ids[i]);
@@ -36,16 +36,18 @@ panmap::LabelledMesh recoloured(const panmap::LabelledMesh& mesh,
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"panmap mapping process. Offline: maps an LCM log (CAMERA_RGBD, CAMERA_POSE, "
-               "PANOPTIC) and writes mesh_{semantic,instance,superpoint}.ply, map.panmap, "
-               "report.json and snapshot PNGs into --out."};
+  CLI::App app{
+      "panmap mapping process. Offline: maps an LCM log (CAMERA_RGBD, CAMERA_POSE, "
+      "PANOPTIC) and writes mesh_{semantic,instance,superpoint}.ply, map.panmap, "
+      "report.json and snapshot PNGs into --out."};
   std::string log_path, out_dir, load_path;
   panmap::MapperConfig config;
   panmap::OfflineOptions options;
   bool quiet = false, geometry_only = false, spatial_only = false, no_snapshots = false;
   app.add_option("--log", log_path, "LCM log to map offline")->required();
   app.add_option("--out", out_dir, "output folder")->required();
-  app.add_option("--voxel-size", config.map.voxel_size_m, "voxel edge, metres")->capture_default_str();
+  app.add_option("--voxel-size", config.map.voxel_size_m, "voxel edge, metres")
+      ->capture_default_str();
   app.add_option("--threads", config.num_threads, "integration threads")->capture_default_str();
   app.add_option("--max-frames", options.max_frames, "stop after N integrated frames (0 = all)");
   app.add_flag("--geometry-only", geometry_only, "ignore panoptic masks (ablation)");
@@ -62,8 +64,9 @@ int main(int argc, char** argv) {
   try {
     config.fusion.geometry_only = geometry_only;
     config.superpoints.semantic_consistency = !spatial_only;
-    std::unique_ptr<panmap::Mapper> mapper =
-        load_path.empty() ? std::make_unique<panmap::Mapper>(config) : panmap::Mapper::load(load_path);
+    std::unique_ptr<panmap::Mapper> mapper = load_path.empty()
+                                                 ? std::make_unique<panmap::Mapper>(config)
+                                                 : panmap::Mapper::load(load_path);
     std::filesystem::create_directories(out_dir);
     panmap::ProgressLine progress("map", "MiB", !quiet);
     const panmap::OfflineReport report = panmap::mapLog(
@@ -89,7 +92,8 @@ int main(int argc, char** argv) {
     }
 
     nlohmann::json timings;
-    for (const auto& [stage, t] : report.timings) timings[stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}};
+    for (const auto& [stage, t] : report.timings)
+      timings[stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}};
     const nlohmann::json json = {
         {"log", log_path},
         {"events", report.events},
@@ -100,27 +104,31 @@ int main(int argc, char** argv) {
         {"unmatched_panoptic", report.sync.unmatched_panoptic},
         {"timings", timings},
         {"wall_s", report.wall_s},
-        {"memory", {{"map_bytes", mapper->map().memoryBytes()}, {"peak_rss_bytes", peakRssBytes()},
-                    {"blocks", mapper->map().numBlocks()},
-                    {"voxels", mapper->map().numBlocks() * panmap::kBlockVoxels}}},
+        {"memory",
+         {{"map_bytes", mapper->map().memoryBytes()},
+          {"peak_rss_bytes", peakRssBytes()},
+          {"blocks", mapper->map().numBlocks()},
+          {"voxels", mapper->map().numBlocks() * panmap::kBlockVoxels}}},
         {"superpoints", mapper->superpoints().states().size()},
         {"superpoint_merges", mapper->superpoints().merges().size()},
         {"instances", mapper->superpoints().numInstances()},
         {"vote_evictions", mapper->voteEvictions()},
         {"mesh", {{"vertices", mesh.numVertices()}, {"faces", mesh.numFaces()}}},
-        {"config", {{"voxel_size_m", mapper->config().map.voxel_size_m},
-                    {"truncation_voxels", mapper->config().integrator.truncation_voxels},
-                    {"geometry_only", mapper->config().fusion.geometry_only},
-                    {"semantic_consistency", mapper->config().superpoints.semantic_consistency},
-                    {"merge_threshold", mapper->config().superpoints.merge_threshold},
-                    {"threads", mapper->config().num_threads}}}};
+        {"config",
+         {{"voxel_size_m", mapper->config().map.voxel_size_m},
+          {"truncation_voxels", mapper->config().integrator.truncation_voxels},
+          {"geometry_only", mapper->config().fusion.geometry_only},
+          {"semantic_consistency", mapper->config().superpoints.semantic_consistency},
+          {"merge_threshold", mapper->config().superpoints.merge_threshold},
+          {"threads", mapper->config().num_threads}}}};
     std::ofstream(out_dir + "/report.json") << json.dump(2) << "\n";
-    std::printf("mapped %lld frames in %.1f s (median %.1f ms/frame): %zu super-points, %d "
-                "instances, %zu mesh vertices; outputs in %s\n",
-                static_cast<long long>(report.frames_integrated), report.wall_s,
-                report.timings.count("total") ? report.timings.at("total").median_ms : 0.0,
-                mapper->superpoints().states().size(), mapper->superpoints().numInstances(),
-                mesh.numVertices(), out_dir.c_str());
+    std::printf(
+        "mapped %lld frames in %.1f s (median %.1f ms/frame): %zu super-points, %d "
+        "instances, %zu mesh vertices; outputs in %s\n",
+        static_cast<long long>(report.frames_integrated), report.wall_s,
+        report.timings.count("total") ? report.timings.at("total").median_ms : 0.0,
+        mapper->superpoints().states().size(), mapper->superpoints().numInstances(),
+        mesh.numVertices(), out_dir.c_str());
     for (const auto& [reason, count] : report.rejected) {
       std::printf("  rejected %lld: %s\n", static_cast<long long>(count), reason.c_str());
     }

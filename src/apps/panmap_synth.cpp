@@ -30,7 +30,8 @@ std::string findOne(const std::string& dir, const std::string& suffix) {
   std::string found;
   for (const auto& e : fs::directory_iterator(dir)) {
     const std::string name = e.path().filename().string();
-    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+    if (name.size() > suffix.size() &&
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
         name.find(".labels.") == std::string::npos) {
       if (!found.empty()) throw panmap::Error(dir + ": more than one *" + suffix);
       found = e.path().string();
@@ -116,7 +117,8 @@ int main(int argc, char** argv) {
       "OUT/gt/instances.txt, OUT/gt/trajectory_gt.txt, OUT/gt/trajectory_input.txt, "
       "OUT/info.json"};
   int64_t room_seed = -1;
-  std::string scannet_dir, scannet_labels = "../shared/data/scannet-meta/scannetv2-labels.combined.tsv";
+  std::string scannet_dir,
+      scannet_labels = "../shared/data/scannet-meta/scannetv2-labels.combined.tsv";
   std::string trajectory_file, masks = "m2f", poses = "slam", out_dir;
   int frames = 300;
   uint64_t seed = 1;
@@ -131,17 +133,22 @@ int main(int argc, char** argv) {
   app.add_option("--scannet-labels", scannet_labels, "ScanNet label table (tsv)")
       ->capture_default_str();
   app.add_option("--trajectory", trajectory_file, "TUM trajectory to follow instead of a survey");
-  app.add_option("--frames", frames, "frames to render (30 Hz)")->capture_default_str()
+  app.add_option("--frames", frames, "frames to render (30 Hz)")
+      ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
   app.add_option("--masks", masks, "segmenter noise preset: clean, m2f, hard")
-      ->capture_default_str()->check(CLI::IsMember({"clean", "m2f", "hard"}));
+      ->capture_default_str()
+      ->check(CLI::IsMember({"clean", "m2f", "hard"}));
   app.add_option("--poses", poses, "pose preset: gt, slam, slam-hard")
-      ->capture_default_str()->check(CLI::IsMember({"gt", "slam", "slam-hard"}));
-  app.add_option("--seed", seed, "seed of trajectory, noise, masks and drift")->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::IsMember({"gt", "slam", "slam-hard"}));
+  app.add_option("--seed", seed, "seed of trajectory, noise, masks and drift")
+      ->capture_default_str();
   app.add_flag("--no-depth-noise", no_depth_noise, "exact depth (quantised to 1 mm)");
   app.add_option("--out", out_dir, "output folder")->required();
-  app.add_option("--preview-every", preview_every,
-                 "write colour, depth and mask PNGs of every Nth frame into OUT/preview (0 = none)");
+  app.add_option(
+      "--preview-every", preview_every,
+      "write colour, depth and mask PNGs of every Nth frame into OUT/preview (0 = none)");
   app.add_flag("-q,--quiet", quiet, "no progress line");
   CLI11_PARSE(app, argc, argv);
 
@@ -159,7 +166,8 @@ int main(int argc, char** argv) {
           findOne(scannet_dir, "_vh_clean_2.ply"), findOne(scannet_dir, ".aggregation.json"),
           findOne(scannet_dir, "_vh_clean_2.0.010000.segs.json"), table);
       mesh = gt.mesh;
-      source_json = {{"type", "scannet"}, {"dir", scannet_dir}, {"unknown_labels", gt.unknown_labels}};
+      source_json = {
+          {"type", "scannet"}, {"dir", scannet_dir}, {"unknown_labels", gt.unknown_labels}};
     }
 
     panmap::SynthConfig config;
@@ -167,12 +175,13 @@ int main(int argc, char** argv) {
     config.masks = panmap::SegmenterNoiseConfig::fromPreset(masks);
     config.poses = panmap::PoseDriftConfig::fromPreset(poses);
     config.depth.enabled = !no_depth_noise;
-    std::vector<panmap::TimedPose> trajectory;
+    std::vector<panmap::StampedPose> trajectory;
     panmap::SurveyConfig survey;
     survey.num_frames = frames;
     if (!trajectory_file.empty()) {
       trajectory = panmap::readTumTrajectory(trajectory_file);
-      if (static_cast<int>(trajectory.size()) > frames) trajectory.resize(static_cast<size_t>(frames));
+      if (static_cast<int>(trajectory.size()) > frames)
+        trajectory.resize(static_cast<size_t>(frames));
     } else {
       trajectory = panmap::planSurvey(mesh, survey, seed);
     }
@@ -181,7 +190,8 @@ int main(int argc, char** argv) {
     panmap::SequenceSynthesizer synth(mesh, trajectory, config);
     panmap::LogWriter log(out_dir + "/sequence.lcmlog");
     const panmap::ImageEncoding encoding;
-    const auto pose_source = poses == "gt" ? panmap::PoseSource::kGroundTruth : panmap::PoseSource::kSlam;
+    const auto pose_source =
+        poses == "gt" ? panmap::PoseSource::kGroundTruth : panmap::PoseSource::kSlam;
     panmap::ProgressLine progress("synth", "frames", !quiet);
     for (size_t k = 0; k < synth.size(); ++k) {
       const panmap::SynthFrame f = synth.frame(k);
@@ -194,7 +204,8 @@ int main(int argc, char** argv) {
       pose.source = pose_source;
       log.write(panmap::kChannelPose, utime, panmap::toMessage(pose));
       log.write(panmap::kChannelPanoptic, utime, panmap::toMessage(f.panoptic, encoding));
-      if (preview_every > 0 && k % static_cast<size_t>(preview_every) == 0) writePreview(out_dir, f);
+      if (preview_every > 0 && k % static_cast<size_t>(preview_every) == 0)
+        writePreview(out_dir, f);
       progress.update(k + 1, synth.size());
     }
     progress.finish();
@@ -207,43 +218,57 @@ int main(int argc, char** argv) {
     std::vector<Eigen::Isometry3d> gt_poses, input_poses;
     for (const auto& p : synth.groundTruthTrajectory()) gt_poses.push_back(p.T_W_C);
     for (const auto& p : synth.inputTrajectory()) input_poses.push_back(p.T_W_C);
-    const double ate = gt_poses.size() >= 3 ? panmap::absoluteTrajectoryErrorRmse(input_poses, gt_poses) : 0.0;
+    const double ate =
+        gt_poses.size() >= 3 ? panmap::absoluteTrajectoryErrorRmse(input_poses, gt_poses) : 0.0;
     const panmap::CoverageStats cov = synth.coverage();
     const panmap::SegmenterNoiseStats& seg = synth.segmenterStats();
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const json info = {
         {"seed", seed},
         {"source", source_json},
         {"frames", synth.size()},
-        {"camera", {{"fx", config.camera.fx}, {"fy", config.camera.fy}, {"cx", config.camera.cx},
-                    {"cy", config.camera.cy}, {"width", config.camera.width},
-                    {"height", config.camera.height}, {"depth_scale_m", config.depth_scale_m}}},
-        {"mesh", {{"vertices", mesh.numVertices()}, {"faces", mesh.numFaces()},
-                  {"instances", synth.instances().size()}}},
-        {"trajectory", {{"source", trajectory_file.empty() ? "survey" : trajectory_file},
-                        {"min_clearance_m", panmap::minClearance(synth.groundTruthTrajectory(), mesh)}}},
+        {"camera",
+         {{"fx", config.camera.fx},
+          {"fy", config.camera.fy},
+          {"cx", config.camera.cx},
+          {"cy", config.camera.cy},
+          {"width", config.camera.width},
+          {"height", config.camera.height},
+          {"depth_scale_m", config.depth_scale_m}}},
+        {"mesh",
+         {{"vertices", mesh.numVertices()},
+          {"faces", mesh.numFaces()},
+          {"instances", synth.instances().size()}}},
+        {"trajectory",
+         {{"source", trajectory_file.empty() ? "survey" : trajectory_file},
+          {"min_clearance_m", panmap::minClearance(synth.groundTruthTrajectory(), mesh)}}},
         {"masks", masksJson(config.masks)},
         {"poses", posesJson(config.poses)},
         {"depth_noise", depthJson(config.depth)},
-        {"coverage", {{"thing_instances", cov.thing_instances}, {"seen_once", cov.seen_once},
-                      {"seen_from_3_views", cov.seen_from_3_views},
-                      {"fraction_seen_from_3_views", cov.fractionSeenFrom3Views()}}},
-        {"measured", {{"input_ate_rmse_m", ate},
-                      {"miss_rate", seg.missRate()},
-                      {"small_miss_rate", seg.smallMissRate()},
-                      {"large_miss_rate", seg.largeMissRate()},
-                      {"confusion_rate", seg.confusionRate()},
-                      {"merge_rate", seg.mergeRate()},
-                      {"split_rate", seg.splitRate()},
-                      {"false_positives_per_frame", seg.falsePositivesPerFrame()},
-                      {"mean_boundary_error_px", seg.meanBoundaryErrorPx()}}},
+        {"coverage",
+         {{"thing_instances", cov.thing_instances},
+          {"seen_once", cov.seen_once},
+          {"seen_from_3_views", cov.seen_from_3_views},
+          {"fraction_seen_from_3_views", cov.fractionSeenFrom3Views()}}},
+        {"measured",
+         {{"input_ate_rmse_m", ate},
+          {"miss_rate", seg.missRate()},
+          {"small_miss_rate", seg.smallMissRate()},
+          {"large_miss_rate", seg.largeMissRate()},
+          {"confusion_rate", seg.confusionRate()},
+          {"merge_rate", seg.mergeRate()},
+          {"split_rate", seg.splitRate()},
+          {"false_positives_per_frame", seg.falsePositivesPerFrame()},
+          {"mean_boundary_error_px", seg.meanBoundaryErrorPx()}}},
         {"log_bytes", log.bytes()},
         {"seconds", seconds}};
     std::ofstream(out_dir + "/info.json") << info.dump(2) << "\n";
-    std::printf("wrote %s: %zu frames, %.1f MB; input ATE %.3f m; %d/%d objects seen from >= 3 "
-                "views; %.1f s\n",
-                (out_dir + "/sequence.lcmlog").c_str(), synth.size(), log.bytes() / 1e6, ate,
-                cov.seen_from_3_views, cov.thing_instances, seconds);
+    std::printf(
+        "wrote %s: %zu frames, %.1f MB; input ATE %.3f m; %d/%d objects seen from >= 3 "
+        "views; %.1f s\n",
+        (out_dir + "/sequence.lcmlog").c_str(), synth.size(), log.bytes() / 1e6, ate,
+        cov.seen_from_3_views, cov.thing_instances, seconds);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-synth: error: %s\n", e.what());
     return 1;

@@ -8,14 +8,14 @@ namespace {
 
 // NYU40 names exactly as in ScanNet's scannetv2-labels.combined.tsv (nyu40class column).
 constexpr std::array<const char*, kMaxNyu40Class + 1> kNyu40Names = {
-    "unknown",        "wall",       "floor",          "cabinet",      "bed",
-    "chair",          "sofa",       "table",          "door",         "window",
-    "bookshelf",      "picture",    "counter",        "blinds",       "desk",
-    "shelves",        "curtain",    "dresser",        "pillow",       "mirror",
-    "floor mat",      "clothes",    "ceiling",        "books",        "refridgerator",
-    "television",     "paper",      "towel",          "shower curtain", "box",
-    "whiteboard",     "person",     "night stand",    "toilet",       "sink",
-    "lamp",           "bathtub",    "bag",            "otherstructure", "otherfurniture",
+    "unknown",    "wall",    "floor",       "cabinet",        "bed",
+    "chair",      "sofa",    "table",       "door",           "window",
+    "bookshelf",  "picture", "counter",     "blinds",         "desk",
+    "shelves",    "curtain", "dresser",     "pillow",         "mirror",
+    "floor mat",  "clothes", "ceiling",     "books",          "refridgerator",
+    "television", "paper",   "towel",       "shower curtain", "box",
+    "whiteboard", "person",  "night stand", "toilet",         "sink",
+    "lamp",       "bathtub", "bag",         "otherstructure", "otherfurniture",
     "otherprop"};
 
 }  // namespace

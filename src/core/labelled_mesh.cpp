@@ -5,8 +5,10 @@ namespace panmap {
 std::string LabelledMesh::check() const {
   const size_t n = vertices.size();
   if (!colors.empty() && colors.size() != n) return "colors has a different length than vertices";
-  if (!semantic.empty() && semantic.size() != n) return "semantic has a different length than vertices";
-  if (!instance.empty() && instance.size() != n) return "instance has a different length than vertices";
+  if (!semantic.empty() && semantic.size() != n)
+    return "semantic has a different length than vertices";
+  if (!instance.empty() && instance.size() != n)
+    return "instance has a different length than vertices";
   if (!superpoint.empty() && superpoint.size() != n) {
     return "superpoint has a different length than vertices";
   }

@@ -16,7 +16,8 @@ bool isRigidTransform(const Eigen::Matrix4d& T, double tolerance, std::string* w
     reason << "last row is not 0 0 0 1";
   } else {
     const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
-    const double ortho_error = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    const double ortho_error =
+        (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
     if (ortho_error > tolerance) {
       reason << "rotation is not orthonormal (error " << ortho_error << ")";
     } else if (R.determinant() < 0.0) {

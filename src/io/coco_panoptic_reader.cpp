@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "panmap/io/internal/json_file.h"
+
 #include "panmap/core/error.h"
 #include "panmap/io/image_codec.h"
 #include "panmap/io/text_files.h"
@@ -14,16 +16,6 @@ namespace panmap {
 namespace {
 
 using nlohmann::json;
-
-json readJson(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error("cannot read " + path);
-  try {
-    return json::parse(in);
-  } catch (const json::exception& e) {
-    throw Error(path + ": malformed JSON (" + std::string(e.what()) + ")");
-  }
-}
 
 std::string stemOf(const std::string& file_name) {
   return std::filesystem::path(file_name).stem().string();
@@ -75,7 +67,7 @@ CocoPanopticReader::CocoPanopticReader(const std::string& mask_dir, const std::s
     : mask_dir_(mask_dir), table_(std::move(table)) {
   if (!isDirectory(mask_dir)) throw Error("mask folder " + mask_dir + " does not exist");
   if (!json_path.empty()) {
-    const json root = readJson(json_path);
+    const json root = internal::readJsonFile(json_path);
     if (!root.is_object() || !root.contains("annotations") || !root["annotations"].is_array()) {
       throw Error(json_path + ": not a COCO panoptic file (no annotations list)");
     }
@@ -95,8 +87,8 @@ CocoPanopticReader::CocoPanopticReader(const std::string& mask_dir, const std::s
       const std::string png = a["file_name"].get<std::string>();
       Entry entry;
       entry.png_path = mask_dir + "/" + png;
-      entry.segments = parseSegments(a["segments_info"], table_, json_path + " (" + png + ")",
-                                     &unknown);
+      entry.segments =
+          parseSegments(a["segments_info"], table_, json_path + " (" + png + ")", &unknown);
       std::string key = stemOf(png);
       if (a.contains("image_id") && a["image_id"].is_number_integer()) {
         const auto it = image_names.find(a["image_id"].get<long long>());
@@ -130,8 +122,9 @@ PanopticFrame CocoPanopticReader::read(const std::string& color_stem) {
   PanopticFrame frame;
   size_t unknown = 0;
   if (!entry.json_path.empty()) {
-    const json root = readJson(entry.json_path);
-    const json& info = root.is_object() && root.contains("segments_info") ? root["segments_info"] : root;
+    const json root = internal::readJsonFile(entry.json_path);
+    const json& info =
+        root.is_object() && root.contains("segments_info") ? root["segments_info"] : root;
     frame.segments = parseSegments(info, table_, entry.json_path, &unknown);
   } else {
     frame.segments = entry.segments;

@@ -17,7 +17,8 @@ void DatasetOptions::check() const {
   }
   if (!(tum_max_dt_s > 0.0)) throw Error("TUM association tolerance must be positive");
   if (!(pose_tolerance > 0.0)) throw Error("pose tolerance must be positive");
-  if (intrinsics && !((*intrinsics)(0) > 0.0 && (*intrinsics)(1) > 0.0 && intrinsics->allFinite())) {
+  if (intrinsics &&
+      !((*intrinsics)(0) > 0.0 && (*intrinsics)(1) > 0.0 && intrinsics->allFinite())) {
     throw Error("intrinsics must be fx,fy,cx,cy with positive focal lengths");
   }
 }

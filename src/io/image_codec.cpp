@@ -14,14 +14,16 @@ namespace panmap {
 std::vector<uint8_t> readFileBytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("cannot read " + path);
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
   if (in.bad()) throw Error("cannot read " + path);
   return bytes;
 }
 
 void writeFileBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
   if (!out) throw Error("cannot write " + path);
 }
 
@@ -60,7 +62,8 @@ std::vector<uint8_t> encodeLabelPng(const LabelImage& image) {
     auto* dst = bgr.ptr<cv::Vec3b>(v);
     for (int u = 0; u < image.width(); ++u) {
       const int32_t id = src[u];
-      if (id < 0 || id >= (1 << 24)) throw Error("label " + std::to_string(id) + " outside [0, 2^24)");
+      if (id < 0 || id >= (1 << 24))
+        throw Error("label " + std::to_string(id) + " outside [0, 2^24)");
       dst[u] = cv::Vec3b(static_cast<uint8_t>(id >> 16), static_cast<uint8_t>((id >> 8) & 255),
                          static_cast<uint8_t>(id & 255));
     }

@@ -179,7 +179,8 @@ class ScanNetReader : public DatasetReader {
         const double z = z_row[u] * scale;
         const Eigen::Vector3d ray((u - d.cx) / d.fx, (v - d.cy) / d.fy, 1.0);
         // Without depth the point is taken at infinity: only the rotation matters.
-        const Eigen::Vector3d p_C = z > 0.0 ? Eigen::Vector3d(R * (ray * z) + t) : Eigen::Vector3d(R * ray);
+        const Eigen::Vector3d p_C =
+            z > 0.0 ? Eigen::Vector3d(R * (ray * z) + t) : Eigen::Vector3d(R * ray);
         float cu = -1.0f, cv = -1.0f;
         if (p_C.z() > 1e-6) {
           cu = static_cast<float>(c.fx * p_C.x() / p_C.z() + c.cx);

@@ -10,6 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "panmap/io/internal/json_file.h"
+
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
 #include "panmap/io/ply.h"
@@ -19,17 +21,6 @@ namespace panmap {
 namespace {
 
 using nlohmann::json;
-
-json readJson(const std::string& path) {
-  if (!isRegularFile(path)) throw Error("cannot read " + path + " (no such file)");
-  std::ifstream in(path);
-  if (!in) throw Error("cannot read " + path);
-  try {
-    return json::parse(in);
-  } catch (const json::exception& e) {
-    throw Error(path + ": malformed JSON (" + std::string(e.what()) + ")");
-  }
-}
 
 std::vector<std::string> splitTabs(const std::string& line) {
   std::vector<std::string> fields;
@@ -118,7 +109,7 @@ ScanNetGroundTruth loadScanNetGroundTruth(const std::string& mesh_ply,
   gt.mesh = readPly(mesh_ply);
   const size_t n = gt.mesh.numVertices();
 
-  const json segs = readJson(segs_json);
+  const json segs = internal::readJsonFile(segs_json);
   if (!segs.is_object() || !segs.contains("segIndices") || !segs["segIndices"].is_array()) {
     throw Error(segs_json + ": no segIndices list");
   }
@@ -128,7 +119,7 @@ ScanNetGroundTruth loadScanNetGroundTruth(const std::string& mesh_ply,
                 mesh_ply + " has " + std::to_string(n) + " vertices");
   }
 
-  const json aggregation = readJson(aggregation_json);
+  const json aggregation = internal::readJsonFile(aggregation_json);
   if (!aggregation.is_object() || !aggregation.contains("segGroups") ||
       !aggregation["segGroups"].is_array()) {
     throw Error(aggregation_json + ": no segGroups list");

@@ -11,6 +11,7 @@
 #include "panmap/io/image_codec.h"
 #include "panmap/io/internal/readers.h"
 #include "panmap/io/text_files.h"
+#include "panmap/io/tum_trajectory.h"
 
 namespace panmap {
 namespace internal {
@@ -41,57 +42,28 @@ std::vector<Stamped> readFileList(const std::string& path) {
   return out;
 }
 
-struct GroundTruth {
-  double t = 0.0;
-  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
-};
-
-std::vector<GroundTruth> readGroundTruth(const std::string& path, double tolerance) {
-  std::vector<GroundTruth> out;
-  std::ifstream in(path);
-  if (!in) return out;  // a TUM folder without ground truth yields frames without poses
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    double v[8];
-    for (double& x : v) {
-      std::string token;
-      if (!(fields >> token)) {
-        throw Error(path + ":" + std::to_string(line_no) + ": expected 't tx ty tz qx qy qz qw'");
-      }
-      x = std::strtod(token.c_str(), nullptr);
-    }
-    const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
-    bool finite = true;
-    for (double x : v) finite = finite && std::isfinite(x);
-    if (!finite || std::abs(q.norm() - 1.0) > std::max(tolerance, 1e-3)) {
-      throw Error(path + ":" + std::to_string(line_no) + ": invalid pose (non-finite or "
-                  "non-unit quaternion)");
-    }
-    GroundTruth gt;
-    gt.t = v[0];
-    gt.T_W_C.linear() = q.normalized().toRotationMatrix();
-    gt.T_W_C.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
-    out.push_back(gt);
-  }
+// Ground truth, sorted by time; a TUM folder without it yields frames without poses.
+std::vector<StampedPose> readGroundTruth(const std::string& path) {
+  if (!isRegularFile(path)) return {};
+  std::vector<StampedPose> out = readTumTrajectory(path);
   std::sort(out.begin(), out.end(),
-            [](const GroundTruth& a, const GroundTruth& b) { return a.t < b.t; });
+            [](const StampedPose& a, const StampedPose& b) { return a.utime < b.utime; });
   return out;
 }
+
+double timeOf(const Stamped& s) { return s.t; }
+double timeOf(const StampedPose& p) { return static_cast<double>(p.utime) * 1e-6; }
 
 // Index of the entry nearest to t in a time-sorted list, or -1 if farther than max_dt.
 template <typename T>
 long nearest(const std::vector<T>& list, double t, double max_dt) {
   auto it = std::lower_bound(list.begin(), list.end(), t,
-                             [](const T& e, double value) { return e.t < value; });
+                             [](const T& e, double value) { return timeOf(e) < value; });
   long best = -1;
   double best_dt = max_dt;
   for (auto c : {it, it == list.begin() ? it : it - 1}) {
     if (c == list.end()) continue;
-    const double dt = std::abs(c->t - t);
+    const double dt = std::abs(timeOf(*c) - t);
     if (dt <= best_dt) {
       best_dt = dt;
       best = c - list.begin();
@@ -118,7 +90,7 @@ class TumReader : public DatasetReader {
       throw Error(dir + ": no depth image has a colour image within " +
                   std::to_string(options.tum_max_dt_s) + " s");
     }
-    ground_truth_ = readGroundTruth(dir + "/groundtruth.txt", options.pose_tolerance);
+    ground_truth_ = readGroundTruth(dir + "/groundtruth.txt");
 
     if (options.intrinsics) {
       const Eigen::Vector4d& k = *options.intrinsics;
@@ -133,7 +105,8 @@ class TumReader : public DatasetReader {
     } else if (dir.find("freiburg3") != std::string::npos) {
       camera_ = PinholeCamera{535.4, 539.2, 320.1, 247.6, 0, 0};
     } else {
-      throw Error(dir + "/camera-intrinsics.txt: intrinsics file missing and the folder name "
+      throw Error(dir +
+                  "/camera-intrinsics.txt: intrinsics file missing and the folder name "
                   "names no freiburg camera (pass --intrinsics fx,fy,cx,cy)");
     }
     const DepthImage first = readDepthFile(dir + "/" + pairs_.front().depth.file);
@@ -182,14 +155,16 @@ class TumReader : public DatasetReader {
 
   std::optional<Eigen::Isometry3d> poseAt(double t, std::string* problem) const {
     const auto& gt = ground_truth_;
-    auto it = std::lower_bound(gt.begin(), gt.end(), t,
-                               [](const GroundTruth& e, double value) { return e.t < value; });
+    auto it = std::lower_bound(gt.begin(), gt.end(), t, [](const StampedPose& e, double value) {
+      return timeOf(e) < value;
+    });
     // Interpolate between bracketing samples no more than 2 tolerances apart.
     if (it != gt.end() && it != gt.begin()) {
-      const GroundTruth& b = *it;
-      const GroundTruth& a = *(it - 1);
-      if (b.t - a.t <= 2.0 * options_.tum_max_dt_s + 1e-9) {
-        const double s = (b.t > a.t) ? (t - a.t) / (b.t - a.t) : 0.0;
+      const double tb = timeOf(*it), ta = timeOf(*(it - 1));
+      const StampedPose& b = *it;
+      const StampedPose& a = *(it - 1);
+      if (tb - ta <= 2.0 * options_.tum_max_dt_s + 1e-9) {
+        const double s = (tb > ta) ? (t - ta) / (tb - ta) : 0.0;
         return interpolatePose(a.T_W_C, b.T_W_C, s);
       }
     }
@@ -207,7 +182,7 @@ class TumReader : public DatasetReader {
   DatasetOptions options_;
   PinholeCamera camera_;
   std::vector<Pair> pairs_;
-  std::vector<GroundTruth> ground_truth_;
+  std::vector<StampedPose> ground_truth_;
   size_t unmatched_ = 0;
 };
 

@@ -87,11 +87,10 @@ image_t colorToMessage(const ColorImage& image, const ImageEncoding& encoding,
                        const std::vector<uint8_t>* jpeg_bytes) {
   switch (encoding.color) {
     case image_t::COMPRESSION_JPEG:
-      return compressedImage(image.width(), image.height(), image_t::PIXEL_FORMAT_RGB8,
-                             image_t::COMPRESSION_JPEG,
-                             jpeg_bytes && !jpeg_bytes->empty()
-                                 ? *jpeg_bytes
-                                 : encodeJpeg(image, encoding.jpeg_quality));
+      return compressedImage(
+          image.width(), image.height(), image_t::PIXEL_FORMAT_RGB8, image_t::COMPRESSION_JPEG,
+          jpeg_bytes && !jpeg_bytes->empty() ? *jpeg_bytes
+                                             : encodeJpeg(image, encoding.jpeg_quality));
     case image_t::COMPRESSION_PNG:
       return compressedImage(image.width(), image.height(), image_t::PIXEL_FORMAT_RGB8,
                              image_t::COMPRESSION_PNG, encodePng(image));
@@ -178,15 +177,16 @@ RgbdFrame fromMessage(const rgbd_frame_t& msg) {
     throw Error("rgbd frame " + std::to_string(msg.frame_id) + ": depth_scale_m must be > 0");
   }
   frame.depth = depthFromMessage(msg.depth, "rgbd depth");
-  frame.camera = PinholeCamera{msg.fx, msg.fy, msg.cx, msg.cy, frame.depth.width(),
-                               frame.depth.height()};
+  frame.camera =
+      PinholeCamera{msg.fx, msg.fy, msg.cx, msg.cy, frame.depth.width(), frame.depth.height()};
   std::string why;
   if (!frame.camera.isValid(&why)) {
     throw Error("rgbd frame " + std::to_string(msg.frame_id) + ": intrinsics: " + why);
   }
   if (msg.color.size > 0 || msg.color.width > 0) {
     frame.color = colorFromMessage(msg.color, "rgbd colour");
-    if (frame.color.width() != frame.depth.width() || frame.color.height() != frame.depth.height()) {
+    if (frame.color.width() != frame.depth.width() ||
+        frame.color.height() != frame.depth.height()) {
       std::ostringstream s;
       s << "rgbd frame " << msg.frame_id << ": colour " << frame.color.width() << "x"
         << frame.color.height() << " is not registered to depth " << frame.depth.width() << "x"
@@ -258,8 +258,8 @@ PanopticFrame fromMessage(const panoptic_t& msg) {
   std::set<int32_t> ids;
   for (const panoptic_segment_t& m : msg.segments) {
     if (m.id <= 0 || !ids.insert(m.id).second) {
-      throw Error("panoptic " + std::to_string(msg.utime) + ": segment id " +
-                  std::to_string(m.id) + " is not positive and unique");
+      throw Error("panoptic " + std::to_string(msg.utime) + ": segment id " + std::to_string(m.id) +
+                  " is not positive and unique");
     }
     if (!(m.score >= 0.0f && m.score <= 1.0f)) {
       throw Error("panoptic " + std::to_string(msg.utime) + ": score of segment " +

@@ -28,8 +28,8 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
   stats.layout = reader->layoutName();
   stats.frames_found = reader->size();
   stats.unmatched_frames = reader->unmatchedFrames();
-  const size_t total = options.max_frames ? std::min(options.max_frames, reader->size())
-                                          : reader->size();
+  const size_t total =
+      options.max_frames ? std::min(options.max_frames, reader->size()) : reader->size();
 
   // Write beside the target and rename at the end: a failed import leaves no partial log.
   const std::string partial = log_path + ".partial";

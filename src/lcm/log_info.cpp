@@ -55,8 +55,7 @@ LogInfo inspectLog(const std::string& path, bool deep,
     }
     ChannelInfo& c = channels[event->channel];
     c.channel = event->channel;
-    const MessageCheck check =
-        checkMessage(event->data, static_cast<size_t>(event->datalen), deep);
+    const MessageCheck check = checkMessage(event->data, static_cast<size_t>(event->datalen), deep);
     const int64_t utime = check.ok ? check.utime : event->timestamp;
     if (c.count == 0) {
       c.type = check.type;
@@ -68,7 +67,8 @@ LogInfo inspectLog(const std::string& path, bool deep,
     ++c.count;
     c.bytes += static_cast<size_t>(event->datalen);
     if (!check.ok) {
-      if (c.failures == 0) c.first_error = "event " + std::to_string(event->eventnum) + ": " + check.error;
+      if (c.failures == 0)
+        c.first_error = "event " + std::to_string(event->eventnum) + ": " + check.error;
       ++c.failures;
     }
     if (progress && info.events % 16 == 0) {
@@ -109,13 +109,13 @@ std::string logInfoToTable(const LogInfo& info) {
   std::ostringstream out;
   out << std::left << std::setw(16) << "channel" << std::setw(20) << "type" << std::right
       << std::setw(8) << "count" << std::setw(10) << "rate_hz" << std::setw(12) << "mean_bytes"
-      << std::setw(18) << "first_utime" << std::setw(18) << "last_utime" << "  decoded\n";
+      << std::setw(18) << "first_utime" << std::setw(18) << "last_utime"
+      << "  decoded\n";
   for (const ChannelInfo& c : info.channels) {
     out << std::left << std::setw(16) << c.channel << std::setw(20)
-        << (c.type.empty() ? "?" : c.type) << std::right << std::setw(8) << c.count
-        << std::setw(10) << std::fixed << std::setprecision(2) << c.rateHz() << std::setw(12)
-        << std::setprecision(0) << c.meanBytes() << std::setw(18) << c.first_utime
-        << std::setw(18) << c.last_utime << "  "
+        << (c.type.empty() ? "?" : c.type) << std::right << std::setw(8) << c.count << std::setw(10)
+        << std::fixed << std::setprecision(2) << c.rateHz() << std::setw(12) << std::setprecision(0)
+        << c.meanBytes() << std::setw(18) << c.first_utime << std::setw(18) << c.last_utime << "  "
         << (c.failures ? std::to_string(c.count - c.failures) + "/" + std::to_string(c.count)
                        : std::string("all"))
         << "\n";
@@ -123,9 +123,11 @@ std::string logInfoToTable(const LogInfo& info) {
   }
   out << info.events << " events";
   if (info.truncated) {
-    out << "; unreadable after byte " << info.readable_bytes << " of " << "the file (truncated or corrupt)";
+    out << "; unreadable after byte " << info.readable_bytes << " of "
+        << "the file (truncated or corrupt)";
   }
-  if (info.skipped_bytes) out << "; " << info.skipped_bytes << " bytes between events are not events";
+  if (info.skipped_bytes)
+    out << "; " << info.skipped_bytes << " bytes between events are not events";
   out << "\n";
   return out.str();
 }

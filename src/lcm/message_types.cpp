@@ -66,12 +66,13 @@ struct TypeEntry {
   MessageCheck (*check)(const char*, const void*, size_t, bool);
 };
 
-#define PANMAP_TYPE(T) TypeEntry{#T, T::getHash(), &decodeAs<T>}
+#define PANMAP_TYPE(T) \
+  TypeEntry { #T, T::getHash(), &decodeAs < T> }
 
 const std::vector<TypeEntry>& types() {
   static const std::vector<TypeEntry> kTypes = {
-      PANMAP_TYPE(rgbd_frame_t),   PANMAP_TYPE(pose_t),          PANMAP_TYPE(panoptic_t),
-      PANMAP_TYPE(status_t),       PANMAP_TYPE(object_list_t),   PANMAP_TYPE(octomap_t),
+      PANMAP_TYPE(rgbd_frame_t),       PANMAP_TYPE(pose_t),         PANMAP_TYPE(panoptic_t),
+      PANMAP_TYPE(status_t),           PANMAP_TYPE(object_list_t),  PANMAP_TYPE(octomap_t),
       PANMAP_TYPE(superpoint_graph_t), PANMAP_TYPE(graph_labels_t), PANMAP_TYPE(command_t)};
   return kTypes;
 }

@@ -112,8 +112,10 @@ OfflineReport mapLog(const std::string& log_path, const OfflineOptions& options,
   if (!done) integrate(sync.flush());
   if (progress) progress(static_cast<size_t>(st.st_size), static_cast<size_t>(st.st_size));
   report.sync = sync.stats();
-  if (report.sync.rejected_no_pose) report.rejected["frame: no pose"] += report.sync.rejected_no_pose;
-  if (report.sync.dropped_queue_full) report.rejected["frame: queue full"] += report.sync.dropped_queue_full;
+  if (report.sync.rejected_no_pose)
+    report.rejected["frame: no pose"] += report.sync.rejected_no_pose;
+  if (report.sync.dropped_queue_full)
+    report.rejected["frame: queue full"] += report.sync.dropped_queue_full;
   for (auto& [stage, list] : times) report.timings[stage] = summariseTimes(list);
   report.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;

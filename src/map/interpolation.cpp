@@ -15,7 +15,8 @@ bool interpolateSdf(const TsdfMap& map, const Eigen::Vector3f& p_W, float* sdf_m
   for (int dz = 0; dz < 2; ++dz) {
     for (int dy = 0; dy < 2; ++dy) {
       for (int dx = 0; dx < 2; ++dx) {
-        const Eigen::Vector3f centre = (base + Eigen::Vector3f(dx, dy, dz) + Eigen::Vector3f::Constant(0.5f)) * v;
+        const Eigen::Vector3f centre =
+            (base + Eigen::Vector3f(dx, dy, dz) + Eigen::Vector3f::Constant(0.5f)) * v;
         const Voxel* voxel = map.findVoxel(centre);
         if (!voxel || voxel->weight <= 0.0f) return false;
         c[dx][dy][dz] = voxel->sdf_m;

@@ -113,8 +113,8 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
   // Blocks near the surface: sample the truncation band of every few pixels' rays (the
   // stride keeps neighbouring samples well under a block apart at the far range).
   const Eigen::Isometry3f T_W_Cf = T_W_C.cast<float>();
-  const int stride = std::clamp(
-      static_cast<int>(map->blockSize() * cam.fx / config_.max_depth_m / 2.0), 1, 8);
+  const int stride =
+      std::clamp(static_cast<int>(map->blockSize() * cam.fx / config_.max_depth_m / 2.0), 1, 8);
   keys_.clear();
   const float inv_block = 1.0f / map->blockSize();
   auto addKey = [&](const Eigen::Vector3f& p_W) {
@@ -127,7 +127,8 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
       const float d = depth_m_(u, v);
       if (d <= 0.0f) continue;
       const Eigen::Vector3f ray_C((u - static_cast<float>(cam.cx)) / static_cast<float>(cam.fx),
-                                  (v - static_cast<float>(cam.cy)) / static_cast<float>(cam.fy), 1.0f);
+                                  (v - static_cast<float>(cam.cy)) / static_cast<float>(cam.fy),
+                                  1.0f);
       const float near = config_.space_carving ? config_.min_depth_m : std::max(d - trunc, 0.0f);
       const float step = std::min(map->blockSize() * 0.5f, trunc);
       for (float z = near; z < d + trunc; z += step) addKey(T_W_Cf * (ray_C * z));

@@ -56,7 +56,8 @@ std::optional<Eigen::Isometry3d> FrameSynchronizer::poseAt(int64_t utime, bool f
   // Nearest within the tolerance; a later pose may still come unless the stream has ended.
   const StampedPose* nearest = nullptr;
   int64_t best = config_.pose_tolerance_us + 1;
-  if (has_after && after->first - utime < best) best = after->first - utime, nearest = &after->second;
+  if (has_after && after->first - utime < best)
+    best = after->first - utime, nearest = &after->second;
   if (has_before) {
     const auto before = std::prev(after);
     if (utime - before->first < best) best = utime - before->first, nearest = &before->second;

@@ -178,7 +178,8 @@ std::unique_ptr<Mapper> Mapper::load(const std::string& path) {
   BinaryReader header(bytes.data(), bytes.size(), path);
   char magic[8];
   header.getBytes(magic, sizeof(magic));
-  if (std::memcmp(magic, kMagic, sizeof(kMagic)) != 0) throw Error(path + ": not a panmap map file");
+  if (std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)
+    throw Error(path + ": not a panmap map file");
   const uint32_t version = header.get<uint32_t>();
   if (version != kVersion) {
     throw Error(path + ": map file version " + std::to_string(version) + ", this panmap reads " +

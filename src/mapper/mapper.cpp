@@ -25,7 +25,8 @@ Mapper::Mapper(const MapperConfig& config) : config_(config) {
   map_ = std::make_unique<TsdfMap>(config_.map);
   // The pipeline's thread count applies to every stage.
   config_.depth_segmentation.num_threads = config_.num_threads;
-  segmenter_ = std::make_unique<PanopticGeometricSegmenter>(config_.depth_segmentation, config_.fusion);
+  segmenter_ =
+      std::make_unique<PanopticGeometricSegmenter>(config_.depth_segmentation, config_.fusion);
   tracker_ = std::make_unique<SuperpointTracker>(config_.superpoints);
   integrator_ = std::make_unique<ProjectiveIntegrator>(config_.integrator, pool_.get());
   MarchingCubesConfig mesh_config;

@@ -9,7 +9,8 @@
 namespace panmap {
 
 void DepthNoiseConfig::check() const {
-  if (axial_sigma_a_m < 0 || axial_sigma_b_m < 0) throw Error("depth noise: axial sigma must be >= 0");
+  if (axial_sigma_a_m < 0 || axial_sigma_b_m < 0)
+    throw Error("depth noise: axial sigma must be >= 0");
   if (lateral_sigma_px < 0) throw Error("depth noise: lateral_sigma_px must be >= 0");
   if (!(quantization_m > 0)) throw Error("depth noise: quantization_m must be > 0");
   if (!(min_range_m >= 0 && max_range_m > min_range_m)) {
@@ -36,7 +37,8 @@ DepthImage simulateDepth(const RenderedView& view, const DepthNoiseConfig& confi
   if (!config.enabled) {
     for (size_t i = 0; i < clean.size(); ++i) {
       const double z = clean.data()[i];
-      out.data()[i] = z > 0 ? static_cast<uint16_t>(std::min(max_units, std::round(z / depth_scale_m))) : 0;
+      out.data()[i] =
+          z > 0 ? static_cast<uint16_t>(std::min(max_units, std::round(z / depth_scale_m))) : 0;
     }
     return out;
   }
@@ -80,8 +82,10 @@ DepthImage simulateDepth(const RenderedView& view, const DepthNoiseConfig& confi
       // the sample along the surface, which the axial term already covers).
       const bool edge = z > 0.0 && isEdge(u, v, z);
       if (edge || z <= 0.0) {
-        su = std::clamp(u + static_cast<int>(std::lround(jitter_u * config.lateral_sigma_px)), 0, w - 1);
-        sv = std::clamp(v + static_cast<int>(std::lround(jitter_v * config.lateral_sigma_px)), 0, h - 1);
+        su = std::clamp(u + static_cast<int>(std::lround(jitter_u * config.lateral_sigma_px)), 0,
+                        w - 1);
+        sv = std::clamp(v + static_cast<int>(std::lround(jitter_v * config.lateral_sigma_px)), 0,
+                        h - 1);
         z = clean(su, sv);
       }
       if (z <= 0.0 || z < config.min_range_m || z > config.max_range_m) continue;
@@ -94,7 +98,8 @@ DepthImage simulateDepth(const RenderedView& view, const DepthNoiseConfig& confi
       // Mixed pixels on depth edges are often invalidated by the sensor.
       if (isEdge(su, sv, z) && drop < config.edge_dropout) continue;
       const double sigma = config.axial_sigma_a_m + config.axial_sigma_b_m *
-                                                        (z - config.axial_z0_m) * (z - config.axial_z0_m);
+                                                        (z - config.axial_z0_m) *
+                                                        (z - config.axial_z0_m);
       const double noise = a_corr * correlated(u, v) + a_white * white;
       const double measured = std::round((z + sigma * noise) / step) * step;
       const double units = std::round(measured / depth_scale_m);

@@ -38,7 +38,9 @@ PoseDriftConfig PoseDriftConfig::fromPreset(const std::string& name) {
 
 namespace {
 
-Eigen::Vector3d gaussian3(Rng* rng) { return Eigen::Vector3d(rng->normal(), rng->normal(), rng->normal()); }
+Eigen::Vector3d gaussian3(Rng* rng) {
+  return Eigen::Vector3d(rng->normal(), rng->normal(), rng->normal());
+}
 
 Eigen::Matrix3d expSO3(const Eigen::Vector3d& w) {
   const double angle = w.norm();
@@ -59,7 +61,8 @@ std::vector<Eigen::Isometry3d> applyPoseDrift(const std::vector<Eigen::Isometry3
   // stationary standard deviation is the configured drift.
   Eigen::Vector3d bias_t = gaussian3(&rng) * config.translation_drift_per_m;
   Eigen::Vector3d bias_r_dist = gaussian3(&rng) * config.rotation_drift_deg_per_m * deg;
-  Eigen::Vector3d bias_r_turn = gaussian3(&rng) * config.rotation_drift_deg_per_90deg * deg / (M_PI / 2);
+  Eigen::Vector3d bias_r_turn =
+      gaussian3(&rng) * config.rotation_drift_deg_per_90deg * deg / (M_PI / 2);
   Eigen::Isometry3d estimate = gt.front();  // drift-free part of the estimate
   out.push_back(gt.front());
   for (size_t k = 1; k < gt.size(); ++k) {
@@ -80,7 +83,8 @@ std::vector<Eigen::Isometry3d> applyPoseDrift(const std::vector<Eigen::Isometry3
     // White jitter on top; it does not feed back into the estimate.
     Eigen::Isometry3d jittered = estimate;
     jittered.translation() += gaussian3(&rng) * config.jitter_translation_m;
-    jittered.linear() = expSO3(gaussian3(&rng) * config.jitter_rotation_deg * deg) * estimate.linear();
+    jittered.linear() =
+        expSO3(gaussian3(&rng) * config.jitter_rotation_deg * deg) * estimate.linear();
     out.push_back(jittered);
   }
   return out;
@@ -99,7 +103,8 @@ double absoluteTrajectoryErrorRmse(const std::vector<Eigen::Isometry3d>& estimat
     dst.col(i) = reference[static_cast<size_t>(i)].translation();
   }
   const Eigen::Matrix4d T = Eigen::umeyama(src, dst, false);
-  const Eigen::Matrix3Xd aligned = (T.topLeftCorner<3, 3>() * src).colwise() + T.topRightCorner<3, 1>();
+  const Eigen::Matrix3Xd aligned =
+      (T.topLeftCorner<3, 3>() * src).colwise() + T.topRightCorner<3, 1>();
   return std::sqrt((aligned - dst).colwise().squaredNorm().mean());
 }
 

@@ -21,8 +21,8 @@ void RenderConfig::check() const {
 // Per-frame working memory: vertices in the camera frame and the z-buffer.
 struct MeshRenderer::Scratch {
   std::vector<Eigen::Vector3f> points_C;
-  Image<float> zbuffer;     // z of the nearest surface so far
-  Image<int32_t> face;      // its face index, -1 = none
+  Image<float> zbuffer;  // z of the nearest surface so far
+  Image<int32_t> face;   // its face index, -1 = none
 };
 
 MeshRenderer::MeshRenderer(const LabelledMesh& mesh, const RenderConfig& config)
@@ -79,10 +79,11 @@ inline void drawTriangle(const PinholeCamera& cam, const Eigen::Vector3f& af,
   if (std::abs(d) < 1e-12) return;  // seen edge-on
   const double iz_du = n.x() / (cam.fx * d), iz_dv = n.y() / (cam.fy * d);
   const double iz_0 = (n.z() - n.x() * cam.cx / cam.fx - n.y() * cam.cy / cam.fy) / d;
-  // Edge functions, normalised barycentrics of corners a and b, linear in (u, v).
+  // Edge functions, normalised barycentrics of corners a and b: evaluated exactly at each
+  // row start, stepped along the row.
   const double inv_area = 1.0 / area;
-  const double wa_du = -(vc - vb) * inv_area, wa_dv = (uc - ub) * inv_area;
-  const double wb_du = -(va - vc) * inv_area, wb_dv = (ua - uc) * inv_area;
+  const double wa_du = -(vc - vb) * inv_area;
+  const double wb_du = -(va - vc) * inv_area;
   const double eps = -1e-6;  // closes seams between neighbouring triangles
   for (int v = v0; v <= v1; ++v) {
     double wa = ((ub - u0) * (vc - v) - (vb - v) * (uc - u0)) * inv_area;
@@ -179,9 +180,9 @@ void MeshRenderer::render(const PinholeCamera& camera, const Eigen::Isometry3d& 
         continue;
       }
       const float z = scratch.zbuffer(u, v);
-      const Eigen::Vector3f ray_C((u - static_cast<float>(camera.cx)) / static_cast<float>(camera.fx),
-                                  (v - static_cast<float>(camera.cy)) / static_cast<float>(camera.fy),
-                                  1.0f);
+      const Eigen::Vector3f ray_C(
+          (u - static_cast<float>(camera.cx)) / static_cast<float>(camera.fx),
+          (v - static_cast<float>(camera.cy)) / static_cast<float>(camera.fy), 1.0f);
       const Eigen::Vector3f ray_W = R_W_C * ray_C.normalized();
       const float cos_i = std::abs(face_normals_W_[f].dot(ray_W));
       view->depth_m(u, v) = z;

@@ -22,19 +22,20 @@ void SynthConfig::check() const {
 
 namespace {
 
-std::vector<TimedPose> drift(const std::vector<TimedPose>& gt, const PoseDriftConfig& config,
-                             uint64_t seed) {
+std::vector<StampedPose> drift(const std::vector<StampedPose>& gt, const PoseDriftConfig& config,
+                               uint64_t seed) {
   std::vector<Eigen::Isometry3d> poses;
-  for (const TimedPose& p : gt) poses.push_back(p.T_W_C);
+  for (const StampedPose& p : gt) poses.push_back(p.T_W_C);
   const std::vector<Eigen::Isometry3d> drifted = applyPoseDrift(poses, config, seed);
-  std::vector<TimedPose> out = gt;
+  std::vector<StampedPose> out = gt;
   for (size_t k = 0; k < out.size(); ++k) out[k].T_W_C = drifted[k];
   return out;
 }
 
 }  // namespace
 
-SequenceSynthesizer::SequenceSynthesizer(const LabelledMesh& mesh, std::vector<TimedPose> T_W_C_gt,
+SequenceSynthesizer::SequenceSynthesizer(const LabelledMesh& mesh,
+                                         std::vector<StampedPose> T_W_C_gt,
                                          const SynthConfig& config)
     : config_(config),
       renderer_(mesh, config.render),
@@ -82,8 +83,8 @@ SynthFrame SequenceSynthesizer::frame(size_t k) {
   out.rgbd.camera_name = "panmap-synth";
   out.rgbd.camera = config_.camera;
   out.rgbd.depth_scale_m = config_.depth_scale_m;
-  out.rgbd.depth = simulateDepth(view_, config_.depth, hashSeed(config_.seed, k, 0xDE9u),
-                                 config_.depth_scale_m);
+  out.rgbd.depth =
+      simulateDepth(view_, config_.depth, hashSeed(config_.seed, k, 0xDE9u), config_.depth_scale_m);
   out.rgbd.color = view_.color;
   out.gt_instance = view_.instance;
   out.panoptic = segmenter_.segment(view_.instance, view_.semantic, static_cast<int>(k), infos_);

@@ -36,8 +36,8 @@ namespace {
 struct FreeSpace {
   Eigen::Vector2d origin;  // world x, y of cell (0, 0)'s corner
   double cell = 0.05;
-  cv::Mat safe;            // CV_8U, 1 where the camera may stand
-  cv::Mat clearance_m;     // CV_32F, distance to the nearest obstacle cell, metres
+  cv::Mat safe;         // CV_8U, 1 where the camera may stand
+  cv::Mat clearance_m;  // CV_32F, distance to the nearest obstacle cell, metres
   double floor_z = 0.0;
 
   Eigen::Vector2d centre(int i, int j) const {
@@ -194,7 +194,8 @@ std::vector<Cell> chooseWaypoints(const FreeSpace& fs, int count, Rng* rng) {
     double best_d = 1e30;
     for (size_t k = 0; k < stops.size(); ++k) {
       if (used[k]) continue;
-      const double di = stops[k].first - tour.back().first, dj = stops[k].second - tour.back().second;
+      const double di = stops[k].first - tour.back().first,
+                   dj = stops[k].second - tour.back().second;
       if (di * di + dj * dj < best_d) {
         best_d = di * di + dj * dj;
         best = k;
@@ -238,7 +239,8 @@ std::vector<Eigen::Vector2d> planLoop(const FreeSpace& fs, const std::vector<Cel
   for (const Eigen::Vector2d& p : points) {
     if (distinct.empty() || (p - distinct.back()).norm() > 1e-4) distinct.push_back(p);
   }
-  while (distinct.size() > 1 && (distinct.front() - distinct.back()).norm() <= 1e-4) distinct.pop_back();
+  while (distinct.size() > 1 && (distinct.front() - distinct.back()).norm() <= 1e-4)
+    distinct.pop_back();
   if (distinct.size() < 4) throw Error("survey: the free space is too small for a loop");
   return distinct;
 }
@@ -274,14 +276,16 @@ double wrapAngle(double a) {
 
 }  // namespace
 
-std::vector<TimedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& config,
-                                  uint64_t seed) {
+std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& config,
+                                    uint64_t seed) {
   config.check();
   Rng rng(hashSeed(seed, 0x5u));
   const FreeSpace fs = buildFreeSpace(mesh, config);
-  const std::vector<Eigen::Vector2d> loop = planLoop(fs, chooseWaypoints(fs, config.num_waypoints, &rng));
+  const std::vector<Eigen::Vector2d> loop =
+      planLoop(fs, chooseWaypoints(fs, config.num_waypoints, &rng));
   std::vector<double> arc = {0.0};
-  for (size_t k = 1; k <= loop.size(); ++k) arc.push_back(arc.back() + (loop[k % loop.size()] - loop[k - 1]).norm());
+  for (size_t k = 1; k <= loop.size(); ++k)
+    arc.push_back(arc.back() + (loop[k % loop.size()] - loop[k - 1]).norm());
   const double loop_length = arc.back();
   std::vector<Target> targets = objectTargets(mesh);
 
@@ -291,7 +295,7 @@ std::vector<TimedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& 
   const double mid = 0.5 * (config.min_height_m + config.max_height_m);
   const double amp = 0.4 * (config.max_height_m - config.min_height_m);
   const double phase = rng.uniform(0.0, 2 * M_PI);
-  std::vector<TimedPose> out;
+  std::vector<StampedPose> out;
   double yaw = 0.0, pitch = -0.2, look_timer = 1e9;
   int target = -1;
   size_t seg = 0;
@@ -314,8 +318,10 @@ std::vector<TimedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& 
     auto suitable = [&](const Target& tg, double* score) {
       const Eigen::Vector3d d = tg.centre - eye;
       const double range = d.head<2>().norm();
-      const double off = std::abs(wrapAngle(std::atan2(d.y(), d.x()) - std::atan2(heading.y(), heading.x())));
-      if (range < config.view_min_m * 0.5 || range > config.view_max_m * 1.5 || off > 0.6 * M_PI) return false;
+      const double off =
+          std::abs(wrapAngle(std::atan2(d.y(), d.x()) - std::atan2(heading.y(), heading.x())));
+      if (range < config.view_min_m * 0.5 || range > config.view_max_m * 1.5 || off > 0.6 * M_PI)
+        return false;
       *score = -tg.looks - 0.3 * std::abs(range - 0.5 * (config.view_min_m + config.view_max_m)) -
                0.5 * off + 0.01 * rng.uniform();
       return true;
@@ -361,7 +367,7 @@ std::vector<TimedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& 
     const Eigen::Vector3d forward(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw),
                                   std::sin(pitch));
     const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
-    TimedPose pose;
+    StampedPose pose;
     pose.utime = static_cast<int64_t>(std::llround(t * 1e6));
     pose.T_W_C.linear().col(0) = right;
     pose.T_W_C.linear().col(1) = forward.cross(right);
@@ -383,12 +389,14 @@ struct VertexCloud {
   size_t kdtree_get_point_count() const { return points->size(); }
   float kdtree_get_pt(size_t i, size_t dim) const { return (*points)[i][static_cast<int>(dim)]; }
   template <class Box>
-  bool kdtree_get_bbox(Box&) const { return false; }
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
 };
 
 }  // namespace
 
-double minClearance(const std::vector<TimedPose>& trajectory, const LabelledMesh& mesh) {
+double minClearance(const std::vector<StampedPose>& trajectory, const LabelledMesh& mesh) {
   if (mesh.vertices.empty()) return std::numeric_limits<double>::infinity();
   VertexCloud cloud{&mesh.vertices};
   using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, VertexCloud>,
@@ -396,7 +404,7 @@ double minClearance(const std::vector<TimedPose>& trajectory, const LabelledMesh
   Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   tree.buildIndex();
   double best = std::numeric_limits<double>::infinity();
-  for (const TimedPose& p : trajectory) {
+  for (const StampedPose& p : trajectory) {
     const Eigen::Vector3f q = p.T_W_C.translation().cast<float>();
     uint32_t index = 0;
     float dist2 = 0.0f;
@@ -404,54 +412,6 @@ double minClearance(const std::vector<TimedPose>& trajectory, const LabelledMesh
     best = std::min(best, std::sqrt(static_cast<double>(dist2)));
   }
   return best;
-}
-
-std::vector<TimedPose> readTumTrajectory(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error("cannot read trajectory " + path);
-  std::vector<TimedPose> out;
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    double v[8];
-    for (double& x : v) {
-      if (!(fields >> x)) {
-        throw Error(path + ":" + std::to_string(line_no) + ": expected 't tx ty tz qx qy qz qw'");
-      }
-    }
-    const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
-    if (!std::isfinite(q.norm()) || std::abs(q.norm() - 1.0) > 1e-3) {
-      throw Error(path + ":" + std::to_string(line_no) + ": quaternion is not unit length");
-    }
-    TimedPose pose;
-    pose.utime = static_cast<int64_t>(std::llround(v[0] * 1e6));
-    pose.T_W_C.linear() = q.normalized().toRotationMatrix();
-    pose.T_W_C.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
-    if (!pose.T_W_C.matrix().allFinite()) {
-      throw Error(path + ":" + std::to_string(line_no) + ": non-finite pose");
-    }
-    out.push_back(pose);
-  }
-  if (out.empty()) throw Error("trajectory " + path + " has no poses");
-  return out;
-}
-
-void writeTumTrajectory(const std::string& path, const std::vector<TimedPose>& trajectory) {
-  std::ofstream out(path);
-  if (!out) throw Error("cannot write trajectory " + path);
-  out << "# timestamp tx ty tz qx qy qz qw\n";
-  char buffer[256];
-  for (const TimedPose& p : trajectory) {
-    const Eigen::Quaterniond q(p.T_W_C.linear());
-    const Eigen::Vector3d t = p.T_W_C.translation();
-    std::snprintf(buffer, sizeof(buffer), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n",
-                  p.utime * 1e-6, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
-    out << buffer;
-  }
-  if (!out) throw Error("cannot write trajectory " + path);
 }
 
 }  // namespace panmap

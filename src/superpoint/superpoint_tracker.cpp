@@ -147,7 +147,8 @@ FrameAssociation SuperpointTracker::associate(const FrameSegmentation& segmentat
       const float d = frame.depth(u, v) * scale;
       if (d <= 0.0f) continue;
       ++samples[sid - 1];
-      const Voxel* voxel = lookup.find(T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d));
+      const Voxel* voxel =
+          lookup.find(T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d));
       if (!voxel) continue;
       const int32_t label = argmaxLabel(*voxel, resolve);
       if (label > 0) ++overlap[sid - 1][label];
@@ -201,7 +202,8 @@ FrameAssociation SuperpointTracker::associate(const FrameSegmentation& segmentat
   out.pixel_labels = LabelImage(w, h, 0);
   for (size_t i = 0; i < out.pixel_labels.size(); ++i) {
     const int32_t sid = segmentation.surfaces.data()[i];
-    if (sid > 0 && static_cast<size_t>(sid) <= n) out.pixel_labels.data()[i] = out.surface_labels[sid - 1];
+    if (sid > 0 && static_cast<size_t>(sid) <= n)
+      out.pixel_labels.data()[i] = out.surface_labels[sid - 1];
   }
   return out;
 }

@@ -69,10 +69,12 @@ TEST(Pose, RigidTransformCheck) {
 
 TEST(Pose, NearestIsometryIsOrthonormalAndClose) {
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
-  T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  T.topLeftCorner<3, 3>() =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   T(0, 1) += 2e-4;  // rounding like a dataset's text file
   const Eigen::Isometry3d iso = nearestIsometry(T);
-  EXPECT_NEAR((iso.linear().transpose() * iso.linear() - Eigen::Matrix3d::Identity()).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((iso.linear().transpose() * iso.linear() - Eigen::Matrix3d::Identity()).norm(), 0.0,
+              1e-12);
   EXPECT_LT((iso.matrix() - T).cwiseAbs().maxCoeff(), 2e-4);
 }
 

@@ -11,9 +11,9 @@ namespace {
 
 void expectFixtureFrame(const PanopticFrame& f) {
   ASSERT_EQ(f.segments.size(), 3u);
-  EXPECT_EQ(f.segments[0], (PanopticSegment{1, 1, 1, false, 1.0f}));     // wall: stuff
-  EXPECT_EQ(f.segments[1], (PanopticSegment{300, 5, 62, true, 0.8f}));   // COCO chair -> 5
-  EXPECT_EQ(f.segments[2], (PanopticSegment{2, 0, 999, true, 0.25f}));   // unknown: class 0
+  EXPECT_EQ(f.segments[0], (PanopticSegment{1, 1, 1, false, 1.0f}));    // wall: stuff
+  EXPECT_EQ(f.segments[1], (PanopticSegment{300, 5, 62, true, 0.8f}));  // COCO chair -> 5
+  EXPECT_EQ(f.segments[2], (PanopticSegment{2, 0, 999, true, 0.25f}));  // unknown: class 0
   ASSERT_EQ(f.segment_ids.width(), 8);
   EXPECT_EQ(f.segment_ids(0, 0), 1);
   EXPECT_EQ(f.segment_ids(7, 0), 300);
@@ -47,7 +47,8 @@ TEST(CocoPanoptic, BadInputNamesTheFile) {
     CocoPanopticReader(test::fixtureDir("coco_tiny/panoptic"), json, LabelTable::nyu40Identity());
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("bad.json: malformed JSON"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("bad.json: malformed JSON"), std::string::npos)
+        << e.what();
   }
   EXPECT_THROW(CocoPanopticReader(dir.path("none"), "", LabelTable::nyu40Identity()), Error);
   EXPECT_THROW(CocoPanopticReader(dir.path(), "", LabelTable::nyu40Identity()), Error);  // empty

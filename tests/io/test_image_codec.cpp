@@ -19,7 +19,7 @@ TEST(ImageCodec, DepthPngRoundTripIsExact) {
 TEST(ImageCodec, LabelPngUsesCocoEncoding) {
   LabelImage labels(3, 2, 0);
   labels(0, 0) = 1;
-  labels(1, 0) = 300;               // R 44, G 1
+  labels(1, 0) = 300;  // R 44, G 1
   labels(2, 1) = 2 * 65536 + 3 * 256 + 4;
   const auto png = encodeLabelPng(labels);
   EXPECT_EQ(decodeLabelPng(png.data(), png.size(), "t"), labels);
@@ -30,7 +30,8 @@ TEST(ImageCodec, LabelPngUsesCocoEncoding) {
 TEST(ImageCodec, ColorRoundTrip) {
   ColorImage color(16, 8);
   for (int v = 0; v < 8; ++v) {
-    for (int u = 0; u < 16; ++u) color(u, v) = Rgb8{static_cast<uint8_t>(u * 16), static_cast<uint8_t>(v * 32), 77};
+    for (int u = 0; u < 16; ++u)
+      color(u, v) = Rgb8{static_cast<uint8_t>(u * 16), static_cast<uint8_t>(v * 32), 77};
   }
   const auto png = encodePng(color);
   EXPECT_EQ(decodeColor(png.data(), png.size(), "t"), color);  // lossless

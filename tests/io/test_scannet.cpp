@@ -34,15 +34,16 @@ TEST(ScanNetExport, RegistersColourToDepth) {
 
   // Reprojection through depth and the metadata's colorToDepthExtrinsics (p_D = E p_C).
   Eigen::Matrix4d E;
-  E << 0.999263, -0.010031, 0.037048, -0.038549, 0.009933, 0.999947, 0.002817, -0.004287,
-      -0.037074, -0.002447, 0.999310, -0.020574, 0, 0, 0, 1;
+  E << 0.999263, -0.010031, 0.037048, -0.038549, 0.009933, 0.999947, 0.002817, -0.004287, -0.037074,
+      -0.002447, 0.999310, -0.020574, 0, 0, 0, 1;
   const Eigen::Matrix4d T_C_D = E.inverse();
   int checked = 0;
   for (int v = 10; v < 480; v += 97) {
     for (int u = 10; u < 640; u += 131) {
       const double z = f.rgbd.depth(u, v) * 0.001;
       if (z <= 0.0) continue;
-      const Eigen::Vector4d p_D(z * (u - 320.287018) / 575.665710, z * (v - 240.126617) / 578.051880, z, 1.0);
+      const Eigen::Vector4d p_D(z * (u - 320.287018) / 575.665710,
+                                z * (v - 240.126617) / 578.051880, z, 1.0);
       const Eigen::Vector4d p_C = T_C_D * p_D;
       const double uc = 1165.723022 * p_C.x() / p_C.z() + 649.094971;
       const double vc = 1165.738037 * p_C.y() / p_C.z() + 484.765015;
@@ -78,7 +79,8 @@ TEST(ScanNetExport, InfPoseIsReportedNotRead) {
   PANMAP_REQUIRE_DATA("scannet-export-3");
   test::TempDir dir;
   const std::string src = test::dataDir("scannet-export-3");
-  for (const char* sub : {"color", "depth", "intrinsic"}) fs::create_directory_symlink(src + "/" + sub, dir.path(sub));
+  for (const char* sub : {"color", "depth", "intrinsic"})
+    fs::create_directory_symlink(src + "/" + sub, dir.path(sub));
   fs::create_symlink(src + "/scene0707_00.txt", dir.path("scene0707_00.txt"));
   fs::create_directory(dir.path("pose"));
   fs::create_symlink(src + "/pose/0.txt", dir.path("pose/0.txt"));
@@ -97,9 +99,11 @@ TEST(ScanNetExport, MissingDepthIntrinsics) {
   PANMAP_REQUIRE_DATA("scannet-export-3");
   test::TempDir dir;
   const std::string src = test::dataDir("scannet-export-3");
-  for (const char* sub : {"color", "depth", "pose"}) fs::create_directory_symlink(src + "/" + sub, dir.path(sub));
+  for (const char* sub : {"color", "depth", "pose"})
+    fs::create_directory_symlink(src + "/" + sub, dir.path(sub));
   fs::create_directory(dir.path("intrinsic"));
-  fs::create_symlink(src + "/intrinsic/intrinsic_color.txt", dir.path("intrinsic/intrinsic_color.txt"));
+  fs::create_symlink(src + "/intrinsic/intrinsic_color.txt",
+                     dir.path("intrinsic/intrinsic_color.txt"));
   try {
     openDataset(dir.path(), DatasetOptions{});
     FAIL();

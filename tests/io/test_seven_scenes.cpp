@@ -30,10 +30,12 @@ TEST(SevenScenes, ReadsTheRealSequence) {
   EXPECT_EQ(f.color_stem, "frame-000003.color");
   EXPECT_FALSE(f.color_jpeg.empty());  // the JPEG travels unchanged
   ASSERT_TRUE(f.T_W_C.has_value());
-  const Eigen::MatrixXd file = readMatrixFile(test::dataDir("7scenes-200/frame-000003.pose.txt"), 4, 4);
+  const Eigen::MatrixXd file =
+      readMatrixFile(test::dataDir("7scenes-200/frame-000003.pose.txt"), 4, 4);
   EXPECT_LT((f.T_W_C->matrix() - file).cwiseAbs().maxCoeff(), 5e-4);
   EXPECT_EQ(f.T_W_C->translation(), Eigen::Vector3d(file.topRightCorner<3, 1>()));
-  const cv::Mat png = cv::imread(test::dataDir("7scenes-200/frame-000003.depth.png"), cv::IMREAD_UNCHANGED);
+  const cv::Mat png =
+      cv::imread(test::dataDir("7scenes-200/frame-000003.depth.png"), cv::IMREAD_UNCHANGED);
   ASSERT_EQ(png.type(), CV_16UC1);
   EXPECT_EQ(std::memcmp(png.data, f.rgbd.depth.data(), f.rgbd.depth.size() * 2), 0);
 }
@@ -49,7 +51,8 @@ class SevenScenesBadInput : public ::testing::Test {
         fs::create_symlink(test::dataDir("7scenes-200/" + name), dir_.path(name));
       }
     }
-    fs::copy_file(test::dataDir("7scenes-200/camera-intrinsics.txt"), dir_.path("camera-intrinsics.txt"));
+    fs::copy_file(test::dataDir("7scenes-200/camera-intrinsics.txt"),
+                  dir_.path("camera-intrinsics.txt"));
   }
 
   // The error of reading every frame, "" if none.

@@ -24,7 +24,8 @@ TEST(Cli, HelpExitsZero) {
 
 TEST(Cli, ImportOfAMissingFolderFailsWithOneLine) {
   test::TempDir dir;
-  const auto r = runCommand(binPath("panmap-import") + " " + dir.path("absent") + " " + dir.path("x.lcmlog"));
+  const auto r =
+      runCommand(binPath("panmap-import") + " " + dir.path("absent") + " " + dir.path("x.lcmlog"));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_EQ(test::countLines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find(dir.path("absent")), std::string::npos) << r.output;
@@ -59,16 +60,20 @@ TEST(Cli, ImportNamesTheBadFile) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   test::TempDir dir;
   namespace fs = std::filesystem;
-  fs::copy_file(test::dataDir("7scenes-200/camera-intrinsics.txt"), dir.path("camera-intrinsics.txt"));
+  fs::copy_file(test::dataDir("7scenes-200/camera-intrinsics.txt"),
+                dir.path("camera-intrinsics.txt"));
   for (const char* kind : {".color.jpg", ".depth.png"}) {
-    fs::create_symlink(test::dataDir(std::string("7scenes-200/frame-000000") + kind), dir.path(std::string("frame-000000") + kind));
+    fs::create_symlink(test::dataDir(std::string("7scenes-200/frame-000000") + kind),
+                       dir.path(std::string("frame-000000") + kind));
   }
   std::ofstream(dir.path("frame-000000.pose.txt")) << "1 0 0 0\n0 1 0 0\n0 0 1 nan\n0 0 0 1\n";
-  const auto r = runCommand(binPath("panmap-import") + " --quiet " + dir.path() + " " + dir.path("x.lcmlog"));
+  const auto r =
+      runCommand(binPath("panmap-import") + " --quiet " + dir.path() + " " + dir.path("x.lcmlog"));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_EQ(test::countLines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("frame-000000.pose.txt"), std::string::npos) << r.output;
-  const auto bad_option = runCommand(binPath("panmap-import") + " --layout nope " + dir.path() + " " + dir.path("x.lcmlog"));
+  const auto bad_option = runCommand(binPath("panmap-import") + " --layout nope " + dir.path() +
+                                     " " + dir.path("x.lcmlog"));
   EXPECT_NE(bad_option.exit_code, 0);
 }
 

@@ -33,14 +33,16 @@ RgbdFrame makeFrame() {
 template <typename Msg>
 std::vector<uint8_t> encode(const Msg& msg) {
   std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
-  EXPECT_EQ(msg.encode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  EXPECT_EQ(msg.encode(bytes.data(), 0, static_cast<int>(bytes.size())),
+            static_cast<int>(bytes.size()));
   return bytes;
 }
 
 template <typename Msg>
 Msg decode(const std::vector<uint8_t>& bytes) {
   Msg msg;
-  EXPECT_EQ(msg.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  EXPECT_EQ(msg.decode(bytes.data(), 0, static_cast<int>(bytes.size())),
+            static_cast<int>(bytes.size()));
   return msg;
 }
 
@@ -99,7 +101,8 @@ TEST(Conversions, PoseRoundTripAndNan) {
   p.utime = 99;
   p.frame_id = 3;
   p.source = PoseSource::kSlam;
-  p.T_W_C.linear() = Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.2, -1, 0.5).normalized()).toRotationMatrix();
+  p.T_W_C.linear() =
+      Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.2, -1, 0.5).normalized()).toRotationMatrix();
   p.T_W_C.translation() << 1.5, -2.25, 0.125;
   const StampedPose back = fromMessage(decode<pose_t>(encode(toMessage(p))));
   EXPECT_EQ(back.utime, 99);

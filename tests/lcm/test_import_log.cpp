@@ -40,7 +40,8 @@ std::vector<Event> readEvents(const std::string& path) {
 template <typename Msg>
 Msg decodeEvent(const Event& e) {
   Msg msg;
-  EXPECT_EQ(msg.decode(e.data.data(), 0, static_cast<int>(e.data.size())), static_cast<int>(e.data.size()));
+  EXPECT_EQ(msg.decode(e.data.data(), 0, static_cast<int>(e.data.size())),
+            static_cast<int>(e.data.size()));
   return msg;
 }
 
@@ -84,7 +85,8 @@ TEST_F(SevenScenesLog, DepthIsBitIdenticalAndPosesEqualTheFiles) {
     if (e.channel == "CAMERA_RGBD") {
       const RgbdFrame f = fromMessage(decodeEvent<rgbd_frame_t>(e));
       char name[64];
-      std::snprintf(name, sizeof(name), "7scenes-200/frame-%06lld", static_cast<long long>(f.frame_id));
+      std::snprintf(name, sizeof(name), "7scenes-200/frame-%06lld",
+                    static_cast<long long>(f.frame_id));
       const cv::Mat png = cv::imread(test::dataDir(name) + ".depth.png", cv::IMREAD_UNCHANGED);
       ASSERT_EQ(png.type(), CV_16UC1);
       ASSERT_EQ(f.depth.width(), png.cols);
@@ -96,11 +98,13 @@ TEST_F(SevenScenesLog, DepthIsBitIdenticalAndPosesEqualTheFiles) {
     } else if (e.channel == "CAMERA_POSE") {
       const StampedPose p = fromMessage(decodeEvent<pose_t>(e));
       char name[64];
-      std::snprintf(name, sizeof(name), "7scenes-200/frame-%06lld.pose.txt", static_cast<long long>(p.frame_id));
+      std::snprintf(name, sizeof(name), "7scenes-200/frame-%06lld.pose.txt",
+                    static_cast<long long>(p.frame_id));
       const Eigen::MatrixXd file = readMatrixFile(test::dataDir(name), 4, 4);
       // Translation exactly; rotation to the file's own rounding (|R^T R - I| < 3e-4).
       EXPECT_EQ(p.T_W_C.translation(), Eigen::Vector3d(file.topRightCorner<3, 1>())) << name;
-      EXPECT_LT((p.T_W_C.linear() - file.topLeftCorner<3, 3>()).cwiseAbs().maxCoeff(), 5e-4) << name;
+      EXPECT_LT((p.T_W_C.linear() - file.topLeftCorner<3, 3>()).cwiseAbs().maxCoeff(), 5e-4)
+          << name;
       EXPECT_EQ(p.source, PoseSource::kGroundTruth);
       ++poses;
     }
@@ -120,7 +124,7 @@ TEST_F(SevenScenesLog, LogInfoDecodesEverything) {
   EXPECT_EQ(rgbd.type, "rgbd_frame_t");
   EXPECT_EQ(rgbd.count, 200u);
   EXPECT_EQ(rgbd.first_utime, 0);
-  EXPECT_EQ(rgbd.last_utime, 19900000);  // frame 597 at 30 Hz
+  EXPECT_EQ(rgbd.last_utime, 19900000);    // frame 597 at 30 Hz
   EXPECT_NEAR(rgbd.rateHz(), 10.0, 1e-9);  // every third frame of a 30 Hz recording
   const auto json = nlohmann::json::parse(logInfoToJson(info));
   EXPECT_EQ(json["channels"][1]["count"], 200);
@@ -143,7 +147,9 @@ TEST_F(SevenScenesLog, TruncatedAndCorruptLogsAreReported) {
   // Event header: sync word, event number, timestamp, channel and data lengths, channel.
   const size_t header = 4 + 8 + 8 + 4 + 4 + events[0].channel.size();
   ASSERT_EQ(events[0].channel, "CAMERA_RGBD");
-  for (size_t i = header + events[0].data.size() - 2000; i < header + events[0].data.size() - 1000; ++i) corrupt[i] ^= 0x5A;
+  for (size_t i = header + events[0].data.size() - 2000; i < header + events[0].data.size() - 1000;
+       ++i)
+    corrupt[i] ^= 0x5A;
   writeFileBytes(dir.path("corrupt.lcmlog"), corrupt);
   const LogInfo deep = inspectLog(dir.path("corrupt.lcmlog"), true);
   EXPECT_FALSE(deep.truncated);
@@ -183,7 +189,8 @@ TEST(Import, ScanNetSkipsInvalidPosesWithACount) {
   PANMAP_REQUIRE_DATA("scannet-export-3");
   test::TempDir dir;
   const std::string src = test::dataDir("scannet-export-3");
-  for (const char* sub : {"color", "depth", "intrinsic"}) fs::create_directory_symlink(src + "/" + sub, dir.path(sub));
+  for (const char* sub : {"color", "depth", "intrinsic"})
+    fs::create_directory_symlink(src + "/" + sub, dir.path(sub));
   fs::create_symlink(src + "/scene0707_00.txt", dir.path("scene0707_00.txt"));
   fs::create_directory(dir.path("pose"));
   fs::create_symlink(src + "/pose/0.txt", dir.path("pose/0.txt"));

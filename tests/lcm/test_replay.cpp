@@ -52,12 +52,14 @@ void expectIntactFrames(const Recorder& recorder, const std::string& log_path) {
   for (const auto& [channel, payloads] : expected) {
     const auto& got = recorder.received.at(channel);
     ASSERT_EQ(got.size(), payloads.size()) << channel;
-    for (size_t i = 0; i < payloads.size(); ++i) EXPECT_EQ(got[i], payloads[i]) << channel << " " << i;
+    for (size_t i = 0; i < payloads.size(); ++i)
+      EXPECT_EQ(got[i], payloads[i]) << channel << " " << i;
   }
   // And every frame decodes into a valid frame.
   for (const auto& bytes : recorder.received.at("CAMERA_RGBD")) {
     rgbd_frame_t msg;
-    ASSERT_EQ(msg.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+    ASSERT_EQ(msg.decode(bytes.data(), 0, static_cast<int>(bytes.size())),
+              static_cast<int>(bytes.size()));
     EXPECT_EQ(fromMessage(msg).depth.width(), 640);
   }
 }

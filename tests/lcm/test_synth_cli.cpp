@@ -41,7 +41,8 @@ TEST(SynthCli, RoomOutputsAreCompleteAndDeterministic) {
   ASSERT_EQ(gt.size(), mesh.numVertices());
   for (size_t v = 0; v < gt.size(); v += 97) {
     const int32_t expected = mesh.instance[v] > 0 && mesh.semantic[v] > 0
-                                 ? mesh.semantic[v] * 1000 + mesh.instance[v] : 0;
+                                 ? mesh.semantic[v] * 1000 + mesh.instance[v]
+                                 : 0;
     EXPECT_EQ(gt[v], expected);
   }
   const auto gt_traj = readTumTrajectory(dir.path("a/gt/trajectory_gt.txt"));
@@ -59,9 +60,11 @@ TEST(SynthCli, RoomOutputsAreCompleteAndDeterministic) {
   EXPECT_GT(json["mesh"]["faces"].get<int>(), 10000);
 
   // Another seed gives another sequence.
-  const auto c = runCommand(binPath("panmap-synth") + " --room 3 --frames 24 --seed 10 --quiet --out " + dir.path("c"));
+  const auto c = runCommand(binPath("panmap-synth") +
+                            " --room 3 --frames 24 --seed 10 --quiet --out " + dir.path("c"));
   ASSERT_EQ(c.exit_code, 0) << c.output;
-  EXPECT_NE(readFileBytes(dir.path("a/sequence.lcmlog")), readFileBytes(dir.path("c/sequence.lcmlog")));
+  EXPECT_NE(readFileBytes(dir.path("a/sequence.lcmlog")),
+            readFileBytes(dir.path("c/sequence.lcmlog")));
 }
 
 TEST(SynthCli, ScanNetGroundTruthWithAGivenTrajectory) {
@@ -71,16 +74,18 @@ TEST(SynthCli, ScanNetGroundTruthWithAGivenTrajectory) {
                                   test::fixtureDir("scannet_gt_tiny") + " --scannet-labels " +
                                   test::dataDir("scannet-meta/scannetv2-labels.combined.tsv") +
                                   " --out " + dir.path("s"));
-  if (!std::filesystem::is_directory(test::dataDir("scannet-meta"))) GTEST_SKIP() << "no scannet-meta";
+  if (!std::filesystem::is_directory(test::dataDir("scannet-meta")))
+    GTEST_SKIP() << "no scannet-meta";
   EXPECT_EQ(no_room.exit_code, 1) << no_room.output;
   EXPECT_EQ(test::countLines(no_room.output), 1) << no_room.output;
   EXPECT_NE(no_room.output.find("survey"), std::string::npos) << no_room.output;
   // ... and a given TUM trajectory renders it.
   std::ofstream(dir.path("traj.txt")) << "0.0 0 0 3 0 0 0 1\n0.033333 0 0 3.01 0 0 0 1\n";
-  const auto ok = runCommand(binPath("panmap-synth") + " --quiet --frames 5 --scannet " +
-                             test::fixtureDir("scannet_gt_tiny") + " --scannet-labels " +
-                             test::dataDir("scannet-meta/scannetv2-labels.combined.tsv") +
-                             " --trajectory " + dir.path("traj.txt") + " --poses gt --out " + dir.path("s"));
+  const auto ok =
+      runCommand(binPath("panmap-synth") + " --quiet --frames 5 --scannet " +
+                 test::fixtureDir("scannet_gt_tiny") + " --scannet-labels " +
+                 test::dataDir("scannet-meta/scannetv2-labels.combined.tsv") + " --trajectory " +
+                 dir.path("traj.txt") + " --poses gt --out " + dir.path("s"));
   ASSERT_EQ(ok.exit_code, 0) << ok.output;
   EXPECT_EQ(inspectLog(dir.path("s/sequence.lcmlog"), true).channels[0].count, 2u);
 }
@@ -89,10 +94,11 @@ TEST(SynthCli, BadArgumentsFailClearly) {
   test::TempDir dir;
   const auto none = runCommand(binPath("panmap-synth") + " --out " + dir.path("x"));
   EXPECT_NE(none.exit_code, 0);
-  const auto bad = runCommand(binPath("panmap-synth") + " --room 1 --masks perfect --out " + dir.path("x"));
+  const auto bad =
+      runCommand(binPath("panmap-synth") + " --room 1 --masks perfect --out " + dir.path("x"));
   EXPECT_NE(bad.exit_code, 0);
-  const auto traj = runCommand(binPath("panmap-synth") + " --room 1 --trajectory " + dir.path("none.txt") +
-                               " --out " + dir.path("x"));
+  const auto traj = runCommand(binPath("panmap-synth") + " --room 1 --trajectory " +
+                               dir.path("none.txt") + " --out " + dir.path("x"));
   EXPECT_EQ(traj.exit_code, 1);
   EXPECT_NE(traj.output.find("none.txt"), std::string::npos) << traj.output;
 }

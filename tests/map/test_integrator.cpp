@@ -58,8 +58,11 @@ TEST_P(AnalyticScene, SurfaceErrorBelowHalfAVoxel) {
   // Points of the visible surfaces, away from where two surfaces meet (there the zero level
   // is shared and the test would measure the corner, not the integrator).
   for (int i = 0; i < 400; ++i) {  // upper sphere, clear of the floor contact
-    const float th = 0.1f + 1.9f * (i % 20) / 20.0f, ph = 2.0f * static_cast<float>(M_PI) * (i / 20) / 20.0f;
-    check(Eigen::Vector3f(0.6f, 0.0f, 0.5f) + 0.4f * Eigen::Vector3f(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)));
+    const float th = 0.1f + 1.9f * (i % 20) / 20.0f,
+                ph = 2.0f * static_cast<float>(M_PI) * (i / 20) / 20.0f;
+    check(Eigen::Vector3f(0.6f, 0.0f, 0.5f) + 0.4f * Eigen::Vector3f(std::sin(th) * std::cos(ph),
+                                                                     std::sin(th) * std::sin(ph),
+                                                                     std::cos(th)));
   }
   for (int i = 0; i < 900; ++i) {  // floor, outside the footprints of the sphere and the box
     const Eigen::Vector3f p(-1.5f + 3.0f * (i % 30) / 30.0f, -1.5f + 3.0f * (i / 30) / 30.0f, 0.0f);
@@ -67,7 +70,8 @@ TEST_P(AnalyticScene, SurfaceErrorBelowHalfAVoxel) {
     if (p.x() > -1.05f && p.x() < -0.15f && p.y() > -0.55f && p.y() < 0.45f) continue;
     check(p);
   }
-  for (int i = 0; i < 100; ++i) check(Eigen::Vector3f(-0.8f + 0.4f * (i % 10) / 10.0f, -0.3f + 0.5f * (i / 10) / 10.0f, 0.7f));
+  for (int i = 0; i < 100; ++i)
+    check(Eigen::Vector3f(-0.8f + 0.4f * (i % 10) / 10.0f, -0.3f + 0.5f * (i / 10) / 10.0f, 0.7f));
   // Surface error: 99 % of the samples within half a voxel; the few outliers sit where a view
   // grazes the sphere; none beyond a voxel.
   ASSERT_GT(errors.size(), 500u);
@@ -122,7 +126,8 @@ TEST(Integrator, VotesGoToSurfaceVoxelsAndSameInputGivesSameMap) {
   ASSERT_EQ(one->numBlocks(), two->numBlocks());
   for (size_t b = 0; b < one->numBlocks(); ++b) {
     ASSERT_EQ(one->blocks()[b]->index, two->blocks()[b]->index);
-    EXPECT_EQ(std::memcmp(one->blocks()[b]->voxels, two->blocks()[b]->voxels, sizeof(Block::voxels)), 0);
+    EXPECT_EQ(
+        std::memcmp(one->blocks()[b]->voxels, two->blocks()[b]->voxels, sizeof(Block::voxels)), 0);
   }
   // The camera looks along +x with x_C = -y_W: image left (u < 320) is world +y.
   const Voxel* left = one->findVoxel({2.0f, 0.5f, 0.1f});

@@ -28,10 +28,11 @@ class BoxScene : public ::testing::Test {
   }
   static LabelledMesh makeScene() {
     LabelledMesh mesh;
-    test::addQuad(&mesh, {-3, -3, 0}, {3, -3, 0}, {3, 3, 0}, {-3, 3, 0}, 1, 2, 30);   // floor
-    test::addQuad(&mesh, {1.6f, -3, 0}, {1.6f, 3, 0}, {1.6f, 3, 2.5f}, {1.6f, -3, 2.5f}, 2, 1, 30);  // wall
-    test::addBox(&mesh, {0.8f, -0.8f, 0.0f}, {1.4f, 0.0f, 0.9f}, 3, 3, 8);   // cabinet
-    test::addBox(&mesh, {0.8f, 0.0f, 0.0f}, {1.4f, 0.7f, 1.6f}, 4, 24, 8);   // fridge, touching
+    test::addQuad(&mesh, {-3, -3, 0}, {3, -3, 0}, {3, 3, 0}, {-3, 3, 0}, 1, 2, 30);  // floor
+    test::addQuad(&mesh, {1.6f, -3, 0}, {1.6f, 3, 0}, {1.6f, 3, 2.5f}, {1.6f, -3, 2.5f}, 2, 1,
+                  30);                                                      // wall
+    test::addBox(&mesh, {0.8f, -0.8f, 0.0f}, {1.4f, 0.0f, 0.9f}, 3, 3, 8);  // cabinet
+    test::addBox(&mesh, {0.8f, 0.0f, 0.0f}, {1.4f, 0.7f, 1.6f}, 4, 24, 8);  // fridge, touching
     return mesh;
   }
   Eigen::Isometry3d pose(int k) const {
@@ -72,7 +73,8 @@ class BoxScene : public ::testing::Test {
 };
 
 // Majority super-point of the mesh vertices inside a box, and the share of its vertices.
-std::pair<int32_t, double> dominantSuperpoint(const LabelledMesh& mesh, const Eigen::AlignedBox3f& box) {
+std::pair<int32_t, double> dominantSuperpoint(const LabelledMesh& mesh,
+                                              const Eigen::AlignedBox3f& box) {
   std::map<int32_t, int> counts;
   int n = 0;
   for (size_t v = 0; v < mesh.numVertices(); ++v) {
@@ -91,9 +93,12 @@ TEST_F(BoxScene, TouchingBoxesOfDifferentClassesStaySeparate) {
   auto mapper = run(config(), 10);
   const LabelledMesh mesh = mapper->extractMesh();
   // The cameras (1.5 m high) see the cabinet's top and front and the fridge's front.
-  const Eigen::AlignedBox3f cabinet_top(Eigen::Vector3f(0.85f, -0.75f, 0.85f), Eigen::Vector3f(1.35f, -0.1f, 0.95f));
-  const Eigen::AlignedBox3f cabinet_front(Eigen::Vector3f(0.75f, -0.7f, 0.1f), Eigen::Vector3f(0.85f, -0.1f, 0.8f));
-  const Eigen::AlignedBox3f fridge_front(Eigen::Vector3f(0.75f, 0.1f, 0.1f), Eigen::Vector3f(0.85f, 0.6f, 1.5f));
+  const Eigen::AlignedBox3f cabinet_top(Eigen::Vector3f(0.85f, -0.75f, 0.85f),
+                                        Eigen::Vector3f(1.35f, -0.1f, 0.95f));
+  const Eigen::AlignedBox3f cabinet_front(Eigen::Vector3f(0.75f, -0.7f, 0.1f),
+                                          Eigen::Vector3f(0.85f, -0.1f, 0.8f));
+  const Eigen::AlignedBox3f fridge_front(Eigen::Vector3f(0.75f, 0.1f, 0.1f),
+                                         Eigen::Vector3f(0.85f, 0.6f, 1.5f));
   const auto top = dominantSuperpoint(mesh, cabinet_top);
   const auto front = dominantSuperpoint(mesh, cabinet_front);
   const auto fridge = dominantSuperpoint(mesh, fridge_front);

@@ -48,8 +48,8 @@ TEST(DepthNoise, RangeAndGrazingDropouts) {
     for (size_t i = 0; i < d.size(); ++i) n += d.data()[i] != 0;
     return n;
   };
-  EXPECT_EQ(valid(simulateDepth(wall(7.0), config, 1)), 0u);   // beyond max range
-  EXPECT_EQ(valid(simulateDepth(wall(0.2), config, 1)), 0u);   // nearer than min range
+  EXPECT_EQ(valid(simulateDepth(wall(7.0), config, 1)), 0u);  // beyond max range
+  EXPECT_EQ(valid(simulateDepth(wall(0.2), config, 1)), 0u);  // nearer than min range
   EXPECT_EQ(valid(simulateDepth(wall(2.0, std::cos(87.0 * M_PI / 180)), config, 1)), 0u);
   // Halfway between 70 and 85 degrees about half the pixels survive.
   const size_t half = valid(simulateDepth(wall(2.0, std::cos(77.5 * M_PI / 180)), config, 1));

@@ -38,8 +38,10 @@ TEST(PoseDrift, SlamPresetsHitTheirAteRange) {
   double slam = 0.0, hard = 0.0;
   const int seeds = 8;
   for (int seed = 1; seed <= seeds; ++seed) {
-    slam += absoluteTrajectoryErrorRmse(applyPoseDrift(gt, PoseDriftConfig::fromPreset("slam"), seed), gt);
-    hard += absoluteTrajectoryErrorRmse(applyPoseDrift(gt, PoseDriftConfig::fromPreset("slam-hard"), seed), gt);
+    slam += absoluteTrajectoryErrorRmse(
+        applyPoseDrift(gt, PoseDriftConfig::fromPreset("slam"), seed), gt);
+    hard += absoluteTrajectoryErrorRmse(
+        applyPoseDrift(gt, PoseDriftConfig::fromPreset("slam-hard"), seed), gt);
   }
   slam /= seeds;
   hard /= seeds;
@@ -55,7 +57,8 @@ TEST(PoseDrift, SlamPresetsHitTheirAteRange) {
 TEST(PoseDrift, DeterministicAndFirstPoseExact) {
   const auto gt = roomScan();
   const auto cfg = PoseDriftConfig::fromPreset("slam");
-  const auto a = applyPoseDrift(gt, cfg, 5), b = applyPoseDrift(gt, cfg, 5), c = applyPoseDrift(gt, cfg, 6);
+  const auto a = applyPoseDrift(gt, cfg, 5), b = applyPoseDrift(gt, cfg, 5),
+             c = applyPoseDrift(gt, cfg, 6);
   EXPECT_TRUE(a[0].isApprox(gt[0]));
   EXPECT_EQ(a[1000].matrix(), b[1000].matrix());
   EXPECT_FALSE(a[1000].isApprox(c[1000], 1e-6));

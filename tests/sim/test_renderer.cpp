@@ -10,7 +10,8 @@ namespace {
 
 // Two triangles spanning an axis-aligned square in the plane x = const (normal -x), labelled.
 void addQuad(LabelledMesh* mesh, const Eigen::Vector3f& a, const Eigen::Vector3f& b,
-             const Eigen::Vector3f& c, const Eigen::Vector3f& d, int32_t instance, int32_t semantic) {
+             const Eigen::Vector3f& c, const Eigen::Vector3f& d, int32_t instance,
+             int32_t semantic) {
   const int base = static_cast<int>(mesh->vertices.size());
   for (const auto& p : {a, b, c, d}) {
     mesh->vertices.push_back(p);
@@ -23,8 +24,8 @@ void addQuad(LabelledMesh* mesh, const Eigen::Vector3f& a, const Eigen::Vector3f
 }
 
 // Closed axis-aligned box, all six faces.
-void addBox(LabelledMesh* mesh, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi, int32_t instance,
-            int32_t semantic) {
+void addBox(LabelledMesh* mesh, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi,
+            int32_t instance, int32_t semantic) {
   auto P = [&](int i, int j, int k) {
     return Eigen::Vector3f(i ? hi.x() : lo.x(), j ? hi.y() : lo.y(), k ? hi.z() : lo.z());
   };
@@ -80,13 +81,14 @@ TEST(Renderer, TiltedPlaneMatchesAnalyticDepth) {
 
 TEST(Renderer, BoxDepthAndLabelsMatchRayCasting) {
   LabelledMesh mesh;
-  addBox(&mesh, {1.0f, -0.5f, 0.0f}, {1.8f, 0.4f, 0.9f}, 3, 5);     // a chair-sized box
-  addBox(&mesh, {2.5f, 0.2f, 0.0f}, {3.0f, 1.0f, 2.0f}, 4, 3);      // behind and to the side
+  addBox(&mesh, {1.0f, -0.5f, 0.0f}, {1.8f, 0.4f, 0.9f}, 3, 5);  // a chair-sized box
+  addBox(&mesh, {2.5f, 0.2f, 0.0f}, {3.0f, 1.0f, 2.0f}, 4, 3);   // behind and to the side
   const MeshRenderer renderer(mesh);
   const Eigen::Isometry3d T_W_C = lookAlong({-0.5, -0.3, 1.4}, {1.0, 0.15, -0.35});
   const RenderedView view = renderer.render(kCamera, T_W_C);
-  const Eigen::AlignedBox3d boxes[2] = {{Eigen::Vector3d(1.0, -0.5, 0.0), Eigen::Vector3d(1.8, 0.4, 0.9)},
-                                        {Eigen::Vector3d(2.5, 0.2, 0.0), Eigen::Vector3d(3.0, 1.0, 2.0)}};
+  const Eigen::AlignedBox3d boxes[2] = {
+      {Eigen::Vector3d(1.0, -0.5, 0.0), Eigen::Vector3d(1.8, 0.4, 0.9)},
+      {Eigen::Vector3d(2.5, 0.2, 0.0), Eigen::Vector3d(3.0, 1.0, 2.0)}};
   int hits[3] = {0, 0, 0};
   for (int v = 0; v < 480; v += 3) {
     for (int u = 0; u < 640; u += 3) {
@@ -168,7 +170,8 @@ TEST(Renderer, RejectsBadInput) {
   LabelledMesh mesh;
   addQuad(&mesh, {3, -1, -1}, {3, 1, -1}, {3, 1, 1}, {3, -1, 1}, 1, 1);
   const MeshRenderer renderer(mesh);
-  EXPECT_THROW(renderer.render(PinholeCamera{0, 0, 0, 0, 640, 480}, Eigen::Isometry3d::Identity()), Error);
+  EXPECT_THROW(renderer.render(PinholeCamera{0, 0, 0, 0, 640, 480}, Eigen::Isometry3d::Identity()),
+               Error);
 }
 
 }  // namespace

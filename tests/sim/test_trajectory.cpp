@@ -42,7 +42,7 @@ TEST_P(SurveyOfRoom, StaysClearSmoothAndAtHeadHeight) {
   const ProceduralRoom room = generateRoom(static_cast<uint64_t>(GetParam()));
   SurveyConfig config;
   config.num_frames = 1800;
-  const std::vector<TimedPose> traj = planSurvey(room.mesh, config, 7);
+  const std::vector<StampedPose> traj = planSurvey(room.mesh, config, 7);
   ASSERT_EQ(traj.size(), 1800u);
   const double dt = 1.0 / config.rate_hz;
   double max_turn = 0.0, max_step = 0.0;
@@ -58,7 +58,8 @@ TEST_P(SurveyOfRoom, StaysClearSmoothAndAtHeadHeight) {
     if (k > 0) {
       const Eigen::Isometry3d& P = traj[k - 1].T_W_C;
       max_step = std::max(max_step, (T.translation() - P.translation()).head<2>().norm());
-      max_turn = std::max(max_turn, std::acos(std::clamp(T.linear().col(2).dot(P.linear().col(2)), -1.0, 1.0)));
+      max_turn = std::max(
+          max_turn, std::acos(std::clamp(T.linear().col(2).dot(P.linear().col(2)), -1.0, 1.0)));
     }
   }
   EXPECT_LE(max_step, config.speed_mps * dt * 1.01);
@@ -66,18 +67,20 @@ TEST_P(SurveyOfRoom, StaysClearSmoothAndAtHeadHeight) {
   EXPECT_LE(max_turn, max_rate + 1e-9);
   // Exact clearance against every triangle, for every 30th pose.
   double clearance = 1e9;
-  std::vector<TimedPose> sampled;
+  std::vector<StampedPose> sampled;
   for (size_t k = 0; k < traj.size(); k += 30) {
     sampled.push_back(traj[k]);
     const Eigen::Vector3d p = traj[k].T_W_C.translation();
     for (const Eigen::Vector3i& f : room.mesh.faces) {
-      clearance = std::min(clearance, pointTriangleDistance(p, room.mesh.vertices[f[0]].cast<double>(),
-                                                            room.mesh.vertices[f[1]].cast<double>(),
-                                                            room.mesh.vertices[f[2]].cast<double>()));
+      clearance =
+          std::min(clearance, pointTriangleDistance(p, room.mesh.vertices[f[0]].cast<double>(),
+                                                    room.mesh.vertices[f[1]].cast<double>(),
+                                                    room.mesh.vertices[f[2]].cast<double>()));
     }
   }
   EXPECT_GE(clearance, config.clearance_m);
-  EXPECT_GE(minClearance(sampled, room.mesh), clearance - 1e-6);  // vertices are never nearer than faces
+  EXPECT_GE(minClearance(sampled, room.mesh),
+            clearance - 1e-6);  // vertices are never nearer than faces
   // Same seed, same trajectory.
   const auto again = planSurvey(room.mesh, config, 7);
   EXPECT_EQ(again.back().T_W_C.matrix(), traj.back().T_W_C.matrix());
@@ -117,10 +120,11 @@ TEST(Survey, NoRoomToWalkIsAClearError) {
 
 TEST(Survey, TumRoundTrip) {
   test::TempDir dir;
-  std::vector<TimedPose> traj(3);
+  std::vector<StampedPose> traj(3);
   for (int k = 0; k < 3; ++k) {
     traj[k].utime = 1000000 + 33333 * k;
-    traj[k].T_W_C.linear() = Eigen::AngleAxisd(0.3 * k, Eigen::Vector3d(1, 2, 2).normalized()).toRotationMatrix();
+    traj[k].T_W_C.linear() =
+        Eigen::AngleAxisd(0.3 * k, Eigen::Vector3d(1, 2, 2).normalized()).toRotationMatrix();
     traj[k].T_W_C.translation() << 0.5 * k, -1.25, 2.0;
   }
   writeTumTrajectory(dir.path("t.txt"), traj);

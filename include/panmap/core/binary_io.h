@@ -53,7 +53,9 @@ class BinaryReader {
   }
   /// Reads raw bytes.
   void getBytes(void* out, size_t size) {
-    if (size > size_ - pos_) throw Error(what_ + ": truncated (needs " + std::to_string(size) + " more bytes at offset " + std::to_string(pos_) + ")");
+    if (size > size_ - pos_)
+      throw Error(what_ + ": truncated (needs " + std::to_string(size) + " more bytes at offset " +
+                  std::to_string(pos_) + ")");
     std::memcpy(out, data_ + pos_, size);
     pos_ += size;
   }
@@ -62,7 +64,8 @@ class BinaryReader {
   uint64_t getCount(size_t min_item_bytes) {
     const uint64_t n = get<uint64_t>();
     if (min_item_bytes > 0 && n > (size_ - pos_) / min_item_bytes) {
-      throw Error(what_ + ": corrupt count " + std::to_string(n) + " at offset " + std::to_string(pos_));
+      throw Error(what_ + ": corrupt count " + std::to_string(n) + " at offset " +
+                  std::to_string(pos_));
     }
     return n;
   }

@@ -11,13 +11,13 @@ namespace panmap {
 
 /// One RGB-D frame with colour registered to the depth camera.
 struct RgbdFrame {
-  int64_t utime = 0;          ///< capture time of the depth image, microseconds
-  int64_t frame_id = 0;       ///< index of the frame in its source sequence
-  std::string camera_name;    ///< free text: camera or dataset name
-  PinholeCamera camera;       ///< depth camera model, shared by the registered colour image
+  int64_t utime = 0;             ///< capture time of the depth image, microseconds
+  int64_t frame_id = 0;          ///< index of the frame in its source sequence
+  std::string camera_name;       ///< free text: camera or dataset name
+  PinholeCamera camera;          ///< depth camera model, shared by the registered colour image
   double depth_scale_m = 0.001;  ///< metres per depth unit
-  DepthImage depth;           ///< camera.width x camera.height
-  ColorImage color;           ///< same size as depth, or empty when the source has no colour
+  DepthImage depth;              ///< camera.width x camera.height
+  ColorImage color;              ///< same size as depth, or empty when the source has no colour
 };
 
 /// One segment of a 2D panoptic segmentation.
@@ -35,8 +35,8 @@ struct PanopticSegment {
 
 /// A 2D panoptic segmentation of one frame, at the depth image's resolution.
 struct PanopticFrame {
-  int64_t utime = 0;     ///< utime of the RgbdFrame it segments
-  int64_t frame_id = 0;  ///< frame_id of that RgbdFrame
+  int64_t utime = 0;       ///< utime of the RgbdFrame it segments
+  int64_t frame_id = 0;    ///< frame_id of that RgbdFrame
   LabelImage segment_ids;  ///< per pixel a PanopticSegment::id, 0 = no segment
   std::vector<PanopticSegment> segments;
 };

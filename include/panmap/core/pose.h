@@ -33,8 +33,7 @@ Eigen::Isometry3d nearestIsometry(const Eigen::Matrix4d& T);
 
 /// Pose between two stamped poses: linear in translation, slerp in rotation.
 /// @param t in [0, 1]: 0 gives a, 1 gives b.
-Eigen::Isometry3d interpolatePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b,
-                                  double t);
+Eigen::Isometry3d interpolatePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double t);
 
 /// Name of a pose source ("ground_truth", "slam", ...).
 const char* poseSourceName(PoseSource source);

@@ -27,8 +27,7 @@ class CocoPanopticReader {
   /// @param mask_dir folder with the PNGs (and per-frame JSONs)
   /// @param json_path COCO panoptic JSON, or "" for per-frame JSONs
   /// @param table the segmenter's categories -> panmap classes
-  CocoPanopticReader(const std::string& mask_dir, const std::string& json_path,
-                     LabelTable table);
+  CocoPanopticReader(const std::string& mask_dir, const std::string& json_path, LabelTable table);
 
   /// True when a mask exists for the colour image with this file stem.
   bool has(const std::string& color_stem) const;
@@ -43,7 +42,7 @@ class CocoPanopticReader {
  private:
   struct Entry {
     std::string png_path;
-    std::string json_path;       // per-frame JSON, or "" when segments come from the COCO file
+    std::string json_path;  // per-frame JSON, or "" when segments come from the COCO file
     std::vector<PanopticSegment> segments;  // from the COCO file
   };
   std::string mask_dir_;

@@ -22,9 +22,9 @@ struct DatasetFrame {
   std::vector<uint8_t> depth_png;
   /// T_W_C when the dataset has a valid pose for this frame.
   std::optional<Eigen::Isometry3d> T_W_C;
-  std::string pose_problem;  ///< why T_W_C is empty (file and reason)
-  std::string color_stem;    ///< colour file name without extension: the key of its masks
-  int color_source_width = 0;   ///< colour image size in the dataset, before registration
+  std::string pose_problem;    ///< why T_W_C is empty (file and reason)
+  std::string color_stem;      ///< colour file name without extension: the key of its masks
+  int color_source_width = 0;  ///< colour image size in the dataset, before registration
   int color_source_height = 0;
   /// Per depth pixel, the colour-image pixel it sees (empty when colour is already registered).
   Image<float> color_map_u;
@@ -47,7 +47,7 @@ struct DatasetOptions {
   std::optional<Eigen::Vector4d> intrinsics;
   double frame_rate_hz = 30.0;  ///< time base for datasets without timestamps
   ColorRegistration registration = ColorRegistration::kReproject;
-  double tum_max_dt_s = 0.02;   ///< TUM: max |t_rgb - t_depth| and |t_pose - t_depth|
+  double tum_max_dt_s = 0.02;  ///< TUM: max |t_rgb - t_depth| and |t_pose - t_depth|
   /// Largest |R^T R - I| entry accepted in a pose file (datasets store rounded matrices).
   double pose_tolerance = 1e-3;
   /// Throws Error naming the bad option.

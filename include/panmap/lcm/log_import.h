@@ -13,15 +13,15 @@ namespace panmap {
 /// Options of panmap-import.
 struct ImportOptions {
   DatasetOptions dataset;
-  ImageEncoding encoding;          ///< JPEG colour + PNG depth unless --raw
-  std::string mask_dir;            ///< COCO panoptic PNGs; "" for no PANOPTIC channel
-  std::string mask_json;           ///< COCO panoptic JSON; "" for per-frame JSON files
-  std::string label_table;         ///< segmenter -> panmap classes; "" = NYU40 identity
+  ImageEncoding encoding;   ///< JPEG colour + PNG depth unless --raw
+  std::string mask_dir;     ///< COCO panoptic PNGs; "" for no PANOPTIC channel
+  std::string mask_json;    ///< COCO panoptic JSON; "" for per-frame JSON files
+  std::string label_table;  ///< segmenter -> panmap classes; "" = NYU40 identity
   /// What to do with a frame whose pose is invalid: skip it (counted) or stop with an error.
   /// kAuto skips where the layout documents invalid poses (ScanNet) and stops elsewhere.
   enum class InvalidPose { kAuto, kSkip, kError } invalid_pose = InvalidPose::kAuto;
   PoseSource pose_source = PoseSource::kGroundTruth;  ///< recorded in every pose message
-  size_t max_frames = 0;           ///< 0 = all
+  size_t max_frames = 0;                              ///< 0 = all
   std::string channel_rgbd = "CAMERA_RGBD";
   std::string channel_pose = "CAMERA_POSE";
   std::string channel_panoptic = "PANOPTIC";
@@ -37,7 +37,7 @@ struct ImportStats {
   size_t skipped_invalid_pose = 0;
   size_t frames_without_mask = 0;
   size_t unknown_category_segments = 0;
-  size_t unmatched_frames = 0;     ///< e.g. TUM depth without colour in time
+  size_t unmatched_frames = 0;  ///< e.g. TUM depth without colour in time
   size_t bytes_written = 0;
   std::string first_skip_reason;
 };

@@ -11,13 +11,13 @@ namespace panmap {
 /// Statistics of one channel of an LCM log.
 struct ChannelInfo {
   std::string channel;
-  std::string type;           ///< panmap type name, "" when unknown or mixed
-  size_t count = 0;           ///< events
-  size_t bytes = 0;           ///< payload bytes
-  size_t failures = 0;        ///< events that did not decode as a panmap type
-  int64_t first_utime = 0;    ///< utime of the first message (event timestamp if undecodable)
+  std::string type;         ///< panmap type name, "" when unknown or mixed
+  size_t count = 0;         ///< events
+  size_t bytes = 0;         ///< payload bytes
+  size_t failures = 0;      ///< events that did not decode as a panmap type
+  int64_t first_utime = 0;  ///< utime of the first message (event timestamp if undecodable)
   int64_t last_utime = 0;
-  std::string first_error;    ///< the first failure's reason
+  std::string first_error;  ///< the first failure's reason
 
   /// Messages per second between the first and last utime (0 for fewer than two).
   double rateHz() const;
@@ -29,9 +29,9 @@ struct ChannelInfo {
 struct LogInfo {
   std::string path;
   size_t events = 0;
-  bool truncated = false;     ///< bytes after the last readable event (cut or corrupt)
-  size_t readable_bytes = 0;  ///< bytes up to the end of the last readable event
-  size_t skipped_bytes = 0;   ///< leading garbage LCM's reader skipped to find an event
+  bool truncated = false;             ///< bytes after the last readable event (cut or corrupt)
+  size_t readable_bytes = 0;          ///< bytes up to the end of the last readable event
+  size_t skipped_bytes = 0;           ///< leading garbage LCM's reader skipped to find an event
   std::vector<ChannelInfo> channels;  ///< sorted by channel name
   /// True when every event decoded and every byte of the file belongs to an event.
   bool allDecoded() const;

@@ -34,7 +34,7 @@ struct IntegrationStats {
   size_t blocks_allocated = 0;  ///< of those, new
   size_t voxels_updated = 0;
   size_t votes_added = 0;
-  size_t votes_evicted = 0;     ///< votes that pushed out a weaker label (never silent)
+  size_t votes_evicted = 0;  ///< votes that pushed out a weaker label (never silent)
 };
 
 /// Projective TSDF integration of depth, colour and per-pixel super-point labels into a
@@ -60,9 +60,9 @@ class ProjectiveIntegrator {
 
   IntegratorConfig config_;
   ThreadPool* pool_;
-  Image<float> depth_m_;              // scratch: depth in metres, 0 = invalid
-  std::vector<uint64_t> keys_;        // scratch: block keys seen this frame
-  std::vector<Block*> blocks_;        // scratch: blocks in view
+  Image<float> depth_m_;        // scratch: depth in metres, 0 = invalid
+  std::vector<uint64_t> keys_;  // scratch: block keys seen this frame
+  std::vector<Block*> blocks_;  // scratch: blocks in view
 };
 
 }  // namespace panmap

@@ -18,10 +18,10 @@ struct LabelVote {
 
 /// A voxel of the label-TSDF: 44 bytes.
 struct Voxel {
-  float sdf_m = 0.0f;     ///< truncated signed distance to the surface, metres (+ in front)
-  float weight = 0.0f;    ///< integration weight, 0 = never observed
-  Rgb8 color;             ///< running mean colour
-  uint8_t flags = 0;      ///< reserved
+  float sdf_m = 0.0f;   ///< truncated signed distance to the surface, metres (+ in front)
+  float weight = 0.0f;  ///< integration weight, 0 = never observed
+  Rgb8 color;           ///< running mean colour
+  uint8_t flags = 0;    ///< reserved
   LabelVote votes[kVoteSlots];
 };
 static_assert(sizeof(Voxel) == 44, "keep voxels lean (<= 64 bytes with votes)");

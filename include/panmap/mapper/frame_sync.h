@@ -42,10 +42,10 @@ struct SyncedFrame {
 struct SyncStats {
   int64_t frames_in = 0;
   int64_t frames_out = 0;
-  int64_t dropped_queue_full = 0;     ///< oldest frames dropped because the queue was full
-  int64_t rejected_no_pose = 0;       ///< no pose arrived in time
-  int64_t geometry_only = 0;          ///< mapped without a panoptic mask
-  int64_t unmatched_panoptic = 0;     ///< masks whose frame never came (or came too late)
+  int64_t dropped_queue_full = 0;  ///< oldest frames dropped because the queue was full
+  int64_t rejected_no_pose = 0;    ///< no pose arrived in time
+  int64_t geometry_only = 0;       ///< mapped without a panoptic mask
+  int64_t unmatched_panoptic = 0;  ///< masks whose frame never came (or came too late)
 };
 
 /// Matches RGB-D frames with poses (exact, nearest within a tolerance, or interpolated) and

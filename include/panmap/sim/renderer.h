@@ -13,20 +13,20 @@ namespace panmap {
 
 /// Everything a pinhole camera sees of a labelled mesh, before sensor noise.
 struct RenderedView {
-  Image<float> depth_m;          ///< z along the optical axis, metres; 0 = no surface
-  ColorImage color;              ///< shaded, textured colour
-  LabelImage instance;           ///< instance id of the visible surface, 0 = none
-  LabelImage semantic;           ///< NYU40 id of the visible surface, 0 = none
-  Image<float> cos_incidence;    ///< |cos| of the angle between view ray and surface normal
+  Image<float> depth_m;        ///< z along the optical axis, metres; 0 = no surface
+  ColorImage color;            ///< shaded, textured colour
+  LabelImage instance;         ///< instance id of the visible surface, 0 = none
+  LabelImage semantic;         ///< NYU40 id of the visible surface, 0 = none
+  Image<float> cos_incidence;  ///< |cos| of the angle between view ray and surface normal
 };
 
 /// Rendering options.
 struct RenderConfig {
-  float near_m = 0.05f;       ///< near clipping plane, metres
-  float far_m = 50.0f;        ///< nothing farther is drawn, metres
-  float ambient = 0.3f;       ///< shading: ambient share of the brightness, the rest is a
-                              ///< headlight (Lambert term |n . ray|)
-  float texture_cell_m = 0.08f;  ///< size of the per-object procedural texture's cells, metres
+  float near_m = 0.05f;            ///< near clipping plane, metres
+  float far_m = 50.0f;             ///< nothing farther is drawn, metres
+  float ambient = 0.3f;            ///< shading: ambient share of the brightness, the rest is a
+                                   ///< headlight (Lambert term |n . ray|)
+  float texture_cell_m = 0.08f;    ///< size of the per-object procedural texture's cells, metres
   float texture_contrast = 0.25f;  ///< brightness swing of that texture, 0..1
   /// Throws Error naming the bad field.
   void check() const;

@@ -19,12 +19,12 @@ namespace panmap {
 /// Everything that shapes a synthetic sequence besides the mesh and the trajectory.
 struct SynthConfig {
   PinholeCamera camera{525.0, 525.0, 319.5, 239.5, 640, 480};  ///< Kinect-like depth camera
-  double depth_scale_m = 0.001;   ///< depth units of the output (millimetres)
+  double depth_scale_m = 0.001;  ///< depth units of the output (millimetres)
   RenderConfig render;
   DepthNoiseConfig depth;
   SegmenterNoiseConfig masks = SegmenterNoiseConfig::fromPreset("m2f");
   PoseDriftConfig poses = PoseDriftConfig::fromPreset("slam");
-  int min_view_px = 200;          ///< an instance counts as seen in a frame from this many pixels
+  int min_view_px = 200;            ///< an instance counts as seen in a frame from this many pixels
   double distinct_view_deg = 20.0;  ///< viewing directions this far apart are distinct viewpoints
   uint64_t seed = 1;
   /// Throws Error naming the bad field.
@@ -34,18 +34,18 @@ struct SynthConfig {
 /// One synthetic frame: what the sensor, the segmenter and the SLAM system deliver, with the
 /// ground truth beside it.
 struct SynthFrame {
-  RgbdFrame rgbd;               ///< noisy depth, rendered colour
-  PanopticFrame panoptic;       ///< simulated segmenter output
-  TimedPose gt_pose;            ///< true T_W_C
-  TimedPose input_pose;         ///< T_W_C as the drifting SLAM system reports it
-  LabelImage gt_instance;       ///< ground-truth instance image
+  RgbdFrame rgbd;          ///< noisy depth, rendered colour
+  PanopticFrame panoptic;  ///< simulated segmenter output
+  StampedPose gt_pose;     ///< true T_W_C
+  StampedPose input_pose;  ///< T_W_C as the drifting SLAM system reports it
+  LabelImage gt_instance;  ///< ground-truth instance image
 };
 
 /// How well a sequence observed the labelled objects.
 struct CoverageStats {
-  int thing_instances = 0;       ///< non-stuff instances in the mesh
-  int seen_once = 0;             ///< seen in at least one frame (min_view_px)
-  int seen_from_3_views = 0;     ///< seen from at least 3 distinct viewpoints
+  int thing_instances = 0;    ///< non-stuff instances in the mesh
+  int seen_once = 0;          ///< seen in at least one frame (min_view_px)
+  int seen_from_3_views = 0;  ///< seen from at least 3 distinct viewpoints
   /// seen_from_3_views / thing_instances.
   double fractionSeenFrom3Views() const {
     return thing_instances ? static_cast<double>(seen_from_3_views) / thing_instances : 0.0;
@@ -57,7 +57,7 @@ struct CoverageStats {
 class SequenceSynthesizer {
  public:
   /// @param T_W_C_gt the true camera trajectory (utime and pose per frame)
-  SequenceSynthesizer(const LabelledMesh& mesh, std::vector<TimedPose> T_W_C_gt,
+  SequenceSynthesizer(const LabelledMesh& mesh, std::vector<StampedPose> T_W_C_gt,
                       const SynthConfig& config);
 
   /// Number of frames.
@@ -65,9 +65,9 @@ class SequenceSynthesizer {
   /// Renders frame k (call with k = 0, 1, 2, ... for the coverage and segmenter statistics).
   SynthFrame frame(size_t k);
   /// Ground-truth trajectory.
-  const std::vector<TimedPose>& groundTruthTrajectory() const { return gt_; }
+  const std::vector<StampedPose>& groundTruthTrajectory() const { return gt_; }
   /// Trajectory as the simulated SLAM system reports it.
-  const std::vector<TimedPose>& inputTrajectory() const { return input_; }
+  const std::vector<StampedPose>& inputTrajectory() const { return input_; }
   /// Coverage over the frames rendered so far.
   CoverageStats coverage() const;
   /// Segmenter error statistics over the frames rendered so far.
@@ -79,8 +79,8 @@ class SequenceSynthesizer {
   SynthConfig config_;
   MeshRenderer renderer_;
   SegmenterNoise segmenter_;
-  std::vector<TimedPose> gt_;
-  std::vector<TimedPose> input_;
+  std::vector<StampedPose> gt_;
+  std::vector<StampedPose> input_;
   std::map<int32_t, InstanceInfo> infos_;
   std::map<int32_t, Eigen::Vector3d> centroids_;
   std::map<int32_t, std::vector<Eigen::Vector3d>> views_;  // distinct view directions seen

@@ -7,30 +7,26 @@
 #include <Eigen/Geometry>
 
 #include "panmap/core/labelled_mesh.h"
+#include "panmap/core/pose.h"
+#include "panmap/io/tum_trajectory.h"
 
 namespace panmap {
 
-/// A camera pose at a time.
-struct TimedPose {
-  int64_t utime = 0;  ///< microseconds
-  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();  ///< optical camera frame
-};
-
 /// Parameters of the survey path planner.
 struct SurveyConfig {
-  int num_frames = 300;          ///< poses to produce
-  double rate_hz = 30.0;         ///< frame rate
-  double speed_mps = 0.35;       ///< walking speed along the path, metres per second
-  double clearance_m = 0.3;      ///< minimum distance of the camera to any surface, metres
-  double min_height_m = 1.2;     ///< camera height band above the floor, metres
+  int num_frames = 300;       ///< poses to produce
+  double rate_hz = 30.0;      ///< frame rate
+  double speed_mps = 0.35;    ///< walking speed along the path, metres per second
+  double clearance_m = 0.3;   ///< minimum distance of the camera to any surface, metres
+  double min_height_m = 1.2;  ///< camera height band above the floor, metres
   double max_height_m = 1.7;
   double max_yaw_rate_dps = 45.0;    ///< head-like turning rate limit, degrees per second
   double max_pitch_rate_dps = 20.0;  ///< degrees per second
-  double grid_m = 0.05;          ///< free-space grid cell, metres
-  int num_waypoints = 10;        ///< tour stops spread over the free space
-  double view_min_m = 0.8;       ///< preferred distance to the object being looked at
+  double grid_m = 0.05;              ///< free-space grid cell, metres
+  int num_waypoints = 10;            ///< tour stops spread over the free space
+  double view_min_m = 0.8;           ///< preferred distance to the object being looked at
   double view_max_m = 3.5;
-  double min_look_s = 1.5;       ///< keep looking at a target at least this long, seconds
+  double min_look_s = 1.5;  ///< keep looking at a target at least this long, seconds
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -39,18 +35,11 @@ struct SurveyConfig {
 /// clearance_m from every surface, at min..max height above the floor, turning to look at
 /// the labelled objects from several sides. Deterministic for a seed. Throws Error when the
 /// mesh has no free space large enough to walk in.
-std::vector<TimedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& config,
-                                  uint64_t seed);
+std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& config,
+                                    uint64_t seed);
 
 /// Smallest distance from any trajectory position to the mesh's vertices, metres (the mesh
 /// is dense, so this bounds the distance to its surfaces within half an edge length).
-double minClearance(const std::vector<TimedPose>& trajectory, const LabelledMesh& mesh);
-
-/// Reads a TUM trajectory file ("t tx ty tz qx qy qz qw" lines, '#' comments). Throws Error
-/// naming the file and line on bad input.
-std::vector<TimedPose> readTumTrajectory(const std::string& path);
-
-/// Writes a TUM trajectory file (timestamps in seconds, 6 decimals).
-void writeTumTrajectory(const std::string& path, const std::vector<TimedPose>& trajectory);
+double minClearance(const std::vector<StampedPose>& trajectory, const LabelledMesh& mesh);
 
 }  // namespace panmap

@@ -19,7 +19,9 @@ class LabelRegistry {
   /// Number of labels ever created.
   int32_t size() const { return static_cast<int32_t>(parent_.size()) - 1; }
   /// True when a label is its own root (a live super-point).
-  bool isRoot(int32_t label) const { return label > 0 && label < static_cast<int32_t>(parent_.size()) && parent_[label] == label; }
+  bool isRoot(int32_t label) const {
+    return label > 0 && label < static_cast<int32_t>(parent_.size()) && parent_[label] == label;
+  }
   /// Parent array (index = label; parent_[0] = 0) for saving.
   const std::vector<int32_t>& parents() const { return parent_; }
   /// Restores from a saved parent array (validated: every parent <= its label).

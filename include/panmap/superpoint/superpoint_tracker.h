@@ -36,8 +36,8 @@ struct SuperpointConfig {
 
 /// What the tracker knows about one live super-point.
 struct SuperpointState {
-  std::map<int32_t, double> class_counts;    ///< frames that saw it as each class (0 = background)
-  std::map<int32_t, int> instance_counts;    ///< frames that assigned it to each global instance
+  std::map<int32_t, double> class_counts;  ///< frames that saw it as each class (0 = background)
+  std::map<int32_t, int> instance_counts;  ///< frames that assigned it to each global instance
   /// C(L_S) from frame counting: the most frequent class (0 = background / none).
   int32_t semanticClass() const;
   /// Its global instance from frame counting (0 = none).
@@ -46,8 +46,8 @@ struct SuperpointState {
 
 /// The result of associating one frame's surfaces with super-points.
 struct FrameAssociation {
-  LabelImage pixel_labels;               ///< super-point label per pixel, 0 = none
-  std::vector<int32_t> surface_labels;   ///< per surface (index = id - 1)
+  LabelImage pixel_labels;                 ///< super-point label per pixel, 0 = none
+  std::vector<int32_t> surface_labels;     ///< per surface (index = id - 1)
   std::vector<int32_t> surface_instances;  ///< global instance per surface, 0 = none
   int new_labels = 0;
   int merges = 0;
@@ -109,7 +109,7 @@ class SuperpointTracker {
 
   SuperpointConfig config_;
   LabelRegistry labels_;
-  std::map<int32_t, SuperpointState> states_;            // by root label
+  std::map<int32_t, SuperpointState> states_;               // by root label
   std::map<std::pair<int32_t, int32_t>, int> co_observed_;  // M, by root labels (a < b)
   std::vector<SuperpointMerge> merge_log_;
   int32_t next_instance_ = 1;

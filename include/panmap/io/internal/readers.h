@@ -15,8 +15,7 @@ std::unique_ptr<DatasetReader> makeSevenScenesReader(const std::string& dir,
                                                      const DatasetOptions& options);
 std::unique_ptr<DatasetReader> makeScanNetReader(const std::string& dir,
                                                  const DatasetOptions& options);
-std::unique_ptr<DatasetReader> makeTumReader(const std::string& dir,
-                                             const DatasetOptions& options);
+std::unique_ptr<DatasetReader> makeTumReader(const std::string& dir, const DatasetOptions& options);
 
 /// Reads a 4x4 camera-to-world pose file. Sets `problem` (file and reason) and returns
 /// nothing when the file is missing or the matrix is not a rigid transform.

@@ -1,0 +1,60 @@
+#include "panmap/io/tum_trajectory.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "panmap/core/error.h"
+
+namespace panmap {
+
+std::vector<StampedPose> readTumTrajectory(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot read trajectory " + path);
+  std::vector<StampedPose> out;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double v[8];
+    for (double& x : v) {
+      if (!(fields >> x)) {
+        throw Error(path + ":" + std::to_string(line_no) + ": expected 't tx ty tz qx qy qz qw'");
+      }
+    }
+    const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+    if (!std::isfinite(q.norm()) || std::abs(q.norm() - 1.0) > 1e-3) {
+      throw Error(path + ":" + std::to_string(line_no) + ": quaternion is not unit length");
+    }
+    StampedPose pose;
+    pose.utime = static_cast<int64_t>(std::llround(v[0] * 1e6));
+    pose.T_W_C.linear() = q.normalized().toRotationMatrix();
+    pose.T_W_C.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+    if (!pose.T_W_C.matrix().allFinite()) {
+      throw Error(path + ":" + std::to_string(line_no) + ": non-finite pose");
+    }
+    out.push_back(pose);
+  }
+  if (out.empty()) throw Error("trajectory " + path + " has no poses");
+  return out;
+}
+
+void writeTumTrajectory(const std::string& path, const std::vector<StampedPose>& trajectory) {
+  std::ofstream out(path);
+  if (!out) throw Error("cannot write trajectory " + path);
+  out << "# timestamp tx ty tz qx qy qz qw\n";
+  char buffer[256];
+  for (const StampedPose& p : trajectory) {
+    const Eigen::Quaterniond q(p.T_W_C.linear());
+    const Eigen::Vector3d t = p.T_W_C.translation();
+    std::snprintf(buffer, sizeof(buffer), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n",
+                  p.utime * 1e-6, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+    out << buffer;
+  }
+  if (!out) throw Error("cannot write trajectory " + path);
+}
+
+}  // namespace panmap
