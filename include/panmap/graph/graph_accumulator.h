@@ -1,0 +1,63 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <utility>
+
+#include <Eigen/Geometry>
+
+#include "panmap/core/frame.h"
+#include "panmap/graph/superpoint_graph.h"
+#include "panmap/map/tsdf_map.h"
+#include "panmap/superpoint/superpoint_tracker.h"
+
+namespace panmap {
+
+/// Parameters of the per-frame graph update (III-C).
+struct GraphConfig {
+  /// P_s = 1 / (1 + d / spatial_scale_m), d the distance between the centroids of the two
+  /// super-points' voxels seen through the same mask in the frame (the paper: "based on the
+  /// inverse distance"; this form is 1 for touching parts and halves at spatial_scale_m).
+  double spatial_scale_m = 0.5;
+  int sample_stride_px = 2;     ///< pixels between ray samples (1 = every pixel)
+  /// Throws Error naming the bad field.
+  void check() const;
+};
+
+/// Accumulates the super-point graph frame by frame: vertex scores P_nu^C (Eq. 5) and edge
+/// confidences P_eps^C (Eq. 6). Keyed by live super-points; merges fold scores and edges
+/// together, so the cost of an update does not grow with the number of frames seen.
+class GraphAccumulator {
+ public:
+  /// Throws Error when the config is invalid.
+  explicit GraphAccumulator(const GraphConfig& config);
+
+  /// Adds one frame: for each panoptic mask o (confidence P_o from Eq. 1), the voxels its
+  /// pixels' rays reach are grouped by super-point (N^S_o, unique voxels), then Eq. 5 and
+  /// Eq. 6 are applied. Call after the frame was integrated. Also folds in the tracker's merges
+  /// made since the last call.
+  void update(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
+              const PanopticFrame& panoptic, const TsdfMap& map,
+              const SuperpointTracker& tracker, float stuff_confidence = 0.5f);
+
+  /// The graph of the live super-points: scores and confidences, centroids and voxel counts
+  /// from the map, initial labels from the tracker's frame counts.
+  SuperpointGraph graph(const TsdfMap& map, const SuperpointTracker& tracker) const;
+
+  /// P_nu^C of a super-point (merges resolved by the caller), empty if never seen.
+  const std::map<int32_t, double>& scores(int32_t label) const;
+  /// P_eps^C of a pair (a < b), empty if never co-observed.
+  const std::map<int32_t, double>& confidences(int32_t a, int32_t b) const;
+  /// Number of edges.
+  size_t numEdges() const { return edges_.size(); }
+
+ private:
+  void applyMerges(const SuperpointTracker& tracker);
+
+  GraphConfig config_;
+  std::map<int32_t, std::map<int32_t, double>> scores_;  // label -> class -> P_nu
+  std::map<std::pair<int32_t, int32_t>, std::map<int32_t, double>> edges_;  // (a<b) -> class -> P_eps
+  size_t merges_applied_ = 0;
+};
+
+}  // namespace panmap

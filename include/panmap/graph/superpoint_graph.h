@@ -1,0 +1,45 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace panmap {
+
+/// A vertex of the super-point graph (paper III-C): one live super-point.
+struct GraphVertex {
+  int32_t id = 0;              ///< super-point label L_S (> 0)
+  int32_t num_voxels = 0;      ///< voxels whose argmax label it is
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< world frame, metres
+  int32_t instance = 0;        ///< initial instance (frame counting), 0 = none
+  int32_t semantic = 0;        ///< initial class (frame counting), 0 = none
+  std::map<int32_t, double> scores;  ///< P_nu^C(L_S) per class C (Eq. 5); absent = 0
+};
+
+/// An edge of the super-point graph: the panoptic-spatial confidence that two super-points
+/// belong to the same object of class C.
+struct GraphEdge {
+  int32_t a = 0;  ///< super-point id, a < b
+  int32_t b = 0;
+  std::map<int32_t, double> confidences;  ///< P_eps^C(a, b) per class C (Eq. 6); absent = 0
+};
+
+/// The super-point graph handed to the final optimisation.
+struct SuperpointGraph {
+  std::vector<int32_t> classes;     ///< the label space the optimiser may assign (NYU40 ids)
+  std::vector<int32_t> background;  ///< classes counted as background C_0 (stuff)
+  std::vector<GraphVertex> vertices;  ///< sorted by id
+  std::vector<GraphEdge> edges;       ///< sorted by (a, b)
+};
+
+/// What the optimisation decided.
+struct GraphLabels {
+  std::map<int32_t, int32_t> semantic;  ///< super-point id -> class
+  std::map<int32_t, int32_t> instance;  ///< super-point id -> instance (0 = none)
+  std::map<int32_t, float> instance_confidence;  ///< instance id -> P_O normalised to [0, 1]
+  double solve_ms = 0.0;
+};
+
+}  // namespace panmap

@@ -1,0 +1,225 @@
+#include "panmap/graph/graph_accumulator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+#include <vector>
+
+#include "panmap/core/classes.h"
+#include "panmap/core/error.h"
+#include "panmap/map/voxel.h"
+
+namespace panmap {
+
+void GraphConfig::check() const {
+  if (!(spatial_scale_m > 0.0)) throw Error("graph spatial_scale_m must be > 0");
+  if (sample_stride_px < 1) throw Error("graph sample_stride_px must be >= 1");
+}
+
+GraphAccumulator::GraphAccumulator(const GraphConfig& config) : config_(config) {
+  config_.check();
+}
+
+const std::map<int32_t, double>& GraphAccumulator::scores(int32_t label) const {
+  static const std::map<int32_t, double> kEmpty;
+  const auto it = scores_.find(label);
+  return it == scores_.end() ? kEmpty : it->second;
+}
+
+const std::map<int32_t, double>& GraphAccumulator::confidences(int32_t a, int32_t b) const {
+  static const std::map<int32_t, double> kEmpty;
+  const auto it = edges_.find(std::minmax(a, b));
+  return it == edges_.end() ? kEmpty : it->second;
+}
+
+void GraphAccumulator::applyMerges(const SuperpointTracker& tracker) {
+  const auto& merges = tracker.merges();
+  for (; merges_applied_ < merges.size(); ++merges_applied_) {
+    const int32_t kept = merges[merges_applied_].kept, gone = merges[merges_applied_].removed;
+    // Scores of merged super-points add up.
+    const auto it = scores_.find(gone);
+    if (it != scores_.end()) {
+      auto& target = scores_[kept];
+      for (const auto& [cls, score] : it->second) target[cls] += score;
+      scores_.erase(it);
+    }
+    // Edges of the removed one move to the survivor; the edge between them disappears.
+    std::vector<std::pair<std::pair<int32_t, int32_t>, std::map<int32_t, double>>> moved;
+    for (auto e = edges_.begin(); e != edges_.end();) {
+      if (e->first.first == gone || e->first.second == gone) {
+        const int32_t other = e->first.first == gone ? e->first.second : e->first.first;
+        if (other != kept) moved.emplace_back(std::minmax(kept, other), std::move(e->second));
+        e = edges_.erase(e);
+      } else {
+        ++e;
+      }
+    }
+    for (auto& [key, conf] : moved) {
+      auto& target = edges_[key];
+      for (const auto& [cls, c] : conf) target[cls] += c;
+    }
+  }
+}
+
+void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
+                              const PanopticFrame& panoptic, const TsdfMap& map,
+                              const SuperpointTracker& tracker, float stuff_confidence) {
+  applyMerges(tracker);
+  const PinholeCamera& cam = frame.camera;
+  if (panoptic.segment_ids.width() != cam.width || panoptic.segment_ids.height() != cam.height) {
+    throw Error("graph update: panoptic mask size differs from the frame's");
+  }
+  // Masks with a known class and their confidence P_o (Eq. 1).
+  std::map<int32_t, std::pair<int32_t, float>> masks;  // id -> (class, P_o)
+  for (const PanopticSegment& s : panoptic.segments) {
+    if (s.category <= 0) continue;
+    masks[s.id] = {s.category, s.is_thing ? s.score : stuff_confidence};
+  }
+  if (masks.empty()) return;
+
+  // Voxels reached by each mask's rays: (mask, voxel key, super-point) per sampled pixel.
+  struct Hit {
+    int32_t mask;
+    uint64_t voxel;
+    int32_t label;
+    bool operator<(const Hit& o) const { return std::tie(mask, voxel) < std::tie(o.mask, o.voxel); }
+    bool operator==(const Hit& o) const { return mask == o.mask && voxel == o.voxel; }
+  };
+  std::vector<Hit> hits;
+  const Eigen::Isometry3f T = T_W_C.cast<float>();
+  const float scale = static_cast<float>(frame.depth_scale_m);
+  const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
+  const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
+  const float inv_voxel = 1.0f / map.voxelSize();
+  auto resolve = [&tracker](int32_t l) { return tracker.labels().resolve(l); };
+  const Block* block = nullptr;
+  BlockIndex block_index = BlockIndex::Zero();
+  bool have_block = false;
+  const int stride = config_.sample_stride_px;
+  for (int v = 0; v < cam.height; v += stride) {
+    for (int u = 0; u < cam.width; u += stride) {
+      const int32_t id = panoptic.segment_ids(u, v);
+      if (id <= 0 || !masks.count(id)) continue;
+      const float d = frame.depth(u, v) * scale;
+      if (d <= 0.0f) continue;
+      const Eigen::Vector3f p = T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d);
+      const int gx = static_cast<int>(std::floor(p.x() * inv_voxel));
+      const int gy = static_cast<int>(std::floor(p.y() * inv_voxel));
+      const int gz = static_cast<int>(std::floor(p.z() * inv_voxel));
+      const BlockIndex b(gx >> 3, gy >> 3, gz >> 3);
+      if (!have_block || b != block_index) {
+        block = map.findBlock(b);
+        block_index = b;
+        have_block = true;
+      }
+      if (!block) continue;
+      const int32_t label = argmaxLabel(block->at(gx & 7, gy & 7, gz & 7), resolve);
+      if (label <= 0) continue;
+      const uint64_t key = (static_cast<uint64_t>(gx & 0x1FFFFF) << 42) |
+                           (static_cast<uint64_t>(gy & 0x1FFFFF) << 21) |
+                           static_cast<uint64_t>(gz & 0x1FFFFF);
+      hits.push_back({id, key, label});
+    }
+  }
+  // N^S_o counts unique voxels: many pixels see the same voxel up close.
+  std::sort(hits.begin(), hits.end());
+  hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
+
+  const float voxel = map.voxelSize();
+  auto centre = [voxel](uint64_t key) {
+    auto field = [](uint64_t x) {
+      const int v = static_cast<int>(x & 0x1FFFFF);
+      return v >= (1 << 20) ? v - (1 << 21) : v;
+    };
+    return Eigen::Vector3d((field(key >> 42) + 0.5) * voxel, (field(key >> 21) + 0.5) * voxel,
+                           (field(key) + 0.5) * voxel);
+  };
+  for (size_t begin = 0; begin < hits.size();) {
+    size_t end = begin;
+    while (end < hits.size() && hits[end].mask == hits[begin].mask) ++end;
+    const auto [cls, p_o] = masks.at(hits[begin].mask);
+    // N^S_o and the centroid of those voxels, per super-point.
+    std::map<int32_t, std::pair<int, Eigen::Vector3d>> groups;
+    for (size_t i = begin; i < end; ++i) {
+      auto& g = groups.try_emplace(hits[i].label, 0, Eigen::Vector3d::Zero()).first->second;
+      ++g.first;
+      g.second += centre(hits[i].voxel);
+    }
+    // Eq. 5: P_nu^C(L_S) += P_o * N^S_o.
+    for (const auto& [label, g] : groups) scores_[label][cls] += p_o * g.first;
+    // Eq. 6: P_eps^C(S1, S2) += P_o * P_s * min(N^S1_o, N^S2_o), for every pair under o.
+    for (auto i = groups.begin(); i != groups.end(); ++i) {
+      for (auto j = std::next(i); j != groups.end(); ++j) {
+        const double distance =
+            (i->second.second / i->second.first - j->second.second / j->second.first).norm();
+        const double p_s = 1.0 / (1.0 + distance / config_.spatial_scale_m);
+        edges_[{i->first, j->first}][cls] +=
+            p_o * p_s * std::min(i->second.first, j->second.first);
+      }
+    }
+    begin = end;
+  }
+}
+
+SuperpointGraph GraphAccumulator::graph(const TsdfMap& map, const SuperpointTracker& tracker) const {
+  SuperpointGraph g;
+  for (int32_t c = 1; c <= kMaxNyu40Class; ++c) g.classes.push_back(c);
+  for (int32_t c = 1; c <= kMaxNyu40Class; ++c) {
+    if (isStuffClass(c)) g.background.push_back(c);
+  }
+  // Voxel counts and centroids of the live super-points.
+  std::map<int32_t, std::pair<int, Eigen::Vector3d>> voxels;
+  auto resolve = [&tracker](int32_t l) { return tracker.labels().resolve(l); };
+  for (const auto& block : map.blocks()) {
+    for (int z = 0; z < kBlockSide; ++z) {
+      for (int y = 0; y < kBlockSide; ++y) {
+        for (int x = 0; x < kBlockSide; ++x) {
+          const int32_t label = argmaxLabel(block->at(x, y, z), resolve);
+          if (label <= 0) continue;
+          auto& v = voxels.try_emplace(label, 0, Eigen::Vector3d::Zero()).first->second;
+          ++v.first;
+          v.second += map.voxelCentre(block->index, x, y, z).cast<double>();
+        }
+      }
+    }
+  }
+  for (const auto& [label, state] : tracker.states()) {
+    GraphVertex vertex;
+    vertex.id = label;
+    const auto it = voxels.find(label);
+    if (it != voxels.end()) {
+      vertex.num_voxels = it->second.first;
+      vertex.centroid = it->second.second / it->second.first;
+    }
+    vertex.instance = state.instance();
+    vertex.semantic = state.semanticClass();
+    const auto s = scores_.find(label);
+    if (s != scores_.end()) vertex.scores = s->second;
+    g.vertices.push_back(vertex);
+  }
+  for (const auto& [key, conf] : edges_) {
+    // Edges only between live super-points (merges are folded in at the next update).
+    const int32_t a = tracker.labels().resolve(key.first), b = tracker.labels().resolve(key.second);
+    if (a == b || a == 0 || b == 0) continue;
+    GraphEdge e;
+    e.a = std::min(a, b);
+    e.b = std::max(a, b);
+    e.confidences = conf;
+    g.edges.push_back(e);
+  }
+  std::sort(g.edges.begin(), g.edges.end(),
+            [](const GraphEdge& x, const GraphEdge& y) { return std::tie(x.a, x.b) < std::tie(y.a, y.b); });
+  // Pending merges can map two stored edges onto one pair: add them up.
+  std::vector<GraphEdge> merged;
+  for (GraphEdge& e : g.edges) {
+    if (!merged.empty() && merged.back().a == e.a && merged.back().b == e.b) {
+      for (const auto& [cls, c] : e.confidences) merged.back().confidences[cls] += c;
+    } else {
+      merged.push_back(std::move(e));
+    }
+  }
+  g.edges = std::move(merged);
+  return g;
+}
+
+}  // namespace panmap

@@ -1,0 +1,139 @@
+#include <gtest/gtest.h>
+
+#include "panmap/core/error.h"
+#include "panmap/graph/graph_accumulator.h"
+#include "panmap/map/projective_integrator.h"
+#include "panmap/sim/depth_noise.h"
+#include "panmap/sim/renderer.h"
+#include "test_meshes.h"
+
+namespace panmap {
+namespace {
+
+// A wall at x = 2 seen head-on, split into image columns by hand-made surfaces and masks.
+class WallGraph : public ::testing::Test {
+ protected:
+  WallGraph() : renderer_(wall()), pool_(1), integrator_(IntegratorConfig{}, &pool_) {
+    T_W_C_ = test::lookAt({0, 0, 1}, {2, 0, 1});
+    DepthNoiseConfig exact;
+    exact.enabled = false;
+    frame_.camera = test::kinectCamera();
+    frame_.depth = simulateDepth(renderer_.render(frame_.camera, T_W_C_), exact, 0);
+  }
+  static LabelledMesh wall() {
+    LabelledMesh mesh;
+    test::addQuad(&mesh, {2, -4, -2}, {2, 4, -2}, {2, 4, 4}, {2, -4, 4}, 1, 1, 8);
+    return mesh;
+  }
+  // Surfaces by column: [0, s1), [s1, s2), [s2, 640) with the given categories.
+  FrameSegmentation columns(int s1, int s2, int32_t c1, int32_t c2, int32_t c3) const {
+    FrameSegmentation seg;
+    seg.geometric = LabelImage(640, 480, 1);
+    seg.surfaces = LabelImage(640, 480, 0);
+    int count[3] = {0, 0, 0};
+    for (int v = 0; v < 480; ++v) {
+      for (int u = 0; u < 640; ++u) {
+        const int k = u < s1 ? 0 : (u < s2 ? 1 : 2);
+        seg.surfaces(u, v) = k + 1;
+        ++count[k];
+      }
+    }
+    const int32_t cats[3] = {c1, c2, c3};
+    for (int k = 0; k < 3; ++k) {
+      if (count[k]) seg.surface_list.push_back(Surface{k + 1, 1, k + 1, cats[k], true, 0.9f, count[k]});
+    }
+    return seg;
+  }
+  // One mask over the whole image (class 5, score 0.8).
+  static PanopticFrame wholeMask(int32_t category = 5, bool thing = true) {
+    PanopticFrame p;
+    p.segment_ids = LabelImage(640, 480, 1);
+    p.segments = {PanopticSegment{1, category, category, thing, 0.8f}};
+    return p;
+  }
+  void step(SuperpointTracker* tracker, TsdfMap* map, const FrameSegmentation& seg) {
+    const FrameAssociation a = tracker->associate(seg, frame_, T_W_C_, *map);
+    integrator_.integrate(frame_, T_W_C_, &a.pixel_labels, map);
+  }
+
+  MeshRenderer renderer_;
+  ThreadPool pool_;
+  ProjectiveIntegrator integrator_;
+  Eigen::Isometry3d T_W_C_;
+  RgbdFrame frame_;
+};
+
+TEST_F(WallGraph, ScoresFollowEquationFiveAndEdgesEquationSix) {
+  TsdfMap map(TsdfMap::Config{0.05f});
+  SuperpointTracker tracker(SuperpointConfig{});
+  step(&tracker, &map, columns(384, 640, 1, 4, 0));  // labels 1 (60 %) and 2 (40 %)
+  GraphAccumulator graph(GraphConfig{});
+  graph.update(frame_, T_W_C_, wholeMask(), map, tracker);
+  const double s1 = graph.scores(1).at(5), s2 = graph.scores(2).at(5);
+  // P_o * N^S_o with N the unique voxels: whole multiples of 0.8, split about 60 / 40.
+  EXPECT_NEAR(s1 / 0.8, std::round(s1 / 0.8), 1e-6);
+  EXPECT_NEAR(s1 / (s1 + s2), 0.6, 0.05);
+  // P_eps = P_o * P_s * min(N1, N2), P_s = 1 / (1 + d / 0.5 m). The wall seen at 2 m spans
+  // y in [-1.217, 1.217] m; column 384 is at y = 0.246 m, so the parts' centroids are
+  // (1.217 + 0.246) / 2 + (1.217 - 0.246) / 2 = 1.217 m apart: P_s = 0.291.
+  const double e = graph.confidences(1, 2).at(5);
+  const double p_s = e / (0.8 * std::min(s1, s2) / 0.8);
+  EXPECT_NEAR(p_s, 1.0 / (1.0 + 1.217 / 0.5), 0.01);
+  // A second identical frame doubles everything.
+  graph.update(frame_, T_W_C_, wholeMask(), map, tracker);
+  EXPECT_DOUBLE_EQ(graph.scores(1).at(5), 2 * s1);
+  EXPECT_DOUBLE_EQ(graph.confidences(2, 1).at(5), 2 * e);
+  // Stuff masks count with P_o = 0.5, whatever their score.
+  GraphAccumulator stuff(GraphConfig{});
+  stuff.update(frame_, T_W_C_, wholeMask(1, false), map, tracker);
+  EXPECT_DOUBLE_EQ(stuff.scores(1).at(1), s1 / 0.8 * 0.5);
+}
+
+TEST_F(WallGraph, MergedSuperpointsAddTheirScoresAndEdges) {
+  TsdfMap map(TsdfMap::Config{0.05f});
+  SuperpointConfig spatial;
+  spatial.semantic_consistency = false;
+  SuperpointTracker tracker(spatial);
+  GraphAccumulator graph(GraphConfig{});
+  // Three super-points side by side (1 | 2 | 3); observed twice with one mask over all.
+  for (int k = 0; k < 2; ++k) {
+    step(&tracker, &map, columns(256, 448, 1, 4, 7));
+    graph.update(frame_, T_W_C_, wholeMask(), map, tracker);
+  }
+  ASSERT_EQ(tracker.labels().size(), 3);
+  const auto s1 = graph.scores(1), s2 = graph.scores(2), s3 = graph.scores(3);
+  const double e12 = graph.confidences(1, 2).at(5), e13 = graph.confidences(1, 3).at(5);
+  const double e23 = graph.confidences(2, 3).at(5);
+  // Surfaces spanning 1 and 2 (alternating with the three-way split so 2 survives) until
+  // spatial-only merging joins them.
+  for (int k = 0; k < 8 && tracker.merges().empty(); ++k) {
+    step(&tracker, &map, k % 2 ? columns(448, 640, 1, 7, 0) : columns(256, 448, 1, 4, 7));
+  }
+  ASSERT_EQ(tracker.merges().size(), 1u);
+  ASSERT_EQ(tracker.merges()[0].kept, 1);
+  ASSERT_EQ(tracker.merges()[0].removed, 2);
+  // An update with no usable mask only folds the merge in.
+  PanopticFrame none = wholeMask();
+  none.segments.clear();
+  graph.update(frame_, T_W_C_, none, map, tracker);
+  EXPECT_DOUBLE_EQ(graph.scores(1).at(5), s1.at(5) + s2.at(5));
+  EXPECT_TRUE(graph.scores(2).empty());
+  EXPECT_TRUE(graph.confidences(1, 2).empty());  // inside the merged super-point now
+  EXPECT_DOUBLE_EQ(graph.confidences(1, 3).at(5), e13 + e23);
+  EXPECT_DOUBLE_EQ(graph.scores(3).at(5), s3.at(5));
+  (void)e12;
+  const SuperpointGraph g = graph.graph(map, tracker);
+  ASSERT_EQ(g.edges.size(), 1u);
+  EXPECT_EQ(g.edges[0].a, 1);
+  EXPECT_EQ(g.edges[0].b, 3);
+  for (const GraphVertex& v : g.vertices) EXPECT_NE(v.id, 2);
+}
+
+TEST(GraphAccumulator, RejectsBadInput) {
+  GraphConfig bad;
+  bad.spatial_scale_m = 0.0;
+  EXPECT_THROW(GraphAccumulator{bad}, Error);
+}
+
+}  // namespace
+}  // namespace panmap
