@@ -39,6 +39,8 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put<uint8_t>(c.superpoints.semantic_consistency);
   w->put<int32_t>(c.superpoints.sample_stride_px);
   w->put(c.superpoints.instance_min_overlap);
+  w->put(c.graph.spatial_scale_m);
+  w->put<int32_t>(c.graph.sample_stride_px);
   w->put<int32_t>(c.num_threads);
 }
 
@@ -67,6 +69,8 @@ MapperConfig getConfig(BinaryReader* r) {
   c.superpoints.semantic_consistency = r->get<uint8_t>() != 0;
   c.superpoints.sample_stride_px = r->get<int32_t>();
   c.superpoints.instance_min_overlap = r->get<float>();
+  c.graph.spatial_scale_m = r->get<double>();
+  c.graph.sample_stride_px = r->get<int32_t>();
   c.num_threads = r->get<int32_t>();
   return c;
 }
@@ -140,6 +144,55 @@ SuperpointTracker::Snapshot getSnapshot(BinaryReader* r) {
   return s;
 }
 
+void putClassMap(BinaryWriter* w, const std::map<int32_t, double>& m) {
+  w->put<uint64_t>(m.size());
+  for (const auto& [cls, value] : m) {
+    w->put<int32_t>(cls);
+    w->put<double>(value);
+  }
+}
+
+std::map<int32_t, double> getClassMap(BinaryReader* r) {
+  std::map<int32_t, double> m;
+  const uint64_t n = r->getCount(12);
+  for (uint64_t i = 0; i < n; ++i) {
+    const int32_t cls = r->get<int32_t>();
+    m[cls] = r->get<double>();
+  }
+  return m;
+}
+
+void putGraph(BinaryWriter* w, const GraphAccumulator::Snapshot& g) {
+  w->put<uint64_t>(g.scores.size());
+  for (const auto& [label, scores] : g.scores) {
+    w->put<int32_t>(label);
+    putClassMap(w, scores);
+  }
+  w->put<uint64_t>(g.edges.size());
+  for (const auto& [key, conf] : g.edges) {
+    w->put<int32_t>(key.first);
+    w->put<int32_t>(key.second);
+    putClassMap(w, conf);
+  }
+  w->put<uint64_t>(g.merges_applied);
+}
+
+GraphAccumulator::Snapshot getGraph(BinaryReader* r) {
+  GraphAccumulator::Snapshot g;
+  const uint64_t labels = r->getCount(12);
+  for (uint64_t i = 0; i < labels; ++i) {
+    const int32_t label = r->get<int32_t>();
+    g.scores[label] = getClassMap(r);
+  }
+  const uint64_t edges = r->getCount(16);
+  for (uint64_t i = 0; i < edges; ++i) {
+    const int32_t a = r->get<int32_t>(), b = r->get<int32_t>();
+    g.edges[{a, b}] = getClassMap(r);
+  }
+  g.merges_applied = r->get<uint64_t>();
+  return g;
+}
+
 }  // namespace
 
 void Mapper::save(const std::string& path) const {
@@ -156,6 +209,7 @@ void Mapper::save(const std::string& path) const {
     payload.putBytes(block->voxels, sizeof(block->voxels));
   }
   putSnapshot(&payload, tracker_->snapshot());
+  putGraph(&payload, graph_->snapshot());
 
   BinaryWriter file;
   file.putBytes(kMagic, sizeof(kMagic));
@@ -208,6 +262,7 @@ std::unique_ptr<Mapper> Mapper::load(const std::string& path) {
     r.getBytes(block->voxels, sizeof(block->voxels));
   }
   mapper->tracker_->restore(getSnapshot(&r));
+  mapper->graph_->restore(getGraph(&r));
   if (r.remaining() != 0) throw Error(path + ": unexpected bytes after the map state");
   return mapper;
 }

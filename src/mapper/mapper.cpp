@@ -16,6 +16,7 @@ void MapperConfig::check() const {
   depth_segmentation.check();
   fusion.check();
   superpoints.check();
+  graph.check();
   if (num_threads < 1 || num_threads > 256) throw Error("mapper num_threads must be in [1, 256]");
 }
 
@@ -33,20 +34,29 @@ Mapper::Mapper(const MapperConfig& config) : config_(config) {
   // A sign change is a surface only between samples closer than the truncation band.
   mesh_config.max_sdf_jump_voxels = config_.integrator.truncation_voxels;
   mesher_ = std::make_unique<IncrementalMesher>(mesh_config, pool_.get());
+  graph_ = std::make_unique<GraphAccumulator>(config_.graph);
 }
 
-LabelledMesh Mapper::extractMesh() {
+LabelledMesh Mapper::extractMesh(const GraphLabels* labels) {
   mesher_->update(map_.get());
   const SuperpointTracker& tracker = *tracker_;
   MeshLabeller labeller;
   labeller.superpoint = [&tracker](const Voxel& voxel) {
     return argmaxLabel(voxel, [&tracker](int32_t l) { return tracker.labels().resolve(l); });
   };
-  labeller.semantic = [&tracker](int32_t label) {
+  labeller.semantic = [&tracker, labels](int32_t label) {
+    if (labels) {
+      const auto it = labels->semantic.find(label);
+      if (it != labels->semantic.end()) return it->second;
+    }
     const SuperpointState* s = tracker.state(label);
     return s ? s->semanticClass() : 0;
   };
-  labeller.instance = [&tracker](int32_t label) {
+  labeller.instance = [&tracker, labels](int32_t label) {
+    if (labels) {
+      const auto it = labels->instance.find(label);
+      if (it != labels->instance.end()) return it->second;
+    }
     const SuperpointState* s = tracker.state(label);
     return s ? s->instance() : 0;
   };
@@ -105,10 +115,15 @@ FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_
   const auto t2 = Clock::now();
   stats.integration = integrator_->integrate(frame, T_W_C, &association.pixel_labels, map_.get());
   const auto t3 = Clock::now();
+  if (panoptic && !config_.fusion.geometry_only) {
+    graph_->update(frame, T_W_C, *panoptic, *map_, *tracker_, config_.fusion.stuff_confidence);
+  }
+  const auto t4 = Clock::now();
+  stats.graph_ms = ms(t3, t4);
   stats.segmentation_ms = ms(t0, t1);
   stats.superpoints_ms = ms(t1, t2);
   stats.integration_ms = ms(t2, t3);
-  stats.total_ms = ms(t0, t3);
+  stats.total_ms = ms(t0, t4);
   stats.surfaces = static_cast<int>(segmentation.surface_list.size());
   stats.new_superpoints = association.new_labels;
   stats.merges = association.merges;

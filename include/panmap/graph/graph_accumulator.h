@@ -51,6 +51,21 @@ class GraphAccumulator {
   /// Number of edges.
   size_t numEdges() const { return edges_.size(); }
 
+  /// Full state for saving and restoring a map.
+  struct Snapshot {
+    std::map<int32_t, std::map<int32_t, double>> scores;
+    std::map<std::pair<int32_t, int32_t>, std::map<int32_t, double>> edges;
+    uint64_t merges_applied = 0;
+  };
+  /// Copies the state out.
+  Snapshot snapshot() const { return Snapshot{scores_, edges_, merges_applied_}; }
+  /// Replaces the state.
+  void restore(const Snapshot& s) {
+    scores_ = s.scores;
+    edges_ = s.edges;
+    merges_applied_ = static_cast<size_t>(s.merges_applied);
+  }
+
  private:
   void applyMerges(const SuperpointTracker& tracker);
 

@@ -8,6 +8,7 @@
 
 #include "panmap/core/frame.h"
 #include "panmap/core/thread_pool.h"
+#include "panmap/graph/graph_accumulator.h"
 #include "panmap/map/projective_integrator.h"
 #include "panmap/map/tsdf_map.h"
 #include "panmap/mesh/incremental_mesher.h"
@@ -23,6 +24,7 @@ struct MapperConfig {
   DepthSegmentationConfig depth_segmentation;
   SurfaceFusionConfig fusion;
   SuperpointConfig superpoints;
+  GraphConfig graph;
   int num_threads = 2;  ///< threads for segmentation and integration (association uses one)
   /// Throws Error naming the bad field.
   void check() const;
@@ -33,6 +35,7 @@ struct FrameStats {
   double segmentation_ms = 0.0;  ///< III-A
   double superpoints_ms = 0.0;   ///< III-B association, merging, frame counting
   double integration_ms = 0.0;   ///< label-TSDF update
+  double graph_ms = 0.0;         ///< III-C super-point graph update
   double total_ms = 0.0;
   int surfaces = 0;
   int new_superpoints = 0;
@@ -59,6 +62,10 @@ class Mapper {
   const TsdfMap& map() const { return *map_; }
   /// Super-points and their frame-count labels.
   const SuperpointTracker& superpoints() const { return *tracker_; }
+  /// The super-point graph as accumulated so far (III-C).
+  const GraphAccumulator& graphAccumulator() const { return *graph_; }
+  /// The super-point graph of the live super-points, ready for the final optimisation.
+  SuperpointGraph graph() const { return graph_->graph(*map_, *tracker_); }
   /// The configuration in use.
   const MapperConfig& config() const { return config_; }
   /// Frames integrated so far.
@@ -69,7 +76,9 @@ class Mapper {
   /// The labelled mesh of the current map: marching cubes re-run only on changed blocks;
   /// per vertex the super-point (argmax of its voxel's votes, merges resolved), and the
   /// super-point's class and instance from frame counting.
-  LabelledMesh extractMesh();
+  /// @param labels optimised labels (panmap-optimizer); super-points it does not name keep
+  ///        their frame-count labels. Null: frame-count labels only.
+  LabelledMesh extractMesh(const GraphLabels* labels = nullptr);
 
   /// Writes the whole state (config, TSDF, votes, super-points) as a versioned binary file
   /// with a CRC-32; throws Error naming the file on failure.
@@ -89,6 +98,7 @@ class Mapper {
   std::unique_ptr<SuperpointTracker> tracker_;
   std::unique_ptr<ProjectiveIntegrator> integrator_;
   std::unique_ptr<IncrementalMesher> mesher_;
+  std::unique_ptr<GraphAccumulator> graph_;
   int64_t frames_ = 0;
   uint64_t vote_evictions_ = 0;
 };
