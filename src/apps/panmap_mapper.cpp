@@ -1,7 +1,9 @@
 // panmap-mapper: the mapping process. Offline mode (--log) maps every frame of an LCM log as
-// fast as it can and writes the outputs; the live LCM mode arrives with roadmap issue 5.
+// fast as it can, runs the final optimisation in-process and writes the outputs; the live
+// LCM mode arrives with roadmap issue 5.
 #include <sys/resource.h>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +14,7 @@
 #include "panmap/core/error.h"
 #include "panmap/core/progress.h"
 #include "panmap/io/image_codec.h"
+#include "panmap/graph/optimiser.h"
 #include "panmap/lcm/offline_mapping.h"
 #include "panmap/mesh/mesh_export.h"
 #include "panmap/sim/overview.h"
@@ -44,6 +47,7 @@ int main(int argc, char** argv) {
   panmap::MapperConfig config;
   panmap::OfflineOptions options;
   bool quiet = false, geometry_only = false, spatial_only = false, no_snapshots = false;
+  bool no_regularise = false, no_refine = false;
   app.add_option("--log", log_path, "LCM log to map offline")->required();
   app.add_option("--out", out_dir, "output folder")->required();
   app.add_option("--voxel-size", config.map.voxel_size_m, "voxel edge, metres")
@@ -53,6 +57,9 @@ int main(int argc, char** argv) {
   app.add_flag("--geometry-only", geometry_only, "ignore panoptic masks (ablation)");
   app.add_flag("--spatial-only", spatial_only,
                "merge super-points without the semantic consistency check (ablation, Voxblox++)");
+  app.add_flag("--no-regularise", no_regularise,
+               "skip the semantic regularisation (ablation, w/o III-C)");
+  app.add_flag("--no-refine", no_refine, "skip the instance refinement (ablation, w/o III-D)");
   app.add_option("--load", load_path, "resume from a map.panmap snapshot");
   app.add_option("--channel-rgbd", options.channel_rgbd)->capture_default_str();
   app.add_option("--channel-pose", options.channel_pose)->capture_default_str();
@@ -74,7 +81,17 @@ int main(int argc, char** argv) {
         [&](size_t done, size_t total) { progress.update(done >> 20, total >> 20); });
     progress.finish();
 
-    const panmap::LabelledMesh mesh = mapper->extractMesh();
+    // The final optimisation, in-process (the live mode asks panmap-optimizer over LCM).
+    const auto optimise_start = std::chrono::steady_clock::now();
+    const panmap::SuperpointGraph graph = mapper->graph();
+    panmap::OptimiserConfig optimiser;
+    optimiser.regularise = !no_regularise;
+    optimiser.refine = !no_refine;
+    const panmap::GraphLabels labels = panmap::optimise(graph, optimiser);
+    const double optimise_ms = std::chrono::duration<double, std::milli>(
+                                   std::chrono::steady_clock::now() - optimise_start)
+                                   .count();
+    const panmap::LabelledMesh mesh = mapper->extractMesh(&labels);
     panmap::writeLabelledMeshes(out_dir, mesh);
     mapper->save(out_dir + "/map.panmap");
     if (!no_snapshots && !mesh.faces.empty()) {
@@ -113,6 +130,9 @@ int main(int argc, char** argv) {
         {"superpoint_merges", mapper->superpoints().merges().size()},
         {"instances", mapper->superpoints().numInstances()},
         {"vote_evictions", mapper->voteEvictions()},
+        {"graph", {{"vertices", graph.vertices.size()}, {"edges", graph.edges.size()},
+                   {"optimise_ms", optimise_ms}, {"solve_ms", labels.solve_ms},
+                   {"regularise", optimiser.regularise}, {"refine", optimiser.refine}}},
         {"mesh", {{"vertices", mesh.numVertices()}, {"faces", mesh.numFaces()}}},
         {"config",
          {{"voxel_size_m", mapper->config().map.voxel_size_m},

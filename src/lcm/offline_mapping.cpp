@@ -61,6 +61,7 @@ OfflineReport mapLog(const std::string& log_path, const OfflineOptions& options,
         times["segmentation"].push_back(s.segmentation_ms);
         times["superpoints"].push_back(s.superpoints_ms);
         times["integration"].push_back(s.integration_ms);
+        times["graph"].push_back(s.graph_ms);
         times["total"].push_back(s.total_ms);
         ++report.frames_integrated;
         if (options.max_frames > 0 && report.frames_integrated >= options.max_frames) done = true;

@@ -1,0 +1,25 @@
+#pragma once
+
+#include <vector>
+
+#include "panmap/graph/internal/semantic_energy.h"
+
+namespace panmap {
+namespace internal {
+
+/// What alphaBetaSwap did.
+struct SwapStats {
+  int sweeps = 0;  ///< sweeps over all label pairs run
+  int moves = 0;   ///< swap moves accepted (each strictly lowered E)
+  int solved = 0;  ///< swap moves solved (the others were skipped as unchanged)
+};
+
+/// Alpha-beta swap (Boykov, Veksler, Zabih 2001) from `labels` (label indices, updated in
+/// place): sweeps over the label pairs (alpha < beta, ascending) and for each solves the
+/// binary problem of the vertices labelled alpha or beta exactly by one min cut
+/// (Boost Graph's boykov_kolmogorov_max_flow), keeping the result when it lowers E. Stops after a
+/// sweep without improvement or after max_sweeps. Deterministic.
+SwapStats alphaBetaSwap(const LabelProblem& problem, std::vector<int>& labels, int max_sweeps);
+
+}  // namespace internal
+}  // namespace panmap

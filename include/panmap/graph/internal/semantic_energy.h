@@ -1,0 +1,76 @@
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "panmap/graph/optimiser.h"
+#include "panmap/graph/superpoint_graph.h"
+
+namespace panmap {
+namespace internal {
+
+/// Eq. 8, unary potential: psi_u(C) = -log(P_nu^C / sum_C' P_nu^C'), the sum over the label
+/// space. The ratio is floored at `floor` (a class without score costs -log(floor), finite);
+/// a vertex without any score (`score_sum` = 0) costs 0 for every class (uniform).
+inline double unaryPotential(double score, double score_sum, double floor) {
+  if (score_sum <= 0.0) return 0.0;
+  return -std::log(std::max(score / score_sum, floor));
+}
+
+/// The edge factor of Eq. 9, 1 / (2 theta^2 sum_C P_eps^C(S1, S2)); 0 for an edge without
+/// confidence (sum 0), which then contributes no pairwise cost.
+inline double edgeFactor(double confidence_sum, double theta) {
+  return confidence_sum > 0.0 ? 1.0 / (2.0 * theta * theta * confidence_sum) : 0.0;
+}
+
+/// Eq. 9, pairwise potential: psi_p(C1, C2) = [C1 != C2] K_C exp(-k / (2 theta^2)) with
+/// k = P_nu^C1(S1) P_nu^C2(S2) / sum_C P_eps^C(S1, S2). `p1`, `p2` are the NORMALISED scores
+/// P_nu^C1(S1) / sum_C P_nu^C(S1) (0 for a vertex without scores): raw scores grow with the
+/// number of frames and voxels, so k on raw scores would grow without bound and the cost
+/// exp(-k / 2 theta^2) would vanish on any well-observed map. The denominator
+/// sum_C P_eps^C stays raw as in the paper (it also grows with observations, lowering k and
+/// raising the cost towards K_C on well-observed edges). `edge_factor` is
+/// edgeFactor(sum_C P_eps^C, theta); 0 drops the edge.
+inline double pairwisePotential(int32_t c1, int32_t c2, double p1, double p2, double edge_factor,
+                                double K_C) {
+  if (c1 == c2 || edge_factor <= 0.0) return 0.0;
+  const double product = p1 * p2;
+  if (product <= 0.0) return K_C;  // k = 0 (also avoids 0 * inf for tiny confidence sums)
+  return K_C * std::exp(-product * edge_factor);
+}
+
+/// The semantic labelling problem in dense form. Label indices 0..L-1 name `labels`.
+struct LabelProblem {
+  /// Classes the optimiser considers, ascending: the classes of graph.classes with a positive
+  /// score at some vertex, plus the initial (argmax) labels. Any other class of graph.classes
+  /// has the floor unary and the largest pairwise cost K_C at every vertex, so it can never
+  /// lower E and is left out.
+  std::vector<int32_t> labels;
+  int num_vertices = 0;
+  std::vector<double> unary;       ///< [vertex * L + label] Eq. 8
+  std::vector<double> score;       ///< [vertex * L + label] normalised P_nu (0 if no scores)
+  std::vector<int> adj_offset;     ///< CSR over edges with a positive confidence sum, n + 1
+  std::vector<int> adj_vertex;     ///< neighbour vertex index
+  std::vector<double> adj_factor;  ///< edgeFactor of that edge
+  std::vector<int> edge_a;         ///< the same edges once, vertex indices
+  std::vector<int> edge_b;
+  std::vector<double> edge_factor;
+  double K_C = 0.0;
+  std::vector<int> initial;  ///< argmax labelling (label indices), see buildLabelProblem
+  /// Number of labels L.
+  int numLabels() const { return static_cast<int>(labels.size()); }
+};
+
+/// Builds the problem from a checked graph. The initial label of a vertex is the argmax of its
+/// scores over graph.classes (ties: the smaller class id); a vertex without scores keeps its
+/// initial `semantic` if that is in graph.classes, else the smallest class.
+LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConfig& config);
+
+/// Eq. 7, the energy E(C) = sum_vertices psi_u + sum_edges psi_p of a labelling (label
+/// indices per vertex).
+double labellingEnergy(const LabelProblem& problem, const std::vector<int>& labels);
+
+}  // namespace internal
+}  // namespace panmap

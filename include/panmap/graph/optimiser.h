@@ -1,0 +1,50 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+
+#include "panmap/graph/superpoint_graph.h"
+
+namespace panmap {
+
+/// Parameters of the final optimisation (paper III-C energy, III-D refinement).
+struct OptimiserConfig {
+  bool regularise = true;  ///< III-C semantic regularisation (off: argmax of the scores)
+  bool refine = true;      ///< III-D instance refinement (off: initial instances)
+  double K_C = 15.0;       ///< pairwise weight (Eq. 9)
+  double theta = 0.5;      ///< pairwise bandwidth (Eq. 9)
+  int max_sweeps = 10;     ///< alpha-beta swap sweeps over all class pairs at most
+  /// Floor of the normalised score P_nu^C / sum_C' P_nu^C' in the unary (Eq. 8): a class
+  /// without score costs -log(score_floor) (13.8 for 1e-6) instead of infinity.
+  double score_floor = 1e-6;
+  /// Instance refinement passes (split + re-examination) per class at most; it stops
+  /// earlier when a pass leaves the partition unchanged.
+  int max_refine_iterations = 10;
+  /// Per-class refinement thresholds theta_D, theta_O, theta_L (III-D); classes not listed
+  /// use the defaults below. Each is a fraction in [0, 1].
+  struct Thresholds {
+    double theta_D = 0.1;  ///< weak link: below theta_D * P_O(own instance)
+    double theta_O = 0.1;  ///< join: link above theta_O * P_O(neighbour instance)
+    double theta_L = 0.5;  ///< join: link above theta_L * P_L (strongest link of the unit)
+  };
+  Thresholds default_thresholds;
+  std::map<int32_t, Thresholds> class_thresholds;
+  /// Throws Error naming the bad field.
+  void check() const;
+  /// The thresholds of a class (class_thresholds entry, else default_thresholds).
+  const Thresholds& thresholds(int32_t class_id) const;
+};
+
+/// Runs the final optimisation: alpha-beta swap over the semantic energy, then per-class
+/// instance refinement. Deterministic. Used by panmap-optimizer and in-process.
+/// Throws Error naming the field when the config or the graph is invalid (vertices not
+/// sorted by id, edges not sorted by (a, b) with a < b or naming unknown vertices, negative
+/// or non-finite scores/confidences, no classes for a non-empty graph).
+GraphLabels optimise(const SuperpointGraph& graph, const OptimiserConfig& config);
+
+/// E(C) of Eq. 7 for a labelling (super-point id -> class), for tests and reports.
+/// Throws Error when a vertex has no label or the graph/config is invalid.
+double semanticEnergy(const SuperpointGraph& graph, const std::map<int32_t, int32_t>& labels,
+                      const OptimiserConfig& config);
+
+}  // namespace panmap

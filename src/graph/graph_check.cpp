@@ -1,0 +1,99 @@
+#include "panmap/graph/internal/graph_check.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "panmap/core/error.h"
+
+namespace panmap {
+namespace internal {
+namespace {
+
+void checkValues(const std::map<int32_t, double>& values, const std::string& field) {
+  for (const auto& [c, v] : values) {
+    if (!std::isfinite(v) || v < 0.0) {
+      throw Error(field + "[" + std::to_string(c) + "]: " + std::to_string(v) +
+                  " (must be finite, >= 0)");
+    }
+  }
+}
+
+}  // namespace
+
+constexpr int32_t kTableSize = 1 << 16;
+
+void checkGraph(const SuperpointGraph& graph) {
+  if (graph.classes.empty() && !graph.vertices.empty()) {
+    throw Error("SuperpointGraph.classes: empty for a graph of " +
+                std::to_string(graph.vertices.size()) + " vertices");
+  }
+  for (size_t i = 0; i < graph.vertices.size(); ++i) {
+    const GraphVertex& v = graph.vertices[i];
+    const std::string field = "SuperpointGraph.vertices[" + std::to_string(i) + "]";
+    if (v.id <= 0) throw Error(field + ".id: " + std::to_string(v.id) + " (must be > 0)");
+    if (i > 0 && v.id <= graph.vertices[i - 1].id) {
+      throw Error(field + ".id: " + std::to_string(v.id) + " not above the previous id " +
+                  std::to_string(graph.vertices[i - 1].id));
+    }
+    checkValues(v.scores, field + ".scores");
+  }
+  const VertexIndex index(graph);
+  for (size_t i = 0; i < graph.edges.size(); ++i) {
+    const GraphEdge& e = graph.edges[i];
+    const std::string field = "SuperpointGraph.edges[" + std::to_string(i) + "]";
+    if (e.a >= e.b) {
+      throw Error(field + ": a = " + std::to_string(e.a) + " not below b = " + std::to_string(e.b));
+    }
+    if (index(e.a) < 0) throw Error(field + ".a: unknown vertex " + std::to_string(e.a));
+    if (index(e.b) < 0) throw Error(field + ".b: unknown vertex " + std::to_string(e.b));
+    if (i > 0) {
+      const GraphEdge& p = graph.edges[i - 1];
+      if (std::make_pair(e.a, e.b) <= std::make_pair(p.a, p.b)) {
+        throw Error(field + ": (" + std::to_string(e.a) + ", " + std::to_string(e.b) +
+                    ") not above the previous edge (sorted by (a, b), no duplicates)");
+      }
+    }
+    checkValues(e.confidences, field + ".confidences");
+  }
+}
+
+VertexIndex::VertexIndex(const SuperpointGraph& graph) : vertices_(graph.vertices) {
+  if (vertices_.empty()) return;
+  const int64_t max_id = vertices_.back().id;
+  if (max_id > 4 * static_cast<int64_t>(vertices_.size()) + 1024) return;
+  table_.assign(max_id + 1, -1);
+  for (size_t i = 0; i < vertices_.size(); ++i) {
+    if (vertices_[i].id >= 0) table_[vertices_[i].id] = static_cast<int>(i);
+  }
+}
+
+int VertexIndex::operator()(int32_t id) const {
+  if (!table_.empty()) {
+    return id >= 0 && id < static_cast<int32_t>(table_.size()) ? table_[id] : -1;
+  }
+  const auto it = std::lower_bound(vertices_.begin(), vertices_.end(), id,
+                                   [](const GraphVertex& v, int32_t x) { return v.id < x; });
+  if (it == vertices_.end() || it->id != id) return -1;
+  return static_cast<int>(it - vertices_.begin());
+}
+
+ClassSet::ClassSet(std::vector<int32_t> classes) : sorted_(std::move(classes)) {
+  std::sort(sorted_.begin(), sorted_.end());
+  sorted_.erase(std::unique(sorted_.begin(), sorted_.end()), sorted_.end());
+  for (int32_t c : sorted_) {
+    if (c < 0 || c >= kTableSize) {
+      flags_complete_ = false;
+      continue;
+    }
+    if (c >= static_cast<int32_t>(flags_.size())) flags_.resize(c + 1, 0);
+    flags_[c] = 1;
+  }
+}
+
+bool ClassSet::containsSorted(const std::vector<int32_t>& sorted, int32_t value) {
+  return std::binary_search(sorted.begin(), sorted.end(), value);
+}
+
+}  // namespace internal
+}  // namespace panmap

@@ -1,0 +1,172 @@
+// The semantic energy of III-C: unary (Eq. 8) and pairwise (Eq. 9) potentials summed into
+// E(C) (Eq. 7), in a dense per-vertex form for the alpha-beta swap and directly on the graph
+// for semanticEnergy().
+#include "panmap/graph/internal/semantic_energy.h"
+
+#include <algorithm>
+#include <string>
+
+#include "panmap/core/error.h"
+#include "panmap/graph/internal/graph_check.h"
+
+namespace panmap {
+namespace internal {
+namespace {
+
+/// Sum of the values whose class is in `classes` (classes outside the label space ignored).
+double sumOver(const std::map<int32_t, double>& values, const ClassSet& classes) {
+  double sum = 0.0;
+  for (const auto& [c, v] : values) {
+    if (classes.contains(c)) sum += v;
+  }
+  return sum;
+}
+
+/// The value of class c, 0 when absent or outside `classes`.
+double valueOf(const std::map<int32_t, double>& values, const ClassSet& classes, int32_t c) {
+  if (!classes.contains(c)) return 0.0;
+  const auto it = values.find(c);
+  return it == values.end() ? 0.0 : it->second;
+}
+
+}  // namespace
+
+LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConfig& config) {
+  const ClassSet classes(graph.classes);
+  const VertexIndex index(graph);
+  const int n = static_cast<int>(graph.vertices.size());
+  LabelProblem problem;
+  problem.num_vertices = n;
+  problem.K_C = config.K_C;
+
+  // Initial classes (argmax) and the label space.
+  std::vector<double> score_sum(n, 0.0);
+  std::vector<int32_t> initial_class(n, 0);
+  std::vector<int32_t> labels;
+  for (int i = 0; i < n; ++i) {
+    const GraphVertex& v = graph.vertices[i];
+    double best = 0.0;
+    int32_t best_class = 0;
+    bool any = false;
+    for (const auto& [c, s] : v.scores) {
+      if (s <= 0.0 || !classes.contains(c)) continue;
+      score_sum[i] += s;
+      labels.push_back(c);
+      if (!any || s > best) {  // map order: ties keep the smaller class
+        best = s;
+        best_class = c;
+        any = true;
+      }
+    }
+    initial_class[i] =
+        any ? best_class : (classes.contains(v.semantic) ? v.semantic : classes.sorted().front());
+    labels.push_back(initial_class[i]);
+  }
+  std::sort(labels.begin(), labels.end());
+  labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
+  problem.labels = labels;
+  const ClassSet label_set(labels);
+  const int L = static_cast<int>(labels.size());
+
+  // Dense unary (Eq. 8) and normalised scores.
+  problem.unary.assign(static_cast<size_t>(n) * L, 0.0);
+  problem.score.assign(static_cast<size_t>(n) * L, 0.0);
+  problem.initial.resize(n);
+  const auto labelIndex = [&](int32_t c) {
+    return static_cast<int>(std::lower_bound(labels.begin(), labels.end(), c) - labels.begin());
+  };
+  for (int i = 0; i < n; ++i) {
+    problem.initial[i] = labelIndex(initial_class[i]);
+    for (int l = 0; l < L; ++l) {
+      problem.unary[static_cast<size_t>(i) * L + l] =
+          unaryPotential(0.0, score_sum[i], config.score_floor);
+    }
+    for (const auto& [c, s] : graph.vertices[i].scores) {
+      if (s <= 0.0 || !label_set.contains(c)) continue;
+      const size_t at = static_cast<size_t>(i) * L + labelIndex(c);
+      problem.unary[at] = unaryPotential(s, score_sum[i], config.score_floor);
+      problem.score[at] = s / score_sum[i];
+    }
+  }
+
+  // Edges with a positive confidence sum, once and as CSR adjacency.
+  std::vector<int> degree(n + 1, 0);
+  for (const GraphEdge& e : graph.edges) {
+    const double factor = edgeFactor(sumOver(e.confidences, classes), config.theta);
+    if (factor <= 0.0) continue;
+    const int a = index(e.a);
+    const int b = index(e.b);
+    problem.edge_a.push_back(a);
+    problem.edge_b.push_back(b);
+    problem.edge_factor.push_back(factor);
+    ++degree[a + 1];
+    ++degree[b + 1];
+  }
+  for (int i = 0; i < n; ++i) degree[i + 1] += degree[i];
+  problem.adj_offset = degree;
+  problem.adj_vertex.resize(degree[n]);
+  problem.adj_factor.resize(degree[n]);
+  std::vector<int> fill(degree.begin(), degree.end() - 1);
+  for (size_t k = 0; k < problem.edge_a.size(); ++k) {
+    const int a = problem.edge_a[k];
+    const int b = problem.edge_b[k];
+    problem.adj_vertex[fill[a]] = b;
+    problem.adj_factor[fill[a]++] = problem.edge_factor[k];
+    problem.adj_vertex[fill[b]] = a;
+    problem.adj_factor[fill[b]++] = problem.edge_factor[k];
+  }
+  return problem;
+}
+
+double labellingEnergy(const LabelProblem& problem, const std::vector<int>& labels) {
+  const int L = problem.numLabels();
+  double energy = 0.0;
+  for (int i = 0; i < problem.num_vertices; ++i) {
+    energy += problem.unary[static_cast<size_t>(i) * L + labels[i]];
+  }
+  for (size_t k = 0; k < problem.edge_a.size(); ++k) {
+    const int a = problem.edge_a[k];
+    const int b = problem.edge_b[k];
+    energy += pairwisePotential(
+        labels[a], labels[b], problem.score[static_cast<size_t>(a) * L + labels[a]],
+        problem.score[static_cast<size_t>(b) * L + labels[b]], problem.edge_factor[k], problem.K_C);
+  }
+  return energy;
+}
+
+}  // namespace internal
+
+double semanticEnergy(const SuperpointGraph& graph, const std::map<int32_t, int32_t>& labels,
+                      const OptimiserConfig& config) {
+  config.check();
+  internal::checkGraph(graph);
+  const internal::ClassSet classes(graph.classes);
+  const internal::VertexIndex index(graph);
+  const size_t n = graph.vertices.size();
+  std::vector<int32_t> label(n);
+  std::vector<double> normalised(n, 0.0);
+  double energy = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const GraphVertex& v = graph.vertices[i];
+    const auto it = labels.find(v.id);
+    if (it == labels.end()) {
+      throw Error("labels: no class for super-point " + std::to_string(v.id));
+    }
+    label[i] = it->second;
+    const double sum = internal::sumOver(v.scores, classes);
+    const double score = internal::valueOf(v.scores, classes, label[i]);
+    normalised[i] = sum > 0.0 ? score / sum : 0.0;
+    energy += internal::unaryPotential(score, sum, config.score_floor);
+  }
+  for (const GraphEdge& e : graph.edges) {
+    const double factor =
+        internal::edgeFactor(internal::sumOver(e.confidences, classes), config.theta);
+    const int a = index(e.a);
+    const int b = index(e.b);
+    energy += internal::pairwisePotential(label[a], label[b], normalised[a], normalised[b], factor,
+                                          config.K_C);
+  }
+  return energy;
+}
+
+}  // namespace panmap

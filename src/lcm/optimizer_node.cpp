@@ -1,0 +1,47 @@
+#include "panmap/lcm/optimizer_node.h"
+
+#include <chrono>
+#include <cstdio>
+
+#include "panmap/core/error.h"
+#include "panmap/lcm/graph_conversions.h"
+
+namespace panmap {
+
+OptimizerNode::OptimizerNode(lcm::LCM* lcm, const Config& config) : lcm_(lcm), config_(config) {
+  config_.optimiser.check();
+  lcm_->subscribe(config_.channel_graph, &OptimizerNode::onGraph, this);
+}
+
+void OptimizerNode::onGraph(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
+  // Called from LCM's C code: nothing may escape.
+  try {
+    superpoint_graph_t msg;
+    int used = -1;
+    try {
+      used = msg.decode(buffer->data, 0, static_cast<int>(buffer->data_size));
+    } catch (const std::exception&) {
+      used = -1;
+    }
+    if (used != static_cast<int>(buffer->data_size)) {
+      ++rejected_["malformed " + channel];
+      std::fprintf(stderr, "panmap-optimizer: malformed message on %s ignored\n", channel.c_str());
+      return;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    GraphLabels labels = optimise(fromMessage(msg), config_.optimiser);
+    labels.solve_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const int64_t now = std::chrono::duration_cast<std::chrono::microseconds>(
+                            std::chrono::system_clock::now().time_since_epoch())
+                            .count();
+    const graph_labels_t out = toMessage(labels, now, msg.request_id);
+    lcm_->publish(config_.channel_labels, &out);
+    ++answered_;
+  } catch (const std::exception& e) {
+    ++rejected_["bad graph"];
+    std::fprintf(stderr, "panmap-optimizer: graph refused: %s\n", e.what());
+  }
+}
+
+}  // namespace panmap

@@ -1,0 +1,389 @@
+// Final optimisation (III-C alpha-beta swap over Eqs. 7-9, III-D instance refinement):
+// energies against hand-computed values and brute force, refinement rules, determinism, errors.
+#include <cmath>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "panmap/core/error.h"
+#include "panmap/core/random.h"
+#include "panmap/graph/optimiser.h"
+
+namespace panmap {
+namespace {
+
+GraphVertex vertex(int32_t id, std::map<int32_t, double> scores, int32_t instance = 0,
+                   int32_t semantic = 0) {
+  GraphVertex v;
+  v.id = id;
+  v.num_voxels = 10;
+  v.instance = instance;
+  v.semantic = semantic;
+  v.scores = std::move(scores);
+  return v;
+}
+
+GraphEdge edge(int32_t a, int32_t b, std::map<int32_t, double> confidences) {
+  GraphEdge e;
+  e.a = a;
+  e.b = b;
+  e.confidences = std::move(confidences);
+  return e;
+}
+
+/// A random graph of 2..max_vertices vertices over `classes`: some vertices without scores,
+/// some with a score of class 99 outside the label space, each class scored with probability
+/// `score_probability` (sparse scores exercise the swap's pruning of vertices that cannot
+/// change), random edges (some without confidence, some vertices isolated).
+SuperpointGraph randomGraph(uint64_t seed, int max_vertices, const std::vector<int32_t>& classes,
+                            double score_probability = 0.6) {
+  Rng rng(seed);
+  SuperpointGraph graph;
+  graph.classes = classes;
+  const int n = 2 + static_cast<int>(rng.below(max_vertices - 1));
+  for (int i = 0; i < n; ++i) {
+    std::map<int32_t, double> scores;
+    if (!rng.bernoulli(0.15)) {
+      for (int32_t c : classes) {
+        if (rng.bernoulli(score_probability)) scores[c] = rng.uniform(0.1, 10.0);
+      }
+      if (rng.bernoulli(0.2)) scores[99] = rng.uniform(0.1, 30.0);
+    }
+    const int32_t semantic = classes[rng.below(classes.size())];
+    graph.vertices.push_back(vertex(i + 1, scores, 0, semantic));
+  }
+  for (int a = 1; a <= n; ++a) {
+    for (int b = a + 1; b <= n; ++b) {
+      if (!rng.bernoulli(0.5)) continue;
+      std::map<int32_t, double> confidences;
+      for (int32_t c : classes) {
+        if (rng.bernoulli(0.5)) confidences[c] = rng.uniform(0.0, 3.0);
+      }
+      graph.edges.push_back(edge(a, b, confidences));
+    }
+  }
+  return graph;
+}
+
+OptimiserConfig semanticOnly() {
+  OptimiserConfig config;
+  config.refine = false;
+  return config;
+}
+
+/// Energy of a labelling given per vertex index.
+double energyOf(const SuperpointGraph& graph, const std::vector<int32_t>& labels,
+                const OptimiserConfig& config) {
+  std::map<int32_t, int32_t> map;
+  for (size_t i = 0; i < labels.size(); ++i) map[graph.vertices[i].id] = labels[i];
+  return semanticEnergy(graph, map, config);
+}
+
+std::vector<int32_t> labelsOf(const SuperpointGraph& graph, const GraphLabels& result) {
+  std::vector<int32_t> labels;
+  for (const GraphVertex& v : graph.vertices) labels.push_back(result.semantic.at(v.id));
+  return labels;
+}
+
+/// Calls visit(labels) for every assignment of the vertices `free` to `choices`, the other
+/// vertices keeping `base`.
+void forEachAssignment(std::vector<int32_t> base, const std::vector<size_t>& free,
+                       const std::vector<int32_t>& choices,
+                       const std::function<void(const std::vector<int32_t>&)>& visit) {
+  const size_t k = choices.size();
+  size_t count = 1;
+  for (size_t i = 0; i < free.size(); ++i) count *= k;
+  for (size_t code = 0; code < count; ++code) {
+    size_t rest = code;
+    for (size_t v : free) {
+      base[v] = choices[rest % k];
+      rest /= k;
+    }
+    visit(base);
+  }
+}
+
+double tolerance(double energy) { return 1e-9 * (1.0 + std::abs(energy)); }
+
+TEST(SemanticEnergy, HandComputedThreeVertices) {
+  SuperpointGraph graph;
+  graph.classes = {1, 2};
+  graph.vertices = {vertex(1, {{1, 3.0}, {2, 1.0}}), vertex(2, {{2, 2.0}}),
+                    vertex(3, {}, 0, /*semantic=*/1)};
+  graph.edges = {edge(1, 2, {{1, 0.5}, {2, 1.0}}), edge(1, 3, {}), edge(2, 3, {{2, 2.0}})};
+  const OptimiserConfig config;  // K_C = 15, theta = 0.5: 2 theta^2 = 0.5
+  // Unary: -log(3/4), -log(1), 0 (no scores). Edge (1,2): k = (3/4 * 1) / 1.5 = 0.5,
+  // 15 exp(-0.5 / 0.5) = 15/e. Edge (2,3): vertex 3 has no scores, k = 0, cost 15.
+  // Edge (1,3): no confidence, 0.
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 1}, {2, 2}, {3, 1}}, config),
+              0.2876820724517809 + 5.5181916175716355 + 15.0, 1e-12);
+  // Vertex 2 has no score for class 1: -log(1e-6) = 13.815510557964274.
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 1}, {2, 1}, {3, 1}}, config),
+              0.2876820724517809 + 13.815510557964274, 1e-12);
+  // The optimum (all class 2): -log(1/4) only.
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 2}, {2, 2}, {3, 2}}, config), 1.3862943611198906, 1e-12);
+  const GraphLabels result = optimise(graph, semanticOnly());
+  EXPECT_EQ(result.semantic, (std::map<int32_t, int32_t>{{1, 2}, {2, 2}, {3, 2}}));
+}
+
+TEST(SemanticEnergy, ClassesOutsideTheLabelSpaceAreIgnored) {
+  SuperpointGraph graph;
+  graph.classes = {3, 7};
+  // Vertex 2 only scores class 99: no score in the label space, uniform unary, keeps its
+  // initial class 7.
+  graph.vertices = {vertex(1, {{3, 1.0}, {99, 100.0}}), vertex(2, {{99, 5.0}}, 0, 7)};
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 3}, {2, 7}}, OptimiserConfig()), 0.0, 1e-15);
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 3}, {2, 3}}, OptimiserConfig()), 0.0, 1e-15);
+  EXPECT_EQ(optimise(graph, semanticOnly()).semantic, (std::map<int32_t, int32_t>{{1, 3}, {2, 7}}));
+}
+
+TEST(SemanticEnergy, PairwiseIsAsymmetricInTheLabels) {
+  // Eq. 9 on one edge: k(C1, C2) = P^C1(S1) P^C2(S2) / sum P_eps, normalised scores.
+  // S1: {1: 0.9, 2: 0.1}, S2: {1: 0.2, 2: 0.8}; sum P_eps = 0.5, 2 theta^2 = 0.5.
+  SuperpointGraph graph;
+  graph.classes = {1, 2};
+  graph.vertices = {vertex(1, {{1, 9.0}, {2, 1.0}}), vertex(2, {{1, 2.0}, {2, 8.0}})};
+  graph.edges = {edge(1, 2, {{1, 0.25}, {2, 0.25}})};
+  const OptimiserConfig config;
+  const double unary_12 = -std::log(0.9) - std::log(0.8);
+  const double unary_21 = -std::log(0.1) - std::log(0.2);
+  // (1, 2): k = 0.9 * 0.8 / 0.5 = 1.44, 15 exp(-2.88); (2, 1): k = 0.1 * 0.2 / 0.5 = 0.04.
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 1}, {2, 2}}, config), unary_12 + 15.0 * std::exp(-2.88),
+              1e-12);
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 2}, {2, 1}}, config), unary_21 + 15.0 * std::exp(-0.08),
+              1e-12);
+}
+
+/// (a) With two labels one swap move covers every labelling: the result is the global minimum
+/// (brute force over all labellings, <= 12 vertices).
+TEST(AlphaBetaSwap, TwoLabelsReachTheGlobalMinimum) {
+  const OptimiserConfig config = semanticOnly();
+  for (uint64_t seed = 0; seed < 50; ++seed) {
+    const SuperpointGraph graph =
+        randomGraph(seed, seed % 5 ? 8 : 12, {3, 7}, seed % 2 ? 0.6 : 0.3);
+    double best = INFINITY;
+    std::vector<size_t> all(graph.vertices.size());
+    for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+    forEachAssignment(std::vector<int32_t>(all.size(), 3), all, {3, 7},
+                      [&](const std::vector<int32_t>& labels) {
+                        best = std::min(best, energyOf(graph, labels, config));
+                      });
+    const double found = energyOf(graph, labelsOf(graph, optimise(graph, config)), config);
+    EXPECT_NEAR(found, best, tolerance(best)) << "seed " << seed;
+  }
+}
+
+/// The argmax labelling the optimiser starts from, computed independently.
+std::vector<int32_t> argmaxLabels(const SuperpointGraph& graph) {
+  std::vector<int32_t> labels;
+  for (const GraphVertex& v : graph.vertices) {
+    int32_t best = 0;
+    double best_score = 0.0;
+    for (int32_t c : graph.classes) {  // ascending in these tests: ties keep the smaller
+      const auto it = v.scores.find(c);
+      if (it != v.scores.end() && it->second > best_score) {
+        best = c;
+        best_score = it->second;
+      }
+    }
+    labels.push_back(best_score > 0.0 ? best : v.semantic);
+  }
+  return labels;
+}
+
+/// (b) With 3-4 labels: E(result) <= E(argmax start), and no single alpha-beta swap move lowers
+/// E (brute force over every pair and every reassignment of its vertices, <= 10 vertices).
+TEST(AlphaBetaSwap, ManyLabelsEndInASwapLocalMinimumBelowTheStart) {
+  const OptimiserConfig config = semanticOnly();
+  for (uint64_t seed = 100; seed < 150; ++seed) {
+    const std::vector<int32_t> classes =
+        seed % 2 ? std::vector<int32_t>{1, 2, 3} : std::vector<int32_t>{1, 2, 3, 4};
+    const SuperpointGraph graph =
+        randomGraph(seed, seed % 5 ? 7 : 10, classes, seed % 4 < 2 ? 0.6 : 0.25);
+    const std::vector<int32_t> start = argmaxLabels(graph);
+    OptimiserConfig no_swap = config;
+    no_swap.regularise = false;
+    EXPECT_EQ(labelsOf(graph, optimise(graph, no_swap)), start) << "seed " << seed;
+
+    const std::vector<int32_t> result = labelsOf(graph, optimise(graph, config));
+    const double energy = energyOf(graph, result, config);
+    EXPECT_LE(energy, energyOf(graph, start, config) + tolerance(energy)) << "seed " << seed;
+    for (size_t a = 0; a < classes.size(); ++a) {
+      for (size_t b = a + 1; b < classes.size(); ++b) {
+        std::vector<size_t> free;
+        for (size_t i = 0; i < result.size(); ++i) {
+          if (result[i] == classes[a] || result[i] == classes[b]) free.push_back(i);
+        }
+        double best = INFINITY;
+        forEachAssignment(result, free, {classes[a], classes[b]},
+                          [&](const std::vector<int32_t>& labels) {
+                            best = std::min(best, energyOf(graph, labels, config));
+                          });
+        EXPECT_GE(best, energy - tolerance(energy))
+            << "seed " << seed << " swap " << classes[a] << "-" << classes[b];
+      }
+    }
+  }
+}
+
+/// Chairs (class 5): instance 7 = {1,2} and {3,4}, each pair strongly linked (10), the pairs
+/// joined by one weak edge (0.5); instance 9 = {6,7} (link 5) and a stray super-point 8 with
+/// its own instance 11, strongly linked to 7 (8). A table (class 6) super-point 11 without
+/// instance. Walls (class 1, stuff) 9 and 10 with instance 3.
+SuperpointGraph refinementGraph() {
+  SuperpointGraph graph;
+  graph.classes = {1, 5, 6};
+  graph.background = {1};
+  graph.vertices = {vertex(1, {{5, 10.0}}, 7),  vertex(2, {{5, 10.0}}, 7),
+                    vertex(3, {{5, 10.0}}, 7),  vertex(4, {{5, 10.0}}, 7),
+                    vertex(6, {{5, 10.0}}, 9),  vertex(7, {{5, 10.0}}, 9),
+                    vertex(8, {{5, 10.0}}, 11), vertex(9, {{1, 10.0}}, 3),
+                    vertex(10, {{1, 10.0}}, 3), vertex(11, {{6, 10.0}}, 0)};
+  graph.edges = {edge(1, 2, {{5, 10.0}}), edge(2, 3, {{5, 0.5}}), edge(3, 4, {{5, 10.0}}),
+                 edge(4, 9, {{1, 0.2}}),  edge(6, 7, {{5, 5.0}}), edge(7, 8, {{5, 8.0}}),
+                 edge(9, 10, {{1, 4.0}})};
+  return graph;
+}
+
+TEST(InstanceRefinement, SplitsWeakLinksJoinsStraysStuffGetsNone) {
+  const SuperpointGraph graph = refinementGraph();
+  const GraphLabels result = optimise(graph, OptimiserConfig());
+  EXPECT_EQ(result.semantic,
+            (std::map<int32_t, int32_t>{
+                {1, 5}, {2, 5}, {3, 5}, {4, 5}, {6, 5}, {7, 5}, {8, 5}, {9, 1}, {10, 1}, {11, 6}}));
+  // {1,2} keeps 7 (tie on voxels: the smaller ids); {3,4} is new: 12 (above the largest
+  // initial id 11); 8 joins 9; the table gets the next new id 13; walls 0.
+  EXPECT_EQ(
+      result.instance,
+      (std::map<int32_t, int32_t>{
+          {1, 7}, {2, 7}, {3, 12}, {4, 12}, {6, 9}, {7, 9}, {8, 9}, {9, 0}, {10, 0}, {11, 13}}));
+  // P_O: 7 -> 10, 12 -> 10, 9 -> max(5, 8) = 8, 13 -> 0 (single super-point); max 10.
+  EXPECT_EQ(result.instance_confidence,
+            (std::map<int32_t, float>{{7, 1.0f}, {9, 0.8f}, {12, 1.0f}, {13, 0.0f}}));
+}
+
+TEST(InstanceRefinement, OffKeepsInitialInstances) {
+  OptimiserConfig config;
+  config.refine = false;
+  const GraphLabels result = optimise(refinementGraph(), config);
+  EXPECT_EQ(
+      result.instance,
+      (std::map<int32_t, int32_t>{
+          {1, 7}, {2, 7}, {3, 7}, {4, 7}, {6, 9}, {7, 9}, {8, 11}, {9, 0}, {10, 0}, {11, 0}}));
+  EXPECT_EQ(result.instance_confidence,
+            (std::map<int32_t, float>{{7, 1.0f}, {9, 0.5f}, {11, 0.0f}}));
+}
+
+TEST(InstanceRefinement, StrayJoinNeedsItsStrongestLink) {
+  // Stray 8's link to instance 9 (8) is below theta_L = 0.5 of its strongest link, a 20 link
+  // to a table super-point 12 of class 6 (P_eps^5 of that edge = 20): it stays alone.
+  SuperpointGraph graph = refinementGraph();
+  graph.vertices.push_back(vertex(12, {{6, 10.0}}, 4));
+  graph.edges.insert(graph.edges.begin() + 6, edge(8, 12, {{5, 20.0}}));  // sorted by (a, b)
+  const GraphLabels result = optimise(graph, OptimiserConfig());
+  EXPECT_EQ(result.semantic.at(8), 5);
+  EXPECT_EQ(result.semantic.at(12), 6);
+  EXPECT_EQ(result.instance.at(8), 11);
+  EXPECT_EQ(result.instance.at(7), 9);
+}
+
+TEST(Optimiser, Deterministic) {
+  SuperpointGraph graph;
+  graph.classes = {1, 2, 3, 4, 5, 6};
+  graph.background = {1};
+  Rng rng(42);
+  for (int i = 1; i <= 300; ++i) {
+    std::map<int32_t, double> scores;
+    scores[1 + static_cast<int32_t>(rng.below(6))] = rng.uniform(1.0, 20.0);
+    scores[1 + static_cast<int32_t>(rng.below(6))] += rng.uniform(0.1, 10.0);
+    graph.vertices.push_back(vertex(i, scores, static_cast<int32_t>(rng.below(40))));
+  }
+  for (int a = 1; a <= 300; ++a) {
+    for (int b = a + 1; b <= std::min(300, a + 6); ++b) {
+      if (rng.bernoulli(0.6)) {
+        graph.edges.push_back(
+            edge(a, b, {{1 + static_cast<int32_t>(rng.below(6)), rng.uniform(0.0, 5.0)}}));
+      }
+    }
+  }
+  const GraphLabels first = optimise(graph, OptimiserConfig());
+  const GraphLabels second = optimise(graph, OptimiserConfig());
+  EXPECT_EQ(first.semantic, second.semantic);
+  EXPECT_EQ(first.instance, second.instance);
+  EXPECT_EQ(first.instance_confidence, second.instance_confidence);
+  EXPECT_EQ(first.semantic.size(), 300u);
+}
+
+TEST(Optimiser, EmptyGraph) {
+  const GraphLabels result = optimise(SuperpointGraph(), OptimiserConfig());
+  EXPECT_TRUE(result.semantic.empty());
+  EXPECT_TRUE(result.instance.empty());
+}
+
+/// Expects `call` to throw Error with a one-line message containing `field`.
+void expectError(const std::function<void()>& call, const std::string& field) {
+  try {
+    call();
+    ADD_FAILURE() << "no Error for " << field;
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(field), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+}
+
+TEST(OptimiserConfig, RejectsBadFields) {
+  const SuperpointGraph graph = refinementGraph();
+  const auto expectBad = [&](const std::function<void(OptimiserConfig&)>& edit,
+                             const std::string& field) {
+    OptimiserConfig config;
+    edit(config);
+    expectError([&] { config.check(); }, field);
+    expectError([&] { optimise(graph, config); }, field);
+  };
+  expectBad([](OptimiserConfig& c) { c.K_C = -1.0; }, "OptimiserConfig.K_C");
+  expectBad([](OptimiserConfig& c) { c.K_C = NAN; }, "OptimiserConfig.K_C");
+  expectBad([](OptimiserConfig& c) { c.theta = 0.0; }, "OptimiserConfig.theta");
+  expectBad([](OptimiserConfig& c) { c.max_sweeps = 0; }, "OptimiserConfig.max_sweeps");
+  expectBad([](OptimiserConfig& c) { c.score_floor = 0.0; }, "OptimiserConfig.score_floor");
+  expectBad([](OptimiserConfig& c) { c.max_refine_iterations = 0; },
+            "OptimiserConfig.max_refine_iterations");
+  expectBad([](OptimiserConfig& c) { c.default_thresholds.theta_D = 1.5; },
+            "OptimiserConfig.default_thresholds.theta_D");
+  expectBad([](OptimiserConfig& c) { c.class_thresholds[5].theta_L = -0.1; },
+            "OptimiserConfig.class_thresholds[5].theta_L");
+  EXPECT_NO_THROW(OptimiserConfig().check());
+}
+
+TEST(OptimiserConfig, RejectsBadGraphs) {
+  const OptimiserConfig config;
+  const auto expectBad = [&](const std::function<void(SuperpointGraph&)>& edit,
+                             const std::string& field) {
+    SuperpointGraph graph = refinementGraph();
+    edit(graph);
+    expectError([&] { optimise(graph, config); }, field);
+  };
+  expectBad([](SuperpointGraph& g) { g.classes.clear(); }, "SuperpointGraph.classes");
+  expectBad([](SuperpointGraph& g) { std::swap(g.vertices[0], g.vertices[1]); },
+            "SuperpointGraph.vertices[1].id");
+  expectBad([](SuperpointGraph& g) { g.vertices[2].scores[5] = -1.0; },
+            "SuperpointGraph.vertices[2].scores[5]");
+  expectBad([](SuperpointGraph& g) { g.edges[0].b = 5; }, "SuperpointGraph.edges[0].b");
+  expectBad([](SuperpointGraph& g) { std::swap(g.edges[0].a, g.edges[0].b); },
+            "SuperpointGraph.edges[0]");
+  expectBad([](SuperpointGraph& g) { g.edges.push_back(g.edges.back()); },
+            "SuperpointGraph.edges[7]");
+  expectBad([](SuperpointGraph& g) { g.edges[1].confidences[5] = NAN; },
+            "SuperpointGraph.edges[1].confidences[5]");
+  expectError(
+      [] {
+        semanticEnergy(refinementGraph(), {{1, 5}}, OptimiserConfig());
+      },
+      "labels: no class for super-point 2");
+}
+
+}  // namespace
+}  // namespace panmap
