@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 [ -x build/panmap-bench-mapping ] || scripts/setup.sh --skip-network
 cmake --build build -j "$(nproc)" --target panmap-bench-mapping panmap-bench-renderer \
-  panmap-bench-segmentation panmap-bench-block-hash >/dev/null
+  panmap-bench-segmentation panmap-bench-block-hash panmap-bench-optimiser panmap-synth >/dev/null
 data=../shared/data/7scenes-200
 out=docs/PERFORMANCE.md
 mkdir -p docs
@@ -21,11 +21,19 @@ for voxel in 0.01 0.02; do
   done
 done
 
+echo "bench: mapping a synthetic room (panmap-synth --room 1, m2f masks) at 1 and 2 cm" >&2
+build/panmap-synth --room 1 --frames 300 --masks m2f --poses gt --seed 1 --quiet --out "$tmp/room1" >/dev/null
+room_rows=""
+for voxel in 0.01 0.02; do
+  room_rows+="$(build/panmap-bench-mapping --log "$tmp/room1/sequence.lcmlog" --voxel-size $voxel --threads 2 --markdown-row)"$'\n'
+done
+
 # Google Benchmark CSV: name,iterations,real_time,cpu_time,time_unit,...
 gb() { "$1" --benchmark_format=csv "${@:2}" 2>/dev/null | grep '^"' ; }
 echo "bench: renderer, segmentation, block hash map" >&2
 render=$(gb build/panmap-bench-renderer | grep median | awk -F, '{gsub(/"/,"",$1); printf "| %s | %.1f ms |\n", $1, $3}')
 segment=$(gb build/panmap-bench-segmentation --benchmark_repetitions=5 --benchmark_report_aggregates_only=true | grep median | awk -F, '{gsub(/"/,"",$1); printf "| %s | %.1f ms |\n", $1, $3}')
+optimiser=$(gb build/panmap-bench-optimiser | grep median | awk -F, '{gsub(/"/,"",$1); printf "| %s | %.1f ms |\n", $1, $3}')
 hash=$(gb build/panmap-bench-block-hash | awk -F, '{gsub(/"/,"",$1); printf "| %s | %.2f ms |\n", $1, $3}')
 
 cat > "$out" <<MD
@@ -42,10 +50,18 @@ frame: 2D segmentation (III-A) + super-point association (III-B) + label-TSDF in
 votes. Cells are median / p95 milliseconds per frame. Map MB: voxel blocks and index at the
 end; peak RSS includes the 200 decoded input frames (~300 MB).
 
-| voxel | threads | frames | segmentation | super-points | integration | total | map MB | peak RSS MB | bytes / voxel |
-|---|---|---|---|---|---|---|---|---|---|
+| voxel | threads | frames | segmentation | super-points | integration | graph | total | map MB | peak RSS MB | bytes / voxel |
+|---|---|---|---|---|---|---|---|---|---|---|
 ${rows}
 Targets of roadmap issue 3: <= 100 ms per frame at 1 cm and <= 33 ms at 2 cm (2 threads).
+
+A synthetic room (\`panmap-synth --room 1 --frames 300 --masks m2f --poses gt\`, 640x480 at
+30 Hz) with panoptic masks, so the super-point graph is updated every frame (III-C; target
+of roadmap issue 4: <= 10 ms median). Peak RSS here excludes input frames (decoded one by one).
+
+| voxel | threads | frames | segmentation | super-points | integration | graph | total | map MB | peak RSS MB | bytes / voxel |
+|---|---|---|---|---|---|---|---|---|---|---|
+${room_rows}
 
 ## Parts
 
@@ -61,6 +77,14 @@ Depth segmentation alone (\`panmap-bench-segmentation\`, 7-Scenes frame 0), medi
 | benchmark | time |
 |---|---|
 ${segment}
+
+Final optimisation (\`panmap-bench-optimiser\`: alpha-beta swap + instance refinement on a
+random graph of 5,000 super-points, 20 classes, 50,000 edges; "typical": 8 % of super-points
+start with a wrong class, "noisy": 22 %; target of roadmap issue 4: <= 100 ms), median of 9:
+
+| benchmark | time |
+|---|---|
+${optimiser}
 
 Block index: \`absl::flat_hash_map\` (used by \`TsdfMap\`) against \`std::unordered_map\`, 300k
 lookups in runs of 8 and 11k inserts (\`panmap-bench-block-hash\`):
