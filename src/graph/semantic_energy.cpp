@@ -92,10 +92,12 @@ LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConf
   // Edges with a positive confidence sum, once and as CSR adjacency.
   std::vector<int> degree(n + 1, 0);
   for (const GraphEdge& e : graph.edges) {
-    const double factor = edgeFactor(sumOver(e.confidences, classes), config.theta);
-    if (factor <= 0.0) continue;
     const int a = index(e.a);
     const int b = index(e.b);
+    const double factor = edgeFactor(
+        normalisedConfidence(sumOver(e.confidences, classes), score_sum[a], score_sum[b]),
+        config.theta);
+    if (factor <= 0.0) continue;
     problem.edge_a.push_back(a);
     problem.edge_b.push_back(b);
     problem.edge_factor.push_back(factor);
@@ -144,7 +146,7 @@ double semanticEnergy(const SuperpointGraph& graph, const std::map<int32_t, int3
   const internal::VertexIndex index(graph);
   const size_t n = graph.vertices.size();
   std::vector<int32_t> label(n);
-  std::vector<double> normalised(n, 0.0);
+  std::vector<double> normalised(n, 0.0), sums(n, 0.0);
   double energy = 0.0;
   for (size_t i = 0; i < n; ++i) {
     const GraphVertex& v = graph.vertices[i];
@@ -154,15 +156,17 @@ double semanticEnergy(const SuperpointGraph& graph, const std::map<int32_t, int3
     }
     label[i] = it->second;
     const double sum = internal::sumOver(v.scores, classes);
+    sums[i] = sum;
     const double score = internal::valueOf(v.scores, classes, label[i]);
     normalised[i] = sum > 0.0 ? score / sum : 0.0;
     energy += internal::unaryPotential(score, sum, config.score_floor);
   }
   for (const GraphEdge& e : graph.edges) {
-    const double factor =
-        internal::edgeFactor(internal::sumOver(e.confidences, classes), config.theta);
     const int a = index(e.a);
     const int b = index(e.b);
+    const double factor = internal::edgeFactor(
+        internal::normalisedConfidence(internal::sumOver(e.confidences, classes), sums[a], sums[b]),
+        config.theta);
     energy += internal::pairwisePotential(label[a], label[b], normalised[a], normalised[b], factor,
                                           config.K_C);
   }

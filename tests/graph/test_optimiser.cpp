@@ -115,18 +115,20 @@ TEST(SemanticEnergy, HandComputedThreeVertices) {
                     vertex(3, {}, 0, /*semantic=*/1)};
   graph.edges = {edge(1, 2, {{1, 0.5}, {2, 1.0}}), edge(1, 3, {}), edge(2, 3, {{2, 2.0}})};
   const OptimiserConfig config;  // K_C = 15, theta = 0.5: 2 theta^2 = 0.5
-  // Unary: -log(3/4), -log(1), 0 (no scores). Edge (1,2): k = (3/4 * 1) / 1.5 = 0.5,
-  // 15 exp(-0.5 / 0.5) = 15/e. Edge (2,3): vertex 3 has no scores, k = 0, cost 15.
-  // Edge (1,3): no confidence, 0.
+  // Unary: -log(3/4), -log(1), 0 (no scores). Edge (1,2): confidence 1.5 over
+  // min(4, 2) = 0.75, k = (3/4 * 1) / 0.75 = 1, 15 exp(-1 / 0.5) = 15 / e^2. Edge (2,3):
+  // vertex 3 has no scores, the edge costs nothing. Edge (1,3): no confidence, 0.
   EXPECT_NEAR(semanticEnergy(graph, {{1, 1}, {2, 2}, {3, 1}}, config),
-              0.2876820724517809 + 5.5181916175716355 + 15.0, 1e-12);
+              0.2876820724517809 + 15.0 * std::exp(-2.0), 1e-12);
   // Vertex 2 has no score for class 1: -log(1e-6) = 13.815510557964274.
   EXPECT_NEAR(semanticEnergy(graph, {{1, 1}, {2, 1}, {3, 1}}, config),
               0.2876820724517809 + 13.815510557964274, 1e-12);
-  // The optimum (all class 2): -log(1/4) only.
+  // The optimum: -log(1/4) only, vertices 1 and 2 in class 2; vertex 3 (no scores, no
+  // costing edge) keeps its initial class.
   EXPECT_NEAR(semanticEnergy(graph, {{1, 2}, {2, 2}, {3, 2}}, config), 1.3862943611198906, 1e-12);
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 2}, {2, 2}, {3, 1}}, config), 1.3862943611198906, 1e-12);
   const GraphLabels result = optimise(graph, semanticOnly());
-  EXPECT_EQ(result.semantic, (std::map<int32_t, int32_t>{{1, 2}, {2, 2}, {3, 2}}));
+  EXPECT_EQ(result.semantic, (std::map<int32_t, int32_t>{{1, 2}, {2, 2}, {3, 1}}));
 }
 
 TEST(SemanticEnergy, ClassesOutsideTheLabelSpaceAreIgnored) {
@@ -142,7 +144,8 @@ TEST(SemanticEnergy, ClassesOutsideTheLabelSpaceAreIgnored) {
 
 TEST(SemanticEnergy, PairwiseIsAsymmetricInTheLabels) {
   // Eq. 9 on one edge: k(C1, C2) = P^C1(S1) P^C2(S2) / sum P_eps, normalised scores.
-  // S1: {1: 0.9, 2: 0.1}, S2: {1: 0.2, 2: 0.8}; sum P_eps = 0.5, 2 theta^2 = 0.5.
+  // S1: {1: 0.9, 2: 0.1}, S2: {1: 0.2, 2: 0.8} (sums 10 each); sum P_eps = 0.5, normalised
+  // by min(10, 10) to 0.05; 2 theta^2 = 0.5.
   SuperpointGraph graph;
   graph.classes = {1, 2};
   graph.vertices = {vertex(1, {{1, 9.0}, {2, 1.0}}), vertex(2, {{1, 2.0}, {2, 8.0}})};
@@ -150,10 +153,11 @@ TEST(SemanticEnergy, PairwiseIsAsymmetricInTheLabels) {
   const OptimiserConfig config;
   const double unary_12 = -std::log(0.9) - std::log(0.8);
   const double unary_21 = -std::log(0.1) - std::log(0.2);
-  // (1, 2): k = 0.9 * 0.8 / 0.5 = 1.44, 15 exp(-2.88); (2, 1): k = 0.1 * 0.2 / 0.5 = 0.04.
-  EXPECT_NEAR(semanticEnergy(graph, {{1, 1}, {2, 2}}, config), unary_12 + 15.0 * std::exp(-2.88),
+  // (1, 2): k = 0.9 * 0.8 / 0.05 = 14.4, 15 exp(-28.8); (2, 1): k = 0.1 * 0.2 / 0.05 = 0.4,
+  // 15 exp(-0.8).
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 1}, {2, 2}}, config), unary_12 + 15.0 * std::exp(-28.8),
               1e-12);
-  EXPECT_NEAR(semanticEnergy(graph, {{1, 2}, {2, 1}}, config), unary_21 + 15.0 * std::exp(-0.08),
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 2}, {2, 1}}, config), unary_21 + 15.0 * std::exp(-0.8),
               1e-12);
 }
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "panmap/core/error.h"
+#include "panmap/graph/optimiser.h"
 #include "panmap/io/image_codec.h"
 #include "panmap/mapper/mapper.h"
 #include "panmap/sim/depth_noise.h"
@@ -117,6 +118,17 @@ TEST_F(BoxScene, TouchingBoxesOfDifferentClassesStaySeparate) {
   // One object, one instance: the cabinet's faces agree, the fridge differs.
   EXPECT_EQ(sp.state(top.first)->instance(), sp.state(front.first)->instance());
   EXPECT_NE(sp.state(top.first)->instance(), sp.state(fridge.first)->instance());
+  // The graph (III-C) saw both boxes; the final optimisation keeps their classes and
+  // instances apart.
+  const SuperpointGraph graph = mapper->graph();
+  EXPECT_GE(graph.vertices.size(), 3u);
+  EXPECT_GE(graph.edges.size(), 1u);
+  const GraphLabels labels = optimise(graph, OptimiserConfig{});
+  EXPECT_EQ(labels.semantic.at(top.first), 3);
+  EXPECT_EQ(labels.semantic.at(fridge.first), 24);
+  EXPECT_EQ(labels.instance.at(top.first), labels.instance.at(front.first));
+  EXPECT_NE(labels.instance.at(top.first), labels.instance.at(fridge.first));
+  EXPECT_GT(labels.instance.at(fridge.first), 0);
   // Along the shared side no vertex of the fridge's front carries a cabinet super-point.
   for (size_t v = 0; v < mesh.numVertices(); ++v) {
     if (fridge_front.contains(mesh.vertices[v]) && mesh.superpoint[v] > 0) {

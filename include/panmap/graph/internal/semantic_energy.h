@@ -19,8 +19,19 @@ inline double unaryPotential(double score, double score_sum, double floor) {
   return -std::log(std::max(score / score_sum, floor));
 }
 
-/// The edge factor of Eq. 9, 1 / (2 theta^2 sum_C P_eps^C(S1, S2)); 0 for an edge without
-/// confidence (sum 0), which then contributes no pairwise cost.
+/// sum_C P_eps^C(S1, S2) made scale-free: divided by the smaller of the two vertices' score
+/// sums, the most co-observation the weaker super-point could have had (Eq. 6 adds at most
+/// P_o min(N1, N2) where Eq. 5 adds P_o N to each). Raw sums grow with frames and voxels like
+/// the scores do; leaving them raw while normalising the scores made every disagreement cost
+/// about K_C, enough to relabel a fridge as the cabinet it touches through a few boundary
+/// voxels. 0 when either vertex has no score (the edge then costs nothing).
+inline double normalisedConfidence(double confidence_sum, double score_sum_a, double score_sum_b) {
+  const double scale = std::min(score_sum_a, score_sum_b);
+  return scale > 0.0 ? confidence_sum / scale : 0.0;
+}
+
+/// The edge factor of Eq. 9, 1 / (2 theta^2 c) with c the normalised confidence
+/// (normalisedConfidence); 0 for an edge without confidence, which then costs nothing.
 inline double edgeFactor(double confidence_sum, double theta) {
   return confidence_sum > 0.0 ? 1.0 / (2.0 * theta * theta * confidence_sum) : 0.0;
 }
@@ -29,10 +40,10 @@ inline double edgeFactor(double confidence_sum, double theta) {
 /// k = P_nu^C1(S1) P_nu^C2(S2) / sum_C P_eps^C(S1, S2). `p1`, `p2` are the NORMALISED scores
 /// P_nu^C1(S1) / sum_C P_nu^C(S1) (0 for a vertex without scores): raw scores grow with the
 /// number of frames and voxels, so k on raw scores would grow without bound and the cost
-/// exp(-k / 2 theta^2) would vanish on any well-observed map. The denominator
-/// sum_C P_eps^C stays raw as in the paper (it also grows with observations, lowering k and
-/// raising the cost towards K_C on well-observed edges). `edge_factor` is
-/// edgeFactor(sum_C P_eps^C, theta); 0 drops the edge.
+/// exp(-k / 2 theta^2) would vanish on any well-observed map. The denominator is normalised
+/// the same way (normalisedConfidence): a weak link makes k large and disagreement cheap, a
+/// strong link between uncertain super-points makes it cost up to K_C. `edge_factor` is
+/// edgeFactor(normalised confidence, theta); 0 drops the edge.
 inline double pairwisePotential(int32_t c1, int32_t c2, double p1, double p2, double edge_factor,
                                 double K_C) {
   if (c1 == c2 || edge_factor <= 0.0) return 0.0;
