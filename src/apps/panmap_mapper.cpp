@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -92,6 +93,10 @@ int main(int argc, char** argv) {
                                    std::chrono::steady_clock::now() - optimise_start)
                                    .count();
     const panmap::LabelledMesh mesh = mapper->extractMesh(&labels);
+    std::set<int32_t> instances_in_mesh;
+    for (int32_t id : mesh.instance) {
+      if (id > 0) instances_in_mesh.insert(id);
+    }
     panmap::writeLabelledMeshes(out_dir, mesh);
     mapper->save(out_dir + "/map.panmap");
     if (!no_snapshots && !mesh.faces.empty()) {
@@ -128,7 +133,8 @@ int main(int argc, char** argv) {
           {"voxels", mapper->map().numBlocks() * panmap::kBlockVoxels}}},
         {"superpoints", mapper->superpoints().states().size()},
         {"superpoint_merges", mapper->superpoints().merges().size()},
-        {"instances", mapper->superpoints().numInstances()},
+        {"instances_frame_counting", mapper->superpoints().numInstances()},
+        {"instances_in_mesh", instances_in_mesh.size()},
         {"vote_evictions", mapper->voteEvictions()},
         {"graph", {{"vertices", graph.vertices.size()}, {"edges", graph.edges.size()},
                    {"optimise_ms", optimise_ms}, {"solve_ms", labels.solve_ms},
@@ -143,12 +149,12 @@ int main(int argc, char** argv) {
           {"threads", mapper->config().num_threads}}}};
     std::ofstream(out_dir + "/report.json") << json.dump(2) << "\n";
     std::printf(
-        "mapped %lld frames in %.1f s (median %.1f ms/frame): %zu super-points, %d "
-        "instances, %zu mesh vertices; outputs in %s\n",
+        "mapped %lld frames in %.1f s (median %.1f ms/frame): %zu super-points, %zu "
+        "instances after optimisation, %zu mesh vertices; outputs in %s\n",
         static_cast<long long>(report.frames_integrated), report.wall_s,
         report.timings.count("total") ? report.timings.at("total").median_ms : 0.0,
-        mapper->superpoints().states().size(), mapper->superpoints().numInstances(),
-        mesh.numVertices(), out_dir.c_str());
+        mapper->superpoints().states().size(), instances_in_mesh.size(), mesh.numVertices(),
+        out_dir.c_str());
     for (const auto& [reason, count] : report.rejected) {
       std::printf("  rejected %lld: %s\n", static_cast<long long>(count), reason.c_str());
     }
