@@ -17,6 +17,7 @@
 #include "panmap/io/image_codec.h"
 #include "panmap/graph/optimiser.h"
 #include "panmap/lcm/offline_mapping.h"
+#include "panmap/mapper/config_file.h"
 #include "panmap/mesh/mesh_export.h"
 #include "panmap/sim/overview.h"
 
@@ -44,13 +45,16 @@ int main(int argc, char** argv) {
       "panmap mapping process. Offline: maps an LCM log (CAMERA_RGBD, CAMERA_POSE, "
       "PANOPTIC) and writes mesh_{semantic,instance,superpoint}.ply, map.panmap, "
       "report.json and snapshot PNGs into --out."};
-  std::string log_path, out_dir, load_path;
+  std::string log_path, out_dir, load_path, config_path;
   panmap::MapperConfig config;
   panmap::OfflineOptions options;
   bool quiet = false, geometry_only = false, spatial_only = false, no_snapshots = false;
-  bool no_regularise = false, no_refine = false;
-  app.add_option("--log", log_path, "LCM log to map offline")->required();
-  app.add_option("--out", out_dir, "output folder")->required();
+  bool no_regularise = false, no_refine = false, print_config = false;
+  app.add_option("--log", log_path, "LCM log to map offline");
+  app.add_option("--out", out_dir, "output folder");
+  app.add_option("--config", config_path,
+                 "YAML config (see --print-config); command-line flags override it");
+  app.add_flag("--print-config", print_config, "print the full default config and exit");
   app.add_option("--voxel-size", config.map.voxel_size_m, "voxel edge, metres")
       ->capture_default_str();
   app.add_option("--threads", config.num_threads, "integration threads")->capture_default_str();
@@ -70,7 +74,25 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
-    config.fusion.geometry_only = geometry_only;
+    panmap::PanmapConfig file_config;
+    if (print_config) {
+      std::printf("%s", panmap::configToYaml(file_config).c_str());
+      return 0;
+    }
+    if (log_path.empty() || out_dir.empty()) throw panmap::Error("--log and --out are required");
+    if (!config_path.empty()) {
+      file_config = panmap::loadConfig(config_path);
+      // Flags given on the command line win over the file.
+      if (app.count("--voxel-size") == 0) config.map.voxel_size_m = file_config.mapper.map.voxel_size_m;
+      if (app.count("--threads") == 0) config.num_threads = file_config.mapper.num_threads;
+      const float voxel = config.map.voxel_size_m;
+      const int threads = config.num_threads;
+      config = file_config.mapper;
+      config.map.voxel_size_m = voxel;
+      config.num_threads = threads;
+    }
+    if (geometry_only) config.fusion.geometry_only = true;
+    if (spatial_only) config.superpoints.semantic_consistency = false;
     config.superpoints.semantic_consistency = !spatial_only;
     std::unique_ptr<panmap::Mapper> mapper = load_path.empty()
                                                  ? std::make_unique<panmap::Mapper>(config)
@@ -85,9 +107,9 @@ int main(int argc, char** argv) {
     // The final optimisation, in-process (the live mode asks panmap-optimizer over LCM).
     const auto optimise_start = std::chrono::steady_clock::now();
     const panmap::SuperpointGraph graph = mapper->graph();
-    panmap::OptimiserConfig optimiser;
-    optimiser.regularise = !no_regularise;
-    optimiser.refine = !no_refine;
+    panmap::OptimiserConfig optimiser = file_config.optimiser;
+    if (no_regularise) optimiser.regularise = false;
+    if (no_refine) optimiser.refine = false;
     const panmap::GraphLabels labels = panmap::optimise(graph, optimiser);
     const double optimise_ms = std::chrono::duration<double, std::milli>(
                                    std::chrono::steady_clock::now() - optimise_start)

@@ -1,0 +1,215 @@
+#include "panmap/mapper/config_file.h"
+
+#include <set>
+#include <sstream>
+
+#include <opencv2/core.hpp>
+
+#include "panmap/core/error.h"
+
+namespace panmap {
+namespace {
+
+// Reads the keys of one section, remembering which it consumed so the rest are reported.
+class Section {
+ public:
+  Section(const cv::FileNode& node, std::string name, std::string file)
+      : node_(node), name_(std::move(name)), file_(std::move(file)) {
+    if (!node_.empty() && !node_.isMap()) fail(name_ + " must be a mapping");
+  }
+  template <typename T>
+  void read(const char* key, T* value) {
+    seen_.insert(key);
+    const cv::FileNode n = node_[key];
+    if (n.empty()) return;
+    if (!n.isInt() && !n.isReal()) fail(name_ + "." + key + " must be a number");
+    if constexpr (std::is_same<T, bool>::value) {
+      *value = static_cast<int>(n) != 0;
+    } else if constexpr (std::is_integral<T>::value) {
+      if (!n.isInt()) fail(name_ + "." + key + " must be an integer");
+      *value = static_cast<T>(static_cast<int>(n));
+    } else {
+      *value = static_cast<T>(static_cast<double>(n));
+    }
+  }
+  const cv::FileNode& node() const { return node_; }
+  void markSeen(const char* key) { seen_.insert(key); }
+  void finish() {
+    if (node_.empty()) return;
+    for (auto it = node_.begin(); it != node_.end(); ++it) {
+      if (!seen_.count((*it).name())) fail("unknown key " + name_ + "." + (*it).name());
+    }
+  }
+  [[noreturn]] void fail(const std::string& what) const { throw Error(file_ + ": " + what); }
+
+ private:
+  cv::FileNode node_;
+  std::string name_;
+  std::string file_;
+  std::set<std::string> seen_;
+};
+
+}  // namespace
+
+PanmapConfig loadConfig(const std::string& path) {
+  cv::FileStorage fs;
+  try {
+    if (!fs.open(path, cv::FileStorage::READ)) throw Error("cannot read config " + path);
+  } catch (const cv::Exception& e) {
+    throw Error(path + ": not a YAML config (" + std::string(e.err) + ")");
+  }
+  PanmapConfig c;
+  MapperConfig& m = c.mapper;
+  const cv::FileNode root = fs.root();
+  const std::set<std::string> sections = {"map", "integrator", "depth_segmentation", "fusion",
+                                          "superpoints", "graph", "optimiser", "threads"};
+  for (auto it = root.begin(); it != root.end(); ++it) {
+    if (!sections.count((*it).name())) throw Error(path + ": unknown section " + (*it).name());
+  }
+  {
+    Section s(root["map"], "map", path);
+    s.read("voxel_size_m", &m.map.voxel_size_m);
+    s.finish();
+  }
+  {
+    Section s(root["integrator"], "integrator", path);
+    s.read("truncation_voxels", &m.integrator.truncation_voxels);
+    s.read("max_weight", &m.integrator.max_weight);
+    s.read("min_depth_m", &m.integrator.min_depth_m);
+    s.read("max_depth_m", &m.integrator.max_depth_m);
+    s.read("weight_dropoff", &m.integrator.weight_dropoff);
+    s.read("space_carving", &m.integrator.space_carving);
+    s.read("vote_stride_px", &m.integrator.vote_stride_px);
+    s.finish();
+  }
+  {
+    Section s(root["depth_segmentation"], "depth_segmentation", path);
+    s.read("normals_window_px", &m.depth_segmentation.normals_window_px);
+    s.read("min_convexity_window_px", &m.depth_segmentation.min_convexity_window_px);
+    s.read("min_convexity_threshold", &m.depth_segmentation.min_convexity_threshold);
+    s.read("depth_discontinuity_ratio", &m.depth_segmentation.depth_discontinuity_ratio);
+    s.read("min_segment_px", &m.depth_segmentation.min_segment_px);
+    s.read("max_depth_m", &m.depth_segmentation.max_depth_m);
+    s.finish();
+  }
+  {
+    Section s(root["fusion"], "fusion", path);
+    s.read("min_surface_px", &m.fusion.min_surface_px);
+    s.read("stuff_confidence", &m.fusion.stuff_confidence);
+    s.read("geometry_only", &m.fusion.geometry_only);
+    s.finish();
+  }
+  {
+    Section s(root["superpoints"], "superpoints", path);
+    s.read("association_min_overlap", &m.superpoints.association_min_overlap);
+    s.read("significant_overlap", &m.superpoints.significant_overlap);
+    s.read("merge_threshold", &m.superpoints.merge_threshold);
+    s.read("semantic_consistency", &m.superpoints.semantic_consistency);
+    s.read("sample_stride_px", &m.superpoints.sample_stride_px);
+    s.read("instance_min_overlap", &m.superpoints.instance_min_overlap);
+    s.finish();
+  }
+  {
+    Section s(root["graph"], "graph", path);
+    s.read("spatial_scale_m", &m.graph.spatial_scale_m);
+    s.read("sample_stride_px", &m.graph.sample_stride_px);
+    s.finish();
+  }
+  {
+    OptimiserConfig& o = c.optimiser;
+    Section s(root["optimiser"], "optimiser", path);
+    s.read("regularise", &o.regularise);
+    s.read("refine", &o.refine);
+    s.read("K_C", &o.K_C);
+    s.read("theta", &o.theta);
+    s.read("max_sweeps", &o.max_sweeps);
+    s.read("theta_D", &o.default_thresholds.theta_D);
+    s.read("theta_O", &o.default_thresholds.theta_O);
+    s.read("theta_L", &o.default_thresholds.theta_L);
+    s.markSeen("classes");
+    const cv::FileNode classes = s.node().empty() ? cv::FileNode() : s.node()["classes"];
+    if (!classes.empty()) {
+      if (!classes.isSeq()) s.fail("optimiser.classes must be a list");
+      for (auto it = classes.begin(); it != classes.end(); ++it) {
+        Section entry(*it, "optimiser.classes[]", path);
+        int32_t cls = -1;
+        OptimiserConfig::Thresholds t = o.default_thresholds;
+        entry.read("class", &cls);
+        entry.read("theta_D", &t.theta_D);
+        entry.read("theta_O", &t.theta_O);
+        entry.read("theta_L", &t.theta_L);
+        entry.finish();
+        if (cls <= 0) entry.fail("optimiser.classes[] needs a positive class");
+        o.class_thresholds[cls] = t;
+      }
+    }
+    s.finish();
+  }
+  if (!root["threads"].empty()) {
+    if (!root["threads"].isInt()) throw Error(path + ": threads must be an integer");
+    m.num_threads = static_cast<int>(root["threads"]);
+  }
+  try {
+    c.mapper.check();
+    c.optimiser.check();
+  } catch (const Error& e) {
+    throw Error(path + ": " + e.what());
+  }
+  return c;
+}
+
+std::string configToYaml(const PanmapConfig& c) {
+  const MapperConfig& m = c.mapper;
+  std::ostringstream y;
+  y << "%YAML:1.0\n---\n# panmap configuration. Every key is optional; missing keys keep these defaults.\n";
+  y << "map:\n   voxel_size_m: " << m.map.voxel_size_m << "   # voxel edge, metres\n";
+  y << "integrator:\n"
+    << "   truncation_voxels: " << m.integrator.truncation_voxels << "   # TSDF truncation, voxels\n"
+    << "   max_weight: " << m.integrator.max_weight << "   # weights saturate here\n"
+    << "   min_depth_m: " << m.integrator.min_depth_m << "   # depth range used, metres\n"
+    << "   max_depth_m: " << m.integrator.max_depth_m << "\n"
+    << "   weight_dropoff: " << m.integrator.weight_dropoff << "   # weight falls behind the surface (0/1)\n"
+    << "   space_carving: " << m.integrator.space_carving << "   # record free space up to the camera (0/1)\n"
+    << "   vote_stride_px: " << m.integrator.vote_stride_px << "   # pixels between label votes\n";
+  y << "depth_segmentation:\n"
+    << "   normals_window_px: " << m.depth_segmentation.normals_window_px << "\n"
+    << "   min_convexity_window_px: " << m.depth_segmentation.min_convexity_window_px << "\n"
+    << "   min_convexity_threshold: " << m.depth_segmentation.min_convexity_threshold << "\n"
+    << "   depth_discontinuity_ratio: " << m.depth_segmentation.depth_discontinuity_ratio << "\n"
+    << "   min_segment_px: " << m.depth_segmentation.min_segment_px << "\n"
+    << "   max_depth_m: " << m.depth_segmentation.max_depth_m << "\n";
+  y << "fusion:\n"
+    << "   min_surface_px: " << m.fusion.min_surface_px << "   # smaller surfaces are dropped\n"
+    << "   stuff_confidence: " << m.fusion.stuff_confidence << "   # P_o of stuff (Eq. 1)\n"
+    << "   geometry_only: " << m.fusion.geometry_only << "   # ignore panoptic masks (0/1)\n";
+  y << "superpoints:\n"
+    << "   association_min_overlap: " << m.superpoints.association_min_overlap << "\n"
+    << "   significant_overlap: " << m.superpoints.significant_overlap << "   # L_N(s_i) share\n"
+    << "   merge_threshold: " << m.superpoints.merge_threshold << "   # theta_merge\n"
+    << "   semantic_consistency: " << m.superpoints.semantic_consistency << "   # 0: spatial-only merging\n"
+    << "   sample_stride_px: " << m.superpoints.sample_stride_px << "\n"
+    << "   instance_min_overlap: " << m.superpoints.instance_min_overlap << "\n";
+  y << "graph:\n"
+    << "   spatial_scale_m: " << m.graph.spatial_scale_m << "   # P_s = 1 / (1 + d / scale)\n"
+    << "   sample_stride_px: " << m.graph.sample_stride_px << "\n";
+  const OptimiserConfig& o = c.optimiser;
+  y << "optimiser:\n"
+    << "   regularise: " << o.regularise << "   # III-C alpha-beta swap (0/1)\n"
+    << "   refine: " << o.refine << "   # III-D instance refinement (0/1)\n"
+    << "   K_C: " << o.K_C << "\n"
+    << "   theta: " << o.theta << "\n"
+    << "   max_sweeps: " << o.max_sweeps << "\n"
+    << "   theta_D: " << o.default_thresholds.theta_D << "   # defaults for classes not listed\n"
+    << "   theta_O: " << o.default_thresholds.theta_O << "\n"
+    << "   theta_L: " << o.default_thresholds.theta_L << "\n";
+  y << "   classes:\n";
+  for (const auto& [cls, t] : o.class_thresholds) {
+    y << "      - { class: " << cls << ", theta_D: " << t.theta_D << ", theta_O: " << t.theta_O
+      << ", theta_L: " << t.theta_L << " }\n";
+  }
+  if (o.class_thresholds.empty()) y << "      []\n";
+  y << "threads: " << m.num_threads << "\n";
+  return y.str();
+}
+
+}  // namespace panmap

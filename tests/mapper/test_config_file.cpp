@@ -1,0 +1,68 @@
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "panmap/core/error.h"
+#include "panmap/mapper/config_file.h"
+#include "test_helpers.h"
+
+namespace panmap {
+namespace {
+
+std::string write(const test::TempDir& dir, const std::string& text) {
+  const std::string path = dir.path("config.yaml");
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(ConfigFile, PrintedDefaultsReadBackUnchanged) {
+  test::TempDir dir;
+  PanmapConfig defaults;
+  defaults.optimiser.class_thresholds[5] = {0.2, 0.3, 0.4};
+  const PanmapConfig back = loadConfig(write(dir, configToYaml(defaults)));
+  EXPECT_EQ(configToYaml(back), configToYaml(defaults));
+  EXPECT_FLOAT_EQ(back.mapper.map.voxel_size_m, 0.01f);
+  EXPECT_EQ(back.mapper.superpoints.merge_threshold, 3);
+  EXPECT_DOUBLE_EQ(back.optimiser.thresholds(5).theta_L, 0.4);
+  EXPECT_DOUBLE_EQ(back.optimiser.thresholds(7).theta_L, 0.5);
+}
+
+TEST(ConfigFile, PartialFilesKeepDefaults) {
+  test::TempDir dir;
+  const PanmapConfig c = loadConfig(write(dir, "%YAML:1.0\n---\nmap:\n   voxel_size_m: 0.02\n"
+                                               "superpoints:\n   semantic_consistency: 0\n"
+                                               "optimiser:\n   classes:\n      - { class: 39, theta_D: 0.3 }\n"
+                                               "threads: 1\n"));
+  EXPECT_FLOAT_EQ(c.mapper.map.voxel_size_m, 0.02f);
+  EXPECT_FALSE(c.mapper.superpoints.semantic_consistency);
+  EXPECT_EQ(c.mapper.num_threads, 1);
+  EXPECT_DOUBLE_EQ(c.optimiser.thresholds(39).theta_D, 0.3);
+  EXPECT_DOUBLE_EQ(c.optimiser.thresholds(39).theta_O, 0.1);  // the default
+  EXPECT_FLOAT_EQ(c.mapper.integrator.truncation_voxels, 4.0f);
+}
+
+TEST(ConfigFile, BadKeysAndValuesNameTheKey) {
+  test::TempDir dir;
+  auto error = [&](const std::string& text) {
+    try {
+      loadConfig(write(dir, text));
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error("%YAML:1.0\n---\nmap:\n   voxel_sise_m: 0.02\n").find("unknown key map.voxel_sise_m"),
+            std::string::npos);
+  EXPECT_NE(error("%YAML:1.0\n---\nmapp:\n   voxel_size_m: 0.02\n").find("unknown section mapp"),
+            std::string::npos);
+  EXPECT_NE(error("%YAML:1.0\n---\nmap:\n   voxel_size_m: -1\n").find("voxel_size_m"),
+            std::string::npos);
+  EXPECT_NE(error("%YAML:1.0\n---\nsuperpoints:\n   merge_threshold: 2.5\n").find("superpoints.merge_threshold"),
+            std::string::npos);
+  EXPECT_NE(error("%YAML:1.0\n---\nmap:\n   voxel_size_m: [1]\n").find("must be a number"),
+            std::string::npos);
+  EXPECT_THROW(loadConfig(dir.path("missing.yaml")), Error);
+}
+
+}  // namespace
+}  // namespace panmap
