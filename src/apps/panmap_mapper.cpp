@@ -170,6 +170,9 @@ int main(int argc, char** argv) {
           {"merge_threshold", mapper->config().superpoints.merge_threshold},
           {"threads", mapper->config().num_threads}}}};
     std::ofstream(out_dir + "/report.json") << json.dump(2) << "\n";
+    // The exact parameters the outputs were made with (a loaded map brings its own).
+    std::ofstream(out_dir + "/config.yaml")
+        << panmap::configToYaml(panmap::PanmapConfig{mapper->config(), optimiser});
     std::printf(
         "mapped %lld frames in %.1f s (median %.1f ms/frame): %zu super-points, %zu "
         "instances after optimisation, %zu mesh vertices; outputs in %s\n",
