@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -59,6 +60,22 @@ class TempDir {
  private:
   std::string path_;
 };
+
+/// Links the ScanNet export fixture (../shared/data/scannet-export-3) into `dir` with frame 1's
+/// pose replaced by the -inf rows ScanNet writes for frames its reconstruction lost.
+inline void makeScanNetExportWithInfPose(const TempDir& dir) {
+  namespace fs = std::filesystem;
+  const std::string src = dataDir("scannet-export-3");
+  for (const char* sub : {"color", "depth", "intrinsic"}) {
+    fs::create_directory_symlink(src + "/" + sub, dir.path(sub));
+  }
+  fs::create_symlink(src + "/scene0707_00.txt", dir.path("scene0707_00.txt"));
+  fs::create_directory(dir.path("pose"));
+  fs::create_symlink(src + "/pose/0.txt", dir.path("pose/0.txt"));
+  fs::create_symlink(src + "/pose/2.txt", dir.path("pose/2.txt"));
+  std::ofstream(dir.path("pose/1.txt")) << "-inf -inf -inf -inf\n-inf -inf -inf -inf\n"
+                                           "-inf -inf -inf -inf\n-inf -inf -inf -inf\n";
+}
 
 /// Result of running a command.
 struct CommandResult {

@@ -188,15 +188,7 @@ TEST(Import, RawImagesAreExact) {
 TEST(Import, ScanNetSkipsInvalidPosesWithACount) {
   PANMAP_REQUIRE_DATA("scannet-export-3");
   test::TempDir dir;
-  const std::string src = test::dataDir("scannet-export-3");
-  for (const char* sub : {"color", "depth", "intrinsic"})
-    fs::create_directory_symlink(src + "/" + sub, dir.path(sub));
-  fs::create_symlink(src + "/scene0707_00.txt", dir.path("scene0707_00.txt"));
-  fs::create_directory(dir.path("pose"));
-  fs::create_symlink(src + "/pose/0.txt", dir.path("pose/0.txt"));
-  fs::create_symlink(src + "/pose/2.txt", dir.path("pose/2.txt"));
-  std::ofstream(dir.path("pose/1.txt")) << "-inf -inf -inf -inf\n-inf -inf -inf -inf\n"
-                                           "-inf -inf -inf -inf\n-inf -inf -inf -inf\n";
+  test::makeScanNetExportWithInfPose(dir);
   const ImportStats s = importDataset(dir.path(), dir.path("s.lcmlog"), ImportOptions{});
   EXPECT_EQ(s.frames_written, 2u);
   EXPECT_EQ(s.skipped_invalid_pose, 1u);
