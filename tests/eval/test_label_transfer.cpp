@@ -1,0 +1,42 @@
+#include <gtest/gtest.h>
+
+#include "panmap/core/error.h"
+#include "panmap/eval/label_transfer.h"
+
+namespace panmap {
+namespace {
+
+TEST(LabelTransfer, RespectsFiveCentimetreRadius) {
+  LabelledMesh pred;
+  pred.vertices = {{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}};
+  pred.semantic = {5, 7};
+  pred.instance = {3, 4};
+  pred.superpoint = {9, 10};
+  const std::vector<Eigen::Vector3f> gt = {
+      {0.049f, 0.0f, 0.0f}, {0.051f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.04f}};
+  const TransferredLabels t = transferLabels(pred, gt);
+  EXPECT_EQ(t.semantic, (std::vector<int32_t>{5, 0, 5, 7}));
+  EXPECT_EQ(t.instance, (std::vector<int32_t>{3, 0, 3, 4}));
+  EXPECT_EQ(t.superpoint, (std::vector<int32_t>{9, 0, 9, 10}));
+  EXPECT_EQ(t.num_transferred, 3u);
+}
+
+TEST(LabelTransfer, MissingArraysReadAsZero) {
+  LabelledMesh pred;
+  pred.vertices = {{0.0f, 0.0f, 0.0f}};
+  pred.semantic = {5};
+  const TransferredLabels t = transferLabels(pred, {{0.01f, 0.0f, 0.0f}});
+  EXPECT_EQ(t.semantic, (std::vector<int32_t>{5}));
+  EXPECT_EQ(t.instance, (std::vector<int32_t>{0}));
+  EXPECT_EQ(t.superpoint, (std::vector<int32_t>{0}));
+}
+
+TEST(LabelTransfer, EmptyPredictionLeavesEverythingUnlabelled) {
+  const TransferredLabels t = transferLabels(LabelledMesh(), {{0.0f, 0.0f, 0.0f}});
+  EXPECT_EQ(t.semantic, (std::vector<int32_t>{0}));
+  EXPECT_EQ(t.num_transferred, 0u);
+  EXPECT_THROW(transferLabels(LabelledMesh(), {}, -1.0), Error);
+}
+
+}  // namespace
+}  // namespace panmap
