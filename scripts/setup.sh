@@ -27,7 +27,7 @@ packages=(
   default-jdk-headless libjchart2d-java               # types jar for lcm-spy, its charts
   libeigen3-dev                                       # geometry
   libabsl-dev zlib1g-dev                              # block hash map, map file checksums
-  libopencv-dev libopencv-contrib-dev                 # image codecs, depth segmentation, max-flow
+  libopencv-dev                                       # image codecs, depth segmentation, resampling
   liboctomap-dev octomap-tools                        # occupancy tree for planners
   libceres-dev                                        # pose refinement against the map
   libgtest-dev libgmock-dev libbenchmark-dev          # tests and benchmarks
