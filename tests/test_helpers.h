@@ -7,9 +7,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
+
+#include "panmap/core/error.h"
 
 namespace panmap {
 namespace test {
@@ -75,6 +79,20 @@ inline void makeScanNetExportWithInfPose(const TempDir& dir) {
   fs::create_symlink(src + "/pose/2.txt", dir.path("pose/2.txt"));
   std::ofstream(dir.path("pose/1.txt")) << "-inf -inf -inf -inf\n-inf -inf -inf -inf\n"
                                            "-inf -inf -inf -inf\n-inf -inf -inf -inf\n";
+}
+
+/// Runs `call` and expects an Error with a one-line message containing every one of `parts`.
+inline void expectError(const std::function<void()>& call, const std::vector<std::string>& parts) {
+  try {
+    call();
+    ADD_FAILURE() << "no Error thrown";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    for (const std::string& part : parts) {
+      EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in: " << message;
+    }
+  }
 }
 
 /// Result of running a command.

@@ -34,10 +34,4 @@ PinholeCamera PinholeCamera::resized(int new_width, int new_height) const {
   return out;
 }
 
-Eigen::Matrix3d PinholeCamera::K() const {
-  Eigen::Matrix3d k;
-  k << fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0;
-  return k;
-}
-
 }  // namespace panmap

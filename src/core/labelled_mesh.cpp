@@ -23,32 +23,4 @@ std::string LabelledMesh::check() const {
   return "";
 }
 
-namespace {
-
-template <typename T>
-void appendAttribute(std::vector<T>* mine, size_t my_count, const std::vector<T>& theirs,
-                     size_t their_count) {
-  if (mine->empty() && theirs.empty()) return;
-  mine->resize(my_count, T());
-  if (theirs.empty()) {
-    mine->resize(my_count + their_count, T());
-  } else {
-    mine->insert(mine->end(), theirs.begin(), theirs.end());
-  }
-}
-
-}  // namespace
-
-void LabelledMesh::append(const LabelledMesh& other) {
-  const size_t mine = vertices.size();
-  const size_t theirs = other.vertices.size();
-  appendAttribute(&colors, mine, other.colors, theirs);
-  appendAttribute(&semantic, mine, other.semantic, theirs);
-  appendAttribute(&instance, mine, other.instance, theirs);
-  appendAttribute(&superpoint, mine, other.superpoint, theirs);
-  vertices.insert(vertices.end(), other.vertices.begin(), other.vertices.end());
-  const Eigen::Vector3i offset = Eigen::Vector3i::Constant(static_cast<int>(mine));
-  for (const Eigen::Vector3i& f : other.faces) faces.push_back(f + offset);
-}
-
 }  // namespace panmap

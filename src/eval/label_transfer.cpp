@@ -2,23 +2,11 @@
 
 #include <cmath>
 
-#include <nanoflann.hpp>
-
 #include "panmap/core/error.h"
+#include "panmap/core/nearest_point.h"
 
 namespace panmap {
 namespace {
-
-// nanoflann adaptor over mesh vertices.
-struct VertexCloud {
-  const std::vector<Eigen::Vector3f>* points;
-  size_t kdtree_get_point_count() const { return points->size(); }
-  float kdtree_get_pt(size_t i, size_t dim) const { return (*points)[i][static_cast<int>(dim)]; }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const {
-    return false;
-  }
-};
 
 int32_t labelOr0(const std::vector<int32_t>& labels, size_t i) {
   return labels.empty() ? 0 : labels[i];
@@ -42,15 +30,11 @@ TransferredLabels transferLabels(const LabelledMesh& predicted,
   out.superpoint.assign(gt_vertices.size(), 0);
   if (predicted.vertices.empty() || gt_vertices.empty()) return out;
 
-  VertexCloud cloud{&predicted.vertices};
-  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, VertexCloud>,
-                                                   VertexCloud, 3>;
-  Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-  tree.buildIndex();
+  const NearestPointIndex tree(&predicted.vertices);
   for (size_t g = 0; g < gt_vertices.size(); ++g) {
-    uint32_t index = 0;
-    float dist2 = 0.0f;
-    if (tree.knnSearch(gt_vertices[g].data(), 1, &index, &dist2) == 0) continue;
+    const int64_t found = tree.nearest(gt_vertices[g]);
+    if (found < 0) continue;
+    const auto index = static_cast<size_t>(found);
     // The radius test in double on the original coordinates, so 4.9 cm / 5.1 cm are exact.
     const double d =
         (predicted.vertices[index].cast<double>() - gt_vertices[g].cast<double>()).norm();

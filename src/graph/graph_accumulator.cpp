@@ -8,6 +8,7 @@
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
 #include "panmap/map/voxel.h"
+#include "panmap/map/voxel_lookup.h"
 
 namespace panmap {
 
@@ -16,9 +17,7 @@ void GraphConfig::check() const {
   if (sample_stride_px < 1) throw Error("graph sample_stride_px must be >= 1");
 }
 
-GraphAccumulator::GraphAccumulator(const GraphConfig& config) : config_(config) {
-  config_.check();
-}
+GraphAccumulator::GraphAccumulator(const GraphConfig& config) : config_(config) { config_.check(); }
 
 const std::map<int32_t, double>& GraphAccumulator::scores(int32_t label) const {
   static const std::map<int32_t, double> kEmpty;
@@ -90,11 +89,8 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   const float scale = static_cast<float>(frame.depth_scale_m);
   const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
   const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
-  const float inv_voxel = 1.0f / map.voxelSize();
   auto resolve = [&tracker](int32_t l) { return tracker.labels().resolve(l); };
-  const Block* block = nullptr;
-  BlockIndex block_index = BlockIndex::Zero();
-  bool have_block = false;
+  VoxelLookup lookup(map);
   const int stride = config_.sample_stride_px;
   for (int v = 0; v < cam.height; v += stride) {
     for (int u = 0; u < cam.width; u += stride) {
@@ -102,22 +98,15 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
       if (id <= 0 || !masks.count(id)) continue;
       const float d = frame.depth(u, v) * scale;
       if (d <= 0.0f) continue;
-      const Eigen::Vector3f p = T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d);
-      const int gx = static_cast<int>(std::floor(p.x() * inv_voxel));
-      const int gy = static_cast<int>(std::floor(p.y() * inv_voxel));
-      const int gz = static_cast<int>(std::floor(p.z() * inv_voxel));
-      const BlockIndex b(gx >> 3, gy >> 3, gz >> 3);
-      if (!have_block || b != block_index) {
-        block = map.findBlock(b);
-        block_index = b;
-        have_block = true;
-      }
-      if (!block) continue;
-      const int32_t label = argmaxLabel(block->at(gx & 7, gy & 7, gz & 7), resolve);
+      const Voxel* voxel =
+          lookup.find(T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d));
+      if (!voxel) continue;
+      const int32_t label = argmaxLabel(*voxel, resolve);
       if (label <= 0) continue;
-      const uint64_t key = (static_cast<uint64_t>(gx & 0x1FFFFF) << 42) |
-                           (static_cast<uint64_t>(gy & 0x1FFFFF) << 21) |
-                           static_cast<uint64_t>(gz & 0x1FFFFF);
+      const Eigen::Vector3i& g = lookup.lastVoxel();
+      const uint64_t key = (static_cast<uint64_t>(g.x() & 0x1FFFFF) << 42) |
+                           (static_cast<uint64_t>(g.y() & 0x1FFFFF) << 21) |
+                           static_cast<uint64_t>(g.z() & 0x1FFFFF);
       hits.push_back({id, key, label});
     }
   }
@@ -153,15 +142,15 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
         const double distance =
             (i->second.second / i->second.first - j->second.second / j->second.first).norm();
         const double p_s = 1.0 / (1.0 + distance / config_.spatial_scale_m);
-        edges_[{i->first, j->first}][cls] +=
-            p_o * p_s * std::min(i->second.first, j->second.first);
+        edges_[{i->first, j->first}][cls] += p_o * p_s * std::min(i->second.first, j->second.first);
       }
     }
     begin = end;
   }
 }
 
-SuperpointGraph GraphAccumulator::graph(const TsdfMap& map, const SuperpointTracker& tracker) const {
+SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
+                                        const SuperpointTracker& tracker) const {
   SuperpointGraph g;
   for (int32_t c = 1; c <= kMaxNyu40Class; ++c) g.classes.push_back(c);
   for (int32_t c = 1; c <= kMaxNyu40Class; ++c) {
@@ -207,8 +196,9 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map, const SuperpointTrac
     e.confidences = conf;
     g.edges.push_back(e);
   }
-  std::sort(g.edges.begin(), g.edges.end(),
-            [](const GraphEdge& x, const GraphEdge& y) { return std::tie(x.a, x.b) < std::tie(y.a, y.b); });
+  std::sort(g.edges.begin(), g.edges.end(), [](const GraphEdge& x, const GraphEdge& y) {
+    return std::tie(x.a, x.b) < std::tie(y.a, y.b);
+  });
   // Pending merges can map two stored edges onto one pair: add them up.
   std::vector<GraphEdge> merged;
   for (GraphEdge& e : g.edges) {

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "panmap/core/error.h"
+#include "panmap/map/voxel_lookup.h"
 
 namespace panmap {
 
@@ -59,29 +60,17 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
   const PinholeCamera& cam = frame.camera;
   const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
   const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
-  const float inv_voxel = 1.0f / map->voxelSize();
   const int stride = config_.vote_stride_px;
-  Block* block = nullptr;
-  BlockIndex block_index = BlockIndex::Zero();
-  bool have_block = false;
+  MutableVoxelLookup lookup(*map);
   for (int v = 0; v < cam.height; v += stride) {
     for (int u = 0; u < cam.width; u += stride) {
       const int32_t label = labels(u, v);
       const float d = depth_m_(u, v);
       if (label <= 0 || d <= 0.0f) continue;
-      const Eigen::Vector3f p_W = T_W_C * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d);
-      const int gx = static_cast<int>(std::floor(p_W.x() * inv_voxel));
-      const int gy = static_cast<int>(std::floor(p_W.y() * inv_voxel));
-      const int gz = static_cast<int>(std::floor(p_W.z() * inv_voxel));
-      const BlockIndex b(gx >> 3, gy >> 3, gz >> 3);
-      if (!have_block || b != block_index) {  // neighbouring pixels share blocks: skip the hash
-        block = map->findBlock(b);
-        block_index = b;
-        have_block = true;
-      }
-      if (!block) continue;
+      Voxel* voxel = lookup.find(T_W_C * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d));
+      if (!voxel) continue;
       ++stats->votes_added;
-      stats->votes_evicted += addVote(&block->at(gx & 7, gy & 7, gz & 7), label);
+      stats->votes_evicted += addVote(voxel, label);
     }
   }
 }

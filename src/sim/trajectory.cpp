@@ -7,11 +7,11 @@
 #include <queue>
 #include <sstream>
 
-#include <nanoflann.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
+#include "panmap/core/nearest_point.h"
 #include "panmap/core/random.h"
 
 namespace panmap {
@@ -381,35 +381,13 @@ std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig
   return out;
 }
 
-namespace {
-
-// nanoflann adaptor over mesh vertices.
-struct VertexCloud {
-  const std::vector<Eigen::Vector3f>* points;
-  size_t kdtree_get_point_count() const { return points->size(); }
-  float kdtree_get_pt(size_t i, size_t dim) const { return (*points)[i][static_cast<int>(dim)]; }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const {
-    return false;
-  }
-};
-
-}  // namespace
-
 double minClearance(const std::vector<StampedPose>& trajectory, const LabelledMesh& mesh) {
-  if (mesh.vertices.empty()) return std::numeric_limits<double>::infinity();
-  VertexCloud cloud{&mesh.vertices};
-  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, VertexCloud>,
-                                                   VertexCloud, 3>;
-  Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-  tree.buildIndex();
   double best = std::numeric_limits<double>::infinity();
+  const NearestPointIndex index(&mesh.vertices);
   for (const StampedPose& p : trajectory) {
     const Eigen::Vector3f q = p.T_W_C.translation().cast<float>();
-    uint32_t index = 0;
-    float dist2 = 0.0f;
-    tree.knnSearch(q.data(), 1, &index, &dist2);
-    best = std::min(best, std::sqrt(static_cast<double>(dist2)));
+    const int64_t i = index.nearest(q);
+    if (i >= 0) best = std::min(best, static_cast<double>((mesh.vertices[i] - q).norm()));
   }
   return best;
 }

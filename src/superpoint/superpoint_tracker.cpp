@@ -5,6 +5,7 @@
 
 #include "panmap/core/error.h"
 #include "panmap/map/voxel.h"
+#include "panmap/map/voxel_lookup.h"
 
 namespace panmap {
 
@@ -47,36 +48,6 @@ const SuperpointState* SuperpointTracker::state(int32_t label) const {
   const auto it = states_.find(labels_.resolve(label));
   return it == states_.end() ? nullptr : &it->second;
 }
-
-namespace {
-
-// The voxel at a world point, remembering the last block: neighbouring pixels mostly fall in
-// the same block, so most lookups skip the hash map.
-class VoxelLookup {
- public:
-  explicit VoxelLookup(const TsdfMap& map) : map_(map), inv_voxel_(1.0f / map.voxelSize()) {}
-  const Voxel* find(const Eigen::Vector3f& p_W) {
-    const int gx = static_cast<int>(std::floor(p_W.x() * inv_voxel_));
-    const int gy = static_cast<int>(std::floor(p_W.y() * inv_voxel_));
-    const int gz = static_cast<int>(std::floor(p_W.z() * inv_voxel_));
-    const BlockIndex b(gx >> 3, gy >> 3, gz >> 3);
-    if (!valid_ || b != last_index_) {
-      last_ = map_.findBlock(b);
-      last_index_ = b;
-      valid_ = true;
-    }
-    return last_ ? &last_->at(gx & 7, gy & 7, gz & 7) : nullptr;
-  }
-
- private:
-  const TsdfMap& map_;
-  float inv_voxel_;
-  const Block* last_ = nullptr;
-  BlockIndex last_index_ = BlockIndex::Zero();
-  bool valid_ = false;
-};
-
-}  // namespace
 
 bool SuperpointTracker::consistent(int32_t a, int32_t b) const {
   if (!config_.semantic_consistency) return true;

@@ -14,6 +14,8 @@
 namespace panmap {
 namespace {
 
+using test::expectError;
+
 const char kTable[] = "scannet-meta/scannetv2-labels.combined.tsv";
 
 std::string tiny(const std::string& name) {
@@ -29,19 +31,6 @@ const std::vector<int32_t> kInstance = {1, 1, 1, 2, 2, 2, 2, 2, 3, 5, 0};
 ScanNetGroundTruth loadTiny(const ScanNetLabelTable& table) {
   return loadScanNetGroundTruth(tiny("_vh_clean_2.ply"), tiny(".aggregation.json"),
                                 tiny("_vh_clean_2.0.010000.segs.json"), table);
-}
-
-void expectError(const std::function<void()>& call, const std::vector<std::string>& parts) {
-  try {
-    call();
-    ADD_FAILURE() << "no Error thrown";
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-    for (const std::string& part : parts) {
-      EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in: " << message;
-    }
-  }
 }
 
 TEST(ScanNetLabelTable, RealTableLookups) {

@@ -35,9 +35,6 @@ struct PinholeCamera {
   /// The same camera seen through an image resized to new_width x new_height (pixel-centre
   /// convention: a pixel's centre maps to the centre of the corresponding resized pixel).
   PinholeCamera resized(int new_width, int new_height) const;
-
-  /// Intrinsic matrix K.
-  Eigen::Matrix3d K() const;
 };
 
 }  // namespace panmap

@@ -29,9 +29,6 @@ struct LabelledMesh {
   /// "" when every per-vertex array is empty or as long as `vertices` and every face index is
   /// in range; otherwise the first problem found.
   std::string check() const;
-  /// Appends another mesh (its face indices shifted). Per-vertex arrays present in either
-  /// mesh are kept, padded with zeros / black where the other lacks them.
-  void append(const LabelledMesh& other);
 };
 
 }  // namespace panmap

@@ -1,0 +1,57 @@
+#pragma once
+
+#include <cmath>
+#include <type_traits>
+
+#include <Eigen/Core>
+
+#include "panmap/map/tsdf_map.h"
+
+namespace panmap {
+
+/// Finds the voxel containing a world point, remembering the last block: neighbouring pixels
+/// of an image mostly fall in the same block, so most lookups skip the hash map. One per
+/// thread and per pass (it caches a block pointer).
+template <typename Map>
+class VoxelLookupT {
+  using BlockPtr = std::conditional_t<std::is_const<Map>::value, const Block*, Block*>;
+  using VoxelPtr = std::conditional_t<std::is_const<Map>::value, const Voxel*, Voxel*>;
+
+ public:
+  /// @param map the TsdfMap (const or not) looked up
+  explicit VoxelLookupT(Map& map) : map_(map), inv_voxel_(1.0f / map.voxelSize()) {}
+
+  /// The voxel containing p_W, or null when its block is not allocated.
+  VoxelPtr find(const Eigen::Vector3f& p_W) {
+    const int gx = static_cast<int>(std::floor(p_W.x() * inv_voxel_));
+    const int gy = static_cast<int>(std::floor(p_W.y() * inv_voxel_));
+    const int gz = static_cast<int>(std::floor(p_W.z() * inv_voxel_));
+    static_assert(kBlockSide == 8, "shifts assume 8 voxels per block side");
+    const BlockIndex b(gx >> 3, gy >> 3, gz >> 3);
+    if (!valid_ || b != last_index_) {
+      last_ = map_.findBlock(b);
+      last_index_ = b;
+      valid_ = true;
+    }
+    last_voxel_ = Eigen::Vector3i(gx, gy, gz);
+    return last_ ? &last_->at(gx & 7, gy & 7, gz & 7) : nullptr;
+  }
+
+  /// Global integer coordinates of the voxel of the last find().
+  const Eigen::Vector3i& lastVoxel() const { return last_voxel_; }
+
+ private:
+  Map& map_;
+  float inv_voxel_;
+  BlockPtr last_ = nullptr;
+  BlockIndex last_index_ = BlockIndex::Zero();
+  Eigen::Vector3i last_voxel_ = Eigen::Vector3i::Zero();
+  bool valid_ = false;
+};
+
+/// Read-only lookups.
+using VoxelLookup = VoxelLookupT<const TsdfMap>;
+/// Lookups that may change the voxels found.
+using MutableVoxelLookup = VoxelLookupT<TsdfMap>;
+
+}  // namespace panmap
