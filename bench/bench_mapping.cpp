@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
     std::map<std::string, std::vector<double>> times;
     if (!log_path.empty()) {
       // Timings per stage come from the mapper; message decoding is not counted.
-      panmap::OfflineOptions options;
+      panmap::SessionOptions options;
       options.max_frames = frames;
       const panmap::OfflineReport report = panmap::mapLog(log_path, options, &mapper);
       for (const auto& [stage, t] : report.timings) {

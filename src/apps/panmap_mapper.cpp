@@ -1,27 +1,33 @@
-// panmap-mapper: the mapping process. Offline mode (--log) maps every frame of an LCM log as
-// fast as it can, runs the final optimisation in-process and writes the outputs; the live
-// LCM mode arrives with roadmap issue 5.
+// panmap-mapper: the mapping process. Live (default): subscribes CAMERA_RGBD, CAMERA_POSE and
+// PANOPTIC over LCM, maps in a worker thread, publishes status, objects and occupancy, and on
+// PANMAP_COMMAND finish (or SIGINT/SIGTERM) asks panmap-optimizer for the final labels and
+// writes the outputs. Offline (--log): maps every frame of a log as fast as it can and runs
+// the final optimisation in-process; the same log and config give the same outputs.
 #include <sys/resource.h>
 
+#include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
-#include <set>
+#include <optional>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "panmap/command_t.hpp"
 #include "panmap/core/error.h"
 #include "panmap/core/progress.h"
-#include "panmap/io/image_codec.h"
 #include "panmap/graph/optimiser.h"
+#include "panmap/lcm/live_mapper.h"
 #include "panmap/lcm/offline_mapping.h"
 #include "panmap/mapper/config_file.h"
-#include "panmap/mesh/mesh_export.h"
-#include "panmap/sim/overview.h"
+#include "panmap/mapper/outputs.h"
 
 namespace {
+
+std::atomic<bool> g_stop{false};
+void onSignal(int) { g_stop = true; }
 
 // Peak resident memory of this process, bytes.
 size_t peakRssBytes() {
@@ -30,28 +36,76 @@ size_t peakRssBytes() {
   return static_cast<size_t>(usage.ru_maxrss) * 1024;
 }
 
-panmap::LabelledMesh recoloured(const panmap::LabelledMesh& mesh, panmap::Rgb8 (*colour)(int32_t),
-                                const std::vector<int32_t>& ids) {
-  panmap::LabelledMesh out = mesh;
-  out.colors.resize(mesh.vertices.size());
-  for (size_t i = 0; i < ids.size(); ++i) out.colors[i] = colour(ids[i]);
-  return out;
+nlohmann::json sessionJson(const panmap::SessionStats& s) {
+  nlohmann::json timings;
+  for (const auto& [stage, t] : s.timings)
+    timings[stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}};
+  return {{"messages", s.messages},
+          {"frames_received", s.frames_received},
+          {"frames_integrated", s.frames_integrated},
+          {"rejected", s.rejected},
+          {"geometry_only_frames", s.sync.geometry_only},
+          {"unmatched_panoptic", s.sync.unmatched_panoptic},
+          {"timings", timings}};
+}
+
+nlohmann::json mapJson(const panmap::Mapper& mapper, const panmap::OutputSummary& outputs) {
+  return {{"frames_total", mapper.framesIntegrated()},
+          {"memory",
+           {{"map_bytes", mapper.map().memoryBytes()},
+            {"peak_rss_bytes", peakRssBytes()},
+            {"blocks", mapper.map().numBlocks()},
+            {"voxels", mapper.map().numBlocks() * panmap::kBlockVoxels}}},
+          {"superpoints", mapper.superpoints().states().size()},
+          {"superpoint_merges", mapper.superpoints().merges().size()},
+          {"instances_frame_counting", mapper.superpoints().numInstances()},
+          {"instances_in_mesh", outputs.instances_in_mesh},
+          {"vote_evictions", mapper.voteEvictions()},
+          {"mesh", {{"vertices", outputs.mesh_vertices}, {"faces", outputs.mesh_faces}}},
+          {"files", outputs.files},
+          {"config",
+           {{"voxel_size_m", mapper.config().map.voxel_size_m},
+            {"truncation_voxels", mapper.config().integrator.truncation_voxels},
+            {"geometry_only", mapper.config().fusion.geometry_only},
+            {"semantic_consistency", mapper.config().superpoints.semantic_consistency},
+            {"merge_threshold", mapper.config().superpoints.merge_threshold},
+            {"threads", mapper.config().num_threads}}}};
+}
+
+void writeJson(const std::string& path, const nlohmann::json& json) {
+  std::ofstream out(path);
+  out << json.dump(2) << "\n";
+  if (!out) throw panmap::Error("cannot write " + path);
+}
+
+void printRejected(const std::map<std::string, int64_t>& rejected) {
+  for (const auto& [reason, count] : rejected) {
+    std::printf("  rejected %lld: %s\n", static_cast<long long>(count), reason.c_str());
+  }
+}
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "panmap mapping process. Offline: maps an LCM log (CAMERA_RGBD, CAMERA_POSE, "
-      "PANOPTIC) and writes mesh_{semantic,instance,superpoint}.ply, map.panmap, "
-      "report.json and snapshot PNGs into --out."};
-  std::string log_path, out_dir, load_path, config_path;
+      "panmap mapping process. Live (default): maps CAMERA_RGBD + CAMERA_POSE + PANOPTIC from "
+      "LCM until PANMAP_COMMAND finish or Ctrl-C, then asks panmap-optimizer for the final "
+      "labels. Offline (--log): maps a log as fast as it can, optimising in-process. Both write "
+      "mesh_{semantic,instance,superpoint}.ply, map.panmap, report.json, config.yaml and "
+      "snapshot PNGs into --out."};
+  std::string log_path, out_dir, load_path, config_path, lcm_url;
   panmap::MapperConfig config;
-  panmap::OfflineOptions options;
+  panmap::LiveOptions live;
+  panmap::SessionOptions& options = live.session;
   bool quiet = false, geometry_only = false, spatial_only = false, no_snapshots = false;
-  bool no_regularise = false, no_refine = false, print_config = false;
-  app.add_option("--log", log_path, "LCM log to map offline");
-  app.add_option("--out", out_dir, "output folder");
+  bool no_regularise = false, no_refine = false, print_config = false, export_only = false;
+  app.add_option("--log", log_path, "LCM log to map offline (omit for the live LCM mode)");
+  app.add_option("--out", out_dir, "output folder")->required(false);
   app.add_option("--config", config_path,
                  "YAML config (see --print-config); command-line flags override it");
   app.add_flag("--print-config", print_config, "print the full default config and exit");
@@ -65,12 +119,37 @@ int main(int argc, char** argv) {
   app.add_flag("--no-regularise", no_regularise,
                "skip the semantic regularisation (ablation, w/o III-C)");
   app.add_flag("--no-refine", no_refine, "skip the instance refinement (ablation, w/o III-D)");
-  app.add_option("--load", load_path, "resume from a map.panmap snapshot");
+  app.add_option("--load", load_path,
+                 "resume from a map.panmap snapshot");
+  app.add_flag("--export-only", export_only,
+               "with --load: no mapping, only run the final optimisation and write the outputs");
   app.add_option("--channel-rgbd", options.channel_rgbd)->capture_default_str();
   app.add_option("--channel-pose", options.channel_pose)->capture_default_str();
   app.add_option("--channel-panoptic", options.channel_panoptic)->capture_default_str();
   app.add_flag("--no-snapshots", no_snapshots, "skip the overview PNGs");
   app.add_flag("-q,--quiet", quiet, "no progress line");
+  auto* live_group = app.add_option_group("live", "live LCM mode");
+  live_group->add_option("--lcm-url", lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's own)");
+  live_group->add_option("--status-period-s", live.status_period_s, "PANMAP_STATUS period")
+      ->capture_default_str();
+  live_group
+      ->add_option("--publish-period-s", live.publish_period_s,
+                   "PANMAP_OBJECTS / PANMAP_OCTOMAP period (0: never)")
+      ->capture_default_str();
+  live_group
+      ->add_option("--optimizer-timeout-s", live.optimiser_timeout_s,
+                   "wait this long for panmap-optimizer's labels, then write unoptimised outputs")
+      ->capture_default_str();
+  live_group
+      ->add_option("--queue-frames", live.max_queued_frames,
+                   "frames waiting for the mapper at most; the oldest is dropped beyond")
+      ->capture_default_str();
+  live_group->add_option("--channel-status", live.channel_status)->capture_default_str();
+  live_group->add_option("--channel-objects", live.channel_objects)->capture_default_str();
+  live_group->add_option("--channel-octomap", live.channel_octomap)->capture_default_str();
+  live_group->add_option("--channel-graph", live.channel_graph)->capture_default_str();
+  live_group->add_option("--channel-labels", live.channel_labels)->capture_default_str();
+  live_group->add_option("--channel-command", live.channel_command)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -79,7 +158,7 @@ int main(int argc, char** argv) {
       std::printf("%s", panmap::configToYaml(file_config).c_str());
       return 0;
     }
-    if (log_path.empty() || out_dir.empty()) throw panmap::Error("--log and --out are required");
+    if (out_dir.empty()) throw panmap::Error("--out is required");
     if (!config_path.empty()) {
       file_config = panmap::loadConfig(config_path);
       // Flags given on the command line win over the file.
@@ -92,100 +171,130 @@ int main(int argc, char** argv) {
       config.num_threads = threads;
     }
     if (geometry_only) config.fusion.geometry_only = true;
-    if (spatial_only) config.superpoints.semantic_consistency = false;
     config.superpoints.semantic_consistency = !spatial_only;
-    std::unique_ptr<panmap::Mapper> mapper = load_path.empty()
-                                                 ? std::make_unique<panmap::Mapper>(config)
-                                                 : panmap::Mapper::load(load_path);
-    std::filesystem::create_directories(out_dir);
-    panmap::ProgressLine progress("map", "MiB", !quiet);
-    const panmap::OfflineReport report = panmap::mapLog(
-        log_path, options, mapper.get(),
-        [&](size_t done, size_t total) { progress.update(done >> 20, total >> 20); });
-    progress.finish();
-
-    // The final optimisation, in-process (the live mode asks panmap-optimizer over LCM).
-    const auto optimise_start = std::chrono::steady_clock::now();
-    const panmap::SuperpointGraph graph = mapper->graph();
     panmap::OptimiserConfig optimiser = file_config.optimiser;
     if (no_regularise) optimiser.regularise = false;
     if (no_refine) optimiser.refine = false;
-    const panmap::GraphLabels labels = panmap::optimise(graph, optimiser);
-    const double optimise_ms = std::chrono::duration<double, std::milli>(
-                                   std::chrono::steady_clock::now() - optimise_start)
-                                   .count();
-    const panmap::LabelledMesh mesh = mapper->extractMesh(&labels);
-    std::set<int32_t> instances_in_mesh;
-    for (int32_t id : mesh.instance) {
-      if (id > 0) instances_in_mesh.insert(id);
-    }
-    panmap::writeLabelledMeshes(out_dir, mesh);
-    mapper->save(out_dir + "/map.panmap");
-    if (!no_snapshots && !mesh.faces.empty()) {
-      panmap::writeFileBytes(out_dir + "/snapshot_semantic.png",
-                             panmap::encodePng(panmap::renderOverview(
-                                 recoloured(mesh, &panmap::semanticColor, mesh.semantic))));
-      panmap::writeFileBytes(out_dir + "/snapshot_instance.png",
-                             panmap::encodePng(panmap::renderOverview(
-                                 recoloured(mesh, &panmap::idColor, mesh.instance))));
-      panmap::writeFileBytes(out_dir + "/snapshot_superpoint.png",
-                             panmap::encodePng(panmap::renderOverview(
-                                 recoloured(mesh, &panmap::idColor, mesh.superpoint))));
-      panmap::writeFileBytes(out_dir + "/snapshot_color.png",
-                             panmap::encodePng(panmap::renderOverview(mesh)));
+    std::unique_ptr<panmap::Mapper> mapper = load_path.empty()
+                                                 ? std::make_unique<panmap::Mapper>(config)
+                                                 : panmap::Mapper::load(load_path);
+    panmap::OutputOptions output_options;
+    output_options.snapshots = !no_snapshots;
+
+    if (export_only && load_path.empty()) throw panmap::Error("--export-only needs --load");
+    if (export_only && !log_path.empty()) throw panmap::Error("--export-only takes no --log");
+
+    if (!log_path.empty() || export_only) {
+      // Offline: every frame, in log order, optimisation in-process.
+      panmap::OfflineReport report;
+      if (!export_only) {
+        panmap::ProgressLine progress("map", "MiB", !quiet);
+        int64_t frames = 0;
+        const auto start = std::chrono::steady_clock::now();
+        report = panmap::mapLog(
+            log_path, options, mapper.get(),
+            [&](size_t done, size_t total) { progress.update(done >> 20, total >> 20); },
+            [&](const panmap::SyncedFrame&, const panmap::FrameStats&) {
+              ++frames;
+              char note[64];
+              std::snprintf(note, sizeof(note), "%lld frames, %.1f frames/s",
+                            static_cast<long long>(frames), frames / (msSince(start) / 1000.0));
+              progress.setNote(note);
+            });
+        progress.finish();
+      }
+      const auto optimise_start = std::chrono::steady_clock::now();
+      const panmap::SuperpointGraph graph = mapper->graph();
+      const panmap::GraphLabels labels = panmap::optimise(graph, optimiser);
+      const double optimise_ms = msSince(optimise_start);
+      const panmap::OutputSummary outputs =
+          panmap::writeOutputs(out_dir, mapper.get(), &labels, optimiser, output_options);
+      nlohmann::json json = sessionJson(report);
+      json["mode"] = export_only ? "export-only" : "offline";
+      json["log"] = log_path;
+      json["events"] = report.events;
+      json["wall_s"] = report.wall_s;
+      json.update(mapJson(*mapper, outputs));
+      json["graph"] = {{"vertices", graph.vertices.size()}, {"edges", graph.edges.size()},
+                       {"optimised", true},          {"optimise_ms", optimise_ms},
+                       {"solve_ms", labels.solve_ms}, {"regularise", optimiser.regularise},
+                       {"refine", optimiser.refine}};
+      writeJson(out_dir + "/report.json", json);
+      std::printf(
+          "mapped %lld frames in %.1f s (median %.1f ms/frame): %zu super-points, %zu "
+          "instances after optimisation, %zu mesh vertices; outputs in %s\n",
+          static_cast<long long>(report.frames_integrated), report.wall_s,
+          report.timings.count("total") ? report.timings.at("total").median_ms : 0.0,
+          mapper->superpoints().states().size(), outputs.instances_in_mesh,
+          outputs.mesh_vertices, out_dir.c_str());
+      printRejected(report.rejected);
+      return 0;
     }
 
-    nlohmann::json timings;
-    for (const auto& [stage, t] : report.timings)
-      timings[stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}};
-    const nlohmann::json json = {
-        {"log", log_path},
-        {"events", report.events},
-        {"frames_integrated", report.frames_integrated},
-        {"frames_total", mapper->framesIntegrated()},
-        {"rejected", report.rejected},
-        {"geometry_only_frames", report.sync.geometry_only},
-        {"unmatched_panoptic", report.sync.unmatched_panoptic},
-        {"timings", timings},
-        {"wall_s", report.wall_s},
-        {"memory",
-         {{"map_bytes", mapper->map().memoryBytes()},
-          {"peak_rss_bytes", peakRssBytes()},
-          {"blocks", mapper->map().numBlocks()},
-          {"voxels", mapper->map().numBlocks() * panmap::kBlockVoxels}}},
-        {"superpoints", mapper->superpoints().states().size()},
-        {"superpoint_merges", mapper->superpoints().merges().size()},
-        {"instances_frame_counting", mapper->superpoints().numInstances()},
-        {"instances_in_mesh", instances_in_mesh.size()},
-        {"vote_evictions", mapper->voteEvictions()},
-        {"graph", {{"vertices", graph.vertices.size()}, {"edges", graph.edges.size()},
-                   {"optimise_ms", optimise_ms}, {"solve_ms", labels.solve_ms},
-                   {"regularise", optimiser.regularise}, {"refine", optimiser.refine}}},
-        {"mesh", {{"vertices", mesh.numVertices()}, {"faces", mesh.numFaces()}}},
-        {"config",
-         {{"voxel_size_m", mapper->config().map.voxel_size_m},
-          {"truncation_voxels", mapper->config().integrator.truncation_voxels},
-          {"geometry_only", mapper->config().fusion.geometry_only},
-          {"semantic_consistency", mapper->config().superpoints.semantic_consistency},
-          {"merge_threshold", mapper->config().superpoints.merge_threshold},
-          {"threads", mapper->config().num_threads}}}};
-    std::ofstream(out_dir + "/report.json") << json.dump(2) << "\n";
-    // The exact parameters the outputs were made with (a loaded map brings its own).
-    std::ofstream(out_dir + "/config.yaml")
-        << panmap::configToYaml(panmap::PanmapConfig{mapper->config(), optimiser});
-    std::printf(
-        "mapped %lld frames in %.1f s (median %.1f ms/frame): %zu super-points, %zu "
-        "instances after optimisation, %zu mesh vertices; outputs in %s\n",
-        static_cast<long long>(report.frames_integrated), report.wall_s,
-        report.timings.count("total") ? report.timings.at("total").median_ms : 0.0,
-        mapper->superpoints().states().size(), instances_in_mesh.size(), mesh.numVertices(),
-        out_dir.c_str());
-    for (const auto& [reason, count] : report.rejected) {
-      std::printf("  rejected %lld: %s\n", static_cast<long long>(count), reason.c_str());
+    // Live: LCM in, LCM out.
+    lcm::LCM lcm(lcm_url);
+    if (!lcm.good()) throw panmap::Error("cannot open LCM URL '" + lcm_url + "'");
+    panmap::LiveMapper node(&lcm, live, mapper.get());
+    node.setCommandHandler([&](int8_t command, const std::string& argument, panmap::Mapper* m,
+                               const panmap::GraphLabels* labels) {
+      if (command == panmap::command_t::COMMAND_SAVE) {
+        const std::string path = argument.empty() ? out_dir + "/map.panmap" : argument;
+        m->save(path);
+        std::fprintf(stderr, "panmap-mapper: map saved to %s\n", path.c_str());
+      } else {
+        const std::string dir = argument.empty() ? out_dir : argument;
+        panmap::writeOutputs(dir, m, labels, optimiser, output_options);
+        std::fprintf(stderr, "panmap-mapper: outputs written to %s\n", dir.c_str());
+      }
+    });
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
+    std::fprintf(stderr, "panmap-mapper: listening on %s, %s, %s; finish with PANMAP_COMMAND "
+                 "or Ctrl-C\n", options.channel_rgbd.c_str(), options.channel_pose.c_str(),
+                 options.channel_panoptic.c_str());
+    const auto start = std::chrono::steady_clock::now();
+    const bool by_command = node.run(g_stop);
+    std::fprintf(stderr, "panmap-mapper: %s; mapping what is queued\n",
+                 by_command ? "finish command" : "signal");
+    node.drain();
+    const double wall_s = msSince(start) / 1000.0;
+    g_stop = false;  // a second Ctrl-C cuts the wait for labels short
+    const auto optimise_start = std::chrono::steady_clock::now();
+    const std::optional<panmap::GraphLabels> labels = node.requestLabels(g_stop);
+    const double optimise_ms = msSince(optimise_start);
+    if (!labels) {
+      std::fprintf(stderr,
+                   "panmap-mapper: no labels from panmap-optimizer within %.0f s: writing "
+                   "unoptimised outputs (frame-count labels)\n",
+                   live.optimiser_timeout_s);
     }
+    const panmap::OutputSummary outputs = panmap::writeOutputs(
+        out_dir, mapper.get(), labels ? &*labels : nullptr, optimiser, output_options);
+    const panmap::SessionStats stats = node.stats();
+    nlohmann::json json = sessionJson(stats);
+    json["mode"] = "live";
+    json["lcm_url"] = lcm_url;
+    json["frames_received"] = node.framesReceived();
+    json["frames_dropped_behind"] = node.framesDropped();
+    json["wall_s"] = wall_s;
+    json.update(mapJson(*mapper, outputs));
+    json["graph"] = {{"optimised", labels.has_value()},
+                     {"optimise_ms", optimise_ms},
+                     {"solve_ms", labels ? labels->solve_ms : 0.0}};
+    writeJson(out_dir + "/report.json", json);
+    std::printf(
+        "mapped %lld of %lld frames received (%lld dropped behind) in %.1f s: %zu "
+        "super-points, %zu instances%s, %zu mesh vertices; outputs in %s\n",
+        static_cast<long long>(stats.frames_integrated),
+        static_cast<long long>(node.framesReceived()),
+        static_cast<long long>(node.framesDropped()), wall_s,
+        mapper->superpoints().states().size(), outputs.instances_in_mesh,
+        labels ? " after optimisation" : " (unoptimised)", outputs.mesh_vertices,
+        out_dir.c_str());
+    printRejected(stats.rejected);
+    return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-mapper: error: %s\n", e.what());
     return 1;
   }
-  return 0;
 }

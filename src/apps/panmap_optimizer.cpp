@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "panmap/lcm/optimizer_node.h"
+#include "panmap/mapper/config_file.h"
 
 namespace {
 volatile std::sig_atomic_t g_stop = 0;
@@ -18,15 +19,19 @@ int main(int argc, char** argv) {
   std::string url;
   panmap::OptimizerNode::Config config;
   bool no_regularise = false, no_refine = false;
+  std::string config_path;
   app.add_option("--lcm-url", url, "LCM URL (default: LCM's default, LCM_DEFAULT_URL)");
+  app.add_option("--config", config_path,
+                 "YAML config; its optimiser section is used (see panmap-mapper --print-config)");
   app.add_option("--channel-graph", config.channel_graph)->capture_default_str();
   app.add_option("--channel-labels", config.channel_labels)->capture_default_str();
   app.add_flag("--no-regularise", no_regularise, "skip the semantic regularisation (III-C)");
   app.add_flag("--no-refine", no_refine, "skip the instance refinement (III-D)");
   CLI11_PARSE(app, argc, argv);
-  config.optimiser.regularise = !no_regularise;
-  config.optimiser.refine = !no_refine;
   try {
+    if (!config_path.empty()) config.optimiser = panmap::loadConfig(config_path).optimiser;
+    if (no_regularise) config.optimiser.regularise = false;
+    if (no_refine) config.optimiser.refine = false;
     lcm::LCM lcm(url);
     if (!lcm.good()) {
       std::fprintf(stderr, "panmap-optimizer: error: cannot open LCM URL '%s'\n", url.c_str());

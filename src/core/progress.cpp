@@ -26,9 +26,10 @@ void ProgressLine::update(size_t done, size_t total) {
   const double elapsed_s = std::chrono::duration<double>(now - start_).count();
   const double rate = elapsed_s > 0.0 ? done / elapsed_s : 0.0;
   const double eta_s = rate > 0.0 ? (total - done) / rate : 0.0;
-  std::fprintf(stderr, "%s%s: %zu/%zu %s (%3.0f%%) %.1f %s/s ETA %.0f s%s", tty_ ? "\r" : "",
-               label_.c_str(), done, total, unit_.c_str(), 100.0 * done / total, rate,
-               unit_.c_str(), eta_s, tty_ ? "  " : "\n");
+  std::fprintf(stderr, "%s%s: %zu/%zu %s (%3.0f%%) %.1f %s/s ETA %.0f s%s%s%s",
+               tty_ ? "\r" : "", label_.c_str(), done, total, unit_.c_str(),
+               100.0 * done / total, rate, unit_.c_str(), eta_s, note_.empty() ? "" : ", ",
+               note_.c_str(), tty_ ? "  " : "\n");
   std::fflush(stderr);
   printed_ = true;
 }

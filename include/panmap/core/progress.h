@@ -15,12 +15,15 @@ class ProgressLine {
   ProgressLine(std::string label, std::string unit, bool enabled = true);
   /// Reports `done` of `total` items.
   void update(size_t done, size_t total);
+  /// Text appended to the line from the next update on (e.g. a second rate).
+  void setNote(std::string note) { note_ = std::move(note); }
   /// Ends the line (call once when done).
   void finish();
 
  private:
   std::string label_;
   std::string unit_;
+  std::string note_;
   bool enabled_;
   bool tty_;
   int last_decile_ = -1;

@@ -1,0 +1,142 @@
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "panmap/graph/superpoint_graph.h"
+#include "panmap/lcm/channels.h"
+#include "panmap/lcm/mapping_session.h"
+#include "panmap/status_t.hpp"
+
+namespace panmap {
+
+/// Channels, rates and limits of the live mapping process.
+struct LiveOptions {
+  SessionOptions session;
+  std::string channel_status = kChannelStatus;
+  std::string channel_objects = kChannelObjects;
+  std::string channel_octomap = kChannelOctomap;
+  std::string channel_graph = kChannelGraph;
+  std::string channel_labels = kChannelLabels;
+  std::string channel_command = kChannelCommand;
+  double status_period_s = 1.0;   ///< PANMAP_STATUS period
+  double publish_period_s = 5.0;  ///< PANMAP_OBJECTS / PANMAP_OCTOMAP period (0 = never)
+  /// RGB-D messages waiting for the worker at most; a newer one pushes the oldest out (counted),
+  /// so a slow mapper stays current instead of falling further behind.
+  size_t max_queued_frames = 4;
+  double optimiser_timeout_s = 30.0;  ///< how long finish() waits for PANMAP_LABELS
+  /// Throws Error naming the bad field.
+  void check() const;
+};
+
+/// A message for LCM, produced off the LCM thread and published by it (LCM's handle and
+/// publish calls stay on one thread).
+struct OutgoingMessage {
+  std::string channel;
+  std::vector<uint8_t> bytes;
+};
+
+/// The live mapper: LCM handlers only copy messages into a bounded queue; a worker thread
+/// decodes, synchronises and integrates them through a MappingSession, and runs tasks (save,
+/// export, periodic publications) between frames, so the map is only touched by one thread.
+class LiveMapper {
+ public:
+  /// Work run on the worker thread with exclusive access to the mapper.
+  using Task = std::function<void(Mapper* mapper)>;
+  /// Builds periodic messages on the worker thread (objects, occupancy); may return none.
+  using Publisher = std::function<std::vector<OutgoingMessage>(Mapper* mapper, int64_t utime)>;
+  /// Runs a command's file work on the worker thread: COMMAND_SAVE / COMMAND_EXPORT with the
+  /// command's argument. Labels are the latest optimised ones, or null.
+  using CommandHandler =
+      std::function<void(int8_t command, const std::string& argument, Mapper* mapper,
+                         const GraphLabels* labels)>;
+
+  /// Subscribes on `lcm` (not owned; must outlive this) and starts the worker.
+  /// @param mapper the map (not owned); only the worker touches it until stop()
+  LiveMapper(lcm::LCM* lcm, const LiveOptions& options, Mapper* mapper);
+  /// Stops the worker (without draining).
+  ~LiveMapper();
+
+  /// Sets what is published every publish_period_s.
+  void setPeriodicPublisher(Publisher publisher) { publisher_ = std::move(publisher); }
+  /// Sets what save and export commands do.
+  void setCommandHandler(CommandHandler handler) { command_handler_ = std::move(handler); }
+
+  /// Handles LCM traffic, status and periodic publications until a finish command arrives or
+  /// `stop` becomes true. Returns true when a finish command ended it.
+  bool run(const std::atomic<bool>& stop);
+  /// Stops taking input, maps everything queued (and what the synchroniser still holds),
+  /// and stops the worker. The mapper is then the caller's again.
+  void drain();
+  /// Publishes the super-point graph and waits for the optimiser's PANMAP_LABELS answer.
+  /// Call after drain(). Returns nothing when no answer came within optimiser_timeout_s.
+  std::optional<GraphLabels> requestLabels(const std::atomic<bool>& stop);
+
+  /// Counters and timings of the session. Call after drain() (the worker owns them before).
+  SessionStats stats() const { return session_.stats(); }
+  /// RGB-D messages pushed out of the full queue so far.
+  int64_t framesDropped() const { return dropped_frames_; }
+  /// RGB-D messages received on the input channel so far.
+  int64_t framesReceived() const { return received_frames_; }
+  /// A status message of the current state. Call from the worker, or after drain().
+  status_t status(const std::string& state) const;
+
+ private:
+  struct Item {
+    std::string channel;  ///< empty: a task
+    std::vector<uint8_t> bytes;
+    Task task;
+  };
+
+  void onInput(const lcm::ReceiveBuffer* buffer, const std::string& channel);
+  void onCommand(const lcm::ReceiveBuffer* buffer, const std::string& channel);
+  void onLabels(const lcm::ReceiveBuffer* buffer, const std::string& channel);
+  void post(Item item);
+  void workerLoop();
+  void publishOutbox();
+  void publishStatus(const std::string& state);
+
+  lcm::LCM* lcm_;
+  LiveOptions options_;
+  Mapper* mapper_;
+  MappingSession session_;
+  std::vector<lcm::Subscription*> subscriptions_;
+  Publisher publisher_;
+  CommandHandler command_handler_;
+
+  // Input queue (LCM thread -> worker).
+  mutable std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::deque<Item> queue_;
+  size_t queued_frames_ = 0;
+  bool draining_ = false;
+  bool stop_worker_ = false;
+  std::thread worker_;
+
+  // Worker -> LCM thread.
+  mutable std::mutex outbox_mutex_;
+  std::vector<OutgoingMessage> outbox_;
+
+  std::atomic<int64_t> received_frames_{0};
+  std::atomic<int64_t> dropped_frames_{0};
+  std::map<std::string, int64_t> rejected_commands_;  // LCM thread only
+  bool finish_requested_ = false;                       // LCM thread only
+
+  // Optimiser round trip (LCM thread only).
+  int64_t request_id_ = 0;
+  std::optional<GraphLabels> labels_;
+  int64_t labels_request_id_ = -1;
+};
+
+}  // namespace panmap

@@ -1,0 +1,89 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "panmap/mapper/frame_sync.h"
+#include "panmap/mapper/mapper.h"
+
+namespace panmap {
+
+/// Input channels and synchronisation of a mapping run (offline or live).
+struct SessionOptions {
+  std::string channel_rgbd = "CAMERA_RGBD";
+  std::string channel_pose = "CAMERA_POSE";
+  std::string channel_panoptic = "PANOPTIC";
+  SyncConfig sync;
+  int64_t max_frames = 0;  ///< stop integrating after this many frames (0 = all)
+};
+
+/// Median and 95th percentile of a stage's per-frame time.
+struct StageTiming {
+  double median_ms = 0.0;
+  double p95_ms = 0.0;
+  double last_ms = 0.0;  ///< the most recent frame
+};
+
+/// What a session has done so far.
+struct SessionStats {
+  int64_t messages = 0;           ///< messages on the three input channels
+  int64_t frames_received = 0;    ///< RGB-D messages that decoded
+  int64_t frames_integrated = 0;  ///< frames fused into the map
+  std::map<std::string, int64_t> rejected;  ///< reason -> frames (or messages) refused
+  SyncStats sync;
+  std::map<std::string, StageTiming> timings;  ///< by stage name
+};
+
+/// One mapping run over a stream of LCM messages, the same for the offline reader and the
+/// live process so that both treat input identically: decodes each message (counting
+/// malformed ones), sanitises it, synchronises frames with poses and masks, and integrates
+/// the ready frames. Bad input is refused with a counted reason and never touches the map.
+/// Not thread-safe: one thread feeds it.
+class MappingSession {
+ public:
+  /// Called after each integrated frame (e.g. to update the occupancy tree).
+  using FrameHook = std::function<void(const SyncedFrame&, const FrameStats&)>;
+
+  /// @param mapper the map to extend (not owned; must outlive the session)
+  MappingSession(const SessionOptions& options, Mapper* mapper);
+
+  /// Handles one message. Messages on other channels are ignored (returns false).
+  /// @param now_utime stream time for the synchroniser's waits; negative: the newest message
+  ///        utime seen so far
+  bool handle(const std::string& channel, const void* data, size_t size, int64_t now_utime = -1);
+  /// Counts a message dropped before it reached the session (e.g. a full queue).
+  void countDropped(const std::string& reason, int64_t n = 1);
+  /// Maps what is still waiting at the end of the stream (frames with a pose), rejects the rest.
+  void flush();
+  /// True once max_frames frames are integrated.
+  bool done() const { return done_; }
+  /// Counters and stage timings so far.
+  SessionStats stats() const;
+  /// Called after every integrated frame.
+  void setFrameHook(FrameHook hook) { hook_ = std::move(hook); }
+
+ private:
+  void integrate(std::vector<SyncedFrame> ready);
+  void sanitise(PanopticFrame* panoptic);
+
+  SessionOptions options_;
+  Mapper* mapper_;
+  FrameSynchronizer sync_;
+  FrameHook hook_;
+  SessionStats stats_;
+  std::map<std::string, std::vector<double>> times_ms_;
+  int64_t newest_utime_ = INT64_MIN;
+  bool done_ = false;
+};
+
+/// Median / p95 / last of a list of times.
+StageTiming summariseTimes(std::vector<double> times_ms);
+
+/// The first words of an error message, used as its counted reason ("pose", "depth is ...").
+std::string reasonOf(const std::string& what);
+
+}  // namespace panmap

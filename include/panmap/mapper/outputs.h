@@ -1,0 +1,33 @@
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "panmap/graph/optimiser.h"
+#include "panmap/mapper/mapper.h"
+
+namespace panmap {
+
+/// What to write besides the meshes and the map.
+struct OutputOptions {
+  bool snapshots = true;  ///< overview PNGs of the meshes (semantic, instance, super-point, colour)
+};
+
+/// What writeOutputs wrote.
+struct OutputSummary {
+  size_t mesh_vertices = 0;
+  size_t mesh_faces = 0;
+  size_t instances_in_mesh = 0;  ///< distinct instance ids > 0 on mesh vertices
+  std::vector<std::string> files;  ///< file names written, in order
+};
+
+/// Writes a map's outputs (DESIGN 4) into `dir` (created when missing): mesh_semantic.ply,
+/// mesh_instance.ply, mesh_superpoint.ply, map.panmap, config.yaml (the exact parameters) and
+/// the snapshot PNGs. Throws Error naming the file that could not be written.
+/// @param labels optimised labels, or null for the frame-count labels
+/// @param optimiser the optimiser settings recorded in config.yaml
+OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLabels* labels,
+                           const OptimiserConfig& optimiser, const OutputOptions& options = {});
+
+}  // namespace panmap

@@ -1,0 +1,51 @@
+// panmap-command: sends one PANMAP_COMMAND to a running panmap-mapper (finish, save, export,
+// optimise), e.g. at the end of an lcm-logplayer replay.
+#include <chrono>
+#include <cstdio>
+#include <map>
+
+#include <CLI/CLI.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include "panmap/command_t.hpp"
+#include "panmap/lcm/channels.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Sends a command to panmap-mapper on PANMAP_COMMAND: finish (optimise, write the "
+      "outputs, exit), save [PATH] (map snapshot), export [DIR] (outputs now), optimise."};
+  std::string url, channel = panmap::kChannelCommand, command, argument;
+  app.add_option("command", command, "finish | save | export | optimise")->required();
+  app.add_option("argument", argument, "save: snapshot path; export: output folder");
+  app.add_option("--lcm-url", url, "LCM URL (default: LCM_DEFAULT_URL or LCM's own)");
+  app.add_option("--channel", channel)->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  const std::map<std::string, int8_t> commands = {
+      {"finish", panmap::command_t::COMMAND_FINISH},
+      {"save", panmap::command_t::COMMAND_SAVE},
+      {"export", panmap::command_t::COMMAND_EXPORT},
+      {"optimise", panmap::command_t::COMMAND_OPTIMISE},
+      {"optimize", panmap::command_t::COMMAND_OPTIMISE}};
+  const auto it = commands.find(command);
+  if (it == commands.end()) {
+    std::fprintf(stderr, "panmap-command: error: unknown command '%s' (finish, save, export, "
+                 "optimise)\n", command.c_str());
+    return 2;
+  }
+  lcm::LCM lcm(url);
+  if (!lcm.good()) {
+    std::fprintf(stderr, "panmap-command: error: cannot open LCM URL '%s'\n", url.c_str());
+    return 1;
+  }
+  panmap::command_t msg;
+  msg.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                  std::chrono::system_clock::now().time_since_epoch())
+                  .count();
+  msg.command = it->second;
+  msg.argument = argument;
+  if (lcm.publish(channel, &msg) != 0) {
+    std::fprintf(stderr, "panmap-command: error: publishing on %s failed\n", channel.c_str());
+    return 1;
+  }
+  return 0;
+}

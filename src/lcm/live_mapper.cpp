@@ -1,0 +1,312 @@
+#include "panmap/lcm/live_mapper.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+
+#include "panmap/command_t.hpp"
+#include "panmap/core/error.h"
+#include "panmap/graph_labels_t.hpp"
+#include "panmap/lcm/graph_conversions.h"
+
+namespace panmap {
+
+namespace {
+
+int64_t wallUtime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// Resident memory of this process, bytes (0 when /proc is unavailable).
+int64_t residentBytes() {
+  std::ifstream statm("/proc/self/statm");
+  int64_t pages = 0, resident = 0;
+  if (!(statm >> pages >> resident)) return 0;
+  return resident * static_cast<int64_t>(::sysconf(_SC_PAGESIZE));
+}
+
+template <typename Msg>
+bool decodeBuffer(const lcm::ReceiveBuffer* buffer, Msg* msg) {
+  try {
+    return msg->decode(buffer->data, 0, static_cast<int>(buffer->data_size)) ==
+           static_cast<int>(buffer->data_size);
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+template <typename Msg>
+OutgoingMessage encode(const std::string& channel, const Msg& msg) {
+  OutgoingMessage out{channel, std::vector<uint8_t>(static_cast<size_t>(msg.getEncodedSize()))};
+  msg.encode(out.bytes.data(), 0, static_cast<int>(out.bytes.size()));
+  return out;
+}
+
+}  // namespace
+
+void LiveOptions::check() const {
+  session.sync.check();
+  if (!(status_period_s > 0.0)) throw Error("live: status_period_s must be positive");
+  if (!(publish_period_s >= 0.0)) throw Error("live: publish_period_s must be >= 0");
+  if (max_queued_frames < 1) throw Error("live: max_queued_frames must be at least 1");
+  if (!(optimiser_timeout_s >= 0.0)) throw Error("live: optimiser_timeout_s must be >= 0");
+}
+
+LiveMapper::LiveMapper(lcm::LCM* lcm, const LiveOptions& options, Mapper* mapper)
+    : lcm_(lcm), options_(options), mapper_(mapper), session_(options.session, mapper) {
+  options_.check();
+  if (!lcm_ || !lcm_->good()) throw Error("LCM is not ready");
+  for (const std::string& channel : {options_.session.channel_rgbd, options_.session.channel_pose,
+                                     options_.session.channel_panoptic}) {
+    subscriptions_.push_back(lcm_->subscribe(channel, &LiveMapper::onInput, this));
+  }
+  subscriptions_.push_back(lcm_->subscribe(options_.channel_command, &LiveMapper::onCommand, this));
+  subscriptions_.push_back(lcm_->subscribe(options_.channel_labels, &LiveMapper::onLabels, this));
+  worker_ = std::thread(&LiveMapper::workerLoop, this);
+}
+
+LiveMapper::~LiveMapper() {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    stop_worker_ = true;
+  }
+  queue_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+  for (lcm::Subscription* s : subscriptions_) lcm_->unsubscribe(s);
+}
+
+void LiveMapper::post(Item item) {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    if (draining_ || stop_worker_) return;
+    if (item.channel == options_.session.channel_rgbd) {
+      if (queued_frames_ >= options_.max_queued_frames) {
+        // Newest data is worth more to a robot than a backlog: push the oldest frame out.
+        for (auto it = queue_.begin(); it != queue_.end(); ++it) {
+          if (it->channel == options_.session.channel_rgbd) {
+            queue_.erase(it);
+            --queued_frames_;
+            ++dropped_frames_;
+            break;
+          }
+        }
+      }
+      ++queued_frames_;
+    }
+    queue_.push_back(std::move(item));
+  }
+  queue_cv_.notify_one();
+}
+
+void LiveMapper::onInput(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
+  // LCM's C code calls this: copy and return, nothing may throw out of here.
+  try {
+    if (channel == options_.session.channel_rgbd) ++received_frames_;
+    const uint8_t* data = static_cast<const uint8_t*>(buffer->data);
+    post(Item{channel, std::vector<uint8_t>(data, data + buffer->data_size), {}});
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "panmap-mapper: message on %s lost: %s\n", channel.c_str(), e.what());
+  }
+}
+
+void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
+  try {
+    command_t msg;
+    if (!decodeBuffer(buffer, &msg)) {
+      ++rejected_commands_["malformed " + channel];
+      std::fprintf(stderr, "panmap-mapper: malformed message on %s ignored\n", channel.c_str());
+      return;
+    }
+    switch (msg.command) {
+      case command_t::COMMAND_FINISH:
+        finish_requested_ = true;
+        return;
+      case command_t::COMMAND_OPTIMISE: {
+        const int64_t request = ++request_id_;
+        const std::string graph_channel = options_.channel_graph;
+        post(Item{"", {}, [this, request, graph_channel](Mapper* mapper) {
+                    const superpoint_graph_t graph =
+                        toMessage(mapper->graph(), wallUtime(), request);
+                    std::lock_guard<std::mutex> lock(outbox_mutex_);
+                    outbox_.push_back(encode(graph_channel, graph));
+                  }});
+        return;
+      }
+      case command_t::COMMAND_SAVE:
+      case command_t::COMMAND_EXPORT: {
+        if (!command_handler_) return;
+        const int8_t command = msg.command;
+        const std::string argument = msg.argument;
+        const std::optional<GraphLabels> labels = labels_;
+        post(Item{"", {}, [this, command, argument, labels](Mapper* mapper) {
+                    try {
+                      command_handler_(command, argument, mapper, labels ? &*labels : nullptr);
+                    } catch (const std::exception& e) {
+                      std::fprintf(stderr, "panmap-mapper: command failed: %s\n", e.what());
+                    }
+                  }});
+        return;
+      }
+      default:
+        ++rejected_commands_["unknown command"];
+        std::fprintf(stderr, "panmap-mapper: unknown command %d ignored\n", msg.command);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "panmap-mapper: command ignored: %s\n", e.what());
+  }
+}
+
+void LiveMapper::onLabels(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
+  try {
+    graph_labels_t msg;
+    if (!decodeBuffer(buffer, &msg)) {
+      ++rejected_commands_["malformed " + channel];
+      return;
+    }
+    // Only answers to our own latest request count (another mapper may share the bus).
+    if (msg.request_id != request_id_ || request_id_ == 0) return;
+    labels_ = fromMessage(msg);
+    labels_request_id_ = msg.request_id;
+  } catch (const std::exception& e) {
+    ++rejected_commands_["bad " + channel];
+    std::fprintf(stderr, "panmap-mapper: labels ignored: %s\n", e.what());
+  }
+}
+
+void LiveMapper::workerLoop() {
+  for (;;) {
+    Item item;
+    {
+      std::unique_lock<std::mutex> lock(queue_mutex_);
+      queue_cv_.wait(lock, [&] { return stop_worker_ || draining_ || !queue_.empty(); });
+      if (stop_worker_) return;
+      if (queue_.empty()) {
+        if (draining_) break;
+        continue;
+      }
+      item = std::move(queue_.front());
+      queue_.pop_front();
+      if (item.channel == options_.session.channel_rgbd) --queued_frames_;
+    }
+    if (item.channel.empty()) {
+      item.task(mapper_);
+    } else {
+      session_.handle(item.channel, item.bytes.data(), item.bytes.size());
+    }
+  }
+  session_.flush();
+}
+
+void LiveMapper::publishOutbox() {
+  std::vector<OutgoingMessage> out;
+  {
+    std::lock_guard<std::mutex> lock(outbox_mutex_);
+    out.swap(outbox_);
+  }
+  for (const OutgoingMessage& m : out) {
+    lcm_->publish(m.channel, m.bytes.data(), static_cast<unsigned int>(m.bytes.size()));
+  }
+}
+
+status_t LiveMapper::status(const std::string& state) const {
+  const SessionStats s = session_.stats();
+  status_t msg;
+  msg.utime = wallUtime();
+  msg.state = state;
+  msg.frames_received = received_frames_;
+  msg.frames_integrated = s.frames_integrated;
+  msg.frames_dropped = dropped_frames_ + s.sync.dropped_queue_full;
+  std::map<std::string, int64_t> reasons = s.rejected;
+  for (const auto& [reason, n] : rejected_commands_) reasons[reason] += n;
+  msg.frames_rejected = 0;
+  for (const auto& [reason, n] : reasons) {
+    msg.reject_reasons.push_back(reason);
+    msg.reject_counts.push_back(n);
+    msg.frames_rejected += n;
+  }
+  msg.num_reject_reasons = static_cast<int32_t>(reasons.size());
+  for (const auto& [stage, t] : s.timings) {
+    msg.stage_names.push_back(stage);
+    msg.stage_median_ms.push_back(static_cast<float>(t.median_ms));
+    msg.stage_last_ms.push_back(static_cast<float>(t.last_ms));
+  }
+  msg.num_stages = static_cast<int32_t>(msg.stage_names.size());
+  msg.memory_bytes = residentBytes();
+  msg.num_blocks = static_cast<int64_t>(mapper_->map().numBlocks());
+  msg.num_voxels = msg.num_blocks * kBlockVoxels;
+  msg.num_superpoints = static_cast<int32_t>(mapper_->superpoints().states().size());
+  msg.num_instances = mapper_->superpoints().numInstances();
+  msg.vote_evictions = static_cast<int64_t>(mapper_->voteEvictions());
+  return msg;
+}
+
+void LiveMapper::publishStatus(const std::string& state) {
+  const status_t msg = status(state);
+  lcm_->publish(options_.channel_status, &msg);
+}
+
+bool LiveMapper::run(const std::atomic<bool>& stop) {
+  using Clock = std::chrono::steady_clock;
+  const auto period = [](double s) {
+    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  };
+  auto next_status = Clock::now();
+  auto next_publish = Clock::now() + period(options_.publish_period_s);
+  while (!stop && !finish_requested_) {
+    lcm_->handleTimeout(20);
+    publishOutbox();
+    const auto now = Clock::now();
+    if (now >= next_status) {
+      next_status = now + period(options_.status_period_s);
+      const std::string channel = options_.channel_status;
+      post(Item{"", {}, [this, channel](Mapper*) {
+                  const status_t msg = status("mapping");
+                  std::lock_guard<std::mutex> lock(outbox_mutex_);
+                  outbox_.push_back(encode(channel, msg));
+                }});
+    }
+    if (options_.publish_period_s > 0.0 && publisher_ && now >= next_publish) {
+      next_publish = now + period(options_.publish_period_s);
+      post(Item{"", {}, [this](Mapper* mapper) {
+                  std::vector<OutgoingMessage> out = publisher_(mapper, wallUtime());
+                  std::lock_guard<std::mutex> lock(outbox_mutex_);
+                  for (OutgoingMessage& m : out) outbox_.push_back(std::move(m));
+                }});
+    }
+  }
+  return finish_requested_;
+}
+
+void LiveMapper::drain() {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    draining_ = true;
+  }
+  queue_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+  publishOutbox();
+  publishStatus("finishing");
+}
+
+std::optional<GraphLabels> LiveMapper::requestLabels(const std::atomic<bool>& stop) {
+  if (worker_.joinable()) throw Error("requestLabels: drain() first");
+  const int64_t request = ++request_id_;
+  labels_.reset();
+  const superpoint_graph_t graph = toMessage(mapper_->graph(), wallUtime(), request);
+  lcm_->publish(options_.channel_graph, &graph);
+  publishStatus("optimising");
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(options_.optimiser_timeout_s));
+  while (!stop && std::chrono::steady_clock::now() < deadline) {
+    lcm_->handleTimeout(50);
+    if (labels_ && labels_request_id_ == request) return labels_;
+  }
+  return std::nullopt;
+}
+
+}  // namespace panmap

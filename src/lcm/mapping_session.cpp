@@ -1,0 +1,147 @@
+#include "panmap/lcm/mapping_session.h"
+
+#include <algorithm>
+
+#include "panmap/core/classes.h"
+#include "panmap/core/error.h"
+#include "panmap/lcm/conversions.h"
+
+namespace panmap {
+
+StageTiming summariseTimes(std::vector<double> times_ms) {
+  StageTiming t;
+  if (times_ms.empty()) return t;
+  t.last_ms = times_ms.back();
+  std::sort(times_ms.begin(), times_ms.end());
+  t.median_ms = times_ms[times_ms.size() / 2];
+  t.p95_ms = times_ms[std::min(times_ms.size() - 1, times_ms.size() * 95 / 100)];
+  return t;
+}
+
+std::string reasonOf(const std::string& what) {
+  const auto colon = what.find(':');
+  return colon == std::string::npos ? what : what.substr(0, colon);
+}
+
+namespace {
+
+template <typename Msg>
+bool decodeInto(const void* data, size_t size, Msg* msg) {
+  try {
+    return msg->decode(data, 0, static_cast<int>(size)) == static_cast<int>(size);
+  } catch (const std::exception&) {
+    return false;  // generated decoders can throw on absurd array lengths
+  }
+}
+
+}  // namespace
+
+MappingSession::MappingSession(const SessionOptions& options, Mapper* mapper)
+    : options_(options), mapper_(mapper), sync_(options.sync) {
+  if (!mapper_) throw Error("MappingSession: no mapper");
+}
+
+void MappingSession::countDropped(const std::string& reason, int64_t n) {
+  stats_.rejected[reason] += n;
+}
+
+void MappingSession::sanitise(PanopticFrame* panoptic) {
+  // A category outside the label space would become a class of its own in votes and graph;
+  // such segments are kept as unlabelled (category 0) pixels and counted.
+  for (PanopticSegment& segment : panoptic->segments) {
+    if (segment.category < 0 || segment.category > kMaxNyu40Class) {
+      ++stats_.rejected["panoptic segment: unknown category"];
+      segment.category = 0;
+    }
+  }
+}
+
+bool MappingSession::handle(const std::string& channel, const void* data, size_t size,
+                            int64_t now_utime) {
+  if (channel != options_.channel_rgbd && channel != options_.channel_pose &&
+      channel != options_.channel_panoptic) {
+    return false;
+  }
+  ++stats_.messages;
+  if (done_) return true;
+  try {
+    if (channel == options_.channel_rgbd) {
+      rgbd_frame_t msg;
+      if (!decodeInto(data, size, &msg)) {
+        ++stats_.rejected["malformed " + channel];
+        return true;
+      }
+      RgbdFrame frame = fromMessage(msg);
+      ++stats_.frames_received;
+      newest_utime_ = std::max(newest_utime_, frame.utime);
+      sync_.addFrame(std::move(frame));
+    } else if (channel == options_.channel_pose) {
+      pose_t msg;
+      if (!decodeInto(data, size, &msg)) {
+        ++stats_.rejected["malformed " + channel];
+        return true;
+      }
+      const StampedPose pose = fromMessage(msg);
+      newest_utime_ = std::max(newest_utime_, pose.utime);
+      sync_.addPose(pose);
+    } else {
+      panoptic_t msg;
+      if (!decodeInto(data, size, &msg)) {
+        ++stats_.rejected["malformed " + channel];
+        return true;
+      }
+      PanopticFrame panoptic = fromMessage(msg);
+      sanitise(&panoptic);
+      newest_utime_ = std::max(newest_utime_, panoptic.utime);
+      sync_.addPanoptic(std::move(panoptic));
+    }
+  } catch (const Error& error) {
+    ++stats_.rejected["bad " + channel + ": " + reasonOf(error.what())];
+    return true;
+  }
+  integrate(sync_.popReady(now_utime >= 0 ? now_utime : newest_utime_));
+  return true;
+}
+
+void MappingSession::flush() {
+  if (!done_) integrate(sync_.flush());
+}
+
+void MappingSession::integrate(std::vector<SyncedFrame> ready) {
+  for (SyncedFrame& f : ready) {
+    if (done_) return;
+    try {
+      const FrameStats s =
+          mapper_->integrate(f.frame, f.T_W_C, f.panoptic ? &*f.panoptic : nullptr);
+      times_ms_["segmentation"].push_back(s.segmentation_ms);
+      times_ms_["superpoints"].push_back(s.superpoints_ms);
+      times_ms_["integration"].push_back(s.integration_ms);
+      times_ms_["graph"].push_back(s.graph_ms);
+      times_ms_["total"].push_back(s.total_ms);
+      ++stats_.frames_integrated;
+      if (options_.max_frames > 0 && stats_.frames_integrated >= options_.max_frames) done_ = true;
+      if (hook_) {
+        try {
+          hook_(f, s);
+        } catch (const Error& e) {
+          ++stats_.rejected["after frame: " + reasonOf(e.what())];
+        }
+      }
+    } catch (const Error& e) {
+      ++stats_.rejected["frame: " + reasonOf(e.what())];
+    }
+  }
+}
+
+SessionStats MappingSession::stats() const {
+  SessionStats out = stats_;
+  out.sync = sync_.stats();
+  if (out.sync.rejected_no_pose) out.rejected["frame: no pose"] += out.sync.rejected_no_pose;
+  if (out.sync.dropped_queue_full) {
+    out.rejected["frame: synchroniser queue full"] += out.sync.dropped_queue_full;
+  }
+  for (const auto& [stage, list] : times_ms_) out.timings[stage] = summariseTimes(list);
+  return out;
+}
+
+}  // namespace panmap

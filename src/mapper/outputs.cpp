@@ -1,0 +1,71 @@
+#include "panmap/mapper/outputs.h"
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "panmap/core/error.h"
+#include "panmap/io/image_codec.h"
+#include "panmap/mapper/config_file.h"
+#include "panmap/mesh/mesh_export.h"
+#include "panmap/sim/overview.h"
+
+namespace panmap {
+
+namespace {
+
+LabelledMesh recoloured(const LabelledMesh& mesh, Rgb8 (*colour)(int32_t),
+                        const std::vector<int32_t>& ids) {
+  LabelledMesh out = mesh;
+  out.colors.resize(mesh.vertices.size());
+  for (size_t i = 0; i < ids.size(); ++i) out.colors[i] = colour(ids[i]);
+  return out;
+}
+
+void writePng(const std::string& dir, const std::string& name, const LabelledMesh& mesh,
+              OutputSummary* summary) {
+  writeFileBytes(dir + "/" + name, encodePng(renderOverview(mesh)));
+  summary->files.push_back(name);
+}
+
+}  // namespace
+
+OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLabels* labels,
+                           const OptimiserConfig& optimiser, const OutputOptions& options) {
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) throw Error("cannot create output folder " + dir + ": " + error.message());
+  OutputSummary summary;
+  const LabelledMesh mesh = mapper->extractMesh(labels);
+  summary.mesh_vertices = mesh.numVertices();
+  summary.mesh_faces = mesh.numFaces();
+  std::set<int32_t> instances;
+  for (int32_t id : mesh.instance) {
+    if (id > 0) instances.insert(id);
+  }
+  summary.instances_in_mesh = instances.size();
+
+  writeLabelledMeshes(dir, mesh);
+  summary.files.insert(summary.files.end(),
+                       {kSemanticMeshFile, kInstanceMeshFile, kSuperpointMeshFile});
+  mapper->save(dir + "/map.panmap");
+  summary.files.push_back("map.panmap");
+  // The exact parameters the outputs were made with (a loaded map brings its own).
+  {
+    std::ofstream out(dir + "/config.yaml");
+    out << configToYaml(PanmapConfig{mapper->config(), optimiser});
+    if (!out) throw Error("cannot write " + dir + "/config.yaml");
+    summary.files.push_back("config.yaml");
+  }
+  if (options.snapshots && !mesh.faces.empty()) {
+    writePng(dir, "snapshot_semantic.png", recoloured(mesh, &semanticColor, mesh.semantic),
+             &summary);
+    writePng(dir, "snapshot_instance.png", recoloured(mesh, &idColor, mesh.instance), &summary);
+    writePng(dir, "snapshot_superpoint.png", recoloured(mesh, &idColor, mesh.superpoint),
+             &summary);
+    writePng(dir, "snapshot_color.png", mesh, &summary);
+  }
+  return summary;
+}
+
+}  // namespace panmap

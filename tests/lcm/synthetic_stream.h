@@ -1,0 +1,86 @@
+// A short synthetic input stream as encoded LCM messages, for session and live-mapper tests:
+// room 1 rendered at 160x120 along a survey, clean masks, ground-truth poses.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "panmap/lcm/conversions.h"
+#include "panmap/mapper/mapper.h"
+#include "panmap/sim/procedural_room.h"
+#include "panmap/sim/sequence.h"
+#include "panmap/sim/trajectory.h"
+
+namespace panmap {
+namespace test {
+
+/// One encoded message.
+struct Encoded {
+  std::string channel;
+  std::vector<uint8_t> bytes;
+};
+
+template <typename Msg>
+Encoded encodeMessage(const std::string& channel, const Msg& msg) {
+  Encoded e{channel, std::vector<uint8_t>(static_cast<size_t>(msg.getEncodedSize()))};
+  msg.encode(e.bytes.data(), 0, static_cast<int>(e.bytes.size()));
+  return e;
+}
+
+/// The frames of the stream, decoded form.
+struct SyntheticStream {
+  std::vector<RgbdFrame> frames;
+  std::vector<StampedPose> poses;
+  std::vector<PanopticFrame> masks;
+
+  /// Messages in capture order: pose, mask, frame for each frame.
+  std::vector<Encoded> messages() const {
+    std::vector<Encoded> out;
+    for (size_t k = 0; k < frames.size(); ++k) {
+      out.push_back(encodeMessage("CAMERA_POSE", toMessage(poses[k])));
+      out.push_back(encodeMessage("PANOPTIC", toMessage(masks[k], ImageEncoding{})));
+      out.push_back(encodeMessage("CAMERA_RGBD", toMessage(frames[k], ImageEncoding{})));
+    }
+    return out;
+  }
+};
+
+/// `n` frames of room 1, every 10th pose of a 30 Hz survey (rendered once per process).
+inline const SyntheticStream& syntheticStream(size_t n = 12) {
+  static std::map<size_t, SyntheticStream> cache;
+  auto it = cache.find(n);
+  if (it != cache.end()) return it->second;
+  const ProceduralRoom room = generateRoom(1);
+  SurveyConfig survey;
+  survey.num_frames = static_cast<int>(10 * n);
+  std::vector<StampedPose> trajectory = planSurvey(room.mesh, survey, 1);
+  std::vector<StampedPose> every_tenth;
+  for (size_t k = 0; k < trajectory.size() && every_tenth.size() < n; k += 10) {
+    every_tenth.push_back(trajectory[k]);
+  }
+  SynthConfig config;
+  config.camera = PinholeCamera{131.25, 131.25, 79.5, 59.5, 160, 120};
+  config.masks = SegmenterNoiseConfig::fromPreset("clean");
+  config.poses = PoseDriftConfig::fromPreset("gt");
+  SequenceSynthesizer synth(room.mesh, every_tenth, config);
+  SyntheticStream stream;
+  for (size_t k = 0; k < synth.size(); ++k) {
+    SynthFrame f = synth.frame(k);
+    stream.frames.push_back(f.rgbd);
+    stream.poses.push_back(f.input_pose);
+    stream.masks.push_back(f.panoptic);
+  }
+  return cache.emplace(n, std::move(stream)).first->second;
+}
+
+/// A mapper config fast enough for tests on the stream (4 cm voxels, one thread).
+inline MapperConfig streamMapperConfig() {
+  MapperConfig config;
+  config.map.voxel_size_m = 0.04f;
+  config.num_threads = 1;
+  return config;
+}
+
+}  // namespace test
+}  // namespace panmap

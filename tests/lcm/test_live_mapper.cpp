@@ -1,0 +1,191 @@
+// The live mapper over LCM's in-process memq:// provider: the same map as the session on the
+// same messages, a bounded queue that drops (and counts) the oldest frames, status messages,
+// commands, the optimiser round trip and its timeout.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iterator>
+
+#include "panmap/command_t.hpp"
+#include "panmap/lcm/live_mapper.h"
+#include "panmap/lcm/optimizer_node.h"
+#include "synthetic_stream.h"
+#include "test_helpers.h"
+
+namespace panmap {
+namespace {
+
+std::string fileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+std::string mapBytes(const Mapper& mapper) {
+  test::TempDir dir;
+  mapper.save(dir.path("map.panmap"));
+  return fileBytes(dir.path("map.panmap"));
+}
+
+struct StatusInbox {
+  std::vector<status_t> received;
+  void onStatus(const lcm::ReceiveBuffer*, const std::string&, const status_t* msg) {
+    received.push_back(*msg);
+  }
+};
+
+void publishAll(lcm::LCM* lcm, const std::vector<test::Encoded>& messages) {
+  for (const test::Encoded& m : messages) {
+    lcm->publish(m.channel, m.bytes.data(), static_cast<unsigned>(m.bytes.size()));
+  }
+}
+
+void publishCommand(lcm::LCM* lcm, int8_t command, const std::string& argument = "") {
+  command_t msg;
+  msg.utime = 0;
+  msg.command = command;
+  msg.argument = argument;
+  lcm->publish("PANMAP_COMMAND", &msg);
+}
+
+LiveOptions testOptions() {
+  LiveOptions options;
+  options.max_queued_frames = 1000;  // no drops: the result must equal the session's
+  options.optimiser_timeout_s = 0.5;
+  options.publish_period_s = 0.0;
+  return options;
+}
+
+TEST(LiveMapper, MapsLikeTheSessionAndAnswersStatus) {
+  const test::SyntheticStream& stream = test::syntheticStream();
+  Mapper reference(test::streamMapperConfig());
+  {
+    MappingSession session(SessionOptions{}, &reference);
+    for (const test::Encoded& m : stream.messages()) {
+      session.handle(m.channel, m.bytes.data(), m.bytes.size());
+    }
+    session.flush();
+  }
+
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  StatusInbox inbox;
+  lcm.subscribe("PANMAP_STATUS", &StatusInbox::onStatus, &inbox);
+  Mapper mapper(test::streamMapperConfig());
+  LiveMapper live(&lcm, testOptions(), &mapper);
+  publishAll(&lcm, stream.messages());
+  const uint8_t junk[3] = {9, 9, 9};
+  lcm.publish("CAMERA_POSE", junk, sizeof(junk));
+  publishCommand(&lcm, command_t::COMMAND_FINISH);
+  std::atomic<bool> stop{false};
+  EXPECT_TRUE(live.run(stop));  // ended by the finish command
+  live.drain();
+  while (lcm.handleTimeout(0) > 0) {
+  }
+  const SessionStats stats = live.stats();
+  EXPECT_EQ(stats.frames_integrated, static_cast<int64_t>(stream.frames.size()));
+  EXPECT_EQ(live.framesReceived(), static_cast<int64_t>(stream.frames.size()));
+  EXPECT_EQ(live.framesDropped(), 0);
+  EXPECT_EQ(stats.rejected.at("malformed CAMERA_POSE"), 1);
+  EXPECT_EQ(mapBytes(mapper), mapBytes(reference));
+
+  // drain() publishes a "finishing" status with the final counts.
+  ASSERT_FALSE(inbox.received.empty());
+  const status_t& last = inbox.received.back();
+  EXPECT_EQ(last.state, "finishing");
+  EXPECT_EQ(last.frames_integrated, static_cast<int64_t>(stream.frames.size()));
+  EXPECT_EQ(last.frames_rejected, 1);
+  ASSERT_EQ(last.num_reject_reasons, 1);
+  EXPECT_EQ(last.reject_reasons[0], "malformed CAMERA_POSE");
+  EXPECT_EQ(last.num_superpoints, static_cast<int32_t>(mapper.superpoints().states().size()));
+  EXPECT_GT(last.num_blocks, 0);
+  EXPECT_GT(last.memory_bytes, 0);
+  EXPECT_GE(last.num_stages, 5);
+}
+
+TEST(LiveMapper, FullQueueDropsTheOldestFramesAndCountsThem) {
+  const test::SyntheticStream& stream = test::syntheticStream();
+  lcm::LCM lcm("memq://");
+  Mapper mapper(test::streamMapperConfig());
+  LiveOptions options = testOptions();
+  options.max_queued_frames = 1;
+  LiveMapper live(&lcm, options, &mapper);
+  publishAll(&lcm, stream.messages());
+  publishCommand(&lcm, command_t::COMMAND_FINISH);
+  std::atomic<bool> stop{false};
+  live.run(stop);
+  live.drain();
+  const SessionStats stats = live.stats();
+  const int64_t n = static_cast<int64_t>(stream.frames.size());
+  // Every frame is accounted for: integrated or dropped, none silently lost.
+  EXPECT_EQ(live.framesReceived(), n);
+  EXPECT_EQ(stats.frames_integrated + live.framesDropped(), n);
+  EXPECT_GE(stats.frames_integrated, 1);
+}
+
+TEST(LiveMapper, OptimiserAnswersAndItsAbsenceTimesOut) {
+  const test::SyntheticStream& stream = test::syntheticStream();
+  std::atomic<bool> stop{false};
+  {
+    lcm::LCM lcm("memq://");
+    Mapper mapper(test::streamMapperConfig());
+    LiveMapper live(&lcm, testOptions(), &mapper);
+    OptimizerNode optimiser(&lcm, OptimizerNode::Config{});
+    publishAll(&lcm, stream.messages());
+    publishCommand(&lcm, command_t::COMMAND_FINISH);
+    live.run(stop);
+    live.drain();
+    const std::optional<GraphLabels> labels = live.requestLabels(stop);
+    ASSERT_TRUE(labels.has_value());
+    EXPECT_EQ(optimiser.answered(), 1);
+    EXPECT_EQ(labels->semantic.size(), mapper.graph().vertices.size());
+    EXPECT_FALSE(labels->semantic.empty());
+  }
+  {
+    // No optimiser on the bus (or one killed mid-run): no labels, the map stays intact.
+    lcm::LCM lcm("memq://");
+    Mapper mapper(test::streamMapperConfig());
+    LiveMapper live(&lcm, testOptions(), &mapper);
+    publishAll(&lcm, stream.messages());
+    publishCommand(&lcm, command_t::COMMAND_FINISH);
+    live.run(stop);
+    live.drain();
+    EXPECT_FALSE(live.requestLabels(stop).has_value());
+    EXPECT_EQ(mapper.framesIntegrated(), static_cast<int64_t>(stream.frames.size()));
+  }
+}
+
+TEST(LiveMapper, SaveCommandRunsOnTheWorkerAndMappingGoesOn) {
+  const test::SyntheticStream& stream = test::syntheticStream();
+  const std::vector<test::Encoded> messages = stream.messages();
+  test::TempDir dir;
+  lcm::LCM lcm("memq://");
+  Mapper mapper(test::streamMapperConfig());
+  LiveMapper live(&lcm, testOptions(), &mapper);
+  std::vector<std::string> saved;
+  live.setCommandHandler([&](int8_t command, const std::string& argument, Mapper* m,
+                             const GraphLabels*) {
+    ASSERT_EQ(command, +command_t::COMMAND_SAVE);
+    m->save(argument);
+    saved.push_back(argument);
+  });
+  // Half the stream, a save, the rest: the snapshot holds exactly the first half.
+  const size_t half = messages.size() / 2 / 3 * 3;
+  publishAll(&lcm, {messages.begin(), messages.begin() + half});
+  publishCommand(&lcm, command_t::COMMAND_SAVE, dir.path("half.panmap"));
+  publishAll(&lcm, {messages.begin() + half, messages.end()});
+  publishCommand(&lcm, 42);  // unknown: counted, ignored
+  publishCommand(&lcm, command_t::COMMAND_FINISH);
+  std::atomic<bool> stop{false};
+  live.run(stop);
+  live.drain();
+  ASSERT_EQ(saved.size(), 1u);
+  const std::unique_ptr<Mapper> snapshot = Mapper::load(dir.path("half.panmap"));
+  // The synchroniser may hold the newest frame back until its mask and pose are in.
+  EXPECT_GE(snapshot->framesIntegrated(), static_cast<int64_t>(half / 3) - 1);
+  EXPECT_LE(snapshot->framesIntegrated(), static_cast<int64_t>(half / 3));
+  EXPECT_EQ(mapper.framesIntegrated(), static_cast<int64_t>(stream.frames.size()));
+  EXPECT_EQ(live.status("done").frames_rejected, 1);
+}
+
+}  // namespace
+}  // namespace panmap
