@@ -1,0 +1,178 @@
+// End to end: panmap-synth makes a short log; lcm-logplayer replays it over loopback UDP into
+// panmap-mapper and panmap-optimizer (skipped where multicast is unavailable); the offline
+// mode gives byte-identical outputs run after run; a dead optimiser costs the labels, not the
+// map.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "child_process.h"
+#include "panmap/command_t.hpp"
+#include "panmap/io/ply.h"
+#include "panmap/mapper/mapper.h"
+#include "panmap/status_t.hpp"
+#include "test_helpers.h"
+
+namespace panmap {
+namespace {
+
+// Non-default port: away from any live LCM traffic on the machine and from the replay test.
+const char* kUrl = "udpm://239.255.76.67:7683?ttl=0&recv_buf_size=16777216";
+
+std::string fileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+nlohmann::json readJson(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+struct StatusWatch {
+  int received = 0;
+  void onStatus(const lcm::ReceiveBuffer*, const std::string&, const status_t*) { ++received; }
+};
+
+bool multicastWorks() {
+  lcm::LCM lcm(kUrl);
+  if (!lcm.good()) return false;
+  StatusWatch watch;
+  lcm.subscribe("PANMAP_STATUS", &StatusWatch::onStatus, &watch);
+  status_t probe;
+  probe.utime = 0;
+  probe.num_reject_reasons = probe.num_stages = 0;
+  for (int attempt = 0; attempt < 3 && watch.received == 0; ++attempt) {
+    lcm.publish("PANMAP_STATUS", &probe);
+    lcm.handleTimeout(300);
+  }
+  return watch.received > 0;
+}
+
+class LiveCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new test::TempDir();
+    const test::CommandResult r =
+        test::runCommand(test::binPath("panmap-synth") + " --room 2 --frames 30 --masks m2f " +
+                         "--poses gt --seed 5 -q --out " + dir_->path("seq"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+  static std::string log() { return dir_->path("seq/sequence.lcmlog"); }
+  static test::TempDir* dir_;
+};
+test::TempDir* LiveCli::dir_ = nullptr;
+
+TEST_F(LiveCli, OfflineRunsAreByteIdentical) {
+  for (const char* out : {"a", "b"}) {
+    const test::CommandResult r = test::runCommand(test::binPath("panmap-mapper") + " -q --log " +
+                                                   log() + " --voxel-size 0.02 --out " +
+                                                   dir_->path(out));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  int compared = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_->path("a"))) {
+    const std::string name = entry.path().filename().string();
+    if (name == "report.json") continue;  // holds wall-clock timings
+    EXPECT_EQ(fileBytes(entry.path().string()), fileBytes(dir_->path("b/" + name))) << name;
+    ++compared;
+  }
+  EXPECT_GE(compared, 9);  // three meshes, map, config, four snapshots (and more as added)
+  const nlohmann::json report = readJson(dir_->path("a/report.json"));
+  EXPECT_EQ(report["frames_integrated"], 30);
+  EXPECT_EQ(report["mode"], "offline");
+}
+
+TEST_F(LiveCli, LogplayerToMapperAndOptimiserOverUdp) {
+  if (!multicastWorks()) {
+    GTEST_SKIP() << "UDP multicast on loopback is unavailable here (run scripts/setup.sh as root: "
+                    "ip link set lo multicast on; ip route add 239.255.76.0/24 dev lo)";
+  }
+  const std::string out = dir_->path("live");
+  test::ChildProcess optimiser({test::binPath("panmap-optimizer"), "--lcm-url", kUrl},
+                               dir_->path("optimizer.log"));
+  test::ChildProcess mapper({test::binPath("panmap-mapper"), "--lcm-url", kUrl, "--out", out,
+                             "--voxel-size", "0.02", "--queue-frames", "64",
+                             "--optimizer-timeout-s", "60"},
+                            dir_->path("mapper.log"));
+  ASSERT_TRUE(optimiser.started() && mapper.started());
+  // The mapper is up once its status arrives.
+  lcm::LCM lcm(kUrl);
+  StatusWatch watch;
+  lcm.subscribe("PANMAP_STATUS", &StatusWatch::onStatus, &watch);
+  for (int i = 0; i < 100 && watch.received == 0; ++i) lcm.handleTimeout(100);
+  ASSERT_GT(watch.received, 0) << fileBytes(dir_->path("mapper.log"));
+
+  test::ChildProcess player({"lcm-logplayer", "-l", kUrl, log()}, dir_->path("player.log"));
+  ASSERT_TRUE(player.wait(60)) << "lcm-logplayer did not finish";
+  ASSERT_EQ(player.exitCode(), 0);
+  command_t finish;
+  finish.utime = 0;
+  finish.command = command_t::COMMAND_FINISH;
+  finish.argument = "";
+  lcm.publish("PANMAP_COMMAND", &finish);
+  ASSERT_TRUE(mapper.wait(120)) << fileBytes(dir_->path("mapper.log"));
+  ASSERT_EQ(mapper.exitCode(), 0) << fileBytes(dir_->path("mapper.log"));
+  optimiser.signal(SIGTERM);
+  ASSERT_TRUE(optimiser.wait(10));
+
+  const nlohmann::json report = readJson(out + "/report.json");
+  EXPECT_EQ(report["mode"], "live");
+  EXPECT_TRUE(report["graph"]["optimised"].get<bool>());
+  EXPECT_EQ(report["frames_received"], 30);
+  // UDP may lose datagrams under load, but every received frame is integrated or counted.
+  EXPECT_GE(report["frames_integrated"].get<int>(), 20);
+  const LabelledMesh mesh = readPly(out + "/mesh_instance.ply");
+  ASSERT_GT(mesh.numVertices(), 1000u);
+  const std::set<int32_t> classes(mesh.semantic.begin(), mesh.semantic.end());
+  const std::set<int32_t> instances(mesh.instance.begin(), mesh.instance.end());
+  EXPECT_GE(classes.size(), 3u);    // wall, floor and furniture at least
+  EXPECT_GE(instances.size(), 3u);  // with 0 (stuff)
+  const std::unique_ptr<Mapper> map = Mapper::load(out + "/map.panmap");
+  EXPECT_EQ(map->framesIntegrated(), report["frames_integrated"].get<int64_t>());
+}
+
+TEST_F(LiveCli, DeadOptimiserCostsTheLabelsNotTheMap) {
+  if (!multicastWorks()) GTEST_SKIP() << "UDP multicast on loopback is unavailable here";
+  const std::string url = "udpm://239.255.76.67:7684?ttl=0&recv_buf_size=16777216";
+  const std::string out = dir_->path("dead");
+  test::ChildProcess optimiser({test::binPath("panmap-optimizer"), "--lcm-url", url});
+  test::ChildProcess mapper({test::binPath("panmap-mapper"), "--lcm-url", url, "--out", out,
+                             "--voxel-size", "0.04", "--queue-frames", "64",
+                             "--optimizer-timeout-s", "1"},
+                            dir_->path("dead.log"));
+  lcm::LCM lcm(url);
+  StatusWatch watch;
+  lcm.subscribe("PANMAP_STATUS", &StatusWatch::onStatus, &watch);
+  for (int i = 0; i < 100 && watch.received == 0; ++i) lcm.handleTimeout(100);
+  ASSERT_GT(watch.received, 0);
+  test::ChildProcess player({"lcm-logplayer", "-l", url, log()});
+  ASSERT_TRUE(player.wait(60));
+  optimiser.signal(SIGKILL);  // the optimiser dies mid-run
+  ASSERT_TRUE(optimiser.wait(10));
+  mapper.signal(SIGINT);  // Ctrl-C finishes like the command
+  ASSERT_TRUE(mapper.wait(120));
+  EXPECT_EQ(mapper.exitCode(), 0);
+  const std::string log_text = fileBytes(dir_->path("dead.log"));
+  EXPECT_NE(log_text.find("writing unoptimised outputs"), std::string::npos) << log_text;
+  const nlohmann::json report = readJson(out + "/report.json");
+  EXPECT_FALSE(report["graph"]["optimised"].get<bool>());
+  const std::unique_ptr<Mapper> map = Mapper::load(out + "/map.panmap");
+  EXPECT_EQ(map->framesIntegrated(), report["frames_integrated"].get<int64_t>());
+  EXPECT_GT(map->framesIntegrated(), 0);
+  EXPECT_GT(readPly(out + "/mesh_instance.ply").numVertices(), 1000u);
+}
+
+}  // namespace
+}  // namespace panmap
