@@ -1,5 +1,7 @@
 // panmap-eval: ScanNet-style instance evaluation (AP, N_TP, PQ), super-point IoU_LS and
-// semantic mIoU of a predicted mesh against a ground-truth mesh (DESIGN 8).
+// semantic mIoU of a predicted mesh against a ground-truth mesh (ours, or a ScanNet scene's
+// vh_clean_2 mesh with its aggregation and segments, or a benchmark GT file with its mesh)
+// (DESIGN 8), and ATE / RPE of a camera trajectory against ground truth (TUM files).
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -12,8 +14,11 @@
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
 #include "panmap/eval/evaluation.h"
+#include "panmap/eval/ground_truth_input.h"
+#include "panmap/eval/trajectory_error.h"
 #include "panmap/io/ply.h"
 #include "panmap/io/scannet_ground_truth.h"
+#include "panmap/io/tum_trajectory.h"
 
 namespace {
 
@@ -94,62 +99,162 @@ json toJson(const panmap::EvalResult& r) {
           {"classes", classes}};
 }
 
+/// Error statistics; null values when there were no errors to summarise.
+json toJson(const panmap::ErrorStats& s) {
+  const auto value = [&s](double v) { return s.count ? json(v) : json(nullptr); };
+  return {{"count", s.count},
+          {"rmse", value(s.rmse)},
+          {"mean", value(s.mean)},
+          {"median", value(s.median)},
+          {"max", value(s.max)}};
+}
+
+json toJson(const panmap::TrajectoryError& e, const panmap::TrajectoryErrorConfig& config) {
+  json T = json::array();
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) T.push_back(e.T_gt_est.matrix()(r, c));
+  }
+  return {{"num_estimated", e.num_estimated},
+          {"num_ground_truth", e.num_ground_truth},
+          {"num_associated", e.num_associated},
+          {"max_time_difference_s", config.max_time_difference_s},
+          {"rpe_delta_s", e.rpe_delta_s},
+          {"ate_m", toJson(e.ate_m)},
+          {"rpe_translation_m", toJson(e.rpe_m)},
+          {"rpe_rotation_deg", toJson(e.rpe_deg)},
+          {"T_gt_est_row_major", T}};
+}
+
+/// The ground-truth mesh from --gt or --gt-scannet, with --gt-instances applied.
+panmap::LabelledMesh loadGroundTruth(const std::string& gt_path, const std::string& scannet_dir,
+                                     const std::string& scannet_labels,
+                                     const std::string& gt_instances_path) {
+  panmap::LabelledMesh gt;
+  std::string source = gt_path;
+  if (!scannet_dir.empty()) {
+    const panmap::ScanNetSceneFiles files = panmap::findScanNetSceneFiles(scannet_dir);
+    const panmap::ScanNetLabelTable table = panmap::ScanNetLabelTable::load(scannet_labels);
+    panmap::ScanNetGroundTruth scene = panmap::loadScanNetGroundTruth(
+        files.mesh_ply, files.aggregation_json, files.segs_json, table);
+    if (!scene.unknown_labels.empty()) {
+      std::string names;
+      for (size_t i = 0; i < scene.unknown_labels.size() && i < 5; ++i) {
+        names += (i ? ", '" : "'") + scene.unknown_labels[i] + "'";
+      }
+      std::fprintf(stderr, "panmap-eval: %zu raw labels of %s match no NYU40 class (%s%s)\n",
+                   scene.unknown_labels.size(), files.scene.c_str(), names.c_str(),
+                   scene.unknown_labels.size() > 5 ? ", ..." : "");
+    }
+    gt = std::move(scene.mesh);
+    source = files.mesh_ply;
+  } else {
+    gt = panmap::readPly(gt_path);
+  }
+  if (!gt_instances_path.empty()) {
+    panmap::applyScanNetInstanceIds(panmap::readScanNetInstanceFile(gt_instances_path),
+                                    gt_instances_path, source, &gt);
+  }
+  if (gt.semantic.size() != gt.numVertices() || gt.instance.size() != gt.numVertices()) {
+    throw panmap::Error(source +
+                        ": needs semantic and instance vertex properties (or "
+                        "--gt-instances)");
+  }
+  return gt;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "Evaluate a predicted panmap mesh against a ground-truth mesh: ScanNet "
-      "evaluate_semantic_instance AP (0.5:0.95, 0.5, 0.75, 0.25), N_TP, PQ/SQ/RQ, super-point "
-      "IoU_LS and semantic mIoU after a nearest-vertex label transfer."};
+      "Evaluate a predicted panmap mesh against ground truth: ScanNet evaluate_semantic_instance "
+      "AP (0.5:0.95, 0.5, 0.75, 0.25), N_TP, PQ/SQ/RQ, super-point IoU_LS and semantic mIoU "
+      "after a nearest-vertex label transfer; and/or a TUM trajectory against ground truth: "
+      "ATE (RMSE after rigid alignment) and RPE."};
   std::string pred_path, gt_path, gt_instances_path, confidences_path, json_path;
+  std::string scannet_dir, scannet_labels, classes_text, traj_path, gt_traj_path;
   panmap::EvalConfig config;
+  panmap::TrajectoryErrorConfig traj_config;
   app.add_option("--pred", pred_path,
                  "predicted mesh (mesh_instance.ply: semantic, instance, "
-                 "superpoint vertex properties)")
-      ->required();
-  app.add_option("--gt", gt_path, "ground-truth mesh PLY (semantic, instance)")->required();
+                 "superpoint vertex properties)");
+  auto* gt_option =
+      app.add_option("--gt", gt_path, "ground-truth mesh PLY (semantic, instance properties)");
+  auto* scannet_option = app.add_option(
+      "--gt-scannet", scannet_dir,
+      "ScanNet scene folder with <scene>_vh_clean_2.ply, <scene>.aggregation.json and "
+      "<scene>_vh_clean_2.0.010000.segs.json (instance = objectId + 1)");
+  auto* labels_option = app.add_option(
+      "--scannet-labels", scannet_labels,
+      "ScanNet's scannetv2-labels.combined.tsv (raw category -> NYU40), for --gt-scannet");
+  scannet_option->excludes(gt_option)->needs(labels_option);
+  labels_option->needs(scannet_option);
   app.add_option("--gt-instances", gt_instances_path,
-                 "ScanNet benchmark GT file (class*1000+k per vertex); overrides the GT mesh's "
-                 "instances");
+                 "ScanNet benchmark GT file (class*1000+k per vertex) of the GT mesh; overrides "
+                 "its labels");
   app.add_option("--confidences", confidences_path,
                  "objects.json with id and confidence per instance (default: confidence 1)");
+  app.add_option("--classes", classes_text,
+                 "evaluated classes, NYU40 ids or names, comma-separated (default: ScanNet's 18)");
+  app.add_option("--min-region-size", config.min_region_size,
+                 "ignore GT and predicted instances with fewer vertices (ScanNet: 100)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--json", json_path, "write the results as JSON to this file");
   app.add_option("--max-distance", config.max_distance_m, "label transfer radius, metres")
       ->capture_default_str();
   app.add_flag("--paper-compatible", config.paper_compatible,
                "score matched predictions at confidence 1 (the released scripts' quirk)");
+  auto* traj_option = app.add_option("--traj", traj_path,
+                                     "estimated trajectory, TUM format (t tx ty tz qx qy qz qw)");
+  auto* gt_traj_option =
+      app.add_option("--gt-traj", gt_traj_path, "ground-truth trajectory, TUM format");
+  traj_option->needs(gt_traj_option);
+  gt_traj_option->needs(traj_option);
+  app.add_option("--max-time-difference", traj_config.max_time_difference_s,
+                 "largest stamp difference of associated poses, seconds")
+      ->capture_default_str();
+  app.add_option("--rpe-delta", traj_config.rpe_delta_s,
+                 "time between the poses of a relative pose error, seconds")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   try {
-    const panmap::LabelledMesh pred = panmap::readPly(pred_path);
-    panmap::LabelledMesh gt = panmap::readPly(gt_path);
-    if (!gt_instances_path.empty()) {
-      const std::vector<int32_t> ids = panmap::readScanNetInstanceFile(gt_instances_path);
-      if (ids.size() != gt.numVertices()) {
-        throw panmap::Error(gt_instances_path + ": " + std::to_string(ids.size()) + " lines but " +
-                            gt_path + " has " + std::to_string(gt.numVertices()) + " vertices");
-      }
-      if (gt.semantic.size() != gt.numVertices()) gt.semantic.assign(gt.numVertices(), 0);
-      gt.instance.assign(gt.numVertices(), 0);
-      for (size_t v = 0; v < ids.size(); ++v) {
-        if (ids[v] <= 0) continue;
-        gt.semantic[v] = ids[v] / 1000;
-        gt.instance[v] = ids[v];
-      }
+    const bool mesh_eval = !pred_path.empty();
+    if (mesh_eval && gt_path.empty() && scannet_dir.empty()) {
+      throw panmap::Error("--pred needs ground truth: --gt MESH or --gt-scannet SCENE_DIR");
     }
-    if (gt.semantic.size() != gt.numVertices() || gt.instance.size() != gt.numVertices()) {
-      throw panmap::Error(gt_path +
-                          ": needs semantic and instance vertex properties (or "
-                          "--gt-instances)");
+    if (!mesh_eval && (!gt_path.empty() || !scannet_dir.empty() || !gt_instances_path.empty() ||
+                       !confidences_path.empty() || !classes_text.empty())) {
+      throw panmap::Error("mesh ground truth, --confidences and --classes need --pred");
     }
-    std::map<int32_t, double> confidences;
-    if (!confidences_path.empty()) confidences = readConfidences(confidences_path);
-    const panmap::EvalResult result = panmap::evaluate(gt, pred, confidences, config);
-    std::printf("%s", panmap::formatEvalTable(result).c_str());
+    if (!mesh_eval && traj_path.empty()) {
+      throw panmap::Error(
+          "nothing to evaluate: give --pred with --gt or --gt-scannet, and/or --traj with "
+          "--gt-traj");
+    }
+    json out;
+    if (mesh_eval) {
+      if (!classes_text.empty()) config.classes = panmap::parseClassList(classes_text);
+      const panmap::LabelledMesh pred = panmap::readPly(pred_path);
+      const panmap::LabelledMesh gt =
+          loadGroundTruth(gt_path, scannet_dir, scannet_labels, gt_instances_path);
+      std::map<int32_t, double> confidences;
+      if (!confidences_path.empty()) confidences = readConfidences(confidences_path);
+      const panmap::EvalResult result = panmap::evaluate(gt, pred, confidences, config);
+      std::printf("%s", panmap::formatEvalTable(result).c_str());
+      out = toJson(result);
+    }
+    if (!traj_path.empty()) {
+      const panmap::TrajectoryError error =
+          panmap::evaluateTrajectory(panmap::readTumTrajectory(traj_path),
+                                     panmap::readTumTrajectory(gt_traj_path), traj_config);
+      std::printf("%s", panmap::formatTrajectoryError(error).c_str());
+      out["trajectory"] = toJson(error, traj_config);
+    }
     if (!json_path.empty()) {
-      std::ofstream out(json_path);
-      out << toJson(result).dump(2) << "\n";
-      if (!out) throw panmap::Error(json_path + ": cannot write");
+      std::ofstream file(json_path);
+      file << out.dump(2) << "\n";
+      if (!file) throw panmap::Error(json_path + ": cannot write");
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-eval: error: %s\n", e.what());

@@ -20,9 +20,12 @@
 #include "panmap/core/progress.h"
 #include "panmap/graph/optimiser.h"
 #include "panmap/lcm/live_mapper.h"
+#include "panmap/lcm/object_conversions.h"
 #include "panmap/lcm/offline_mapping.h"
 #include "panmap/mapper/config_file.h"
+#include "panmap/mapper/objects.h"
 #include "panmap/mapper/outputs.h"
+#include "panmap/octomap_t.hpp"
 
 namespace {
 
@@ -49,6 +52,17 @@ nlohmann::json sessionJson(const panmap::SessionStats& s) {
           {"timings", timings}};
 }
 
+nlohmann::json trackingJson(const panmap::Mapper& mapper) {
+  static const char* kNames[] = {"accepted",     "accepted_partially", "too_few_points",
+                                 "degenerate",   "low_inlier_ratio",   "correction_too_large",
+                                 "solver_failed"};
+  nlohmann::json out = nlohmann::json::object();
+  for (int i = 0; i < panmap::kAlignmentStatusCount; ++i) {
+    out[kNames[i]] = mapper.trackingCounts()[static_cast<size_t>(i)];
+  }
+  return out;
+}
+
 nlohmann::json mapJson(const panmap::Mapper& mapper, const panmap::OutputSummary& outputs) {
   return {{"frames_total", mapper.framesIntegrated()},
           {"memory",
@@ -60,7 +74,9 @@ nlohmann::json mapJson(const panmap::Mapper& mapper, const panmap::OutputSummary
           {"superpoint_merges", mapper.superpoints().merges().size()},
           {"instances_frame_counting", mapper.superpoints().numInstances()},
           {"instances_in_mesh", outputs.instances_in_mesh},
+          {"objects", outputs.objects},
           {"vote_evictions", mapper.voteEvictions()},
+          {"tracking", trackingJson(mapper)},
           {"mesh", {{"vertices", outputs.mesh_vertices}, {"faces", outputs.mesh_faces}}},
           {"files", outputs.files},
           {"config",
@@ -119,8 +135,12 @@ int main(int argc, char** argv) {
   app.add_flag("--no-regularise", no_regularise,
                "skip the semantic regularisation (ablation, w/o III-C)");
   app.add_flag("--no-refine", no_refine, "skip the instance refinement (ablation, w/o III-D)");
-  app.add_option("--load", load_path,
-                 "resume from a map.panmap snapshot");
+  std::string tracking;
+  app.add_option("--tracking", tracking,
+                 "refine poses against the map: off, auto (poses flagged SLAM or odometry), on "
+                 "(default: the config's tracking.mode, auto)")
+      ->check(CLI::IsMember({"off", "auto", "on"}));
+  app.add_option("--load", load_path, "resume from a map.panmap snapshot");
   app.add_flag("--export-only", export_only,
                "with --load: no mapping, only run the final optimisation and write the outputs");
   app.add_option("--channel-rgbd", options.channel_rgbd)->capture_default_str();
@@ -162,7 +182,8 @@ int main(int argc, char** argv) {
     if (!config_path.empty()) {
       file_config = panmap::loadConfig(config_path);
       // Flags given on the command line win over the file.
-      if (app.count("--voxel-size") == 0) config.map.voxel_size_m = file_config.mapper.map.voxel_size_m;
+      if (app.count("--voxel-size") == 0)
+        config.map.voxel_size_m = file_config.mapper.map.voxel_size_m;
       if (app.count("--threads") == 0) config.num_threads = file_config.mapper.num_threads;
       const float voxel = config.map.voxel_size_m;
       const int threads = config.num_threads;
@@ -172,6 +193,9 @@ int main(int argc, char** argv) {
     }
     if (geometry_only) config.fusion.geometry_only = true;
     config.superpoints.semantic_consistency = !spatial_only;
+    if (tracking == "off") config.tracking_mode = panmap::MapperConfig::TrackingMode::kOff;
+    if (tracking == "auto") config.tracking_mode = panmap::MapperConfig::TrackingMode::kAuto;
+    if (tracking == "on") config.tracking_mode = panmap::MapperConfig::TrackingMode::kOn;
     panmap::OptimiserConfig optimiser = file_config.optimiser;
     if (no_regularise) optimiser.regularise = false;
     if (no_refine) optimiser.refine = false;
@@ -207,6 +231,7 @@ int main(int argc, char** argv) {
       const panmap::SuperpointGraph graph = mapper->graph();
       const panmap::GraphLabels labels = panmap::optimise(graph, optimiser);
       const double optimise_ms = msSince(optimise_start);
+      output_options.utime = report.last_frame_utime;
       const panmap::OutputSummary outputs =
           panmap::writeOutputs(out_dir, mapper.get(), &labels, optimiser, output_options);
       nlohmann::json json = sessionJson(report);
@@ -215,9 +240,12 @@ int main(int argc, char** argv) {
       json["events"] = report.events;
       json["wall_s"] = report.wall_s;
       json.update(mapJson(*mapper, outputs));
-      json["graph"] = {{"vertices", graph.vertices.size()}, {"edges", graph.edges.size()},
-                       {"optimised", true},          {"optimise_ms", optimise_ms},
-                       {"solve_ms", labels.solve_ms}, {"regularise", optimiser.regularise},
+      json["graph"] = {{"vertices", graph.vertices.size()},
+                       {"edges", graph.edges.size()},
+                       {"optimised", true},
+                       {"optimise_ms", optimise_ms},
+                       {"solve_ms", labels.solve_ms},
+                       {"regularise", optimiser.regularise},
                        {"refine", optimiser.refine}};
       writeJson(out_dir + "/report.json", json);
       std::printf(
@@ -225,8 +253,8 @@ int main(int argc, char** argv) {
           "instances after optimisation, %zu mesh vertices; outputs in %s\n",
           static_cast<long long>(report.frames_integrated), report.wall_s,
           report.timings.count("total") ? report.timings.at("total").median_ms : 0.0,
-          mapper->superpoints().states().size(), outputs.instances_in_mesh,
-          outputs.mesh_vertices, out_dir.c_str());
+          mapper->superpoints().states().size(), outputs.instances_in_mesh, outputs.mesh_vertices,
+          out_dir.c_str());
       printRejected(report.rejected);
       return 0;
     }
@@ -247,10 +275,29 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "panmap-mapper: outputs written to %s\n", dir.c_str());
       }
     });
+    node.setPeriodicPublisher([&live](panmap::Mapper* m, int64_t utime) {
+      std::vector<panmap::OutgoingMessage> out;
+      out.push_back(panmap::encodeMessage(
+          live.channel_objects, panmap::toMessage(panmap::computeObjects(*m, nullptr), utime)));
+      if (m->occupancy()) {
+        panmap::octomap_t tree;
+        tree.utime = utime;
+        tree.resolution_m = m->occupancy()->resolution();
+        tree.tree_type = "OcTree";
+        tree.binary = true;
+        const std::string data = m->occupancy()->toBinaryData();
+        tree.data.assign(data.begin(), data.end());
+        tree.size = static_cast<int32_t>(tree.data.size());
+        out.push_back(panmap::encodeMessage(live.channel_octomap, tree));
+      }
+      return out;
+    });
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
-    std::fprintf(stderr, "panmap-mapper: listening on %s, %s, %s; finish with PANMAP_COMMAND "
-                 "or Ctrl-C\n", options.channel_rgbd.c_str(), options.channel_pose.c_str(),
+    std::fprintf(stderr,
+                 "panmap-mapper: listening on %s, %s, %s; finish with PANMAP_COMMAND "
+                 "or Ctrl-C\n",
+                 options.channel_rgbd.c_str(), options.channel_pose.c_str(),
                  options.channel_panoptic.c_str());
     const auto start = std::chrono::steady_clock::now();
     const bool by_command = node.run(g_stop);
@@ -268,9 +315,10 @@ int main(int argc, char** argv) {
                    "unoptimised outputs (frame-count labels)\n",
                    live.optimiser_timeout_s);
     }
+    const panmap::SessionStats stats = node.stats();
+    output_options.utime = stats.last_frame_utime;
     const panmap::OutputSummary outputs = panmap::writeOutputs(
         out_dir, mapper.get(), labels ? &*labels : nullptr, optimiser, output_options);
-    const panmap::SessionStats stats = node.stats();
     nlohmann::json json = sessionJson(stats);
     json["mode"] = "live";
     json["lcm_url"] = lcm_url;
@@ -286,11 +334,9 @@ int main(int argc, char** argv) {
         "mapped %lld of %lld frames received (%lld dropped behind) in %.1f s: %zu "
         "super-points, %zu instances%s, %zu mesh vertices; outputs in %s\n",
         static_cast<long long>(stats.frames_integrated),
-        static_cast<long long>(node.framesReceived()),
-        static_cast<long long>(node.framesDropped()), wall_s,
-        mapper->superpoints().states().size(), outputs.instances_in_mesh,
-        labels ? " after optimisation" : " (unoptimised)", outputs.mesh_vertices,
-        out_dir.c_str());
+        static_cast<long long>(node.framesReceived()), static_cast<long long>(node.framesDropped()),
+        wall_s, mapper->superpoints().states().size(), outputs.instances_in_mesh,
+        labels ? " after optimisation" : " (unoptimised)", outputs.mesh_vertices, out_dir.c_str());
     printRejected(stats.rejected);
     return 0;
   } catch (const std::exception& e) {

@@ -14,8 +14,9 @@ void onSignal(int) { g_stop = 1; }
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"panmap's optimiser process: answers each super-point graph (PANMAP_GRAPH) with "
-               "optimised semantic and instance labels (PANMAP_LABELS). Runs until SIGINT/SIGTERM."};
+  CLI::App app{
+      "panmap's optimiser process: answers each super-point graph (PANMAP_GRAPH) with "
+      "optimised semantic and instance labels (PANMAP_LABELS). Runs until SIGINT/SIGTERM."};
   std::string url;
   panmap::OptimizerNode::Config config;
   bool no_regularise = false, no_refine = false;
@@ -40,7 +41,8 @@ int main(int argc, char** argv) {
     panmap::OptimizerNode node(&lcm, config);
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
-    std::fprintf(stderr, "panmap-optimizer: waiting for graphs on %s\n", config.channel_graph.c_str());
+    std::fprintf(stderr, "panmap-optimizer: waiting for graphs on %s\n",
+                 config.channel_graph.c_str());
     while (!g_stop) lcm.handleTimeout(200);
     std::fprintf(stderr, "panmap-optimizer: answered %lld graphs\n",
                  static_cast<long long>(node.answered()));

@@ -133,9 +133,14 @@ int main(int argc, char** argv) {
   app.add_option("--scannet-labels", scannet_labels, "ScanNet label table (tsv)")
       ->capture_default_str();
   app.add_option("--trajectory", trajectory_file, "TUM trajectory to follow instead of a survey");
-  app.add_option("--frames", frames, "frames to render (30 Hz)")
+  app.add_option("--frames", frames, "frames to render")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
+  double rate_hz = 30.0;
+  app.add_option("--rate-hz", rate_hz,
+                 "frame rate of the survey (a lower rate covers more of the room per frame)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.5, 120.0));
   app.add_option("--masks", masks, "segmenter noise preset: clean, m2f, hard")
       ->capture_default_str()
       ->check(CLI::IsMember({"clean", "m2f", "hard"}));
@@ -178,6 +183,7 @@ int main(int argc, char** argv) {
     std::vector<panmap::StampedPose> trajectory;
     panmap::SurveyConfig survey;
     survey.num_frames = frames;
+    survey.rate_hz = rate_hz;
     if (!trajectory_file.empty()) {
       trajectory = panmap::readTumTrajectory(trajectory_file);
       if (static_cast<int>(trajectory.size()) > frames)
@@ -228,6 +234,7 @@ int main(int argc, char** argv) {
         {"seed", seed},
         {"source", source_json},
         {"frames", synth.size()},
+        {"rate_hz", trajectory_file.empty() ? rate_hz : 0.0},
         {"camera",
          {{"fx", config.camera.fx},
           {"fy", config.camera.fy},

@@ -13,10 +13,6 @@ bool PinholeCamera::isValid(std::string* why) const {
     reason << "principal point must be finite";
   } else if (width <= 0 || height <= 0) {
     reason << "image size must be positive (" << width << "x" << height << ")";
-  } else if (cx < 0.0 || cx > width || cy < 0.0 || cy > height) {
-    // The usual sign of intrinsics calibrated for another resolution than the image's.
-    reason << "principal point (" << cx << ", " << cy << ") lies outside the " << width << "x"
-           << height << " image";
   } else {
     return true;
   }

@@ -183,6 +183,15 @@ RgbdFrame fromMessage(const rgbd_frame_t& msg) {
   if (!frame.camera.isValid(&why)) {
     throw Error("rgbd frame " + std::to_string(msg.frame_id) + ": intrinsics: " + why);
   }
+  if (msg.cx < 0.0 || msg.cx > frame.depth.width() || msg.cy < 0.0 ||
+      msg.cy > frame.depth.height()) {
+    // The usual sign of intrinsics calibrated for another resolution than the image's.
+    std::ostringstream s;
+    s << "rgbd frame " << msg.frame_id << ": principal point (" << msg.cx << ", " << msg.cy
+      << ") lies outside the " << frame.depth.width() << "x" << frame.depth.height()
+      << " depth image";
+    throw Error(s.str());
+  }
   if (msg.color.size > 0 || msg.color.width > 0) {
     frame.color = colorFromMessage(msg.color, "rgbd colour");
     if (frame.color.width() != frame.depth.width() ||

@@ -39,13 +39,6 @@ bool decodeBuffer(const lcm::ReceiveBuffer* buffer, Msg* msg) {
   }
 }
 
-template <typename Msg>
-OutgoingMessage encode(const std::string& channel, const Msg& msg) {
-  OutgoingMessage out{channel, std::vector<uint8_t>(static_cast<size_t>(msg.getEncodedSize()))};
-  msg.encode(out.bytes.data(), 0, static_cast<int>(out.bytes.size()));
-  return out;
-}
-
 }  // namespace
 
 void LiveOptions::check() const {
@@ -132,7 +125,7 @@ void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& 
                     const superpoint_graph_t graph =
                         toMessage(mapper->graph(), wallUtime(), request);
                     std::lock_guard<std::mutex> lock(outbox_mutex_);
-                    outbox_.push_back(encode(graph_channel, graph));
+                    outbox_.push_back(encodeMessage(graph_channel, graph));
                   }});
         return;
       }
@@ -266,7 +259,7 @@ bool LiveMapper::run(const std::atomic<bool>& stop) {
       post(Item{"", {}, [this, channel](Mapper*) {
                   const status_t msg = status("mapping");
                   std::lock_guard<std::mutex> lock(outbox_mutex_);
-                  outbox_.push_back(encode(channel, msg));
+                  outbox_.push_back(encodeMessage(channel, msg));
                 }});
     }
     if (options_.publish_period_s > 0.0 && publisher_ && now >= next_publish) {

@@ -62,7 +62,8 @@ PanmapConfig loadConfig(const std::string& path) {
   MapperConfig& m = c.mapper;
   const cv::FileNode root = fs.root();
   const std::set<std::string> sections = {"map", "integrator", "depth_segmentation", "fusion",
-                                          "superpoints", "graph", "optimiser", "threads"};
+                                          "superpoints", "graph", "occupancy", "tracking",
+                                          "optimiser", "threads"};
   for (auto it = root.begin(); it != root.end(); ++it) {
     if (!sections.count((*it).name())) throw Error(path + ": unknown section " + (*it).name());
   }
@@ -113,6 +114,54 @@ PanmapConfig loadConfig(const std::string& path) {
     Section s(root["graph"], "graph", path);
     s.read("spatial_scale_m", &m.graph.spatial_scale_m);
     s.read("sample_stride_px", &m.graph.sample_stride_px);
+    s.finish();
+  }
+  {
+    Section s(root["occupancy"], "occupancy", path);
+    s.read("enabled", &m.occupancy_enabled);
+    s.read("resolution_m", &m.occupancy.resolution_m);
+    s.read("min_depth_m", &m.occupancy.min_depth_m);
+    s.read("max_depth_m", &m.occupancy.max_depth_m);
+    s.read("pixel_stride", &m.occupancy.pixel_stride);
+    s.read("prob_hit", &m.occupancy.prob_hit);
+    s.read("prob_miss", &m.occupancy.prob_miss);
+    s.read("clamping_min", &m.occupancy.clamping_min);
+    s.read("clamping_max", &m.occupancy.clamping_max);
+    s.read("occupancy_threshold", &m.occupancy.occupancy_threshold);
+    s.finish();
+  }
+  {
+    FrameToModelAligner::Config& t = m.tracking;
+    Section s(root["tracking"], "tracking", path);
+    s.markSeen("mode");
+    const cv::FileNode mode = s.node().empty() ? cv::FileNode() : s.node()["mode"];
+    if (!mode.empty()) {
+      std::string text = mode.isString() ? static_cast<std::string>(mode) : "";
+      // OpenCV keeps a trailing comment as part of an unquoted string.
+      text = text.substr(0, text.find('#'));
+      text.erase(text.find_last_not_of(" \t") + 1);
+      if (text == "off") {
+        m.tracking_mode = MapperConfig::TrackingMode::kOff;
+      } else if (text == "auto") {
+        m.tracking_mode = MapperConfig::TrackingMode::kAuto;
+      } else if (text == "on") {
+        m.tracking_mode = MapperConfig::TrackingMode::kOn;
+      } else {
+        s.fail("tracking.mode must be off, auto or on, not \"" + text + "\"");
+      }
+    }
+    s.read("warmup_frames", &m.tracking_warmup_frames);
+    s.read("max_iterations", &t.max_iterations);
+    s.read("robust_scale_m", &t.robust_scale_m);
+    s.read("prior_sigma_translation_m", &t.prior_sigma_translation_m);
+    s.read("prior_sigma_rotation_rad", &t.prior_sigma_rotation_rad);
+    s.read("min_points", &t.min_points);
+    s.read("inlier_distance_m", &t.inlier_distance_m);
+    s.read("min_inlier_ratio", &t.min_inlier_ratio);
+    s.read("min_relative_eigenvalue", &t.min_relative_eigenvalue);
+    s.read("remap_degenerate", &t.remap_degenerate);
+    s.read("max_correction_translation_m", &t.max_correction_translation_m);
+    s.read("max_correction_rotation_rad", &t.max_correction_rotation_rad);
     s.finish();
   }
   {
@@ -192,6 +241,36 @@ std::string configToYaml(const PanmapConfig& c) {
   y << "graph:\n"
     << "   spatial_scale_m: " << m.graph.spatial_scale_m << "   # P_s = 1 / (1 + d / scale)\n"
     << "   sample_stride_px: " << m.graph.sample_stride_px << "\n";
+  const OccupancyMap::Config& oc = m.occupancy;
+  y << "occupancy:\n"
+    << "   enabled: " << m.occupancy_enabled << "   # OctoMap tree for planners (0/1)\n"
+    << "   resolution_m: " << oc.resolution_m << "   # cell edge, metres\n"
+    << "   min_depth_m: " << oc.min_depth_m << "\n"
+    << "   max_depth_m: " << oc.max_depth_m << "   # free space reaches this far, metres\n"
+    << "   pixel_stride: " << oc.pixel_stride << "   # pixels between hits\n"
+    << "   prob_hit: " << oc.prob_hit << "\n"
+    << "   prob_miss: " << oc.prob_miss << "\n"
+    << "   clamping_min: " << oc.clamping_min << "\n"
+    << "   clamping_max: " << oc.clamping_max << "\n"
+    << "   occupancy_threshold: " << oc.occupancy_threshold << "\n";
+  const FrameToModelAligner::Config& t = m.tracking;
+  const char* mode = m.tracking_mode == MapperConfig::TrackingMode::kOff  ? "off"
+                     : m.tracking_mode == MapperConfig::TrackingMode::kOn ? "on"
+                                                                          : "auto";
+  y << "tracking:\n"
+    << "   mode: \"" << mode << "\"   # refine poses against the map - off, auto (SLAM or odometry poses) or on\n"
+    << "   warmup_frames: " << m.tracking_warmup_frames << "   # frames mapped before refining\n"
+    << "   max_iterations: " << t.max_iterations << "   # per pyramid level\n"
+    << "   robust_scale_m: " << t.robust_scale_m << "   # Huber scale, metres\n"
+    << "   prior_sigma_translation_m: " << t.prior_sigma_translation_m << "   # prior on the correction\n"
+    << "   prior_sigma_rotation_rad: " << t.prior_sigma_rotation_rad << "\n"
+    << "   min_points: " << t.min_points << "\n"
+    << "   inlier_distance_m: " << t.inlier_distance_m << "\n"
+    << "   min_inlier_ratio: " << t.min_inlier_ratio << "\n"
+    << "   min_relative_eigenvalue: " << t.min_relative_eigenvalue << "   # below: an unconstrained direction\n"
+    << "   remap_degenerate: " << t.remap_degenerate << "   # correct only constrained directions (0: refuse)\n"
+    << "   max_correction_translation_m: " << t.max_correction_translation_m << "\n"
+    << "   max_correction_rotation_rad: " << t.max_correction_rotation_rad << "\n";
   const OptimiserConfig& o = c.optimiser;
   y << "optimiser:\n"
     << "   regularise: " << o.regularise << "   # III-C alpha-beta swap (0/1)\n"

@@ -13,7 +13,8 @@ namespace panmap {
 namespace {
 
 constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
-constexpr uint32_t kVersion = 1;
+// 2: occupancy cells, pose refinement state and the trajectory.
+constexpr uint32_t kVersion = 2;
 
 void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put(c.map.voxel_size_m);
@@ -41,6 +42,28 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put(c.superpoints.instance_min_overlap);
   w->put(c.graph.spatial_scale_m);
   w->put<int32_t>(c.graph.sample_stride_px);
+  w->put<uint8_t>(c.occupancy_enabled);
+  const OccupancyMap::Config& o = c.occupancy;
+  for (double v : {o.resolution_m, o.min_depth_m, o.max_depth_m, o.prob_hit, o.prob_miss,
+                   o.clamping_min, o.clamping_max, o.occupancy_threshold}) {
+    w->put(v);
+  }
+  w->put<int32_t>(o.pixel_stride);
+  w->put<int8_t>(static_cast<int8_t>(c.tracking_mode));
+  w->put<int32_t>(c.tracking_warmup_frames);
+  const FrameToModelAligner::Config& t = c.tracking;
+  w->put<uint64_t>(t.level_strides_px.size());
+  for (int stride : t.level_strides_px) w->put<int32_t>(stride);
+  w->put<int32_t>(t.max_iterations);
+  w->put<int8_t>(static_cast<int8_t>(t.loss));
+  for (double v :
+       {t.robust_scale_m, t.point_sigma_m, t.prior_sigma_translation_m, t.prior_sigma_rotation_rad,
+        t.min_depth_m, t.max_depth_m, t.inlier_distance_m, t.min_inlier_ratio,
+        t.min_relative_eigenvalue, t.max_correction_translation_m, t.max_correction_rotation_rad}) {
+    w->put(v);
+  }
+  w->put<int32_t>(t.min_points);
+  w->put<uint8_t>(t.remap_degenerate);
   w->put<int32_t>(c.num_threads);
 }
 
@@ -71,8 +94,44 @@ MapperConfig getConfig(BinaryReader* r) {
   c.superpoints.instance_min_overlap = r->get<float>();
   c.graph.spatial_scale_m = r->get<double>();
   c.graph.sample_stride_px = r->get<int32_t>();
+  c.occupancy_enabled = r->get<uint8_t>() != 0;
+  OccupancyMap::Config& o = c.occupancy;
+  for (double* v : {&o.resolution_m, &o.min_depth_m, &o.max_depth_m, &o.prob_hit, &o.prob_miss,
+                    &o.clamping_min, &o.clamping_max, &o.occupancy_threshold}) {
+    *v = r->get<double>();
+  }
+  o.pixel_stride = r->get<int32_t>();
+  c.tracking_mode = static_cast<MapperConfig::TrackingMode>(r->get<int8_t>());
+  c.tracking_warmup_frames = r->get<int32_t>();
+  FrameToModelAligner::Config& t = c.tracking;
+  t.level_strides_px.resize(r->getCount(sizeof(int32_t)));
+  for (int& stride : t.level_strides_px) stride = r->get<int32_t>();
+  t.max_iterations = r->get<int32_t>();
+  t.loss = static_cast<RobustLoss>(r->get<int8_t>());
+  for (double* v : {&t.robust_scale_m, &t.point_sigma_m, &t.prior_sigma_translation_m,
+                    &t.prior_sigma_rotation_rad, &t.min_depth_m, &t.max_depth_m,
+                    &t.inlier_distance_m, &t.min_inlier_ratio, &t.min_relative_eigenvalue,
+                    &t.max_correction_translation_m, &t.max_correction_rotation_rad}) {
+    *v = r->get<double>();
+  }
+  t.min_points = r->get<int32_t>();
+  t.remap_degenerate = r->get<uint8_t>() != 0;
   c.num_threads = r->get<int32_t>();
   return c;
+}
+
+void putPose(BinaryWriter* w, const Eigen::Isometry3d& T) {
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 4; ++j) w->put(T.matrix()(i, j));
+  }
+}
+
+Eigen::Isometry3d getPose(BinaryReader* r) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 4; ++j) T.matrix()(i, j) = r->get<double>();
+  }
+  return T;
 }
 
 void putSnapshot(BinaryWriter* w, const SuperpointTracker::Snapshot& s) {
@@ -210,6 +269,16 @@ void Mapper::save(const std::string& path) const {
   }
   putSnapshot(&payload, tracker_->snapshot());
   putGraph(&payload, graph_->snapshot());
+  putPose(&payload, correction_);
+  for (int64_t n : tracking_counts_) payload.put(n);
+  payload.put<uint64_t>(trajectory_.size());
+  for (const StampedPose& p : trajectory_) {
+    payload.put(p.utime);
+    payload.put(p.frame_id);
+    payload.put<int8_t>(static_cast<int8_t>(p.source));
+    putPose(&payload, p.T_W_C);
+  }
+  if (occupancy_) occupancy_->writeState(&payload);
 
   BinaryWriter file;
   file.putBytes(kMagic, sizeof(kMagic));
@@ -263,6 +332,16 @@ std::unique_ptr<Mapper> Mapper::load(const std::string& path) {
   }
   mapper->tracker_->restore(getSnapshot(&r));
   mapper->graph_->restore(getGraph(&r));
+  mapper->correction_ = getPose(&r);
+  for (int64_t& n : mapper->tracking_counts_) n = r.get<int64_t>();
+  mapper->trajectory_.resize(r.getCount(17 + 12 * sizeof(double)));
+  for (StampedPose& p : mapper->trajectory_) {
+    p.utime = r.get<int64_t>();
+    p.frame_id = r.get<int64_t>();
+    p.source = static_cast<PoseSource>(r.get<int8_t>());
+    p.T_W_C = getPose(&r);
+  }
+  if (mapper->occupancy_) mapper->occupancy_->readState(&r);
   if (r.remaining() != 0) throw Error(path + ": unexpected bytes after the map state");
   return mapper;
 }

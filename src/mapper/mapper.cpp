@@ -7,6 +7,7 @@
 
 #include "panmap/core/error.h"
 #include "panmap/core/pose.h"
+#include "panmap/mapper/final_labels.h"
 
 namespace panmap {
 
@@ -17,6 +18,9 @@ void MapperConfig::check() const {
   fusion.check();
   superpoints.check();
   graph.check();
+  occupancy.check();
+  tracking.check();
+  if (tracking_warmup_frames < 0) throw Error("mapper tracking_warmup_frames must be >= 0");
   if (num_threads < 1 || num_threads > 256) throw Error("mapper num_threads must be in [1, 256]");
 }
 
@@ -35,6 +39,8 @@ Mapper::Mapper(const MapperConfig& config) : config_(config) {
   mesh_config.max_sdf_jump_voxels = config_.integrator.truncation_voxels;
   mesher_ = std::make_unique<IncrementalMesher>(mesh_config, pool_.get());
   graph_ = std::make_unique<GraphAccumulator>(config_.graph);
+  if (config_.occupancy_enabled) occupancy_ = std::make_unique<OccupancyMap>(config_.occupancy);
+  aligner_ = std::make_unique<FrameToModelAligner>(config_.tracking);
 }
 
 LabelledMesh Mapper::extractMesh(const GraphLabels* labels) {
@@ -45,20 +51,10 @@ LabelledMesh Mapper::extractMesh(const GraphLabels* labels) {
     return argmaxLabel(voxel, [&tracker](int32_t l) { return tracker.labels().resolve(l); });
   };
   labeller.semantic = [&tracker, labels](int32_t label) {
-    if (labels) {
-      const auto it = labels->semantic.find(label);
-      if (it != labels->semantic.end()) return it->second;
-    }
-    const SuperpointState* s = tracker.state(label);
-    return s ? s->semanticClass() : 0;
+    return finalLabels(label, tracker, labels).semantic;
   };
   labeller.instance = [&tracker, labels](int32_t label) {
-    if (labels) {
-      const auto it = labels->instance.find(label);
-      if (it != labels->instance.end()) return it->second;
-    }
-    const SuperpointState* s = tracker.state(label);
-    return s ? s->instance() : 0;
+    return finalLabels(label, tracker, labels).instance;
   };
   return mesher_->assemble(*map_, labeller);
 }
@@ -99,15 +95,38 @@ void Mapper::validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
   }
 }
 
-FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
-                             const PanopticFrame* panoptic) {
+FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C_given,
+                             const PanopticFrame* panoptic, PoseSource source) {
   using Clock = std::chrono::steady_clock;
   auto ms = [](Clock::time_point a, Clock::time_point b) {
     return std::chrono::duration<double, std::milli>(b - a).count();
   };
-  validate(frame, T_W_C, panoptic);
+  validate(frame, T_W_C_given, panoptic);
   FrameStats stats;
+  const auto t_start = Clock::now();
+  // Refine the pose against the map first: every later stage then sees the refined pose.
+  Eigen::Isometry3d T_W_C = T_W_C_given;
+  const bool track = config_.tracking_mode == MapperConfig::TrackingMode::kOn ||
+                     (config_.tracking_mode == MapperConfig::TrackingMode::kAuto &&
+                      (source == PoseSource::kSlam || source == PoseSource::kOdometry));
+  if (track && frames_ >= config_.tracking_warmup_frames) {
+    const Eigen::Isometry3d prior = correction_ * T_W_C_given;
+    const AlignmentResult result = aligner_->align(*map_, frame, prior);
+    stats.tracked = true;
+    stats.tracking_status = result.status;
+    ++tracking_counts_[static_cast<size_t>(result.status)];
+    // A refused frame keeps the last accepted correction rather than jumping back to the raw
+    // pose, which would tear the map where it joins the corrected part.
+    T_W_C = result.accepted ? result.T_W_C : prior;
+    if (result.accepted) {
+      correction_ = T_W_C * T_W_C_given.inverse();
+      correction_.linear() =
+          Eigen::Quaterniond(correction_.rotation()).normalized().toRotationMatrix();
+    }
+  }
+  stats.T_W_C = T_W_C;
   const auto t0 = Clock::now();
+  stats.tracking_ms = stats.tracked ? ms(t_start, t0) : 0.0;
   const FrameSegmentation segmentation =
       segmenter_->segment(frame, config_.fusion.geometry_only ? nullptr : panoptic);
   const auto t1 = Clock::now();
@@ -119,15 +138,24 @@ FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_
     graph_->update(frame, T_W_C, *panoptic, *map_, *tracker_, config_.fusion.stuff_confidence);
   }
   const auto t4 = Clock::now();
+  if (occupancy_) occupancy_->integrate(frame, T_W_C);
+  const auto t5 = Clock::now();
   stats.graph_ms = ms(t3, t4);
   stats.segmentation_ms = ms(t0, t1);
   stats.superpoints_ms = ms(t1, t2);
   stats.integration_ms = ms(t2, t3);
-  stats.total_ms = ms(t0, t4);
+  stats.occupancy_ms = ms(t4, t5);
+  stats.total_ms = ms(t_start, t5);
   stats.surfaces = static_cast<int>(segmentation.surface_list.size());
   stats.new_superpoints = association.new_labels;
   stats.merges = association.merges;
   vote_evictions_ += stats.integration.votes_evicted;
+  StampedPose used;
+  used.utime = frame.utime;
+  used.frame_id = frame.frame_id;
+  used.T_W_C = T_W_C;
+  used.source = source;
+  trajectory_.push_back(used);
   ++frames_;
   return stats;
 }

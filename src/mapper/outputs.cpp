@@ -6,7 +6,9 @@
 
 #include "panmap/core/error.h"
 #include "panmap/io/image_codec.h"
+#include "panmap/io/tum_trajectory.h"
 #include "panmap/mapper/config_file.h"
+#include "panmap/mapper/objects.h"
 #include "panmap/mesh/mesh_export.h"
 #include "panmap/sim/overview.h"
 
@@ -48,6 +50,16 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
   writeLabelledMeshes(dir, mesh);
   summary.files.insert(summary.files.end(),
                        {kSemanticMeshFile, kInstanceMeshFile, kSuperpointMeshFile});
+  const std::vector<MappedObject> objects = computeObjects(*mapper, labels);
+  writeObjectsJson(dir + "/objects.json", objects, options.utime);
+  summary.objects = objects.size();
+  summary.files.push_back("objects.json");
+  if (mapper->occupancy()) {
+    mapper->occupancy()->writeBt(dir + "/occupancy.bt");
+    summary.files.push_back("occupancy.bt");
+  }
+  writeTumTrajectory(dir + "/trajectory.txt", mapper->trajectory());
+  summary.files.push_back("trajectory.txt");
   mapper->save(dir + "/map.panmap");
   summary.files.push_back("map.panmap");
   // The exact parameters the outputs were made with (a loaded map brings its own).
@@ -61,8 +73,7 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
     writePng(dir, "snapshot_semantic.png", recoloured(mesh, &semanticColor, mesh.semantic),
              &summary);
     writePng(dir, "snapshot_instance.png", recoloured(mesh, &idColor, mesh.instance), &summary);
-    writePng(dir, "snapshot_superpoint.png", recoloured(mesh, &idColor, mesh.superpoint),
-             &summary);
+    writePng(dir, "snapshot_superpoint.png", recoloured(mesh, &idColor, mesh.superpoint), &summary);
     writePng(dir, "snapshot_color.png", mesh, &summary);
   }
   return summary;

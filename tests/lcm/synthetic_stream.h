@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "panmap/lcm/conversions.h"
+#include "panmap/lcm/live_mapper.h"
 #include "panmap/mapper/mapper.h"
 #include "panmap/sim/procedural_room.h"
 #include "panmap/sim/sequence.h"
@@ -16,17 +17,8 @@ namespace panmap {
 namespace test {
 
 /// One encoded message.
-struct Encoded {
-  std::string channel;
-  std::vector<uint8_t> bytes;
-};
-
-template <typename Msg>
-Encoded encodeMessage(const std::string& channel, const Msg& msg) {
-  Encoded e{channel, std::vector<uint8_t>(static_cast<size_t>(msg.getEncodedSize()))};
-  msg.encode(e.bytes.data(), 0, static_cast<int>(e.bytes.size()));
-  return e;
-}
+using Encoded = OutgoingMessage;
+using panmap::encodeMessage;
 
 /// The frames of the stream, decoded form.
 struct SyntheticStream {

@@ -14,7 +14,8 @@ using test::runCommand;
 
 TEST(EvalCli, GroundTruthAgainstItselfScoresOne) {
   test::TempDir dir;
-  const auto synth = runCommand(binPath("panmap-synth") + " --room 4 --frames 2 --quiet --out " + dir.path("r"));
+  const auto synth =
+      runCommand(binPath("panmap-synth") + " --room 4 --frames 2 --quiet --out " + dir.path("r"));
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
   const std::string mesh = dir.path("r/gt/mesh.ply");
   const auto eval = runCommand(binPath("panmap-eval") + " --pred " + mesh + " --gt " + mesh +
@@ -31,7 +32,8 @@ TEST(EvalCli, GroundTruthAgainstItselfScoresOne) {
   const auto scannet = runCommand(binPath("panmap-eval") + " --pred " + mesh + " --gt " + mesh +
                                   " --gt-instances " + dir.path("r/gt/instances.txt"));
   EXPECT_EQ(scannet.exit_code, 0) << scannet.output;
-  const auto missing = runCommand(binPath("panmap-eval") + " --pred " + dir.path("none.ply") + " --gt " + mesh);
+  const auto missing =
+      runCommand(binPath("panmap-eval") + " --pred " + dir.path("none.ply") + " --gt " + mesh);
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.output.find("none.ply"), std::string::npos) << missing.output;
 }

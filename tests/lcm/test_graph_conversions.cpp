@@ -11,7 +11,8 @@ Msg throughBytes(const Msg& msg) {
   std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
   msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   Msg out;
-  EXPECT_EQ(out.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  EXPECT_EQ(out.decode(bytes.data(), 0, static_cast<int>(bytes.size())),
+            static_cast<int>(bytes.size()));
   return out;
 }
 

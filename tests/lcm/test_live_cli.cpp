@@ -76,9 +76,9 @@ test::TempDir* LiveCli::dir_ = nullptr;
 
 TEST_F(LiveCli, OfflineRunsAreByteIdentical) {
   for (const char* out : {"a", "b"}) {
-    const test::CommandResult r = test::runCommand(test::binPath("panmap-mapper") + " -q --log " +
-                                                   log() + " --voxel-size 0.02 --out " +
-                                                   dir_->path(out));
+    const test::CommandResult r =
+        test::runCommand(test::binPath("panmap-mapper") + " -q --log " + log() +
+                         " --voxel-size 0.02 --out " + dir_->path(out));
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   int compared = 0;
@@ -102,10 +102,10 @@ TEST_F(LiveCli, LogplayerToMapperAndOptimiserOverUdp) {
   const std::string out = dir_->path("live");
   test::ChildProcess optimiser({test::binPath("panmap-optimizer"), "--lcm-url", kUrl},
                                dir_->path("optimizer.log"));
-  test::ChildProcess mapper({test::binPath("panmap-mapper"), "--lcm-url", kUrl, "--out", out,
-                             "--voxel-size", "0.02", "--queue-frames", "64",
-                             "--optimizer-timeout-s", "60"},
-                            dir_->path("mapper.log"));
+  test::ChildProcess mapper(
+      {test::binPath("panmap-mapper"), "--lcm-url", kUrl, "--out", out, "--voxel-size", "0.02",
+       "--queue-frames", "64", "--optimizer-timeout-s", "60"},
+      dir_->path("mapper.log"));
   ASSERT_TRUE(optimiser.started() && mapper.started());
   // The mapper is up once its status arrives.
   lcm::LCM lcm(kUrl);
@@ -148,10 +148,10 @@ TEST_F(LiveCli, DeadOptimiserCostsTheLabelsNotTheMap) {
   const std::string url = "udpm://239.255.76.67:7684?ttl=0&recv_buf_size=16777216";
   const std::string out = dir_->path("dead");
   test::ChildProcess optimiser({test::binPath("panmap-optimizer"), "--lcm-url", url});
-  test::ChildProcess mapper({test::binPath("panmap-mapper"), "--lcm-url", url, "--out", out,
-                             "--voxel-size", "0.04", "--queue-frames", "64",
-                             "--optimizer-timeout-s", "1"},
-                            dir_->path("dead.log"));
+  test::ChildProcess mapper(
+      {test::binPath("panmap-mapper"), "--lcm-url", url, "--out", out, "--voxel-size", "0.04",
+       "--queue-frames", "64", "--optimizer-timeout-s", "1"},
+      dir_->path("dead.log"));
   lcm::LCM lcm(url);
   StatusWatch watch;
   lcm.subscribe("PANMAP_STATUS", &StatusWatch::onStatus, &watch);

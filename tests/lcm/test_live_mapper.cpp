@@ -162,12 +162,12 @@ TEST(LiveMapper, SaveCommandRunsOnTheWorkerAndMappingGoesOn) {
   Mapper mapper(test::streamMapperConfig());
   LiveMapper live(&lcm, testOptions(), &mapper);
   std::vector<std::string> saved;
-  live.setCommandHandler([&](int8_t command, const std::string& argument, Mapper* m,
-                             const GraphLabels*) {
-    ASSERT_EQ(command, +command_t::COMMAND_SAVE);
-    m->save(argument);
-    saved.push_back(argument);
-  });
+  live.setCommandHandler(
+      [&](int8_t command, const std::string& argument, Mapper* m, const GraphLabels*) {
+        ASSERT_EQ(command, +command_t::COMMAND_SAVE);
+        m->save(argument);
+        saved.push_back(argument);
+      });
   // Half the stream, a save, the rest: the snapshot holds exactly the first half.
   const size_t half = messages.size() / 2 / 3 * 3;
   publishAll(&lcm, {messages.begin(), messages.begin() + half});

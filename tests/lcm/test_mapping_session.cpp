@@ -27,7 +27,8 @@ std::string mapBytes(const Mapper& mapper) {
 }
 
 void feed(MappingSession* session, const std::vector<test::Encoded>& messages) {
-  for (const test::Encoded& m : messages) session->handle(m.channel, m.bytes.data(), m.bytes.size());
+  for (const test::Encoded& m : messages)
+    session->handle(m.channel, m.bytes.data(), m.bytes.size());
   session->flush();
 }
 

@@ -47,6 +47,14 @@ struct OutgoingMessage {
   std::vector<uint8_t> bytes;
 };
 
+/// Encodes an LCM message for the outbox.
+template <typename Msg>
+OutgoingMessage encodeMessage(const std::string& channel, const Msg& msg) {
+  OutgoingMessage out{channel, std::vector<uint8_t>(static_cast<size_t>(msg.getEncodedSize()))};
+  msg.encode(out.bytes.data(), 0, static_cast<int>(out.bytes.size()));
+  return out;
+}
+
 /// The live mapper: LCM handlers only copy messages into a bounded queue; a worker thread
 /// decodes, synchronises and integrates them through a MappingSession, and runs tasks (save,
 /// export, periodic publications) between frames, so the map is only touched by one thread.
@@ -58,9 +66,8 @@ class LiveMapper {
   using Publisher = std::function<std::vector<OutgoingMessage>(Mapper* mapper, int64_t utime)>;
   /// Runs a command's file work on the worker thread: COMMAND_SAVE / COMMAND_EXPORT with the
   /// command's argument. Labels are the latest optimised ones, or null.
-  using CommandHandler =
-      std::function<void(int8_t command, const std::string& argument, Mapper* mapper,
-                         const GraphLabels* labels)>;
+  using CommandHandler = std::function<void(int8_t command, const std::string& argument,
+                                            Mapper* mapper, const GraphLabels* labels)>;
 
   /// Subscribes on `lcm` (not owned; must outlive this) and starts the worker.
   /// @param mapper the map (not owned); only the worker touches it until stop()
@@ -131,7 +138,7 @@ class LiveMapper {
   std::atomic<int64_t> received_frames_{0};
   std::atomic<int64_t> dropped_frames_{0};
   std::map<std::string, int64_t> rejected_commands_;  // LCM thread only
-  bool finish_requested_ = false;                       // LCM thread only
+  bool finish_requested_ = false;                     // LCM thread only
 
   // Optimiser round trip (LCM thread only).
   int64_t request_id_ = 0;

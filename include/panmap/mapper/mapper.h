@@ -1,19 +1,24 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 
 #include "panmap/core/frame.h"
+#include "panmap/core/pose.h"
 #include "panmap/core/thread_pool.h"
 #include "panmap/graph/graph_accumulator.h"
 #include "panmap/map/projective_integrator.h"
 #include "panmap/map/tsdf_map.h"
 #include "panmap/mesh/incremental_mesher.h"
+#include "panmap/occupancy/occupancy_map.h"
 #include "panmap/segmentation/panoptic_geometric.h"
 #include "panmap/superpoint/superpoint_tracker.h"
+#include "panmap/tracking/frame_to_model_aligner.h"
 
 namespace panmap {
 
@@ -25,6 +30,19 @@ struct MapperConfig {
   SurfaceFusionConfig fusion;
   SuperpointConfig superpoints;
   GraphConfig graph;
+  /// The occupancy tree for planners (OctoMap cells, 5 cm by default).
+  bool occupancy_enabled = true;
+  OccupancyMap::Config occupancy;
+  /// When to refine incoming poses against the map before integrating them.
+  enum class TrackingMode : int8_t {
+    kOff = 0,   ///< never
+    kAuto = 1,  ///< poses flagged as SLAM or odometry (not ground truth, not unknown)
+    kOn = 2,    ///< every pose
+  };
+  TrackingMode tracking_mode = TrackingMode::kAuto;
+  /// Frames mapped with their given pose before refinement starts (the map needs a model).
+  int tracking_warmup_frames = 5;
+  FrameToModelAligner::Config tracking;
   int num_threads = 2;  ///< threads for segmentation and integration (association uses one)
   /// Throws Error naming the bad field.
   void check() const;
@@ -36,7 +54,13 @@ struct FrameStats {
   double superpoints_ms = 0.0;   ///< III-B association, merging, frame counting
   double integration_ms = 0.0;   ///< label-TSDF update
   double graph_ms = 0.0;         ///< III-C super-point graph update
+  double tracking_ms = 0.0;      ///< pose refinement against the map (0 when not run)
+  double occupancy_ms = 0.0;     ///< occupancy update
   double total_ms = 0.0;
+  /// The pose the frame was integrated with (the given one, or refined against the map).
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+  bool tracked = false;                                          ///< pose refinement ran
+  AlignmentStatus tracking_status = AlignmentStatus::kAccepted;  ///< when tracked
   int surfaces = 0;
   int new_superpoints = 0;
   int merges = 0;
@@ -55,8 +79,10 @@ class Mapper {
   /// input, leaving the map untouched.
   /// @param T_W_C camera-to-world pose of the frame (optical frame)
   /// @param panoptic the frame's 2D panoptic segmentation, or null (geometry only)
+  /// @param source where the pose comes from; SLAM / odometry poses are refined against the
+  ///        map first (MapperConfig::tracking_mode)
   FrameStats integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
-                       const PanopticFrame* panoptic);
+                       const PanopticFrame* panoptic, PoseSource source = PoseSource::kUnknown);
 
   /// The label-TSDF.
   const TsdfMap& map() const { return *map_; }
@@ -72,6 +98,14 @@ class Mapper {
   int64_t framesIntegrated() const { return frames_; }
   /// Votes evicted from full voxel slots so far (never silent).
   uint64_t voteEvictions() const { return vote_evictions_; }
+  /// The occupancy map, or null when disabled.
+  const OccupancyMap* occupancy() const { return occupancy_.get(); }
+  /// Every integrated frame's pose as used (refined where tracking ran), in order.
+  const std::vector<StampedPose>& trajectory() const { return trajectory_; }
+  /// Pose refinement outcomes so far, by AlignmentStatus.
+  const std::array<int64_t, kAlignmentStatusCount>& trackingCounts() const {
+    return tracking_counts_;
+  }
 
   /// The labelled mesh of the current map: marching cubes re-run only on changed blocks;
   /// per vertex the super-point (argmax of its voxel's votes, merges resolved), and the
@@ -99,6 +133,13 @@ class Mapper {
   std::unique_ptr<ProjectiveIntegrator> integrator_;
   std::unique_ptr<IncrementalMesher> mesher_;
   std::unique_ptr<GraphAccumulator> graph_;
+  std::unique_ptr<OccupancyMap> occupancy_;
+  std::unique_ptr<FrameToModelAligner> aligner_;
+  /// Refined pose = correction_ * given pose: the last accepted correction carries over to
+  /// the next frame, so drift that builds up slowly stays inside the aligner's reach.
+  Eigen::Isometry3d correction_ = Eigen::Isometry3d::Identity();
+  std::array<int64_t, kAlignmentStatusCount> tracking_counts_{};
+  std::vector<StampedPose> trajectory_;
   int64_t frames_ = 0;
   uint64_t vote_evictions_ = 0;
 };

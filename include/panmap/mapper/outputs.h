@@ -12,19 +12,22 @@ namespace panmap {
 /// What to write besides the meshes and the map.
 struct OutputOptions {
   bool snapshots = true;  ///< overview PNGs of the meshes (semantic, instance, super-point, colour)
+  int64_t utime = 0;      ///< time of the map state (newest frame), written into objects.json
 };
 
 /// What writeOutputs wrote.
 struct OutputSummary {
   size_t mesh_vertices = 0;
   size_t mesh_faces = 0;
-  size_t instances_in_mesh = 0;  ///< distinct instance ids > 0 on mesh vertices
+  size_t instances_in_mesh = 0;    ///< distinct instance ids > 0 on mesh vertices
+  size_t objects = 0;              ///< entries of objects.json
   std::vector<std::string> files;  ///< file names written, in order
 };
 
 /// Writes a map's outputs (DESIGN 4) into `dir` (created when missing): mesh_semantic.ply,
-/// mesh_instance.ply, mesh_superpoint.ply, map.panmap, config.yaml (the exact parameters) and
-/// the snapshot PNGs. Throws Error naming the file that could not be written.
+/// mesh_instance.ply, mesh_superpoint.ply, objects.json, occupancy.bt (when enabled),
+/// trajectory.txt (TUM, the poses as integrated), map.panmap, config.yaml (the exact parameters)
+/// and the snapshot PNGs. Throws Error naming the file that could not be written.
 /// @param labels optimised labels, or null for the frame-count labels
 /// @param optimiser the optimiser settings recorded in config.yaml
 OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLabels* labels,
