@@ -21,7 +21,9 @@ while [ $# -gt 0 ]; do
   shift
 done
 
-scripts/setup.sh
+# Only the tools the demo runs (scripts/test.sh builds everything).
+scripts/setup.sh --targets "panmap-import panmap-loginfo panmap-synth panmap-mapper \
+  panmap-optimizer panmap-command panmap-eval panmap-occupancy-probe"
 mkdir -p logs
 data=../shared/data/7scenes-200
 if [ -d "$data" ] && [ ! -f logs/7scenes-200.lcmlog ]; then

@@ -4,17 +4,19 @@
 # at the end, and the build still runs when the packages are there.
 #
 #   scripts/setup.sh [--skip-apt] [--skip-network] [--skip-build] [--build-dir DIR]
+#                    [--targets "panmap-mapper panmap-synth ..."]   (default: everything)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-skip_apt=0 skip_network=0 skip_build=0 build_dir=build
+skip_apt=0 skip_network=0 skip_build=0 build_dir=build targets=
 while [ $# -gt 0 ]; do
   case "$1" in
     --skip-apt) skip_apt=1 ;;
     --skip-network) skip_network=1 ;;
     --skip-build) skip_build=1 ;;
     --build-dir) build_dir="$2"; shift ;;
-    -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
+    --targets) targets="$2"; shift ;;
+    -h|--help) sed -n '2,8p' "$0"; exit 0 ;;
     *) echo "setup.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -88,8 +90,10 @@ if [ "$skip_build" -eq 0 ]; then
   mkdir -p "$build_dir"
   cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release >"$build_dir/configure.log" 2>&1 ||
     { cat "$build_dir/configure.log"; echo "setup: cmake configure failed" >&2; exit 1; }
-  echo "setup: building into $build_dir/ with $jobs jobs"
-  if ! cmake --build "$build_dir" -j "$jobs" >"$build_dir/build.log" 2>&1; then
+  echo "setup: building ${targets:-everything} into $build_dir/ with $jobs jobs"
+  target_args=()
+  for t in $targets; do target_args+=(--target "$t"); done
+  if ! cmake --build "$build_dir" -j "$jobs" "${target_args[@]}" >"$build_dir/build.log" 2>&1; then
     grep -E -B2 -A6 "error" "$build_dir/build.log" | head -80
     echo "setup: build failed (full log: $build_dir/build.log)" >&2
     exit 1

@@ -5,7 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 [ -x build/panmap-bench-mapping ] || scripts/setup.sh --skip-network
 cmake --build build -j "$(nproc)" --target panmap-bench-mapping panmap-bench-renderer \
-  panmap-bench-segmentation panmap-bench-block-hash panmap-bench-optimiser panmap-synth >/dev/null
+  panmap-bench-segmentation panmap-bench-block-hash panmap-bench-optimiser panmap-bench-tracking \
+  panmap-bench-occupancy panmap-synth >/dev/null
 data=../shared/data/7scenes-200
 out=docs/PERFORMANCE.md
 mkdir -p docs
@@ -34,6 +35,9 @@ echo "bench: renderer, segmentation, block hash map" >&2
 render=$(gb build/panmap-bench-renderer | grep median | awk -F, '{gsub(/"/,"",$1); printf "| %s | %.1f ms |\n", $1, $3}')
 segment=$(gb build/panmap-bench-segmentation --benchmark_repetitions=5 --benchmark_report_aggregates_only=true | grep median | awk -F, '{gsub(/"/,"",$1); printf "| %s | %.1f ms |\n", $1, $3}')
 optimiser=$(gb build/panmap-bench-optimiser | grep median | awk -F, '{gsub(/"/,"",$1); printf "| %s | %.1f ms |\n", $1, $3}')
+echo "bench: pose refinement, occupancy" >&2
+tracking=$(build/panmap-bench-tracking --benchmark_format=csv 2>/dev/null | python3 scripts/bench/gb_counters.py median_ms p95_ms)
+occupancy=$(build/panmap-bench-occupancy --benchmark_format=csv 2>/dev/null | python3 scripts/bench/gb_counters.py median_ms)
 hash=$(gb build/panmap-bench-block-hash | awk -F, '{gsub(/"/,"",$1); printf "| %s | %.2f ms |\n", $1, $3}')
 
 cat > "$out" <<MD
@@ -85,6 +89,21 @@ start with a wrong class, "noisy": 22 %; target of roadmap issue 4: <= 100 ms), 
 | benchmark | time |
 |---|---|
 ${optimiser}
+
+Pose refinement against the map (\`panmap-bench-tracking\`: 640x480 frames of a procedural
+room against its 1 cm TSDF, default config, strides 16 then 8 px; target of roadmap issue 8:
+<= 15 ms), median:
+
+| benchmark | median ms | p95 ms |
+|---|---|---|
+${tracking}
+
+Occupancy update (\`panmap-bench-occupancy\`: a 640x480 frame into the 5 cm cell grid, every
+4th pixel), median:
+
+| benchmark | median ms |
+|---|---|
+${occupancy}
 
 Block index: \`absl::flat_hash_map\` (used by \`TsdfMap\`) against \`std::unordered_map\`, 300k
 lookups in runs of 8 and 11k inserts (\`panmap-bench-block-hash\`):

@@ -12,6 +12,7 @@
 #include "panmap/sim/procedural_room.h"
 #include "panmap/sim/sequence.h"
 #include "panmap/sim/trajectory.h"
+#include "test_helpers.h"
 
 namespace panmap {
 namespace test {
@@ -64,6 +65,14 @@ inline const SyntheticStream& syntheticStream(size_t n = 12) {
     stream.masks.push_back(f.panoptic);
   }
   return cache.emplace(n, std::move(stream)).first->second;
+}
+
+/// The map file of a mapper (config, TSDF, votes, super-points, graph, occupancy), byte for
+/// byte: two mappers in the same state give the same bytes.
+inline std::string mapBytes(const Mapper& mapper) {
+  TempDir dir;
+  mapper.save(dir.path("map.panmap"));
+  return fileBytes(dir.path("map.panmap"));
 }
 
 /// A mapper config fast enough for tests on the stream (4 cm voxels, one thread).

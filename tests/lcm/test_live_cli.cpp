@@ -26,11 +26,6 @@ namespace {
 // Non-default port: away from any live LCM traffic on the machine and from the replay test.
 const char* kUrl = "udpm://239.255.76.67:7683?ttl=0&recv_buf_size=16777216";
 
-std::string fileBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 nlohmann::json readJson(const std::string& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);
@@ -85,7 +80,7 @@ TEST_F(LiveCli, OfflineRunsAreByteIdentical) {
   for (const auto& entry : std::filesystem::directory_iterator(dir_->path("a"))) {
     const std::string name = entry.path().filename().string();
     if (name == "report.json") continue;  // holds wall-clock timings
-    EXPECT_EQ(fileBytes(entry.path().string()), fileBytes(dir_->path("b/" + name))) << name;
+    EXPECT_EQ(test::fileBytes(entry.path().string()), test::fileBytes(dir_->path("b/" + name))) << name;
     ++compared;
   }
   EXPECT_GE(compared, 9);  // three meshes, map, config, four snapshots (and more as added)
@@ -112,7 +107,7 @@ TEST_F(LiveCli, LogplayerToMapperAndOptimiserOverUdp) {
   StatusWatch watch;
   lcm.subscribe("PANMAP_STATUS", &StatusWatch::onStatus, &watch);
   for (int i = 0; i < 100 && watch.received == 0; ++i) lcm.handleTimeout(100);
-  ASSERT_GT(watch.received, 0) << fileBytes(dir_->path("mapper.log"));
+  ASSERT_GT(watch.received, 0) << test::fileBytes(dir_->path("mapper.log"));
 
   test::ChildProcess player({"lcm-logplayer", "-l", kUrl, log()}, dir_->path("player.log"));
   ASSERT_TRUE(player.wait(60)) << "lcm-logplayer did not finish";
@@ -122,8 +117,8 @@ TEST_F(LiveCli, LogplayerToMapperAndOptimiserOverUdp) {
   finish.command = command_t::COMMAND_FINISH;
   finish.argument = "";
   lcm.publish("PANMAP_COMMAND", &finish);
-  ASSERT_TRUE(mapper.wait(120)) << fileBytes(dir_->path("mapper.log"));
-  ASSERT_EQ(mapper.exitCode(), 0) << fileBytes(dir_->path("mapper.log"));
+  ASSERT_TRUE(mapper.wait(120)) << test::fileBytes(dir_->path("mapper.log"));
+  ASSERT_EQ(mapper.exitCode(), 0) << test::fileBytes(dir_->path("mapper.log"));
   optimiser.signal(SIGTERM);
   ASSERT_TRUE(optimiser.wait(10));
 
@@ -164,7 +159,7 @@ TEST_F(LiveCli, DeadOptimiserCostsTheLabelsNotTheMap) {
   mapper.signal(SIGINT);  // Ctrl-C finishes like the command
   ASSERT_TRUE(mapper.wait(120));
   EXPECT_EQ(mapper.exitCode(), 0);
-  const std::string log_text = fileBytes(dir_->path("dead.log"));
+  const std::string log_text = test::fileBytes(dir_->path("dead.log"));
   EXPECT_NE(log_text.find("writing unoptimised outputs"), std::string::npos) << log_text;
   const nlohmann::json report = readJson(out + "/report.json");
   EXPECT_FALSE(report["graph"]["optimised"].get<bool>());

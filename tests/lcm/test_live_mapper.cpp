@@ -15,17 +15,6 @@
 namespace panmap {
 namespace {
 
-std::string fileBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-std::string mapBytes(const Mapper& mapper) {
-  test::TempDir dir;
-  mapper.save(dir.path("map.panmap"));
-  return fileBytes(dir.path("map.panmap"));
-}
-
 struct StatusInbox {
   std::vector<status_t> received;
   void onStatus(const lcm::ReceiveBuffer*, const std::string&, const status_t* msg) {
@@ -86,7 +75,7 @@ TEST(LiveMapper, MapsLikeTheSessionAndAnswersStatus) {
   EXPECT_EQ(live.framesReceived(), static_cast<int64_t>(stream.frames.size()));
   EXPECT_EQ(live.framesDropped(), 0);
   EXPECT_EQ(stats.rejected.at("malformed CAMERA_POSE"), 1);
-  EXPECT_EQ(mapBytes(mapper), mapBytes(reference));
+  EXPECT_EQ(test::mapBytes(mapper), test::mapBytes(reference));
 
   // drain() publishes a "finishing" status with the final counts.
   ASSERT_FALSE(inbox.received.empty());

@@ -14,18 +14,6 @@
 namespace panmap {
 namespace {
 
-std::string fileBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-// The map file of a mapper: config, TSDF, votes, super-points and graph, byte for byte.
-std::string mapBytes(const Mapper& mapper) {
-  test::TempDir dir;
-  mapper.save(dir.path("map.panmap"));
-  return fileBytes(dir.path("map.panmap"));
-}
-
 void feed(MappingSession* session, const std::vector<test::Encoded>& messages) {
   for (const test::Encoded& m : messages)
     session->handle(m.channel, m.bytes.data(), m.bytes.size());
@@ -39,7 +27,7 @@ class MappingSessionTest : public ::testing::Test {
     Mapper mapper(test::streamMapperConfig());
     MappingSession session(SessionOptions{}, &mapper);
     feed(&session, stream_.messages());
-    clean_ = mapBytes(mapper);
+    clean_ = test::mapBytes(mapper);
     clean_stats_ = session.stats();
   }
   test::SyntheticStream stream_;
@@ -73,7 +61,7 @@ TEST_F(MappingSessionTest, MalformedAndTruncatedMessagesAreCounted) {
   EXPECT_EQ(stats.rejected.at("malformed CAMERA_POSE"), 1);
   EXPECT_EQ(stats.rejected.at("malformed PANOPTIC"), 1);
   EXPECT_EQ(stats.frames_integrated, clean_stats_.frames_integrated);
-  EXPECT_EQ(mapBytes(mapper), clean_);
+  EXPECT_EQ(test::mapBytes(mapper), clean_);
 }
 
 TEST_F(MappingSessionTest, NanPoseAndMismatchedDepthAreRefused) {
@@ -105,7 +93,7 @@ TEST_F(MappingSessionTest, NanPoseAndMismatchedDepthAreRefused) {
   EXPECT_EQ(pose_rejects, 1);
   EXPECT_EQ(frame_rejects, 1);
   EXPECT_EQ(stats.frames_integrated, clean_stats_.frames_integrated);
-  EXPECT_EQ(mapBytes(mapper), clean_);
+  EXPECT_EQ(test::mapBytes(mapper), clean_);
 }
 
 TEST_F(MappingSessionTest, UnknownCategoriesBecomeUnlabelled) {
@@ -124,7 +112,7 @@ TEST_F(MappingSessionTest, UnknownCategoriesBecomeUnlabelled) {
   feed(&session, unknown.messages());
   EXPECT_EQ(session.stats().rejected.at("panoptic segment: unknown category"),
             static_cast<int64_t>(stream_.masks.size()));
-  EXPECT_EQ(mapBytes(mapper), mapBytes(reference));
+  EXPECT_EQ(test::mapBytes(mapper), test::mapBytes(reference));
 }
 
 TEST_F(MappingSessionTest, FramesWithoutPoseAndAStoppedPoseStream) {
@@ -143,7 +131,7 @@ TEST_F(MappingSessionTest, FramesWithoutPoseAndAStoppedPoseStream) {
   const SessionStats stats = session.stats();
   EXPECT_EQ(stats.rejected.at("frame: no pose"), 5);
   EXPECT_EQ(stats.frames_integrated, clean_stats_.frames_integrated);
-  EXPECT_EQ(mapBytes(mapper), clean_);
+  EXPECT_EQ(test::mapBytes(mapper), clean_);
 }
 
 TEST_F(MappingSessionTest, MaxFramesStopsIntegration) {
