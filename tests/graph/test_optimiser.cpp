@@ -15,6 +15,14 @@
 namespace panmap {
 namespace {
 
+// The refinement expectations below are computed by hand for the starting thresholds
+// theta_D 0.1, theta_O 0.1, theta_L 0.5 (the tuned defaults of docs/TUNING.md never split).
+OptimiserConfig handConfig() {
+  OptimiserConfig config;
+  config.default_thresholds = {0.1, 0.1, 0.5};
+  return config;
+}
+
 GraphVertex vertex(int32_t id, std::map<int32_t, double> scores, int32_t instance = 0,
                    int32_t semantic = 0) {
   GraphVertex v;
@@ -69,7 +77,7 @@ SuperpointGraph randomGraph(uint64_t seed, int max_vertices, const std::vector<i
 }
 
 OptimiserConfig semanticOnly() {
-  OptimiserConfig config;
+  OptimiserConfig config = handConfig();
   config.refine = false;
   return config;
 }
@@ -114,7 +122,7 @@ TEST(SemanticEnergy, HandComputedThreeVertices) {
   graph.vertices = {vertex(1, {{1, 3.0}, {2, 1.0}}), vertex(2, {{2, 2.0}}),
                     vertex(3, {}, 0, /*semantic=*/1)};
   graph.edges = {edge(1, 2, {{1, 0.5}, {2, 1.0}}), edge(1, 3, {}), edge(2, 3, {{2, 2.0}})};
-  const OptimiserConfig config;  // K_C = 15, theta = 0.5: 2 theta^2 = 0.5
+  const OptimiserConfig config = handConfig();  // K_C = 15, theta = 0.5: 2 theta^2 = 0.5
   // Unary: -log(3/4), -log(1), 0 (no scores). Edge (1,2): confidence 1.5 over
   // min(4, 2) = 0.75, k = (3/4 * 1) / 0.75 = 1, 15 exp(-1 / 0.5) = 15 / e^2. Edge (2,3):
   // vertex 3 has no scores, the edge costs nothing. Edge (1,3): no confidence, 0.
@@ -150,7 +158,7 @@ TEST(SemanticEnergy, PairwiseIsAsymmetricInTheLabels) {
   graph.classes = {1, 2};
   graph.vertices = {vertex(1, {{1, 9.0}, {2, 1.0}}), vertex(2, {{1, 2.0}, {2, 8.0}})};
   graph.edges = {edge(1, 2, {{1, 0.25}, {2, 0.25}})};
-  const OptimiserConfig config;
+  const OptimiserConfig config = handConfig();
   const double unary_12 = -std::log(0.9) - std::log(0.8);
   const double unary_21 = -std::log(0.1) - std::log(0.2);
   // (1, 2): k = 0.9 * 0.8 / 0.05 = 14.4, 15 exp(-28.8); (2, 1): k = 0.1 * 0.2 / 0.05 = 0.4,
@@ -254,7 +262,7 @@ SuperpointGraph refinementGraph() {
 
 TEST(InstanceRefinement, SplitsWeakLinksJoinsStraysStuffGetsNone) {
   const SuperpointGraph graph = refinementGraph();
-  const GraphLabels result = optimise(graph, OptimiserConfig());
+  const GraphLabels result = optimise(graph, handConfig());
   EXPECT_EQ(result.semantic,
             (std::map<int32_t, int32_t>{
                 {1, 5}, {2, 5}, {3, 5}, {4, 5}, {6, 5}, {7, 5}, {8, 5}, {9, 1}, {10, 1}, {11, 6}}));
@@ -270,7 +278,7 @@ TEST(InstanceRefinement, SplitsWeakLinksJoinsStraysStuffGetsNone) {
 }
 
 TEST(InstanceRefinement, OffKeepsInitialInstances) {
-  OptimiserConfig config;
+  OptimiserConfig config = handConfig();
   config.refine = false;
   const GraphLabels result = optimise(refinementGraph(), config);
   EXPECT_EQ(
@@ -287,7 +295,7 @@ TEST(InstanceRefinement, StrayJoinNeedsItsStrongestLink) {
   SuperpointGraph graph = refinementGraph();
   graph.vertices.push_back(vertex(12, {{6, 10.0}}, 4));
   graph.edges.insert(graph.edges.begin() + 6, edge(8, 12, {{5, 20.0}}));  // sorted by (a, b)
-  const GraphLabels result = optimise(graph, OptimiserConfig());
+  const GraphLabels result = optimise(graph, handConfig());
   EXPECT_EQ(result.semantic.at(8), 5);
   EXPECT_EQ(result.semantic.at(12), 6);
   EXPECT_EQ(result.instance.at(8), 11);
@@ -313,8 +321,8 @@ TEST(Optimiser, Deterministic) {
       }
     }
   }
-  const GraphLabels first = optimise(graph, OptimiserConfig());
-  const GraphLabels second = optimise(graph, OptimiserConfig());
+  const GraphLabels first = optimise(graph, handConfig());
+  const GraphLabels second = optimise(graph, handConfig());
   EXPECT_EQ(first.semantic, second.semantic);
   EXPECT_EQ(first.instance, second.instance);
   EXPECT_EQ(first.instance_confidence, second.instance_confidence);
@@ -322,7 +330,7 @@ TEST(Optimiser, Deterministic) {
 }
 
 TEST(Optimiser, EmptyGraph) {
-  const GraphLabels result = optimise(SuperpointGraph(), OptimiserConfig());
+  const GraphLabels result = optimise(SuperpointGraph(), handConfig());
   EXPECT_TRUE(result.semantic.empty());
   EXPECT_TRUE(result.instance.empty());
 }
@@ -363,7 +371,7 @@ TEST(OptimiserConfig, RejectsBadFields) {
 }
 
 TEST(OptimiserConfig, RejectsBadGraphs) {
-  const OptimiserConfig config;
+  const OptimiserConfig config = handConfig();
   const auto expectBad = [&](const std::function<void(SuperpointGraph&)>& edit,
                              const std::string& field) {
     SuperpointGraph graph = refinementGraph();

@@ -21,11 +21,13 @@ struct OptimiserConfig {
   /// earlier when a pass leaves the partition unchanged.
   int max_refine_iterations = 10;
   /// Per-class refinement thresholds theta_D, theta_O, theta_L (III-D); classes not listed
-  /// use the defaults below. Each is a fraction in [0, 1].
+  /// use the defaults below. Each is a fraction in [0, 1]. The defaults were chosen by
+  /// scripts/bench/tune_refinement.py on rooms kept out of docs/RESULTS.md (docs/TUNING.md):
+  /// weak-link splits (theta_D > 0) only lost accuracy there, so they are off by default.
   struct Thresholds {
-    double theta_D = 0.1;  ///< weak link: below theta_D * P_O(own instance)
-    double theta_O = 0.1;  ///< join: link above theta_O * P_O(neighbour instance)
-    double theta_L = 0.5;  ///< join: link above theta_L * P_L (strongest link of the unit)
+    double theta_D = 0.0;   ///< weak link: below theta_D * P_O(own instance)
+    double theta_O = 0.05;  ///< join: link above theta_O * P_O(neighbour instance)
+    double theta_L = 0.3;   ///< join: link above theta_L * P_L (strongest link of the unit)
   };
   Thresholds default_thresholds;
   std::map<int32_t, Thresholds> class_thresholds;
