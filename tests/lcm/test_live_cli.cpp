@@ -16,6 +16,7 @@
 #include "child_process.h"
 #include "panmap/command_t.hpp"
 #include "panmap/io/ply.h"
+#include "panmap/io/tum_trajectory.h"
 #include "panmap/mapper/mapper.h"
 #include "panmap/status_t.hpp"
 #include "test_helpers.h"
@@ -80,7 +81,8 @@ TEST_F(LiveCli, OfflineRunsAreByteIdentical) {
   for (const auto& entry : std::filesystem::directory_iterator(dir_->path("a"))) {
     const std::string name = entry.path().filename().string();
     if (name == "report.json") continue;  // holds wall-clock timings
-    EXPECT_EQ(test::fileBytes(entry.path().string()), test::fileBytes(dir_->path("b/" + name))) << name;
+    EXPECT_EQ(test::fileBytes(entry.path().string()), test::fileBytes(dir_->path("b/" + name)))
+        << name;
     ++compared;
   }
   EXPECT_GE(compared, 9);  // three meshes, map, config, four snapshots (and more as added)
@@ -112,6 +114,22 @@ TEST_F(LiveCli, LogplayerToMapperAndOptimiserOverUdp) {
   test::ChildProcess player({"lcm-logplayer", "-l", kUrl, log()}, dir_->path("player.log"));
   ASSERT_TRUE(player.wait(60)) << "lcm-logplayer did not finish";
   ASSERT_EQ(player.exitCode(), 0);
+  // A planner's view: the probe takes the next PANMAP_OCTOMAP and answers from the tree. Half
+  // a metre in front of the camera's last position is free space it looked through; far
+  // outside the room nothing was seen.
+  const StampedPose last = readTumTrajectory(dir_->path("seq/gt/trajectory_gt.txt")).back();
+  const Eigen::Vector3d ahead_W = last.T_W_C * Eigen::Vector3d(0.0, 0.0, 0.5);
+  char point[256];
+  std::snprintf(point, sizeof(point), " --point %.3f %.3f %.3f --segment %.3f %.3f %.3f 0 0 -100",
+                ahead_W.x(), ahead_W.y(), ahead_W.z(), ahead_W.x(), ahead_W.y(), ahead_W.z());
+  const test::CommandResult probe = test::runCommand(
+      test::binPath("panmap-occupancy-probe") + " --lcm-url '" + kUrl + "' --timeout-s 30" + point);
+  EXPECT_EQ(probe.exit_code, 0) << probe.output;
+  EXPECT_NE(probe.output.find("\nfree\n"), std::string::npos) << probe.output;
+  // The way down through the floor is not free: blocked by it (or unknown below it).
+  EXPECT_TRUE(probe.output.find("\nblocked at") != std::string::npos ||
+              probe.output.find("\nunknown at") != std::string::npos)
+      << probe.output;
   command_t finish;
   finish.utime = 0;
   finish.command = command_t::COMMAND_FINISH;
