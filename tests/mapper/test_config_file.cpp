@@ -24,21 +24,44 @@ TEST(ConfigFile, PrintedDefaultsReadBackUnchanged) {
   EXPECT_FLOAT_EQ(back.mapper.map.voxel_size_m, 0.01f);
   EXPECT_EQ(back.mapper.superpoints.merge_threshold, 3);
   EXPECT_DOUBLE_EQ(back.optimiser.thresholds(5).theta_L, 0.4);
-  EXPECT_DOUBLE_EQ(back.optimiser.thresholds(7).theta_L, 0.5);
+  EXPECT_DOUBLE_EQ(back.optimiser.thresholds(7).theta_L, 0.3);  // the tuned default
 }
 
 TEST(ConfigFile, PartialFilesKeepDefaults) {
   test::TempDir dir;
-  const PanmapConfig c = loadConfig(write(dir, "%YAML:1.0\n---\nmap:\n   voxel_size_m: 0.02\n"
-                                               "superpoints:\n   semantic_consistency: 0\n"
-                                               "optimiser:\n   classes:\n      - { class: 39, theta_D: 0.3 }\n"
-                                               "threads: 1\n"));
+  const PanmapConfig c =
+      loadConfig(write(dir,
+                       "%YAML:1.0\n---\nmap:\n   voxel_size_m: 0.02\n"
+                       "superpoints:\n   semantic_consistency: 0\n"
+                       "optimiser:\n   classes:\n      - { class: 39, theta_D: 0.3 }\n"
+                       "threads: 1\n"));
   EXPECT_FLOAT_EQ(c.mapper.map.voxel_size_m, 0.02f);
   EXPECT_FALSE(c.mapper.superpoints.semantic_consistency);
   EXPECT_EQ(c.mapper.num_threads, 1);
   EXPECT_DOUBLE_EQ(c.optimiser.thresholds(39).theta_D, 0.3);
-  EXPECT_DOUBLE_EQ(c.optimiser.thresholds(39).theta_O, 0.1);  // the default
+  EXPECT_DOUBLE_EQ(c.optimiser.thresholds(39).theta_O, 0.05);  // the tuned default
   EXPECT_FLOAT_EQ(c.mapper.integrator.truncation_voxels, 4.0f);
+}
+
+TEST(ConfigFile, TrackingAndOccupancySections) {
+  test::TempDir dir;
+  const PanmapConfig c = loadConfig(write(dir,
+                                          "%YAML:1.0\n---\ntracking:\n   mode: \"off\"\n"
+                                          "   warmup_frames: 9\noccupancy:\n   enabled: 0\n"
+                                          "   resolution_m: 0.1\n"));
+  EXPECT_EQ(c.mapper.tracking_mode, MapperConfig::TrackingMode::kOff);
+  EXPECT_EQ(c.mapper.tracking_warmup_frames, 9);
+  EXPECT_FALSE(c.mapper.occupancy_enabled);
+  EXPECT_DOUBLE_EQ(c.mapper.occupancy.resolution_m, 0.1);
+  // An unquoted value with a comment after it reads the same.
+  EXPECT_EQ(loadConfig(write(dir, "%YAML:1.0\n---\ntracking:\n   mode: on   # refine all\n"))
+                .mapper.tracking_mode,
+            MapperConfig::TrackingMode::kOn);
+  test::expectError([&] { loadConfig(write(dir, "%YAML:1.0\n---\ntracking:\n   mode: always\n")); },
+                    {"tracking.mode", "always"});
+  test::expectError(
+      [&] { loadConfig(write(dir, "%YAML:1.0\n---\noccupancy:\n   resolution_m: -1\n")); },
+      {"resolution"});
 }
 
 TEST(ConfigFile, BadKeysAndValuesNameTheKey) {
@@ -51,13 +74,15 @@ TEST(ConfigFile, BadKeysAndValuesNameTheKey) {
     }
     return std::string();
   };
-  EXPECT_NE(error("%YAML:1.0\n---\nmap:\n   voxel_sise_m: 0.02\n").find("unknown key map.voxel_sise_m"),
-            std::string::npos);
+  EXPECT_NE(
+      error("%YAML:1.0\n---\nmap:\n   voxel_sise_m: 0.02\n").find("unknown key map.voxel_sise_m"),
+      std::string::npos);
   EXPECT_NE(error("%YAML:1.0\n---\nmapp:\n   voxel_size_m: 0.02\n").find("unknown section mapp"),
             std::string::npos);
   EXPECT_NE(error("%YAML:1.0\n---\nmap:\n   voxel_size_m: -1\n").find("voxel_size_m"),
             std::string::npos);
-  EXPECT_NE(error("%YAML:1.0\n---\nsuperpoints:\n   merge_threshold: 2.5\n").find("superpoints.merge_threshold"),
+  EXPECT_NE(error("%YAML:1.0\n---\nsuperpoints:\n   merge_threshold: 2.5\n")
+                .find("superpoints.merge_threshold"),
             std::string::npos);
   EXPECT_NE(error("%YAML:1.0\n---\nmap:\n   voxel_size_m: [1]\n").find("must be a number"),
             std::string::npos);
