@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
         times["superpoints"].push_back(s.superpoints_ms);
         times["integration"].push_back(s.integration_ms);
         times["graph"].push_back(s.graph_ms);
+        times["occupancy"].push_back(s.occupancy_ms);
         times["total"].push_back(s.total_ms);
       }
     }
@@ -87,7 +88,8 @@ int main(int argc, char** argv) {
     }
     out["frames"] = mapper.framesIntegrated();
     if (markdown) {
-      // | voxel | threads | frames | segmentation | super-points | integration | total | ...
+      // | voxel | threads | frames | segmentation | super-points | integration | graph |
+      // occupancy | total | ...
       auto cell = [&](const char* stage) {
         const auto& t = out["stages"][stage];
         char buf[64];
@@ -95,14 +97,14 @@ int main(int argc, char** argv) {
                       t["p95_ms"].get<double>());
         return std::string(buf);
       };
-      std::printf("| %.0f cm | %d | %lld | %s | %s | %s | %s | **%s** | %.0f | %.0f | %.1f |\n",
-                  config.map.voxel_size_m * 100.0, config.num_threads,
-                  static_cast<long long>(mapper.framesIntegrated()), cell("segmentation").c_str(),
-                  cell("superpoints").c_str(), cell("integration").c_str(), cell("graph").c_str(),
-                  cell("total").c_str(),
-                  mapper.map().memoryBytes() / 1048576.0,
-                  static_cast<double>(usage.ru_maxrss) / 1024.0,
-                  static_cast<double>(mapper.map().memoryBytes()) / voxels);
+      std::printf(
+          "| %.0f cm | %d | %lld | %s | %s | %s | %s | %s | **%s** | %.0f | %.0f | %.1f |\n",
+          config.map.voxel_size_m * 100.0, config.num_threads,
+          static_cast<long long>(mapper.framesIntegrated()), cell("segmentation").c_str(),
+          cell("superpoints").c_str(), cell("integration").c_str(), cell("graph").c_str(),
+          cell("occupancy").c_str(), cell("total").c_str(), mapper.map().memoryBytes() / 1048576.0,
+          static_cast<double>(usage.ru_maxrss) / 1024.0,
+          static_cast<double>(mapper.map().memoryBytes()) / voxels);
     } else {
       std::printf("%s\n", out.dump(2).c_str());
     }
