@@ -106,11 +106,16 @@ void LiveMapper::onInput(const lcm::ReceiveBuffer* buffer, const std::string& ch
   }
 }
 
+void LiveMapper::countRejected(const std::string& reason) {
+  std::lock_guard<std::mutex> lock(rejected_mutex_);
+  ++rejected_commands_[reason];
+}
+
 void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
   try {
     command_t msg;
     if (!decodeBuffer(buffer, &msg)) {
-      ++rejected_commands_["malformed " + channel];
+      countRejected("malformed " + channel);
       std::fprintf(stderr, "panmap-mapper: malformed message on %s ignored\n", channel.c_str());
       return;
     }
@@ -145,7 +150,7 @@ void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& 
         return;
       }
       default:
-        ++rejected_commands_["unknown command"];
+        countRejected("unknown command");
         std::fprintf(stderr, "panmap-mapper: unknown command %d ignored\n", msg.command);
     }
   } catch (const std::exception& e) {
@@ -157,7 +162,7 @@ void LiveMapper::onLabels(const lcm::ReceiveBuffer* buffer, const std::string& c
   try {
     graph_labels_t msg;
     if (!decodeBuffer(buffer, &msg)) {
-      ++rejected_commands_["malformed " + channel];
+      countRejected("malformed " + channel);
       return;
     }
     // Only answers to our own latest request count (another mapper may share the bus).
@@ -165,7 +170,7 @@ void LiveMapper::onLabels(const lcm::ReceiveBuffer* buffer, const std::string& c
     labels_ = fromMessage(msg);
     labels_request_id_ = msg.request_id;
   } catch (const std::exception& e) {
-    ++rejected_commands_["bad " + channel];
+    countRejected("bad " + channel);
     std::fprintf(stderr, "panmap-mapper: labels ignored: %s\n", e.what());
   }
 }
@@ -214,7 +219,10 @@ status_t LiveMapper::status(const std::string& state) const {
   msg.frames_integrated = s.frames_integrated;
   msg.frames_dropped = dropped_frames_ + s.sync.dropped_queue_full;
   std::map<std::string, int64_t> reasons = s.rejected;
-  for (const auto& [reason, n] : rejected_commands_) reasons[reason] += n;
+  {
+    std::lock_guard<std::mutex> lock(rejected_mutex_);
+    for (const auto& [reason, n] : rejected_commands_) reasons[reason] += n;
+  }
   msg.frames_rejected = 0;
   for (const auto& [reason, n] : reasons) {
     msg.reject_reasons.push_back(reason);

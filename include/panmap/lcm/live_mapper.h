@@ -113,6 +113,7 @@ class LiveMapper {
   void workerLoop();
   void publishOutbox();
   void publishStatus(const std::string& state);
+  void countRejected(const std::string& reason);
 
   lcm::LCM* lcm_;
   LiveOptions options_;
@@ -137,8 +138,10 @@ class LiveMapper {
 
   std::atomic<int64_t> received_frames_{0};
   std::atomic<int64_t> dropped_frames_{0};
-  std::map<std::string, int64_t> rejected_commands_;  // LCM thread only
-  bool finish_requested_ = false;                     // LCM thread only
+  // Commands and labels refused (written by the LCM thread, read by status()).
+  mutable std::mutex rejected_mutex_;
+  std::map<std::string, int64_t> rejected_commands_;
+  bool finish_requested_ = false;  // LCM thread only
 
   // Optimiser round trip (LCM thread only).
   int64_t request_id_ = 0;
