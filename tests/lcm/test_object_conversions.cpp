@@ -49,20 +49,7 @@ TEST(ObjectConversions, RoundTripIsExact) {
   EXPECT_EQ(msg.objects[0].obb_orientation[0], objects[0].q_W_B.w());
   EXPECT_EQ(msg.objects[0].obb_orientation[3], objects[0].q_W_B.z());
   const std::vector<MappedObject> back = fromMessage(msg);
-  ASSERT_EQ(back.size(), 2u);
-  for (size_t i = 0; i < back.size(); ++i) {
-    EXPECT_EQ(back[i].id, objects[i].id);
-    EXPECT_EQ(back[i].class_id, objects[i].class_id);
-    EXPECT_EQ(back[i].confidence, objects[i].confidence);
-    EXPECT_EQ(back[i].num_voxels, objects[i].num_voxels);
-    EXPECT_EQ(back[i].centroid_W, objects[i].centroid_W);
-    EXPECT_EQ(back[i].aabb_min_W, objects[i].aabb_min_W);
-    EXPECT_EQ(back[i].aabb_max_W, objects[i].aabb_max_W);
-    EXPECT_EQ(back[i].obb_center_W, objects[i].obb_center_W);
-    EXPECT_EQ(back[i].q_W_B.coeffs(), objects[i].q_W_B.coeffs());
-    EXPECT_EQ(back[i].obb_extent_m, objects[i].obb_extent_m);
-    EXPECT_EQ(back[i].superpoints, objects[i].superpoints);
-  }
+  EXPECT_EQ(back, objects);  // every field, exactly
   EXPECT_TRUE(fromMessage(toMessage(std::vector<MappedObject>{}, 5)).empty());
 }
 

@@ -190,20 +190,7 @@ TEST(Objects, JsonRoundTripIsExactAndReadableByPanmapEval) {
   int64_t utime = 0;
   const std::vector<MappedObject> back = readObjectsJson(dir.path("objects.json"), &utime);
   EXPECT_EQ(utime, 123456789);
-  ASSERT_EQ(back.size(), objects.size());
-  for (size_t i = 0; i < back.size(); ++i) {
-    EXPECT_EQ(back[i].id, objects[i].id);
-    EXPECT_EQ(back[i].class_id, objects[i].class_id);
-    EXPECT_EQ(back[i].confidence, objects[i].confidence);
-    EXPECT_EQ(back[i].num_voxels, objects[i].num_voxels);
-    EXPECT_EQ(back[i].centroid_W, objects[i].centroid_W);
-    EXPECT_EQ(back[i].aabb_min_W, objects[i].aabb_min_W);
-    EXPECT_EQ(back[i].aabb_max_W, objects[i].aabb_max_W);
-    EXPECT_EQ(back[i].obb_center_W, objects[i].obb_center_W);
-    EXPECT_EQ(back[i].q_W_B.coeffs(), objects[i].q_W_B.coeffs());
-    EXPECT_EQ(back[i].obb_extent_m, objects[i].obb_extent_m);
-    EXPECT_EQ(back[i].superpoints, objects[i].superpoints);
-  }
+  EXPECT_EQ(back, objects);  // every field, exactly
   // What panmap-eval --confidences reads: {"objects": [{"id", "confidence"}]}.
   std::ifstream in(dir.path("objects.json"));
   const nlohmann::json j = nlohmann::json::parse(in);
