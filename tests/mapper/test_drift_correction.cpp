@@ -94,8 +94,8 @@ TEST(DriftCorrection, GroundTruthPosesAreNotTouched) {
 
 // Disabled: fails today. With the recorded poses themselves (no drift) the refinement wanders
 // 3-11 cm from them on this sample, so the slam drift (0.6 cm ATE over these 200 frames) is
-// not halved (refined 3.6 cm). 7-Scenes' depth is known not to be registered to its poses
-// (its colour camera's); see the issue-8 notes in docs/MAPPING.md.
+// not halved (refined 3.6 cm): frame-to-model drift on real Kinect depth, cause not pinned
+// down (docs/MAPPING.md, pose refinement).
 TEST(DriftCorrection, DISABLED_SevenScenesWithSlamDrift) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   const auto reader = openDataset(test::dataDir("7scenes-200"), DatasetOptions{});
