@@ -54,12 +54,7 @@ int main(int argc, char** argv) {
       for (const panmap::DatasetFrame& f : input) {
         if (!f.T_W_C) continue;
         const panmap::FrameStats s = mapper.integrate(f.rgbd, *f.T_W_C, nullptr);
-        times["segmentation"].push_back(s.segmentation_ms);
-        times["superpoints"].push_back(s.superpoints_ms);
-        times["integration"].push_back(s.integration_ms);
-        times["graph"].push_back(s.graph_ms);
-        times["occupancy"].push_back(s.occupancy_ms);
-        times["total"].push_back(s.total_ms);
+        for (const auto& [stage, ms] : s.stageTimes()) times[stage].push_back(ms);
       }
     }
     const auto t0 = std::chrono::steady_clock::now();

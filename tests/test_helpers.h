@@ -122,6 +122,17 @@ inline std::string fileBytes(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+/// An LCM message encoded and decoded again (the decode must consume every byte).
+template <typename Msg>
+Msg throughBytes(const Msg& msg) {
+  std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  Msg out;
+  EXPECT_EQ(out.decode(bytes.data(), 0, static_cast<int>(bytes.size())),
+            static_cast<int>(bytes.size()));
+  return out;
+}
+
 /// Number of lines in a text.
 inline int countLines(const std::string& text) {
   int lines = 0;

@@ -113,13 +113,7 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
     try {
       const FrameStats s =
           mapper_->integrate(f.frame, f.T_W_C, f.panoptic ? &*f.panoptic : nullptr, f.pose_source);
-      times_ms_["segmentation"].push_back(s.segmentation_ms);
-      times_ms_["superpoints"].push_back(s.superpoints_ms);
-      times_ms_["integration"].push_back(s.integration_ms);
-      times_ms_["graph"].push_back(s.graph_ms);
-      times_ms_["occupancy"].push_back(s.occupancy_ms);
-      if (s.tracked) times_ms_["tracking"].push_back(s.tracking_ms);
-      times_ms_["total"].push_back(s.total_ms);
+      for (const auto& [stage, ms] : s.stageTimes()) times_ms_[stage].push_back(ms);
       ++stats_.frames_integrated;
       stats_.last_frame_utime = std::max(stats_.last_frame_utime, f.frame.utime);
       if (options_.max_frames > 0 && stats_.frames_integrated >= options_.max_frames) done_ = true;

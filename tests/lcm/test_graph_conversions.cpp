@@ -2,19 +2,10 @@
 
 #include "panmap/core/error.h"
 #include "panmap/lcm/graph_conversions.h"
+#include "test_helpers.h"
 
 namespace panmap {
 namespace {
-
-template <typename Msg>
-Msg throughBytes(const Msg& msg) {
-  std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
-  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  Msg out;
-  EXPECT_EQ(out.decode(bytes.data(), 0, static_cast<int>(bytes.size())),
-            static_cast<int>(bytes.size()));
-  return out;
-}
 
 SuperpointGraph sampleGraph() {
   SuperpointGraph g;
@@ -41,7 +32,7 @@ SuperpointGraph sampleGraph() {
 
 TEST(GraphConversions, GraphRoundTripIsExact) {
   const SuperpointGraph g = sampleGraph();
-  const superpoint_graph_t msg = throughBytes(toMessage(g, 1234, 42));
+  const superpoint_graph_t msg = test::throughBytes(toMessage(g, 1234, 42));
   EXPECT_EQ(msg.utime, 1234);
   EXPECT_EQ(msg.request_id, 42);
   const SuperpointGraph back = fromMessage(msg);
@@ -62,7 +53,7 @@ TEST(GraphConversions, LabelsRoundTripIsExact) {
   labels.instance = {{3, 7}, {9, 0}};
   labels.instance_confidence = {{7, 0.625f}};
   labels.solve_ms = 12.5;
-  const GraphLabels back = fromMessage(throughBytes(toMessage(labels, 5, 42)));
+  const GraphLabels back = fromMessage(test::throughBytes(toMessage(labels, 5, 42)));
   EXPECT_EQ(back.semantic, labels.semantic);
   EXPECT_EQ(back.instance, labels.instance);
   EXPECT_EQ(back.instance_confidence, labels.instance_confidence);

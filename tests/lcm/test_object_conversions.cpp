@@ -9,16 +9,6 @@
 namespace panmap {
 namespace {
 
-template <typename Msg>
-Msg throughBytes(const Msg& msg) {
-  std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
-  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  Msg out;
-  EXPECT_EQ(out.decode(bytes.data(), 0, static_cast<int>(bytes.size())),
-            static_cast<int>(bytes.size()));
-  return out;
-}
-
 std::vector<MappedObject> sampleObjects() {
   MappedObject a;
   a.id = 4;
@@ -42,7 +32,7 @@ std::vector<MappedObject> sampleObjects() {
 
 TEST(ObjectConversions, RoundTripIsExact) {
   const std::vector<MappedObject> objects = sampleObjects();
-  const object_list_t msg = throughBytes(toMessage(objects, 987654321));
+  const object_list_t msg = test::throughBytes(toMessage(objects, 987654321));
   EXPECT_EQ(msg.utime, 987654321);
   EXPECT_EQ(msg.num_objects, 2);
   EXPECT_EQ(msg.objects[0].category, 5);

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -65,6 +66,19 @@ struct FrameStats {
   int new_superpoints = 0;
   int merges = 0;
   IntegrationStats integration;
+
+  /// The stage times by name, as reports and benchmarks list them ("tracking" only when the
+  /// pose was refined), "total" last.
+  std::vector<std::pair<const char*, double>> stageTimes() const {
+    std::vector<std::pair<const char*, double>> out = {{"segmentation", segmentation_ms},
+                                                       {"superpoints", superpoints_ms},
+                                                       {"integration", integration_ms},
+                                                       {"graph", graph_ms},
+                                                       {"occupancy", occupancy_ms}};
+    if (tracked) out.emplace_back("tracking", tracking_ms);
+    out.emplace_back("total", total_ms);
+    return out;
+  }
 };
 
 /// The mapping core: takes (RGB-D frame, T_W_C, panoptic segmentation) and keeps a label-TSDF

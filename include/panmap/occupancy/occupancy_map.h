@@ -41,14 +41,14 @@ struct OccupancyUpdateStats {
 ///    without depth, or nearer than min_depth_m, vetoes); and the cell holding the camera;
 ///  - cells never hit or missed are unknown.
 ///
-/// Why projective and not OctoMap's insertPointCloud: measured on 640x480 frames of a
-/// procedural room at 5 cm, insertPointCloud (discretised) takes 25-45 ms per frame at pixel
-/// strides of 8-4, almost all of it in OcTree updates of the ~50k free cells of the frustum
-/// (0.3 us each), which no stride reduces. Here each frustum cell is tested once
-/// per frame against the depth image and updated in a flat grid of 8^3-cell blocks with the
-/// same float log-odds arithmetic as OctoMap: 2.1 ms per frame on the same frames (median
-/// thread CPU time, bench/bench_occupancy.cpp). The OcTree is built with OctoMap's API when
-/// exported (toOcTree(), ~0.1 s for a room). The corner samples keep grazing surfaces (a
+/// Why projective and not OctoMap's insertPointCloud: on 640x480 frames of a procedural room
+/// at 5 cm, insertPointCloud (discretised) takes 12-16 ms median per frame at pixel strides
+/// of 8-4, most of it in OcTree updates of the free cells of the frustum, which a coarser
+/// stride barely reduces. Here each frustum cell is tested once per frame against the depth
+/// image and updated in a flat grid of 8^3-cell blocks with the same float log-odds
+/// arithmetic as OctoMap: about 2 ms per frame on the same frames (both measured by
+/// bench/bench_occupancy.cpp, figures in docs/PERFORMANCE.md). The OcTree is built with OctoMap's
+/// API when exported (toOcTree(), ~0.1 s for a room). The corner samples keep grazing surfaces (a
 /// floor seen at a shallow angle) from being carved, the classic failure of ray casting.
 ///
 /// Deterministic: single-threaded, cells change by at most one hit or one miss per frame, and
