@@ -1,6 +1,7 @@
 #include "panmap/core/thread_pool.h"
 
 #include <algorithm>
+#include <atomic>
 
 namespace panmap {
 
@@ -46,6 +47,21 @@ void ThreadPool::parallelFor(size_t n, const std::function<void(size_t, size_t, 
   std::unique_lock<std::mutex> lock(mutex_);
   done_cv_.wait(lock, [this] { return pending_ == 0; });
   job_ = nullptr;
+}
+
+void ThreadPool::parallelForDynamic(size_t n, size_t grain,
+                                    const std::function<void(size_t, size_t, int)>& fn) {
+  grain = std::max<size_t>(grain, 1);
+  if (workers_.empty() || n <= grain) {
+    if (n > 0) fn(0, n, 0);
+    return;
+  }
+  std::atomic<size_t> next{0};
+  parallelFor(static_cast<size_t>(size()), [&](size_t, size_t, int thread) {
+    for (size_t begin = next.fetch_add(grain); begin < n; begin = next.fetch_add(grain)) {
+      fn(begin, std::min(n, begin + grain), thread);
+    }
+  });
 }
 
 void ThreadPool::workerLoop(int index) {

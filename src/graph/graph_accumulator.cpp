@@ -75,6 +75,14 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
     masks[s.id] = {s.category, s.is_thing ? s.score : stuff_confidence};
   }
   if (masks.empty()) return;
+  // Per-pixel membership test without a tree lookup: ids are small in practice (a network's
+  // segments of one frame); larger ones fall back to the map.
+  constexpr int32_t kDenseIds = 4096;
+  std::vector<uint8_t> known(kDenseIds, 0);
+  for (const auto& [id, unused] : masks) {
+    if (id < kDenseIds) known[id] = 1;
+  }
+  auto isKnown = [&](int32_t id) { return id < kDenseIds ? known[id] != 0 : masks.count(id) != 0; };
 
   // Voxels reached by each mask's rays: (mask, voxel key, super-point) per sampled pixel.
   struct Hit {
@@ -95,7 +103,7 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   for (int v = 0; v < cam.height; v += stride) {
     for (int u = 0; u < cam.width; u += stride) {
       const int32_t id = panoptic.segment_ids(u, v);
-      if (id <= 0 || !masks.count(id)) continue;
+      if (id <= 0 || !isKnown(id)) continue;
       const float d = frame.depth(u, v) * scale;
       if (d <= 0.0f) continue;
       const Voxel* voxel =
@@ -107,6 +115,8 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
       const uint64_t key = (static_cast<uint64_t>(g.x() & 0x1FFFFF) << 42) |
                            (static_cast<uint64_t>(g.y() & 0x1FFFFF) << 21) |
                            static_cast<uint64_t>(g.z() & 0x1FFFFF);
+      // Neighbouring pixels often repeat the last hit: keep the sort below small.
+      if (!hits.empty() && hits.back().mask == id && hits.back().voxel == key) continue;
       hits.push_back({id, key, label});
     }
   }

@@ -5,6 +5,8 @@
 #include <cmath>
 
 #include "panmap/core/error.h"
+#include "panmap/core/vector_clones.h"
+#include "panmap/map/internal/block_integration.h"
 #include "panmap/map/voxel_lookup.h"
 
 namespace panmap {
@@ -34,19 +36,24 @@ BlockIndex unpackKey(uint64_t key) {
   return BlockIndex(field(key >> 42), field(key >> 21), field(key));
 }
 
-// Depth seen through (uf, vf): bilinear between the four surrounding pixels on a smooth
-// surface (nearest-pixel depth on slanted surfaces is off by up to half a pixel's depth
-// change, centimetres at grazing angles), the nearest pixel across depth edges or holes.
-inline float sampleDepth(const Image<float>& depth, float uf, float vf, int u, int v) {
-  const int u0 = static_cast<int>(std::floor(uf)), v0 = static_cast<int>(std::floor(vf));
-  if (u0 < 0 || v0 < 0 || u0 + 1 >= depth.width() || v0 + 1 >= depth.height()) return depth(u, v);
-  const float d00 = depth(u0, v0), d10 = depth(u0 + 1, v0);
-  const float d01 = depth(u0, v0 + 1), d11 = depth(u0 + 1, v0 + 1);
-  const float lo = std::min(std::min(d00, d10), std::min(d01, d11));
-  const float hi = std::max(std::max(d00, d10), std::max(d01, d11));
-  if (lo <= 0.0f || hi - lo > 0.05f * lo) return depth(u, v);
-  const float a = uf - u0, b = vf - v0;
-  return (1 - b) * ((1 - a) * d00 + a * d10) + b * ((1 - a) * d01 + a * d11);
+struct RowCamera {
+  float fx, fy, cx, cy;
+};
+
+// Phase 1 of voteLabels for image row v: the voxel of each labelled pixel with depth, or null.
+// Compiled for AVX2 too, where the voxel lookup's floor() is one instruction instead of a call.
+PANMAP_VECTOR_CLONES void findRowVoxels(const Image<float>& depth_m, const LabelImage& labels,
+                                        int v, int stride, const Eigen::Isometry3f& T_W_C,
+                                        const RowCamera& cam, MutableVoxelLookup* lookup,
+                                        Voxel** out) {
+  for (int u = 0; u < depth_m.width(); u += stride, ++out) {
+    const int32_t label = labels(u, v);
+    const float d = depth_m(u, v);
+    *out = nullptr;
+    if (label <= 0 || d <= 0.0f) continue;
+    *out = lookup->find(T_W_C *
+                        Eigen::Vector3f((u - cam.cx) * d / cam.fx, (v - cam.cy) * d / cam.fy, d));
+  }
 }
 
 }  // namespace
@@ -54,25 +61,48 @@ inline float sampleDepth(const Image<float>& depth, float uf, float vf, int u, i
 // Pi_V (Eq. 2's counts): every labelled pixel votes for its label in the voxel its measured
 // point falls in, as in the paper (a vote per point, not per projected voxel: projective
 // distances stretch at grazing angles and would miss the surface voxels there).
+// Two passes so both can run on every thread and still give the single-threaded result: first
+// each pixel's voxel is looked up (rows split between threads, the map is only read), then
+// every thread walks all pixels in order but applies only the votes for voxels it owns (by
+// address), so each voxel sees its votes in pixel order whatever the thread count.
 void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isometry3f& T_W_C,
                                       const LabelImage& labels, TsdfMap* map,
                                       IntegrationStats* stats) {
   const PinholeCamera& cam = frame.camera;
-  const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
-  const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
+  const RowCamera row_cam{static_cast<float>(cam.fx), static_cast<float>(cam.fy),
+                          static_cast<float>(cam.cx), static_cast<float>(cam.cy)};
   const int stride = config_.vote_stride_px;
-  MutableVoxelLookup lookup(*map);
-  for (int v = 0; v < cam.height; v += stride) {
-    for (int u = 0; u < cam.width; u += stride) {
-      const int32_t label = labels(u, v);
-      const float d = depth_m_(u, v);
-      if (label <= 0 || d <= 0.0f) continue;
-      Voxel* voxel = lookup.find(T_W_C * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d));
-      if (!voxel) continue;
-      ++stats->votes_added;
-      stats->votes_evicted += addVote(voxel, label);
+  const size_t cols = (cam.width + stride - 1) / stride, rows = (cam.height + stride - 1) / stride;
+  vote_voxels_.resize(cols * rows);
+  pool_->parallelFor(rows, [&](size_t r0, size_t r1, int) {
+    MutableVoxelLookup lookup(*map);
+    for (size_t r = r0; r < r1; ++r) {
+      findRowVoxels(depth_m_, labels, static_cast<int>(r) * stride, stride, T_W_C, row_cam, &lookup,
+                    &vote_voxels_[r * cols]);
     }
-  }
+  });
+  const size_t threads = static_cast<size_t>(pool_->size());
+  std::atomic<size_t> added{0}, evicted{0};
+  pool_->parallelFor(threads, [&](size_t t0, size_t t1, int) {
+    size_t my_added = 0, my_evicted = 0;
+    for (size_t t = t0; t < t1; ++t) {
+      for (size_t r = 0; r < rows; ++r) {
+        const int32_t* label_row = &labels(0, static_cast<int>(r) * stride);
+        Voxel* const* voxels = &vote_voxels_[r * cols];
+        for (size_t c = 0; c < cols; ++c) {
+          Voxel* voxel = voxels[c];
+          // 4 KiB regions: voxels sharing a cache line nearly always have the same owner.
+          if (!voxel || (reinterpret_cast<uintptr_t>(voxel) >> 12) % threads != t) continue;
+          ++my_added;
+          my_evicted += addVote(voxel, label_row[c * stride]);
+        }
+      }
+    }
+    added += my_added;
+    evicted += my_evicted;
+  });
+  stats->votes_added += added;
+  stats->votes_evicted += evicted;
 }
 
 IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
@@ -134,61 +164,32 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
   stats.blocks_allocated = map->numBlocks() - before;
 
   const Eigen::Isometry3f T_C_W = T_W_Cf.inverse();
-  const Eigen::Matrix3f R = T_C_W.linear();
-  const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
-  const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
-  const float max_weight = config_.max_weight;
-  const bool dropoff = config_.weight_dropoff;
+  internal::BlockUpdateParams params;
+  params.depth_m = &depth_m_;
+  params.color = has_color ? &frame.color : nullptr;
+  params.fx = static_cast<float>(cam.fx);
+  params.fy = static_cast<float>(cam.fy);
+  params.cx = static_cast<float>(cam.cx);
+  params.cy = static_cast<float>(cam.cy);
+  params.R_C_W = T_C_W.linear();
+  params.voxel_m = voxel;
+  params.truncation_m = trunc;
+  params.min_depth_m = config_.min_depth_m;
+  params.max_weight = config_.max_weight;
+  params.weight_dropoff = config_.weight_dropoff;
+  params.space_carving = config_.space_carving;
   std::atomic<size_t> voxels_updated{0};
-
-  pool_->parallelFor(blocks_.size(), [&](size_t begin, size_t end, int) {
+  // Blocks differ a lot in how many of their voxels lie in the band: hand them out in small
+  // chunks. Each block is updated by one thread from its own data only, so the result does
+  // not depend on which thread takes it.
+  pool_->parallelForDynamic(blocks_.size(), 8, [&](size_t begin, size_t end, int) {
     size_t updated = 0;
     for (size_t b = begin; b < end; ++b) {
       Block& block = *blocks_[b];
-      bool changed = false;
-      const Eigen::Vector3f origin_C = T_C_W * map->voxelCentre(block.index, 0, 0, 0);
-      const Eigen::Vector3f dx = R.col(0) * voxel, dy = R.col(1) * voxel, dz = R.col(2) * voxel;
-      for (int z = 0; z < kBlockSide; ++z) {
-        for (int y = 0; y < kBlockSide; ++y) {
-          Eigen::Vector3f p_C = origin_C + dy * static_cast<float>(y) + dz * static_cast<float>(z);
-          Voxel* row = &block.at(0, y, z);
-          for (int x = 0; x < kBlockSide; ++x, p_C += dx) {
-            if (p_C.z() < config_.min_depth_m) continue;
-            const float inv_z = 1.0f / p_C.z();
-            const float uf = fx * p_C.x() * inv_z + cx, vf = fy * p_C.y() * inv_z + cy;
-            const int u = static_cast<int>(std::lround(uf));
-            const int v = static_cast<int>(std::lround(vf));
-            if (u < 0 || v < 0 || u >= w || v >= h) continue;
-            const float d = sampleDepth(depth_m_, uf, vf, u, v);
-            if (d <= 0.0f) continue;
-            // Projective distance along the optical axis.
-            const float sdf = d - p_C.z();
-            if (sdf < -trunc) continue;  // hidden behind the surface
-            // Far in front of the surface: free space. Only carving records it; otherwise a
-            // voxel inside an object near its silhouette, whose projection misses the object
-            // and lands on the background, would be pulled outward.
-            if (sdf > trunc && !config_.space_carving) continue;
-            float weight = 1.0f;
-            if (dropoff && sdf < -voxel) weight = (trunc + sdf) / (trunc - voxel);
-            if (weight <= 0.0f) continue;
-            Voxel& vox = row[x];
-            const float s = std::min(sdf, trunc);
-            const float total = vox.weight + weight;
-            vox.sdf_m = (vox.sdf_m * vox.weight + s * weight) / total;
-            if (has_color && sdf < trunc) {
-              const Rgb8 c = frame.color(u, v);
-              const float a = weight / total;
-              vox.color.r = static_cast<uint8_t>(vox.color.r + a * (c.r - vox.color.r) + 0.5f);
-              vox.color.g = static_cast<uint8_t>(vox.color.g + a * (c.g - vox.color.g) + 0.5f);
-              vox.color.b = static_cast<uint8_t>(vox.color.b + a * (c.b - vox.color.b) + 0.5f);
-            }
-            vox.weight = std::min(total, max_weight);
-            ++updated;
-            changed = true;
-          }
-        }
-      }
-      if (changed) block.updated = true;
+      const size_t n =
+          internal::updateBlock(params, T_C_W * map->voxelCentre(block.index, 0, 0, 0), &block);
+      if (n > 0) block.updated = true;
+      updated += n;
     }
     voxels_updated += updated;
   });

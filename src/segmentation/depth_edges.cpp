@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "panmap/segmentation/internal/depth_edges.h"
-#include "panmap/segmentation/internal/vector_clones.h"
+#include "panmap/core/vector_clones.h"
 
 namespace panmap {
 namespace internal {

@@ -5,7 +5,7 @@
 #include <cstring>
 
 #include "panmap/segmentation/internal/depth_geometry.h"
-#include "panmap/segmentation/internal/vector_clones.h"
+#include "panmap/core/vector_clones.h"
 
 namespace panmap {
 namespace internal {

@@ -111,6 +111,14 @@ FrameAssociation SuperpointTracker::associate(const FrameSegmentation& segmentat
   VoxelLookup lookup(map);
   auto resolve = [this](int32_t l) { return labels_.resolve(l); };
   const int stride = config_.sample_stride_px;
+  // Neighbouring samples mostly see the same surface and super-point: count runs, and touch
+  // the per-surface maps once per run instead of once per sample.
+  int run_sid = 0, run_count = 0;
+  int32_t run_label = 0;
+  auto flush = [&] {
+    if (run_count > 0) overlap[run_sid - 1][run_label] += run_count;
+    run_count = 0;
+  };
   for (int v = 0; v < h; v += stride) {
     for (int u = 0; u < w; u += stride) {
       const int32_t sid = segmentation.surfaces(u, v);
@@ -122,9 +130,16 @@ FrameAssociation SuperpointTracker::associate(const FrameSegmentation& segmentat
           lookup.find(T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d));
       if (!voxel) continue;
       const int32_t label = argmaxLabel(*voxel, resolve);
-      if (label > 0) ++overlap[sid - 1][label];
+      if (label <= 0) continue;
+      if (run_count == 0 || sid != run_sid || label != run_label) {
+        flush();
+        run_sid = sid;
+        run_label = label;
+      }
+      ++run_count;
     }
   }
+  flush();
 
   // Association: best pairs first, one surface per super-point per frame (as Voxblox++).
   std::vector<std::tuple<int, size_t, int32_t>> pairs;  // (-count, surface, label)

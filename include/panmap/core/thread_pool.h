@@ -26,6 +26,13 @@ class ThreadPool {
   /// as long as fn's effects depend only on its range.
   void parallelFor(size_t n, const std::function<void(size_t, size_t, int)>& fn);
 
+  /// Like parallelFor, but hands out chunks of `grain` indices to whichever thread is free, so
+  /// uneven work per index is balanced. Which thread runs a chunk varies from run to run: use
+  /// it only where fn's effect on an index does not depend on the thread (per-thread outputs
+  /// must be combined order-independently, e.g. summed counts).
+  void parallelForDynamic(size_t n, size_t grain,
+                          const std::function<void(size_t, size_t, int)>& fn);
+
  private:
   void workerLoop(int index);
 

@@ -60,9 +60,10 @@ class ProjectiveIntegrator {
 
   IntegratorConfig config_;
   ThreadPool* pool_;
-  Image<float> depth_m_;        // scratch: depth in metres, 0 = invalid
-  std::vector<uint64_t> keys_;  // scratch: block keys seen this frame
-  std::vector<Block*> blocks_;  // scratch: blocks in view
+  Image<float> depth_m_;             // scratch: depth in metres, 0 = invalid
+  std::vector<uint64_t> keys_;       // scratch: block keys seen this frame
+  std::vector<Block*> blocks_;       // scratch: blocks in view
+  std::vector<Voxel*> vote_voxels_;  // scratch: each voting pixel's voxel (null: no vote)
 };
 
 }  // namespace panmap

@@ -1,0 +1,128 @@
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+
+#include "panmap/map/internal/block_integration.h"
+
+namespace panmap {
+namespace internal {
+namespace {
+
+// A depth image with smooth slopes, steps, holes and out-of-range pixels, so every branch of
+// the depth sampling (bilinear, nearest across an edge, invalid) is taken.
+Image<float> roughDepth(int w, int h, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> jitter(-0.002f, 0.002f);
+  std::uniform_int_distribution<int> hole(0, 40);
+  Image<float> depth(w, h);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      float d = 0.9f + 0.0015f * u + 0.0007f * v + jitter(rng);
+      if ((u / 9 + v / 7) % 5 == 0) d += 0.12f;  // steps: depth edges
+      if (hole(rng) == 0) d = 0.0f;              // missing depth
+      depth(u, v) = d;
+    }
+  }
+  return depth;
+}
+
+Image<Rgb8> gradientColour(int w, int h) {
+  Image<Rgb8> color(w, h);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      color(u, v) = Rgb8{static_cast<uint8_t>(u * 3), static_cast<uint8_t>(v * 5),
+                         static_cast<uint8_t>(u + v)};
+    }
+  }
+  return color;
+}
+
+// Starting voxels with history, so the weighted running means are exercised too.
+void seedBlock(Block* block, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> sdf(-0.03f, 0.03f), weight(0.0f, 5.0f);
+  for (Voxel& v : block->voxels) {
+    v.sdf_m = sdf(rng);
+    v.weight = weight(rng) > 2.5f ? weight(rng) : 0.0f;
+    v.color =
+        Rgb8{static_cast<uint8_t>(rng()), static_cast<uint8_t>(rng()), static_cast<uint8_t>(rng())};
+  }
+}
+
+// The 8-wide path must give the portable path's voxels bit for bit, over blocks straddling
+// the image border, the minimum depth and the truncation band, with and without colour,
+// carving and weight drop-off.
+TEST(BlockUpdate, VectorPathMatchesScalarBitForBit) {
+  const int w = 80, h = 60;
+  const Image<float> depth = roughDepth(w, h, 7);
+  const Image<Rgb8> color = gradientColour(w, h);
+  BlockUpdateParams p;
+  p.depth_m = &depth;
+  p.fx = p.fy = 70.0f;
+  p.cx = 39.5f;
+  p.cy = 29.5f;
+  p.voxel_m = 0.01f;
+  p.truncation_m = 0.04f;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> angle(-0.4f, 0.4f), lateral(-0.6f, 0.6f),
+      range(0.05f, 1.2f);
+  size_t total_updated = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    p.color = trial % 2 ? &color : nullptr;
+    p.space_carving = trial % 3 == 0;
+    p.weight_dropoff = trial % 5 != 0;
+    p.R_C_W = (Eigen::AngleAxisf(angle(rng), Eigen::Vector3f::UnitX()) *
+               Eigen::AngleAxisf(angle(rng), Eigen::Vector3f::UnitY()))
+                  .toRotationMatrix();
+    const Eigen::Vector3f origin_C(lateral(rng), lateral(rng), range(rng));
+    Block scalar, vector;
+    seedBlock(&scalar, trial);
+    std::memcpy(static_cast<void*>(&vector), &scalar, sizeof(Block));
+    const size_t n_scalar = updateBlockScalar(p, origin_C, &scalar);
+    const size_t n_vector = updateBlock(p, origin_C, &vector);
+    ASSERT_EQ(n_scalar, n_vector) << "trial " << trial;
+    ASSERT_EQ(0, std::memcmp(scalar.voxels, vector.voxels, sizeof(scalar.voxels)))
+        << "trial " << trial;
+    total_updated += n_scalar;
+  }
+  // The trials must actually reach the surface, or the comparison proves nothing.
+  EXPECT_GT(total_updated, 10000u);
+  if (!blockUpdateUsesAvx2()) GTEST_SKIP() << "no AVX2 on this CPU: only the scalar path ran";
+}
+
+// A fronto-parallel wall 1 m away seen by the voxel column on the optical axis: each voxel's
+// new SDF is exactly the measured distance, truncated, and only the band is touched.
+TEST(BlockUpdate, WallAtOneMetre) {
+  const int w = 40, h = 40;
+  Image<float> depth(w, h);
+  for (size_t i = 0; i < depth.size(); ++i) depth.data()[i] = 1.0f;
+  BlockUpdateParams p;
+  p.depth_m = &depth;
+  p.fx = p.fy = 50.0f;
+  p.cx = p.cy = 19.5f;
+  p.voxel_m = 0.01f;
+  p.truncation_m = 0.03f;
+  p.weight_dropoff = false;
+  Block block;
+  // Voxel centres at z = 0.965 .. 1.035 on the axis.
+  const size_t n = updateBlock(p, Eigen::Vector3f(0.0f, 0.0f, 0.965f), &block);
+  EXPECT_GT(n, 0u);
+  for (int z = 0; z < kBlockSide; ++z) {
+    const float vz = 0.965f + 0.01f * z;
+    const Voxel& v = block.at(0, 0, z);
+    const float sdf = 1.0f - vz;
+    if (sdf < -p.truncation_m || sdf > p.truncation_m) {
+      EXPECT_EQ(v.weight, 0.0f) << "z " << z;
+    } else {
+      EXPECT_EQ(v.weight, 1.0f) << "z " << z;
+      EXPECT_NEAR(v.sdf_m, sdf, 1e-6f) << "z " << z;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace internal
+}  // namespace panmap
