@@ -17,7 +17,10 @@ void GraphConfig::check() const {
   if (sample_stride_px < 1) throw Error("graph sample_stride_px must be >= 1");
 }
 
-GraphAccumulator::GraphAccumulator(const GraphConfig& config) : config_(config) { config_.check(); }
+GraphAccumulator::GraphAccumulator(const GraphConfig& config, ThreadPool* pool)
+    : config_(config), pool_(pool) {
+  config_.check();
+}
 
 const std::map<int32_t, double>& GraphAccumulator::scores(int32_t label) const {
   static const std::map<int32_t, double> kEmpty;
@@ -84,42 +87,56 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   }
   auto isKnown = [&](int32_t id) { return id < kDenseIds ? known[id] != 0 : masks.count(id) != 0; };
 
-  // Voxels reached by each mask's rays: (mask, voxel key, super-point) per sampled pixel.
-  struct Hit {
-    int32_t mask;
-    uint64_t voxel;
-    int32_t label;
-    bool operator<(const Hit& o) const { return std::tie(mask, voxel) < std::tie(o.mask, o.voxel); }
-    bool operator==(const Hit& o) const { return mask == o.mask && voxel == o.voxel; }
-  };
-  std::vector<Hit> hits;
+  // Voxels reached by each mask's rays: (mask, voxel key, super-point) per sampled pixel. Rows
+  // are split between threads; concatenated in row order they are what one thread would find.
   const Eigen::Isometry3f T = T_W_C.cast<float>();
   const float scale = static_cast<float>(frame.depth_scale_m);
   const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
   const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
-  auto resolve = [&tracker](int32_t l) { return tracker.labels().resolve(l); };
-  VoxelLookup lookup(map);
+  const LabelRegistry& registry = tracker.labels();
+  registry.flatten();  // resolve() only reads from here on: safe on every thread
+  auto resolve = [&registry](int32_t l) { return registry.resolve(l); };
   const int stride = config_.sample_stride_px;
-  for (int v = 0; v < cam.height; v += stride) {
-    for (int u = 0; u < cam.width; u += stride) {
-      const int32_t id = panoptic.segment_ids(u, v);
-      if (id <= 0 || !isKnown(id)) continue;
-      const float d = frame.depth(u, v) * scale;
-      if (d <= 0.0f) continue;
-      const Voxel* voxel =
-          lookup.find(T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d));
-      if (!voxel) continue;
-      const int32_t label = argmaxLabel(*voxel, resolve);
-      if (label <= 0) continue;
-      const Eigen::Vector3i& g = lookup.lastVoxel();
-      const uint64_t key = (static_cast<uint64_t>(g.x() & 0x1FFFFF) << 42) |
-                           (static_cast<uint64_t>(g.y() & 0x1FFFFF) << 21) |
-                           static_cast<uint64_t>(g.z() & 0x1FFFFF);
-      // Neighbouring pixels often repeat the last hit: keep the sort below small.
-      if (!hits.empty() && hits.back().mask == id && hits.back().voxel == key) continue;
-      hits.push_back({id, key, label});
+  const size_t rows = static_cast<size_t>((cam.height + stride - 1) / stride);
+  auto collect = [&](size_t r0, size_t r1, std::vector<Hit>* out) {
+    out->clear();
+    VoxelLookup lookup(map);
+    for (size_t r = r0; r < r1; ++r) {
+      const int v = static_cast<int>(r) * stride;
+      for (int u = 0; u < cam.width; u += stride) {
+        const int32_t id = panoptic.segment_ids(u, v);
+        if (id <= 0 || !isKnown(id)) continue;
+        const float d = frame.depth(u, v) * scale;
+        if (d <= 0.0f) continue;
+        const Voxel* voxel =
+            lookup.find(T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d));
+        if (!voxel) continue;
+        const int32_t label = argmaxLabel(*voxel, resolve);
+        if (label <= 0) continue;
+        const Eigen::Vector3i& g = lookup.lastVoxel();
+        const uint64_t key = (static_cast<uint64_t>(g.x() & 0x1FFFFF) << 42) |
+                             (static_cast<uint64_t>(g.y() & 0x1FFFFF) << 21) |
+                             static_cast<uint64_t>(g.z() & 0x1FFFFF);
+        // Neighbouring pixels often repeat the last hit: keep the sort below small.
+        if (!out->empty() && out->back().mask == id && out->back().voxel == key) continue;
+        out->push_back({id, key, label});
+      }
     }
+  };
+  const int threads = pool_ ? pool_->size() : 1;
+  thread_hits_.resize(static_cast<size_t>(threads));
+  if (pool_) {
+    pool_->parallelFor(rows, [&](size_t r0, size_t r1, int t) {
+      collect(r0, r1, &thread_hits_[static_cast<size_t>(t)]);
+    });
+  } else {
+    collect(0, rows, &thread_hits_[0]);
   }
+  std::vector<Hit>& hits = hits_;
+  hits.clear();
+  for (const std::vector<Hit>& part : thread_hits_)
+    hits.insert(hits.end(), part.begin(), part.end());
+  for (std::vector<Hit>& part : thread_hits_) part.clear();
   // N^S_o counts unique voxels: many pixels see the same voxel up close.
   std::sort(hits.begin(), hits.end());
   hits.erase(std::unique(hits.begin(), hits.end()), hits.end());

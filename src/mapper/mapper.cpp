@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <set>
 #include <sstream>
 
@@ -38,7 +39,7 @@ Mapper::Mapper(const MapperConfig& config) : config_(config) {
   // A sign change is a surface only between samples closer than the truncation band.
   mesh_config.max_sdf_jump_voxels = config_.integrator.truncation_voxels;
   mesher_ = std::make_unique<IncrementalMesher>(mesh_config, pool_.get());
-  graph_ = std::make_unique<GraphAccumulator>(config_.graph);
+  graph_ = std::make_unique<GraphAccumulator>(config_.graph, pool_.get());
   if (config_.occupancy_enabled) occupancy_ = std::make_unique<OccupancyMap>(config_.occupancy);
   aligner_ = std::make_unique<FrameToModelAligner>(config_.tracking);
 }
@@ -130,7 +131,29 @@ FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_
   const FrameSegmentation segmentation =
       segmenter_->segment(frame, config_.fusion.geometry_only ? nullptr : panoptic);
   const auto t1 = Clock::now();
-  const FrameAssociation association = tracker_->associate(segmentation, frame, T_W_C, *map_);
+  // Association runs on one thread, so the occupancy update (which needs only the frame and
+  // its pose) takes the other one meanwhile.
+  FrameAssociation association;
+  std::exception_ptr failures[2];
+  pool_->parallelFor(2, [&](size_t begin, size_t end, int) {
+    for (size_t task = begin; task < end; ++task) {
+      try {
+        const auto start = Clock::now();
+        if (task == 0) {
+          association = tracker_->associate(segmentation, frame, T_W_C, *map_);
+          stats.superpoints_ms = ms(start, Clock::now());
+        } else if (occupancy_) {
+          occupancy_->integrate(frame, T_W_C);
+          stats.occupancy_ms = ms(start, Clock::now());
+        }
+      } catch (...) {
+        failures[task] = std::current_exception();
+      }
+    }
+  });
+  for (const std::exception_ptr& failure : failures) {
+    if (failure) std::rethrow_exception(failure);
+  }
   const auto t2 = Clock::now();
   stats.integration = integrator_->integrate(frame, T_W_C, &association.pixel_labels, map_.get());
   const auto t3 = Clock::now();
@@ -138,14 +161,10 @@ FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_
     graph_->update(frame, T_W_C, *panoptic, *map_, *tracker_, config_.fusion.stuff_confidence);
   }
   const auto t4 = Clock::now();
-  if (occupancy_) occupancy_->integrate(frame, T_W_C);
-  const auto t5 = Clock::now();
   stats.graph_ms = ms(t3, t4);
   stats.segmentation_ms = ms(t0, t1);
-  stats.superpoints_ms = ms(t1, t2);
   stats.integration_ms = ms(t2, t3);
-  stats.occupancy_ms = ms(t4, t5);
-  stats.total_ms = ms(t_start, t5);
+  stats.total_ms = ms(t_start, t4);
   stats.surfaces = static_cast<int>(segmentation.surface_list.size());
   stats.new_superpoints = association.new_labels;
   stats.merges = association.merges;

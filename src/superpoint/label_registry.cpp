@@ -21,6 +21,11 @@ int32_t LabelRegistry::resolve(int32_t label) const {
   return root;
 }
 
+void LabelRegistry::flatten() const {
+  // Parents never exceed their label, so one pass in increasing order finds every root.
+  for (size_t i = 1; i < parent_.size(); ++i) parent_[i] = parent_[parent_[i]];
+}
+
 int32_t LabelRegistry::merge(int32_t a, int32_t b) {
   const int32_t ra = resolve(a), rb = resolve(b);
   if (ra == 0 || rb == 0) throw Error("cannot merge unknown super-point labels");

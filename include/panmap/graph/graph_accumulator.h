@@ -3,10 +3,12 @@
 #include <cstdint>
 #include <map>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Geometry>
 
 #include "panmap/core/frame.h"
+#include "panmap/core/thread_pool.h"
 #include "panmap/graph/superpoint_graph.h"
 #include "panmap/map/tsdf_map.h"
 #include "panmap/superpoint/superpoint_tracker.h"
@@ -19,7 +21,7 @@ struct GraphConfig {
   /// super-points' voxels seen through the same mask in the frame (the paper: "based on the
   /// inverse distance"; this form is 1 for touching parts and halves at spatial_scale_m).
   double spatial_scale_m = 0.5;
-  int sample_stride_px = 2;     ///< pixels between ray samples (1 = every pixel)
+  int sample_stride_px = 2;  ///< pixels between ray samples (1 = every pixel)
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -30,15 +32,15 @@ struct GraphConfig {
 class GraphAccumulator {
  public:
   /// Throws Error when the config is invalid.
-  explicit GraphAccumulator(const GraphConfig& config);
+  /// @param pool threads for sampling the frame's rays (not owned; null: the caller's thread)
+  explicit GraphAccumulator(const GraphConfig& config, ThreadPool* pool = nullptr);
 
   /// Adds one frame: for each panoptic mask o (confidence P_o from Eq. 1), the voxels its
   /// pixels' rays reach are grouped by super-point (N^S_o, unique voxels), then Eq. 5 and
   /// Eq. 6 are applied. Call after the frame was integrated. Also folds in the tracker's merges
   /// made since the last call.
-  void update(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
-              const PanopticFrame& panoptic, const TsdfMap& map,
-              const SuperpointTracker& tracker, float stuff_confidence = 0.5f);
+  void update(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const PanopticFrame& panoptic,
+              const TsdfMap& map, const SuperpointTracker& tracker, float stuff_confidence = 0.5f);
 
   /// The graph of the live super-points: scores and confidences, centroids and voxel counts
   /// from the map, initial labels from the tracker's frame counts.
@@ -69,9 +71,24 @@ class GraphAccumulator {
  private:
   void applyMerges(const SuperpointTracker& tracker);
 
+  /// A sampled pixel's mask, the voxel its ray reaches and that voxel's super-point.
+  struct Hit {
+    int32_t mask;
+    uint64_t voxel;
+    int32_t label;
+    bool operator<(const Hit& o) const {
+      return mask < o.mask || (mask == o.mask && voxel < o.voxel);
+    }
+    bool operator==(const Hit& o) const { return mask == o.mask && voxel == o.voxel; }
+  };
+
   GraphConfig config_;
+  ThreadPool* pool_ = nullptr;
+  std::vector<std::vector<Hit>> thread_hits_;            // scratch, one per thread
+  std::vector<Hit> hits_;                                // scratch
   std::map<int32_t, std::map<int32_t, double>> scores_;  // label -> class -> P_nu
-  std::map<std::pair<int32_t, int32_t>, std::map<int32_t, double>> edges_;  // (a<b) -> class -> P_eps
+  std::map<std::pair<int32_t, int32_t>, std::map<int32_t, double>>
+      edges_;  // (a<b) -> class -> P_eps
   size_t merges_applied_ = 0;
 };
 

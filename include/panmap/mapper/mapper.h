@@ -56,7 +56,7 @@ struct FrameStats {
   double integration_ms = 0.0;   ///< label-TSDF update
   double graph_ms = 0.0;         ///< III-C super-point graph update
   double tracking_ms = 0.0;      ///< pose refinement against the map (0 when not run)
-  double occupancy_ms = 0.0;     ///< occupancy update
+  double occupancy_ms = 0.0;     ///< occupancy update (runs alongside the super-point stage)
   double total_ms = 0.0;
   /// The pose the frame was integrated with (the given one, or refined against the map).
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();

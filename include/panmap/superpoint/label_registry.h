@@ -14,6 +14,9 @@ class LabelRegistry {
   int32_t create();
   /// The label a (possibly merged-away) label belongs to now; 0 stays 0.
   int32_t resolve(int32_t label) const;
+  /// Points every label straight at its root. Until the next merge or create, resolve() then
+  /// only reads, so several threads may call it at once.
+  void flatten() const;
   /// Merges two super-points; the smaller (older) root survives. Returns the survivor.
   int32_t merge(int32_t a, int32_t b);
   /// Number of labels ever created.
