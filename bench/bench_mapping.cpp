@@ -1,6 +1,9 @@
-// Per-frame mapping cost over a real RGB-D sequence: segmentation (III-A) + super-points
-// (III-B) + label-TSDF integration, median and p95 per stage, peak memory, bytes per voxel.
-//   panmap-bench-mapping [--data DIR] [--voxel-size M] [--threads N] [--frames N] [--json FILE]
+// Per-frame mapping cost over a real RGB-D sequence or a synthetic log: segmentation (III-A),
+// super-points (III-B), label-TSDF integration with votes, graph update (III-C) and occupancy,
+// median and p95 per stage; the periodic outputs (incremental mesh update, occupancy tree
+// export) timed every --outputs-every frames; peak memory and bytes per voxel.
+//   panmap-bench-mapping [--data DIR | --log FILE] [--voxel-size M] [--threads N] [--frames N]
+//                        [--outputs-every N] [--json FILE] [--markdown-row]
 #include <sys/resource.h>
 
 #include <chrono>
@@ -15,35 +18,87 @@
 #include "panmap/lcm/offline_mapping.h"
 #include "panmap/mapper/mapper.h"
 
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// Per-stage samples, plus the periodic outputs a live mapper produces (mesh, octree).
+class Recorder {
+ public:
+  Recorder(panmap::Mapper* mapper, int outputs_every)
+      : mapper_(mapper), outputs_every_(outputs_every) {}
+
+  void add(const panmap::FrameStats& s) {
+    for (const auto& [stage, ms] : s.stageTimes()) times_[stage].push_back(ms);
+    voxels_updated_.push_back(static_cast<double>(s.integration.voxels_updated));
+    blocks_in_view_.push_back(static_cast<double>(s.integration.blocks_in_view));
+    if (outputs_every_ > 0 && ++frames_ % outputs_every_ == 0) {
+      auto start = Clock::now();
+      mapper_->extractMesh();
+      times_["mesh_update"].push_back(msSince(start));
+      if (mapper_->occupancy()) {
+        start = Clock::now();
+        const std::string tree = mapper_->occupancy()->toBinaryData();
+        times_["octree_export"].push_back(msSince(start));
+      }
+    }
+  }
+
+  nlohmann::json summary() const {
+    nlohmann::json out;
+    for (const auto& [stage, list] : times_) {
+      const panmap::StageTiming t = panmap::summariseTimes(list);
+      out["stages"][stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}};
+    }
+    out["voxels_updated_median"] = panmap::summariseTimes(voxels_updated_).median_ms;
+    out["blocks_in_view_median"] = panmap::summariseTimes(blocks_in_view_).median_ms;
+    return out;
+  }
+
+ private:
+  panmap::Mapper* mapper_;
+  int outputs_every_;
+  int frames_ = 0;
+  std::map<std::string, std::vector<double>> times_;
+  std::vector<double> voxels_updated_, blocks_in_view_;
+};
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  CLI::App app{"Time the mapping pipeline (no network) on every frame of a dataset folder."};
+  CLI::App app{"Time the mapping pipeline (no network) on every frame of a dataset or log."};
   std::string data = "../shared/data/7scenes-200", json_path, log_path;
   panmap::MapperConfig config;
-  int frames = 0;
+  int frames = 0, outputs_every = 30;
   bool markdown = false;
   app.add_option("--data", data, "dataset folder (7-Scenes, ScanNet export or TUM)")
       ->capture_default_str();
   app.add_option("--voxel-size", config.map.voxel_size_m, "metres")->capture_default_str();
-  app.add_option("--threads", config.num_threads, "integration threads")->capture_default_str();
+  app.add_option("--threads", config.num_threads, "mapping threads")->capture_default_str();
   app.add_option("--frames", frames, "frames to map (0 = all)");
   app.add_option("--log", log_path,
                  "map an LCM log instead (with its panoptic masks: adds the graph update)");
+  app.add_option("--outputs-every", outputs_every,
+                 "frames between incremental mesh updates and occupancy exports, timed on their "
+                 "own (0 = none)")
+      ->capture_default_str();
   app.add_option("--json", json_path, "write the figures as JSON");
   app.add_flag("--markdown-row", markdown, "print one Markdown table row instead of JSON");
   CLI11_PARSE(app, argc, argv);
-  std::map<std::string, double> p95;
   try {
     panmap::Mapper mapper(config);
-    std::map<std::string, std::vector<double>> times;
+    Recorder recorder(&mapper, outputs_every);
     if (!log_path.empty()) {
-      // Timings per stage come from the mapper; message decoding is not counted.
+      // Messages are decoded between frames; only the mapper's own stages are timed.
       panmap::SessionOptions options;
       options.max_frames = frames;
-      const panmap::OfflineReport report = panmap::mapLog(log_path, options, &mapper);
-      for (const auto& [stage, t] : report.timings) {
-        times[stage] = {t.median_ms};
-        p95[stage] = t.p95_ms;
-      }
+      panmap::mapLog(
+          log_path, options, &mapper, {},
+          [&](const panmap::SyncedFrame&, const panmap::FrameStats& s) { recorder.add(s); });
       data = log_path;
     } else {
       const auto reader = panmap::openDataset(data, panmap::DatasetOptions{});
@@ -52,40 +107,33 @@ int main(int argc, char** argv) {
       std::vector<panmap::DatasetFrame> input;
       for (size_t i = 0; i < n; ++i) input.push_back(reader->read(i));
       for (const panmap::DatasetFrame& f : input) {
-        if (!f.T_W_C) continue;
-        const panmap::FrameStats s = mapper.integrate(f.rgbd, *f.T_W_C, nullptr);
-        for (const auto& [stage, ms] : s.stageTimes()) times[stage].push_back(ms);
+        if (f.T_W_C) recorder.add(mapper.integrate(f.rgbd, *f.T_W_C, nullptr));
       }
     }
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     const panmap::LabelledMesh mesh = mapper.extractMesh();
-    const double mesh_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const double mesh_ms = msSince(start);
     struct rusage usage;
     getrusage(RUSAGE_SELF, &usage);
     const size_t voxels = mapper.map().numBlocks() * panmap::kBlockVoxels;
-    nlohmann::json out = {
-        {"data", data},
-        {"frames", times["total"].size()},
-        {"voxel_size_m", config.map.voxel_size_m},
-        {"threads", config.num_threads},
-        {"blocks", mapper.map().numBlocks()},
-        {"voxels", voxels},
-        {"bytes_per_voxel", static_cast<double>(mapper.map().memoryBytes()) / voxels},
-        {"map_bytes", mapper.map().memoryBytes()},
-        {"peak_rss_bytes", static_cast<size_t>(usage.ru_maxrss) * 1024},
-        {"final_mesh_ms", mesh_ms},
-        {"mesh_vertices", mesh.numVertices()}};
-    for (auto& [stage, list] : times) {
-      panmap::StageTiming t = panmap::summariseTimes(list);
-      if (p95.count(stage)) t.p95_ms = p95[stage];  // from a log run: summarised already
-      out["stages"][stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}};
-    }
-    out["frames"] = mapper.framesIntegrated();
+    nlohmann::json out = recorder.summary();
+    out.update({{"data", data},
+                {"frames", mapper.framesIntegrated()},
+                {"voxel_size_m", config.map.voxel_size_m},
+                {"threads", config.num_threads},
+                {"outputs_every", outputs_every},
+                {"blocks", mapper.map().numBlocks()},
+                {"voxels", voxels},
+                {"bytes_per_voxel", static_cast<double>(mapper.map().memoryBytes()) / voxels},
+                {"map_bytes", mapper.map().memoryBytes()},
+                {"peak_rss_bytes", static_cast<size_t>(usage.ru_maxrss) * 1024},
+                {"final_mesh_ms", mesh_ms},
+                {"mesh_vertices", mesh.numVertices()}});
     if (markdown) {
       // | voxel | threads | frames | segmentation | super-points | integration | graph |
-      // occupancy | total | ...
+      // occupancy | total | mesh update | octree export | map MB | peak RSS MB | bytes / voxel |
       auto cell = [&](const char* stage) {
+        if (!out["stages"].contains(stage)) return std::string("-");
         const auto& t = out["stages"][stage];
         char buf[64];
         std::snprintf(buf, sizeof(buf), "%.1f / %.1f", t["median_ms"].get<double>(),
@@ -93,11 +141,13 @@ int main(int argc, char** argv) {
         return std::string(buf);
       };
       std::printf(
-          "| %.0f cm | %d | %lld | %s | %s | %s | %s | %s | **%s** | %.0f | %.0f | %.1f |\n",
+          "| %.0f cm | %d | %lld | %s | %s | %s | %s | %s | **%s** | %s | %s | %.0f | %.0f | "
+          "%.1f |\n",
           config.map.voxel_size_m * 100.0, config.num_threads,
           static_cast<long long>(mapper.framesIntegrated()), cell("segmentation").c_str(),
           cell("superpoints").c_str(), cell("integration").c_str(), cell("graph").c_str(),
-          cell("occupancy").c_str(), cell("total").c_str(), mapper.map().memoryBytes() / 1048576.0,
+          cell("occupancy").c_str(), cell("total").c_str(), cell("mesh_update").c_str(),
+          cell("octree_export").c_str(), mapper.map().memoryBytes() / 1048576.0,
           static_cast<double>(usage.ru_maxrss) / 1024.0,
           static_cast<double>(mapper.map().memoryBytes()) / voxels);
     } else {

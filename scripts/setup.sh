@@ -5,10 +5,11 @@
 #
 #   scripts/setup.sh [--skip-apt] [--skip-network] [--skip-build] [--build-dir DIR]
 #                    [--targets "panmap-mapper panmap-synth ..."]   (default: everything)
+#                    [--with-open3d]   (also Open3D, for scripts/bench/speed.sh only)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-skip_apt=0 skip_network=0 skip_build=0 build_dir=build targets=
+skip_apt=0 skip_network=0 skip_build=0 build_dir=build targets= with_open3d=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --skip-apt) skip_apt=1 ;;
@@ -16,7 +17,8 @@ while [ $# -gt 0 ]; do
     --skip-build) skip_build=1 ;;
     --build-dir) build_dir="$2"; shift ;;
     --targets) targets="$2"; shift ;;
-    -h|--help) sed -n '2,8p' "$0"; exit 0 ;;
+    --with-open3d) with_open3d=1 ;;
+    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
     *) echo "setup.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -37,6 +39,9 @@ packages=(
   libnanoflann-dev libboost-graph-dev                 # k-d tree (evaluation), graph algorithms
   iproute2 procps                                     # ip / sysctl for the LCM network setup
 )
+
+# Open3D's TSDF volume is only measured side by side with ours (panmap-bench-open3d).
+[ "$with_open3d" -eq 1 ] && packages+=(libopen3d-dev)
 
 problems=()
 as_root() {
@@ -88,7 +93,9 @@ fi
 if [ "$skip_build" -eq 0 ]; then
   jobs=$(nproc 2>/dev/null || echo 2)
   mkdir -p "$build_dir"
-  cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release >"$build_dir/configure.log" 2>&1 ||
+  cmake_args=(-DCMAKE_BUILD_TYPE=Release)
+  [ "$with_open3d" -eq 1 ] && cmake_args+=(-DPANMAP_WITH_OPEN3D=ON)
+  cmake -S . -B "$build_dir" "${cmake_args[@]}" >"$build_dir/configure.log" 2>&1 ||
     { cat "$build_dir/configure.log"; echo "setup: cmake configure failed" >&2; exit 1; }
   echo "setup: building ${targets:-everything} into $build_dir/ with $jobs jobs"
   target_args=()

@@ -176,6 +176,20 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   }
 }
 
+void GraphAccumulator::forgetUnvoted(const std::vector<uint8_t>& has_votes,
+                                     const LabelRegistry& registry) {
+  auto voted = [&](int32_t label) {
+    const int32_t root = registry.resolve(label);
+    return root > 0 && static_cast<size_t>(root) < has_votes.size() && has_votes[root] != 0;
+  };
+  for (auto it = scores_.begin(); it != scores_.end();) {
+    it = voted(it->first) ? std::next(it) : scores_.erase(it);
+  }
+  for (auto it = edges_.begin(); it != edges_.end();) {
+    it = voted(it->first.first) && voted(it->first.second) ? std::next(it) : edges_.erase(it);
+  }
+}
+
 SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
                                         const SuperpointTracker& tracker) const {
   SuperpointGraph g;

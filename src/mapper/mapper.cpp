@@ -96,6 +96,31 @@ void Mapper::validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
   }
 }
 
+void Mapper::forgetUnvotedSuperpoints() {
+  const LabelRegistry& registry = tracker_->labels();
+  registry.flatten();  // resolve() only reads from here on: safe on every thread
+  const int threads = pool_->size();
+  std::vector<std::vector<uint8_t>> flags(static_cast<size_t>(threads));
+  const auto& blocks = map_->blocks();
+  pool_->parallelFor(blocks.size(), [&](size_t begin, size_t end, int t) {
+    std::vector<uint8_t>& has_votes = flags[static_cast<size_t>(t)];
+    has_votes.assign(static_cast<size_t>(registry.size()) + 1, 0);
+    for (size_t b = begin; b < end; ++b) {
+      for (const Voxel& voxel : blocks[b]->voxels) {
+        for (const LabelVote& vote : voxel.votes) {
+          if (vote.count > 0) has_votes[static_cast<size_t>(registry.resolve(vote.label))] = 1;
+        }
+      }
+    }
+  });
+  std::vector<uint8_t> has_votes(static_cast<size_t>(registry.size()) + 1, 0);
+  for (const std::vector<uint8_t>& part : flags) {
+    for (size_t i = 0; i < part.size(); ++i) has_votes[i] |= part[i];
+  }
+  superpoints_forgotten_ += tracker_->forgetUnvoted(has_votes);
+  graph_->forgetUnvoted(has_votes, registry);
+}
+
 FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C_given,
                              const PanopticFrame* panoptic, PoseSource source) {
   using Clock = std::chrono::steady_clock;
@@ -160,6 +185,7 @@ FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_
   if (panoptic && !config_.fusion.geometry_only) {
     graph_->update(frame, T_W_C, *panoptic, *map_, *tracker_, config_.fusion.stuff_confidence);
   }
+  if ((frames_ + 1) % kForgetEveryFrames == 0) forgetUnvotedSuperpoints();
   const auto t4 = Clock::now();
   stats.graph_ms = ms(t3, t4);
   stats.segmentation_ms = ms(t0, t1);

@@ -87,6 +87,26 @@ void SuperpointTracker::mergeLabels(int32_t a, int32_t b, FrameAssociation* out)
   ++out->merges;
 }
 
+size_t SuperpointTracker::forgetUnvoted(const std::vector<uint8_t>& has_votes) {
+  auto voted = [&](int32_t label) {
+    const int32_t root = labels_.resolve(label);
+    return root > 0 && static_cast<size_t>(root) < has_votes.size() && has_votes[root] != 0;
+  };
+  size_t forgotten = 0;
+  for (auto it = states_.begin(); it != states_.end();) {
+    if (voted(it->first)) {
+      ++it;
+    } else {
+      it = states_.erase(it);
+      ++forgotten;
+    }
+  }
+  for (auto it = co_observed_.begin(); it != co_observed_.end();) {
+    it = voted(it->first.first) && voted(it->first.second) ? std::next(it) : co_observed_.erase(it);
+  }
+  return forgotten;
+}
+
 FrameAssociation SuperpointTracker::associate(const FrameSegmentation& segmentation,
                                               const RgbdFrame& frame,
                                               const Eigen::Isometry3d& T_W_C, const TsdfMap& map) {

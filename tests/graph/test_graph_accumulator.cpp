@@ -137,3 +137,30 @@ TEST(GraphAccumulator, RejectsBadInput) {
 
 }  // namespace
 }  // namespace panmap
+
+namespace panmap {
+namespace {
+
+// Scores and edges of super-points no voxel votes for are dropped, the rest kept exactly.
+TEST(GraphAccumulator, ForgetsSuperpointsWithoutVotes) {
+  GraphAccumulator graph{GraphConfig{}};
+  GraphAccumulator::Snapshot s;
+  s.scores[1][5] = 2.5;
+  s.scores[3][7] = 1.0;
+  s.scores[4][5] = 0.5;
+  s.edges[{1, 3}][5] = 0.7;
+  s.edges[{1, 4}][5] = 0.9;
+  graph.restore(s);
+  LabelRegistry registry;
+  for (int i = 0; i < 4; ++i) registry.create();
+  graph.forgetUnvoted({0, 1, 0, 0, 1}, registry);
+  const GraphAccumulator::Snapshot after = graph.snapshot();
+  ASSERT_EQ(2u, after.scores.size());
+  EXPECT_EQ(2.5, after.scores.at(1).at(5));
+  EXPECT_EQ(0.5, after.scores.at(4).at(5));
+  ASSERT_EQ(1u, after.edges.size());
+  EXPECT_EQ(0.9, after.edges.at({1, 4}).at(5));
+}
+
+}  // namespace
+}  // namespace panmap

@@ -155,3 +155,34 @@ TEST(LabelRegistry, MergesResolveToTheOldestId) {
 
 }  // namespace
 }  // namespace panmap
+
+namespace panmap {
+namespace {
+
+// Super-points 1..4 where 2 was merged into 1; only 1 (through its merged label 2) and 4 still
+// hold votes. 3 is forgotten with its co-observations; the others keep their counts.
+TEST(SuperpointTracker, ForgetsSuperpointsWithoutVotes) {
+  SuperpointTracker tracker{SuperpointConfig{}};
+  SuperpointTracker::Snapshot s;
+  s.parents = {0, 1, 1, 3, 4};
+  s.states[1].class_counts[5] = 3.0;
+  s.states[3].class_counts[7] = 1.0;
+  s.states[4].class_counts[0] = 2.0;
+  s.co_observed[{1, 3}] = 2;
+  s.co_observed[{1, 4}] = 5;
+  s.co_observed[{3, 4}] = 1;
+  tracker.restore(s);
+  std::vector<uint8_t> has_votes = {0, 1, 0, 0, 1};
+  EXPECT_EQ(1u, tracker.forgetUnvoted(has_votes));
+  ASSERT_EQ(2u, tracker.states().size());
+  EXPECT_EQ(3.0, tracker.states().at(1).class_counts.at(5));
+  EXPECT_EQ(2.0, tracker.states().at(4).class_counts.at(0));
+  ASSERT_EQ(1u, tracker.coObservations().size());
+  EXPECT_EQ(5, tracker.coObservations().at({1, 4}));
+  // Labels beyond the flags (created after they were computed) count as unvoted.
+  EXPECT_EQ(2u, tracker.forgetUnvoted({0, 0}));
+  EXPECT_TRUE(tracker.states().empty());
+}
+
+}  // namespace
+}  // namespace panmap

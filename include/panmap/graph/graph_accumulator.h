@@ -42,6 +42,10 @@ class GraphAccumulator {
   void update(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const PanopticFrame& panoptic,
               const TsdfMap& map, const SuperpointTracker& tracker, float stuff_confidence = 0.5f);
 
+  /// Drops the scores and edges of super-points no voxel votes for any more (see
+  /// SuperpointTracker::forgetUnvoted; has_votes is indexed by root label).
+  void forgetUnvoted(const std::vector<uint8_t>& has_votes, const LabelRegistry& registry);
+
   /// The graph of the live super-points: scores and confidences, centroids and voxel counts
   /// from the map, initial labels from the tracker's frame counts.
   SuperpointGraph graph(const TsdfMap& map, const SuperpointTracker& tracker) const;

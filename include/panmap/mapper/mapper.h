@@ -54,7 +54,7 @@ struct FrameStats {
   double segmentation_ms = 0.0;  ///< III-A
   double superpoints_ms = 0.0;   ///< III-B association, merging, frame counting
   double integration_ms = 0.0;   ///< label-TSDF update
-  double graph_ms = 0.0;         ///< III-C super-point graph update
+  double graph_ms = 0.0;         ///< III-C graph update (and every 100th frame, forgetting unvoted)
   double tracking_ms = 0.0;      ///< pose refinement against the map (0 when not run)
   double occupancy_ms = 0.0;     ///< occupancy update (runs alongside the super-point stage)
   double total_ms = 0.0;
@@ -112,6 +112,11 @@ class Mapper {
   int64_t framesIntegrated() const { return frames_; }
   /// Votes evicted from full voxel slots so far (never silent).
   uint64_t voteEvictions() const { return vote_evictions_; }
+  /// Super-points forgotten so far because no voxel voted for them any more (checked every
+  /// kForgetEveryFrames frames; they would otherwise pile up in the graph on long runs).
+  uint64_t superpointsForgotten() const { return superpoints_forgotten_; }
+  /// Frames between checks for super-points without votes.
+  static constexpr int64_t kForgetEveryFrames = 100;
   /// The occupancy map, or null when disabled.
   const OccupancyMap* occupancy() const { return occupancy_.get(); }
   /// Every integrated frame's pose as used (refined where tracking ran), in order.
@@ -138,6 +143,7 @@ class Mapper {
  private:
   void validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
                 const PanopticFrame* panoptic) const;
+  void forgetUnvotedSuperpoints();
 
   MapperConfig config_;
   std::unique_ptr<ThreadPool> pool_;
@@ -156,6 +162,7 @@ class Mapper {
   std::vector<StampedPose> trajectory_;
   int64_t frames_ = 0;
   uint64_t vote_evictions_ = 0;
+  uint64_t superpoints_forgotten_ = 0;
 };
 
 }  // namespace panmap

@@ -73,6 +73,13 @@ class SuperpointTracker {
   FrameAssociation associate(const FrameSegmentation& segmentation, const RgbdFrame& frame,
                              const Eigen::Isometry3d& T_W_C, const TsdfMap& map);
 
+  /// Forgets super-points that no voxel votes for any more (their votes were all evicted by
+  /// stronger labels): their frame counts and co-observations. They can never be associated
+  /// again, and on long runs they would outnumber the live ones many times over.
+  /// @param has_votes flag per root label (index = label), non-zero when some voxel votes for it
+  /// @return the number of super-points forgotten
+  size_t forgetUnvoted(const std::vector<uint8_t>& has_votes);
+
   /// Label registry (creation and merges).
   const LabelRegistry& labels() const { return labels_; }
   /// State of a live super-point (resolves merged labels); null if unknown.
