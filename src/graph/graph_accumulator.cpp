@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "panmap/core/classes.h"
+#include "panmap/core/container_memory.h"
 #include "panmap/core/error.h"
 #include "panmap/map/voxel.h"
 #include "panmap/map/voxel_lookup.h"
@@ -174,6 +175,14 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
     }
     begin = end;
   }
+}
+
+size_t GraphAccumulator::memoryBytes() const {
+  size_t bytes = mapNodesBytes(scores_) + mapNodesBytes(edges_);
+  for (const auto& [label, by_class] : scores_) bytes += mapNodesBytes(by_class);
+  for (const auto& [pair, by_class] : edges_) bytes += mapNodesBytes(by_class);
+  for (const auto& part : thread_hits_) bytes += vectorBytes(part);
+  return bytes + vectorBytes(hits_);
 }
 
 void GraphAccumulator::forgetUnvoted(const std::vector<uint8_t>& has_votes,

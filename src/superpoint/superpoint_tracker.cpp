@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <tuple>
 
+#include "panmap/core/container_memory.h"
 #include "panmap/core/error.h"
 #include "panmap/map/voxel.h"
 #include "panmap/map/voxel_lookup.h"
@@ -85,6 +86,15 @@ void SuperpointTracker::mergeLabels(int32_t a, int32_t b, FrameAssociation* out)
   for (const auto& [key, count] : moved) co_observed_[key] += count;
   merge_log_.push_back({keep, gone, frames_});
   ++out->merges;
+}
+
+size_t SuperpointTracker::memoryBytes() const {
+  size_t bytes = mapNodesBytes(states_) + mapNodesBytes(co_observed_) + vectorBytes(merge_log_) +
+                 vectorBytes(labels_.parents());
+  for (const auto& [label, state] : states_) {
+    bytes += mapNodesBytes(state.class_counts) + mapNodesBytes(state.instance_counts);
+  }
+  return bytes;
 }
 
 size_t SuperpointTracker::forgetUnvoted(const std::vector<uint8_t>& has_votes) {

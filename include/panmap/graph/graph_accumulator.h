@@ -56,6 +56,8 @@ class GraphAccumulator {
   const std::map<int32_t, double>& confidences(int32_t a, int32_t b) const;
   /// Number of edges.
   size_t numEdges() const { return edges_.size(); }
+  /// Estimated heap bytes of the scores and edges (std::map nodes).
+  size_t memoryBytes() const;
 
   /// Full state for saving and restoring a map.
   struct Snapshot {

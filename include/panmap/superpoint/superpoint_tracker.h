@@ -94,6 +94,9 @@ class SuperpointTracker {
   const std::map<std::pair<int32_t, int32_t>, int>& coObservations() const { return co_observed_; }
   /// The config in use.
   const SuperpointConfig& config() const { return config_; }
+  /// Estimated heap bytes of the super-point bookkeeping (states, co-observations, merge log,
+  /// label registry).
+  size_t memoryBytes() const;
 
   /// Full state for saving and restoring a map.
   struct Snapshot {
