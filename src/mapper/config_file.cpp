@@ -61,9 +61,9 @@ PanmapConfig loadConfig(const std::string& path) {
   PanmapConfig c;
   MapperConfig& m = c.mapper;
   const cv::FileNode root = fs.root();
-  const std::set<std::string> sections = {"map", "integrator", "depth_segmentation", "fusion",
-                                          "superpoints", "graph", "occupancy", "tracking",
-                                          "optimiser", "threads"};
+  const std::set<std::string> sections = {
+      "map",   "integrator", "depth_segmentation", "fusion",    "superpoints",
+      "graph", "occupancy",  "tracking",           "optimiser", "threads"};
   for (auto it = root.begin(); it != root.end(); ++it) {
     if (!sections.count((*it).name())) throw Error(path + ": unknown section " + (*it).name());
   }
@@ -159,6 +159,7 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("inlier_distance_m", &t.inlier_distance_m);
     s.read("min_inlier_ratio", &t.min_inlier_ratio);
     s.read("min_relative_eigenvalue", &t.min_relative_eigenvalue);
+    s.read("weak_direction_damping", &t.weak_direction_damping);
     s.read("remap_degenerate", &t.remap_degenerate);
     s.read("max_correction_translation_m", &t.max_correction_translation_m);
     s.read("max_correction_rotation_rad", &t.max_correction_rotation_rad);
@@ -210,15 +211,19 @@ PanmapConfig loadConfig(const std::string& path) {
 std::string configToYaml(const PanmapConfig& c) {
   const MapperConfig& m = c.mapper;
   std::ostringstream y;
-  y << "%YAML:1.0\n---\n# panmap configuration. Every key is optional; missing keys keep these defaults.\n";
+  y << "%YAML:1.0\n---\n# panmap configuration. Every key is optional; missing keys keep these "
+       "defaults.\n";
   y << "map:\n   voxel_size_m: " << m.map.voxel_size_m << "   # voxel edge, metres\n";
   y << "integrator:\n"
-    << "   truncation_voxels: " << m.integrator.truncation_voxels << "   # TSDF truncation, voxels\n"
+    << "   truncation_voxels: " << m.integrator.truncation_voxels
+    << "   # TSDF truncation, voxels\n"
     << "   max_weight: " << m.integrator.max_weight << "   # weights saturate here\n"
     << "   min_depth_m: " << m.integrator.min_depth_m << "   # depth range used, metres\n"
     << "   max_depth_m: " << m.integrator.max_depth_m << "\n"
-    << "   weight_dropoff: " << m.integrator.weight_dropoff << "   # weight falls behind the surface (0/1)\n"
-    << "   space_carving: " << m.integrator.space_carving << "   # record free space up to the camera (0/1)\n"
+    << "   weight_dropoff: " << m.integrator.weight_dropoff
+    << "   # weight falls behind the surface (0/1)\n"
+    << "   space_carving: " << m.integrator.space_carving
+    << "   # record free space up to the camera (0/1)\n"
     << "   vote_stride_px: " << m.integrator.vote_stride_px << "   # pixels between label votes\n";
   y << "depth_segmentation:\n"
     << "   normals_window_px: " << m.depth_segmentation.normals_window_px << "\n"
@@ -235,7 +240,8 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   association_min_overlap: " << m.superpoints.association_min_overlap << "\n"
     << "   significant_overlap: " << m.superpoints.significant_overlap << "   # L_N(s_i) share\n"
     << "   merge_threshold: " << m.superpoints.merge_threshold << "   # theta_merge\n"
-    << "   semantic_consistency: " << m.superpoints.semantic_consistency << "   # 0: spatial-only merging\n"
+    << "   semantic_consistency: " << m.superpoints.semantic_consistency
+    << "   # 0: spatial-only merging\n"
     << "   sample_stride_px: " << m.superpoints.sample_stride_px << "\n"
     << "   instance_min_overlap: " << m.superpoints.instance_min_overlap << "\n";
   y << "graph:\n"
@@ -258,17 +264,23 @@ std::string configToYaml(const PanmapConfig& c) {
                      : m.tracking_mode == MapperConfig::TrackingMode::kOn ? "on"
                                                                           : "auto";
   y << "tracking:\n"
-    << "   mode: \"" << mode << "\"   # refine poses against the map - off, auto (SLAM or odometry poses) or on\n"
+    << "   mode: \"" << mode
+    << "\"   # refine poses against the map - off, auto (SLAM or odometry poses) or on\n"
     << "   warmup_frames: " << m.tracking_warmup_frames << "   # frames mapped before refining\n"
     << "   max_iterations: " << t.max_iterations << "   # per pyramid level\n"
     << "   robust_scale_m: " << t.robust_scale_m << "   # Huber scale, metres\n"
-    << "   prior_sigma_translation_m: " << t.prior_sigma_translation_m << "   # prior on the correction\n"
+    << "   prior_sigma_translation_m: " << t.prior_sigma_translation_m
+    << "   # prior on the correction\n"
     << "   prior_sigma_rotation_rad: " << t.prior_sigma_rotation_rad << "\n"
     << "   min_points: " << t.min_points << "\n"
     << "   inlier_distance_m: " << t.inlier_distance_m << "\n"
     << "   min_inlier_ratio: " << t.min_inlier_ratio << "\n"
-    << "   min_relative_eigenvalue: " << t.min_relative_eigenvalue << "   # below: an unconstrained direction\n"
-    << "   remap_degenerate: " << t.remap_degenerate << "   # correct only constrained directions (0: refuse)\n"
+    << "   min_relative_eigenvalue: " << t.min_relative_eigenvalue
+    << "   # below: an unconstrained direction\n"
+    << "   weak_direction_damping: " << t.weak_direction_damping
+    << "   # extra prior, share of the strongest direction's information (0: off)\n"
+    << "   remap_degenerate: " << t.remap_degenerate
+    << "   # correct only constrained directions (0: refuse)\n"
     << "   max_correction_translation_m: " << t.max_correction_translation_m << "\n"
     << "   max_correction_rotation_rad: " << t.max_correction_rotation_rad << "\n";
   const OptimiserConfig& o = c.optimiser;

@@ -14,7 +14,8 @@ namespace {
 
 constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 // 2: occupancy cells, pose refinement state and the trajectory.
-constexpr uint32_t kVersion = 2;
+// 3: the pose refinement's weak_direction_damping.
+constexpr uint32_t kVersion = 3;
 
 void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put(c.map.voxel_size_m);
@@ -56,10 +57,10 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   for (int stride : t.level_strides_px) w->put<int32_t>(stride);
   w->put<int32_t>(t.max_iterations);
   w->put<int8_t>(static_cast<int8_t>(t.loss));
-  for (double v :
-       {t.robust_scale_m, t.point_sigma_m, t.prior_sigma_translation_m, t.prior_sigma_rotation_rad,
-        t.min_depth_m, t.max_depth_m, t.inlier_distance_m, t.min_inlier_ratio,
-        t.min_relative_eigenvalue, t.max_correction_translation_m, t.max_correction_rotation_rad}) {
+  for (double v : {t.robust_scale_m, t.point_sigma_m, t.prior_sigma_translation_m,
+                   t.prior_sigma_rotation_rad, t.min_depth_m, t.max_depth_m, t.inlier_distance_m,
+                   t.min_inlier_ratio, t.min_relative_eigenvalue, t.max_correction_translation_m,
+                   t.max_correction_rotation_rad, t.weak_direction_damping}) {
     w->put(v);
   }
   w->put<int32_t>(t.min_points);
@@ -108,10 +109,11 @@ MapperConfig getConfig(BinaryReader* r) {
   for (int& stride : t.level_strides_px) stride = r->get<int32_t>();
   t.max_iterations = r->get<int32_t>();
   t.loss = static_cast<RobustLoss>(r->get<int8_t>());
-  for (double* v : {&t.robust_scale_m, &t.point_sigma_m, &t.prior_sigma_translation_m,
-                    &t.prior_sigma_rotation_rad, &t.min_depth_m, &t.max_depth_m,
-                    &t.inlier_distance_m, &t.min_inlier_ratio, &t.min_relative_eigenvalue,
-                    &t.max_correction_translation_m, &t.max_correction_rotation_rad}) {
+  for (double* v :
+       {&t.robust_scale_m, &t.point_sigma_m, &t.prior_sigma_translation_m,
+        &t.prior_sigma_rotation_rad, &t.min_depth_m, &t.max_depth_m, &t.inlier_distance_m,
+        &t.min_inlier_ratio, &t.min_relative_eigenvalue, &t.max_correction_translation_m,
+        &t.max_correction_rotation_rad, &t.weak_direction_damping}) {
     *v = r->get<double>();
   }
   t.min_points = r->get<int32_t>();

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -113,9 +114,9 @@ std::vector<Eigen::Vector3f> selectPoints(const DepthImage& depth, const Pinhole
 }
 
 // Runs Ceres on one level from *delta; returns false (with a message) when Ceres fails.
-bool solveLevel(SdfResiduals* residuals, PriorCost* prior, ceres::Manifold* manifold,
-                int max_iterations, double tolerance, Vector6d* delta, int* iterations,
-                std::string* message) {
+bool solveLevel(SdfResiduals* residuals, PriorCost* prior, PriorCost* damping,
+                ceres::Manifold* manifold, int max_iterations, double tolerance, Vector6d* delta,
+                int* iterations, std::string* message) {
   SdfCost data(residuals);
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -123,6 +124,7 @@ bool solveLevel(SdfResiduals* residuals, PriorCost* prior, ceres::Manifold* mani
   ceres::Problem problem(problem_options);
   problem.AddResidualBlock(&data, nullptr, delta->data());
   problem.AddResidualBlock(prior, nullptr, delta->data());
+  if (damping) problem.AddResidualBlock(damping, nullptr, delta->data());
   if (manifold) problem.SetManifold(delta->data(), manifold);
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
@@ -216,6 +218,9 @@ void FrameToModelAligner::Config::check() const {
   if (!(min_inlier_ratio >= 0.0 && min_inlier_ratio <= 1.0)) {
     throw Error("tracking min_inlier_ratio must be in [0, 1]");
   }
+  if (!(weak_direction_damping >= 0.0 && std::isfinite(weak_direction_damping))) {
+    throw Error("tracking weak_direction_damping must be >= 0");
+  }
   if (!(min_relative_eigenvalue > 0.0 && min_relative_eigenvalue < 1.0)) {
     throw Error("tracking min_relative_eigenvalue must be in (0, 1)");
   }
@@ -225,6 +230,14 @@ void FrameToModelAligner::Config::check() const {
   if (!(max_correction_rotation_rad > 0.0)) {
     throw Error("tracking max_correction_rotation_rad must be > 0");
   }
+}
+
+FrameToModelAligner::Config FrameToModelAligner::Config::forSequences() {
+  Config config;
+  config.prior_sigma_translation_m = 0.01;
+  config.prior_sigma_rotation_rad = 0.01;
+  config.weak_direction_damping = 0.01;
+  return config;
 }
 
 FrameToModelAligner::FrameToModelAligner(const Config& config) : config_(config) {
@@ -284,8 +297,8 @@ AlignmentResult FrameToModelAligner::align(const TsdfMap& map, const DepthImage&
                      config_.min_depth_m, config_.max_depth_m),
         options);
     if (residuals.keepPointsInMap(delta) == 0) continue;
-    if (!solveLevel(&residuals, &prior, nullptr, config_.max_iterations, kCoarseTolerance, &delta,
-                    &result.iterations, &message)) {
+    if (!solveLevel(&residuals, &prior, nullptr, nullptr, config_.max_iterations, kCoarseTolerance,
+                    &delta, &result.iterations, &message)) {
       return finish(AlignmentStatus::kSolverFailed, "solver failed: " + message);
     }
   }
@@ -294,8 +307,26 @@ AlignmentResult FrameToModelAligner::align(const TsdfMap& map, const DepthImage&
   SdfResiduals residuals(map, T_W_C_prior, finest, options);
   result.points_used = residuals.keepPointsInMap(delta);
   if (result.points_used < config_.min_points) return tooFew(result.points_used);
-  if (!solveLevel(&residuals, &prior, nullptr, config_.max_iterations, kFineTolerance, &delta,
-                  &result.iterations, &message)) {
+  // Weak-direction damping (Config::weak_direction_damping): a second prior on the increment
+  // whose information is the share times the points' strongest eigenvalue, isotropic in the
+  // rotation-scaled coordinates of the degeneracy analysis (rotations in metres at the RMS
+  // range), measured where the coarser levels left the pose.
+  std::unique_ptr<PriorCost> damping;
+  if (config_.weak_direction_damping > 0.0) {
+    const SdfFitStats shape = residuals.statistics(delta, config_.inlier_distance_m);
+    if (shape.points_in_map > 0 && shape.rms_range_m > 0.0) {
+      const DegeneracyAnalysis analysis = analyseDegeneracy(shape.normal_matrix, shape.rms_range_m,
+                                                            config_.min_relative_eigenvalue);
+      const double information = config_.weak_direction_damping * analysis.eigenvalues[5] *
+                                 shape.weight_sum / (config_.point_sigma_m * config_.point_sigma_m);
+      if (information > 0.0 && std::isfinite(information)) {
+        const double sigma_m = 1.0 / std::sqrt(information);
+        damping = std::make_unique<PriorCost>(sigma_m, sigma_m / shape.rms_range_m);
+      }
+    }
+  }
+  if (!solveLevel(&residuals, &prior, damping.get(), nullptr, config_.max_iterations,
+                  kFineTolerance, &delta, &result.iterations, &message)) {
     return finish(AlignmentStatus::kSolverFailed, "solver failed: " + message);
   }
 
@@ -318,8 +349,8 @@ AlignmentResult FrameToModelAligner::align(const TsdfMap& map, const DepthImage&
     // settle without them.
     delta = analysis.project(delta);
     SubspaceManifold subspace(analysis);
-    if (!solveLevel(&residuals, &prior, &subspace, config_.max_iterations, kFineTolerance, &delta,
-                    &result.iterations, &message)) {
+    if (!solveLevel(&residuals, &prior, damping.get(), &subspace, config_.max_iterations,
+                    kFineTolerance, &delta, &result.iterations, &message)) {
       return finish(AlignmentStatus::kSolverFailed, "solver failed: " + message);
     }
     stats = residuals.statistics(delta, config_.inlier_distance_m);

@@ -133,6 +133,7 @@ SdfFitStats SdfResiduals::statistics(const Vector6d& delta, double inlier_distan
     stats.rms_range_m = std::sqrt(range_sq_sum / stats.points_in_map);
     stats.normal_matrix = H.selfadjointView<Eigen::Upper>();
     stats.normal_matrix /= weight_sum;
+    stats.weight_sum = weight_sum;
   }
   return stats;
 }

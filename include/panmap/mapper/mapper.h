@@ -43,7 +43,8 @@ struct MapperConfig {
   TrackingMode tracking_mode = TrackingMode::kAuto;
   /// Frames mapped with their given pose before refinement starts (the map needs a model).
   int tracking_warmup_frames = 5;
-  FrameToModelAligner::Config tracking;
+  /// The aligner's sequence defaults (FrameToModelAligner::Config::forSequences()).
+  FrameToModelAligner::Config tracking = FrameToModelAligner::Config::forSequences();
   int num_threads = 2;  ///< threads for segmentation and integration (association uses one)
   /// Throws Error naming the bad field.
   void check() const;

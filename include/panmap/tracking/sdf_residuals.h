@@ -36,6 +36,9 @@ struct SdfFitStats {
   /// (J = d sdf / d increment at the increment, without the point sigma): the shape of the
   /// information, for the degeneracy check.
   Matrix6d normal_matrix = Matrix6d::Zero();
+  /// Sum of the robust weights (rho') of the in-map points: normal_matrix * weight_sum /
+  /// point_sigma^2 is the Gauss-Newton information of the points.
+  double weight_sum = 0.0;
 };
 
 /// Point-to-model residuals of a frame's depth points against the TSDF zero crossing: the
