@@ -123,8 +123,9 @@ Targets of roadmap issue 9 (2 threads, median total): <= 33 ms at 1 cm, <= 15 ms
 
 \`panmap-bench-memory --room 1 --frames 3000 --voxel-size 0.02\`: a 100 s walk (30 Hz)
 through one room, rendered in-process and mapped frame by frame with its masks. Resident
-memory against what the map holds: TSDF blocks and occupancy cells; \`other\` is the rest
-of the process (super-point and graph state, the renderer and its room, scratch buffers).
+memory against what the map holds: TSDF blocks, occupancy cells and the super-point graph
+with its bookkeeping (estimated from its std::map nodes); \`other\` is the rest of the
+process (the renderer and its room, libraries, scratch buffers), which must stay flat.
 
 ${memory_rows}
 
