@@ -4,7 +4,6 @@
 // export) timed every --outputs-every frames; peak memory and bytes per voxel.
 //   panmap-bench-mapping [--data DIR | --log FILE] [--voxel-size M] [--threads N] [--frames N]
 //                        [--outputs-every N] [--json FILE] [--markdown-row]
-#include <sys/resource.h>
 
 #include <chrono>
 #include <cstdio>
@@ -14,6 +13,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "panmap/core/process_memory.h"
 #include "panmap/io/dataset_reader.h"
 #include "panmap/lcm/offline_mapping.h"
 #include "panmap/mapper/mapper.h"
@@ -113,8 +113,7 @@ int main(int argc, char** argv) {
     const auto start = Clock::now();
     const panmap::LabelledMesh mesh = mapper.extractMesh();
     const double mesh_ms = msSince(start);
-    struct rusage usage;
-    getrusage(RUSAGE_SELF, &usage);
+    const size_t peak_rss = panmap::peakResidentBytes();
     const size_t voxels = mapper.map().numBlocks() * panmap::kBlockVoxels;
     nlohmann::json out = recorder.summary();
     out.update({{"data", data},
@@ -126,7 +125,7 @@ int main(int argc, char** argv) {
                 {"voxels", voxels},
                 {"bytes_per_voxel", static_cast<double>(mapper.map().memoryBytes()) / voxels},
                 {"map_bytes", mapper.map().memoryBytes()},
-                {"peak_rss_bytes", static_cast<size_t>(usage.ru_maxrss) * 1024},
+                {"peak_rss_bytes", peak_rss},
                 {"final_mesh_ms", mesh_ms},
                 {"mesh_vertices", mesh.numVertices()}});
     if (markdown) {
@@ -148,8 +147,7 @@ int main(int argc, char** argv) {
           cell("superpoints").c_str(), cell("integration").c_str(), cell("graph").c_str(),
           cell("occupancy").c_str(), cell("total").c_str(), cell("mesh_update").c_str(),
           cell("octree_export").c_str(), mapper.map().memoryBytes() / 1048576.0,
-          static_cast<double>(usage.ru_maxrss) / 1024.0,
-          static_cast<double>(mapper.map().memoryBytes()) / voxels);
+          peak_rss / 1048576.0, static_cast<double>(mapper.map().memoryBytes()) / voxels);
     } else {
       std::printf("%s\n", out.dump(2).c_str());
     }

@@ -4,7 +4,6 @@
 // everything else (scratch buffers, queues, per-frame state) must stay flat with it.
 //   panmap-bench-memory [--room N] [--frames N] [--voxel-size M] [--threads N] [--every N]
 //                       [--json FILE]
-#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -15,20 +14,13 @@
 #include <nlohmann/json.hpp>
 
 #include "panmap/core/error.h"
+#include "panmap/core/process_memory.h"
 #include "panmap/mapper/mapper.h"
 #include "panmap/sim/procedural_room.h"
 #include "panmap/sim/sequence.h"
 #include "panmap/sim/trajectory.h"
 
 namespace {
-
-// Resident memory of this process now, bytes (0 without /proc).
-size_t residentBytes() {
-  std::ifstream statm("/proc/self/statm");
-  size_t pages = 0, resident = 0;
-  if (!(statm >> pages >> resident)) return 0;
-  return resident * static_cast<size_t>(::sysconf(_SC_PAGESIZE));
-}
 
 constexpr double kMiB = 1024.0 * 1024.0;
 
@@ -88,7 +80,7 @@ int main(int argc, char** argv) {
       const panmap::SynthFrame f = synth.frame(k);
       mapper.integrate(f.rgbd, f.gt_pose.T_W_C, &f.panoptic, panmap::PoseSource::kGroundTruth);
       if ((k + 1) % static_cast<size_t>(every) != 0 && k + 1 != synth.size()) continue;
-      const size_t rss = residentBytes();
+      const size_t rss = panmap::residentBytes();
       const size_t tsdf = mapper.map().memoryBytes();
       const size_t occupancy = mapper.occupancy() ? mapper.occupancy()->grid().memoryBytes() : 0;
       // Super-point graph and bookkeeping: estimated from their std::map nodes.

@@ -77,6 +77,7 @@
 #include <open3d/utility/Parallel.h>
 
 #include "panmap/core/error.h"
+#include "panmap/core/process_memory.h"
 #include "panmap/io/dataset_reader.h"
 #include "panmap/lcm/conversions.h"
 #include "panmap/lcm/mapping_session.h"
@@ -109,14 +110,6 @@ double cpuMs() {
   timespec t;
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
   return 1e3 * t.tv_sec + 1e-6 * t.tv_nsec;
-}
-
-/// Resident set size now, bytes (0 when /proc is unavailable).
-size_t currentRssBytes() {
-  std::ifstream statm("/proc/self/statm");
-  size_t pages_total = 0, pages_resident = 0;
-  if (!(statm >> pages_total >> pages_resident)) return 0;
-  return pages_resident * static_cast<size_t>(sysconf(_SC_PAGESIZE));
 }
 
 Input readDataset(const std::string& dir, int max_frames) {
@@ -314,7 +307,7 @@ int main(int argc, char** argv) {
     Input input = log_path.empty() ? readDataset(data, frames) : readLog(log_path, frames);
     const std::string source = log_path.empty() ? data : log_path;
     if (input.frames.empty()) throw panmap::Error("no frame with a pose in " + source);
-    const size_t rss_before = currentRssBytes();
+    const size_t rss_before = panmap::residentBytes();
 
     const double sdf_trunc = truncation_voxels * voxel_size_m;
     open3d::pipelines::integration::ScalableTSDFVolume volume(
@@ -346,8 +339,7 @@ int main(int argc, char** argv) {
     if (!mesh_path.empty() && !open3d::io::WriteTriangleMesh(mesh_path, *mesh)) {
       throw panmap::Error("cannot write mesh " + mesh_path);
     }
-    struct rusage usage;
-    getrusage(RUSAGE_SELF, &usage);
+    const size_t peak_rss = panmap::peakResidentBytes();
     const size_t units = volume.volume_units_.size();
     const size_t unit_voxels = size_t(volume.volume_unit_resolution_) *
                                volume.volume_unit_resolution_ * volume.volume_unit_resolution_;
@@ -395,7 +387,7 @@ int main(int argc, char** argv) {
         {"volume_units", units},
         {"voxels", units * unit_voxels},
         {"rss_before_integration_bytes", rss_before},
-        {"peak_rss_bytes", static_cast<size_t>(usage.ru_maxrss) * 1024},
+        {"peak_rss_bytes", peak_rss},
         {"final_mesh_ms", mesh_ms},
         {"mesh_vertices", mesh->vertices_.size()},
         {"mesh_triangles", mesh->triangles_.size()},
@@ -410,7 +402,7 @@ int main(int argc, char** argv) {
     if (markdown) {
       std::printf("| %g cm | %d | %zu | %.1f / %.1f | %.0f |\n", voxel_size_m * 100.0,
                   open3d_threads, integrate_ms.size(), integration.median_ms, integration.p95_ms,
-                  static_cast<double>(usage.ru_maxrss) / 1024.0);
+                  peak_rss / 1048576.0);
     } else {
       std::printf("%s\n", out.dump(2).c_str());
     }

@@ -3,7 +3,6 @@
 // PANMAP_COMMAND finish (or SIGINT/SIGTERM) asks panmap-optimizer for the final labels and
 // writes the outputs. Offline (--log): maps every frame of a log as fast as it can and runs
 // the final optimisation in-process; the same log and config give the same outputs.
-#include <sys/resource.h>
 
 #include <atomic>
 #include <chrono>
@@ -17,6 +16,7 @@
 
 #include "panmap/command_t.hpp"
 #include "panmap/core/error.h"
+#include "panmap/core/process_memory.h"
 #include "panmap/core/progress.h"
 #include "panmap/graph/optimiser.h"
 #include "panmap/lcm/live_mapper.h"
@@ -31,13 +31,6 @@ namespace {
 
 std::atomic<bool> g_stop{false};
 void onSignal(int) { g_stop = true; }
-
-// Peak resident memory of this process, bytes.
-size_t peakRssBytes() {
-  struct rusage usage;
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<size_t>(usage.ru_maxrss) * 1024;
-}
 
 nlohmann::json sessionJson(const panmap::SessionStats& s) {
   nlohmann::json timings;
@@ -67,7 +60,7 @@ nlohmann::json mapJson(const panmap::Mapper& mapper, const panmap::OutputSummary
   return {{"frames_total", mapper.framesIntegrated()},
           {"memory",
            {{"map_bytes", mapper.map().memoryBytes()},
-            {"peak_rss_bytes", peakRssBytes()},
+            {"peak_rss_bytes", panmap::peakResidentBytes()},
             {"blocks", mapper.map().numBlocks()},
             {"voxels", mapper.map().numBlocks() * panmap::kBlockVoxels}}},
           {"superpoints", mapper.superpoints().states().size()},

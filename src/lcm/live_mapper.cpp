@@ -1,13 +1,11 @@
 #include "panmap/lcm/live_mapper.h"
 
-#include <unistd.h>
-
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 
 #include "panmap/command_t.hpp"
 #include "panmap/core/error.h"
+#include "panmap/core/process_memory.h"
 #include "panmap/graph_labels_t.hpp"
 #include "panmap/lcm/graph_conversions.h"
 
@@ -19,14 +17,6 @@ int64_t wallUtime() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
              std::chrono::system_clock::now().time_since_epoch())
       .count();
-}
-
-// Resident memory of this process, bytes (0 when /proc is unavailable).
-int64_t residentBytes() {
-  std::ifstream statm("/proc/self/statm");
-  int64_t pages = 0, resident = 0;
-  if (!(statm >> pages >> resident)) return 0;
-  return resident * static_cast<int64_t>(::sysconf(_SC_PAGESIZE));
 }
 
 template <typename Msg>
@@ -236,7 +226,7 @@ status_t LiveMapper::status(const std::string& state) const {
     msg.stage_last_ms.push_back(static_cast<float>(t.last_ms));
   }
   msg.num_stages = static_cast<int32_t>(msg.stage_names.size());
-  msg.memory_bytes = residentBytes();
+  msg.memory_bytes = static_cast<int64_t>(residentBytes());
   msg.num_blocks = static_cast<int64_t>(mapper_->map().numBlocks());
   msg.num_voxels = msg.num_blocks * kBlockVoxels;
   msg.num_superpoints = static_cast<int32_t>(mapper_->superpoints().states().size());
