@@ -80,6 +80,7 @@
 #include "panmap/core/process_memory.h"
 #include "panmap/io/dataset_reader.h"
 #include "panmap/lcm/conversions.h"
+#include "panmap/lcm/decode.h"
 #include "panmap/lcm/mapping_session.h"
 #include "panmap/mapper/frame_sync.h"
 
@@ -128,15 +129,6 @@ Input readDataset(const std::string& dir, int max_frames) {
   return input;
 }
 
-template <typename Msg>
-bool decodeInto(const lcm::LogEvent& e, Msg* msg) {
-  try {
-    return msg->decode(e.data, 0, e.datalen) == e.datalen;
-  } catch (const std::exception&) {
-    return false;  // generated decoders can throw on absurd array lengths
-  }
-}
-
 /// The frames panmap-mapper --log would map: the same channels, decoding and synchroniser
 /// (stream time = newest event timestamp), stopping after max_frames ready frames.
 Input readLog(const std::string& path, int max_frames) {
@@ -164,14 +156,14 @@ Input readLog(const std::string& path, int max_frames) {
     try {
       if (e->channel == options.channel_rgbd) {
         panmap::rgbd_frame_t msg;
-        if (!decodeInto(*e, &msg)) {
+        if (!panmap::decodeExactly(e->data, static_cast<size_t>(e->datalen), &msg)) {
           ++input.rejected["malformed " + e->channel];
           continue;
         }
         sync.addFrame(panmap::fromMessage(msg));
       } else if (e->channel == options.channel_pose) {
         panmap::pose_t msg;
-        if (!decodeInto(*e, &msg)) {
+        if (!panmap::decodeExactly(e->data, static_cast<size_t>(e->datalen), &msg)) {
           ++input.rejected["malformed " + e->channel];
           continue;
         }
@@ -179,7 +171,7 @@ Input readLog(const std::string& path, int max_frames) {
       } else if (e->channel == options.channel_panoptic) {
         // Only its arrival matters here (a frame waits for its mask), not its content.
         panmap::panoptic_t msg;
-        if (!decodeInto(*e, &msg)) {
+        if (!panmap::decodeExactly(e->data, static_cast<size_t>(e->datalen), &msg)) {
           ++input.rejected["malformed " + e->channel];
           continue;
         }

@@ -15,6 +15,7 @@
 
 #include "panmap/core/error.h"
 #include "panmap/lcm/channels.h"
+#include "panmap/lcm/decode.h"
 #include "panmap/occupancy/occupancy_query.h"
 #include "panmap/occupancy/octree_io.h"
 #include "panmap/octomap_t.hpp"
@@ -30,13 +31,7 @@ class TreeReceiver {
     done_ = true;
     try {
       panmap::octomap_t msg;
-      int used = -1;
-      try {
-        used = msg.decode(buffer->data, 0, static_cast<int>(buffer->data_size));
-      } catch (const std::exception&) {
-        used = -1;
-      }
-      if (used != static_cast<int>(buffer->data_size)) {
+      if (!panmap::decodeExactly(buffer->data, buffer->data_size, &msg)) {
         error_ = "malformed message on " + channel + " (not a panmap.octomap_t)";
         return;
       }

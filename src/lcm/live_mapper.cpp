@@ -7,6 +7,7 @@
 #include "panmap/core/error.h"
 #include "panmap/core/process_memory.h"
 #include "panmap/graph_labels_t.hpp"
+#include "panmap/lcm/decode.h"
 #include "panmap/lcm/graph_conversions.h"
 
 namespace panmap {
@@ -17,16 +18,6 @@ int64_t wallUtime() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
              std::chrono::system_clock::now().time_since_epoch())
       .count();
-}
-
-template <typename Msg>
-bool decodeBuffer(const lcm::ReceiveBuffer* buffer, Msg* msg) {
-  try {
-    return msg->decode(buffer->data, 0, static_cast<int>(buffer->data_size)) ==
-           static_cast<int>(buffer->data_size);
-  } catch (const std::exception&) {
-    return false;
-  }
 }
 
 }  // namespace
@@ -104,7 +95,7 @@ void LiveMapper::countRejected(const std::string& reason) {
 void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
   try {
     command_t msg;
-    if (!decodeBuffer(buffer, &msg)) {
+    if (!decodeExactly(buffer->data, buffer->data_size, &msg)) {
       countRejected("malformed " + channel);
       std::fprintf(stderr, "panmap-mapper: malformed message on %s ignored\n", channel.c_str());
       return;
@@ -151,7 +142,7 @@ void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& 
 void LiveMapper::onLabels(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
   try {
     graph_labels_t msg;
-    if (!decodeBuffer(buffer, &msg)) {
+    if (!decodeExactly(buffer->data, buffer->data_size, &msg)) {
       countRejected("malformed " + channel);
       return;
     }

@@ -5,6 +5,7 @@
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
 #include "panmap/lcm/conversions.h"
+#include "panmap/lcm/decode.h"
 
 namespace panmap {
 
@@ -23,18 +24,7 @@ std::string reasonOf(const std::string& what) {
   return colon == std::string::npos ? what : what.substr(0, colon);
 }
 
-namespace {
-
-template <typename Msg>
-bool decodeInto(const void* data, size_t size, Msg* msg) {
-  try {
-    return msg->decode(data, 0, static_cast<int>(size)) == static_cast<int>(size);
-  } catch (const std::exception&) {
-    return false;  // generated decoders can throw on absurd array lengths
-  }
-}
-
-}  // namespace
+namespace {}  // namespace
 
 MappingSession::MappingSession(const SessionOptions& options, Mapper* mapper)
     : options_(options), mapper_(mapper), sync_(options.sync) {
@@ -67,7 +57,7 @@ bool MappingSession::handle(const std::string& channel, const void* data, size_t
   try {
     if (channel == options_.channel_rgbd) {
       rgbd_frame_t msg;
-      if (!decodeInto(data, size, &msg)) {
+      if (!decodeExactly(data, size, &msg)) {
         ++stats_.rejected["malformed " + channel];
         return true;
       }
@@ -77,7 +67,7 @@ bool MappingSession::handle(const std::string& channel, const void* data, size_t
       sync_.addFrame(std::move(frame));
     } else if (channel == options_.channel_pose) {
       pose_t msg;
-      if (!decodeInto(data, size, &msg)) {
+      if (!decodeExactly(data, size, &msg)) {
         ++stats_.rejected["malformed " + channel];
         return true;
       }
@@ -86,7 +76,7 @@ bool MappingSession::handle(const std::string& channel, const void* data, size_t
       sync_.addPose(pose);
     } else {
       panoptic_t msg;
-      if (!decodeInto(data, size, &msg)) {
+      if (!decodeExactly(data, size, &msg)) {
         ++stats_.rejected["malformed " + channel];
         return true;
       }

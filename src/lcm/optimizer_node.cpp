@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "panmap/core/error.h"
+#include "panmap/lcm/decode.h"
 #include "panmap/lcm/graph_conversions.h"
 
 namespace panmap {
@@ -17,13 +18,7 @@ void OptimizerNode::onGraph(const lcm::ReceiveBuffer* buffer, const std::string&
   // Called from LCM's C code: nothing may escape.
   try {
     superpoint_graph_t msg;
-    int used = -1;
-    try {
-      used = msg.decode(buffer->data, 0, static_cast<int>(buffer->data_size));
-    } catch (const std::exception&) {
-      used = -1;
-    }
-    if (used != static_cast<int>(buffer->data_size)) {
+    if (!decodeExactly(buffer->data, buffer->data_size, &msg)) {
       ++rejected_["malformed " + channel];
       std::fprintf(stderr, "panmap-optimizer: malformed message on %s ignored\n", channel.c_str());
       return;
