@@ -99,9 +99,13 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   auto resolve = [&registry](int32_t l) { return registry.resolve(l); };
   const int stride = config_.sample_stride_px;
   const size_t rows = static_cast<size_t>((cam.height + stride - 1) / stride);
+  // Each thread sorts and dedupes its own rows' hits; merged, they are what one sort of all
+  // hits would give (equal hits are identical: one voxel has one super-point here).
   auto collect = [&](size_t r0, size_t r1, std::vector<Hit>* out) {
     out->clear();
     VoxelLookup lookup(map);
+    const Voxel* last_voxel = nullptr;
+    int32_t last_label = 0;
     for (size_t r = r0; r < r1; ++r) {
       const int v = static_cast<int>(r) * stride;
       for (int u = 0; u < cam.width; u += stride) {
@@ -112,7 +116,11 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
         const Voxel* voxel =
             lookup.find(T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d));
         if (!voxel) continue;
-        const int32_t label = argmaxLabel(*voxel, resolve);
+        if (voxel != last_voxel) {
+          last_voxel = voxel;
+          last_label = argmaxLabel(*voxel, resolve);
+        }
+        const int32_t label = last_label;
         if (label <= 0) continue;
         const Eigen::Vector3i& g = lookup.lastVoxel();
         const uint64_t key = (static_cast<uint64_t>(g.x() & 0x1FFFFF) << 42) |
@@ -120,9 +128,11 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
                              static_cast<uint64_t>(g.z() & 0x1FFFFF);
         // Neighbouring pixels often repeat the last hit: keep the sort below small.
         if (!out->empty() && out->back().mask == id && out->back().voxel == key) continue;
-        out->push_back({id, key, label});
+        out->push_back({key, id, label});
       }
     }
+    std::sort(out->begin(), out->end());
+    out->erase(std::unique(out->begin(), out->end()), out->end());
   };
   const int threads = pool_ ? pool_->size() : 1;
   thread_hits_.resize(static_cast<size_t>(threads));
@@ -133,14 +143,16 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   } else {
     collect(0, rows, &thread_hits_[0]);
   }
+  // N^S_o counts unique voxels: many pixels see the same voxel up close.
   std::vector<Hit>& hits = hits_;
   hits.clear();
-  for (const std::vector<Hit>& part : thread_hits_)
-    hits.insert(hits.end(), part.begin(), part.end());
-  for (std::vector<Hit>& part : thread_hits_) part.clear();
-  // N^S_o counts unique voxels: many pixels see the same voxel up close.
-  std::sort(hits.begin(), hits.end());
-  hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
+  for (std::vector<Hit>& part : thread_hits_) {
+    merged_.resize(hits.size() + part.size());
+    std::merge(hits.begin(), hits.end(), part.begin(), part.end(), merged_.begin());
+    merged_.erase(std::unique(merged_.begin(), merged_.end()), merged_.end());
+    hits.swap(merged_);
+    part.clear();
+  }
 
   const float voxel = map.voxelSize();
   auto centre = [voxel](uint64_t key) {
@@ -182,7 +194,7 @@ size_t GraphAccumulator::memoryBytes() const {
   for (const auto& [label, by_class] : scores_) bytes += mapNodesBytes(by_class);
   for (const auto& [pair, by_class] : edges_) bytes += mapNodesBytes(by_class);
   for (const auto& part : thread_hits_) bytes += vectorBytes(part);
-  return bytes + vectorBytes(hits_);
+  return bytes + vectorBytes(hits_) + vectorBytes(merged_);
 }
 
 void GraphAccumulator::forgetUnvoted(const std::vector<uint8_t>& has_votes,

@@ -5,8 +5,8 @@
 #include <cmath>
 
 #include "panmap/core/error.h"
-#include "panmap/core/vector_clones.h"
 #include "panmap/map/internal/block_integration.h"
+#include "panmap/map/internal/vote_rows.h"
 #include "panmap/map/voxel_lookup.h"
 
 namespace panmap {
@@ -36,26 +36,6 @@ BlockIndex unpackKey(uint64_t key) {
   return BlockIndex(field(key >> 42), field(key >> 21), field(key));
 }
 
-struct RowCamera {
-  float fx, fy, cx, cy;
-};
-
-// Phase 1 of voteLabels for image row v: the voxel of each labelled pixel with depth, or null.
-// Compiled for AVX2 too, where the voxel lookup's floor() is one instruction instead of a call.
-PANMAP_VECTOR_CLONES void findRowVoxels(const Image<float>& depth_m, const LabelImage& labels,
-                                        int v, int stride, const Eigen::Isometry3f& T_W_C,
-                                        const RowCamera& cam, MutableVoxelLookup* lookup,
-                                        Voxel** out) {
-  for (int u = 0; u < depth_m.width(); u += stride, ++out) {
-    const int32_t label = labels(u, v);
-    const float d = depth_m(u, v);
-    *out = nullptr;
-    if (label <= 0 || d <= 0.0f) continue;
-    *out = lookup->find(T_W_C *
-                        Eigen::Vector3f((u - cam.cx) * d / cam.fx, (v - cam.cy) * d / cam.fy, d));
-  }
-}
-
 }  // namespace
 
 // Pi_V (Eq. 2's counts): every labelled pixel votes for its label in the voxel its measured
@@ -69,16 +49,17 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
                                       const LabelImage& labels, TsdfMap* map,
                                       IntegrationStats* stats) {
   const PinholeCamera& cam = frame.camera;
-  const RowCamera row_cam{static_cast<float>(cam.fx), static_cast<float>(cam.fy),
-                          static_cast<float>(cam.cx), static_cast<float>(cam.cy)};
+  const internal::RowCamera row_cam{static_cast<float>(cam.fx), static_cast<float>(cam.fy),
+                                    static_cast<float>(cam.cx), static_cast<float>(cam.cy)};
   const int stride = config_.vote_stride_px;
   const size_t cols = (cam.width + stride - 1) / stride, rows = (cam.height + stride - 1) / stride;
-  vote_voxels_.resize(cols * rows);
+  vote_runs_.resize(cols * rows);
+  row_runs_.resize(rows);
   pool_->parallelFor(rows, [&](size_t r0, size_t r1, int) {
     MutableVoxelLookup lookup(*map);
     for (size_t r = r0; r < r1; ++r) {
-      findRowVoxels(depth_m_, labels, static_cast<int>(r) * stride, stride, T_W_C, row_cam, &lookup,
-                    &vote_voxels_[r * cols]);
+      row_runs_[r] = internal::findRowVotes(depth_m_, labels, static_cast<int>(r) * stride, stride,
+                                            T_W_C, row_cam, &lookup, &vote_runs_[r * cols]);
     }
   });
   const size_t threads = static_cast<size_t>(pool_->size());
@@ -87,14 +68,13 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
     size_t my_added = 0, my_evicted = 0;
     for (size_t t = t0; t < t1; ++t) {
       for (size_t r = 0; r < rows; ++r) {
-        const int32_t* label_row = &labels(0, static_cast<int>(r) * stride);
-        Voxel* const* voxels = &vote_voxels_[r * cols];
-        for (size_t c = 0; c < cols; ++c) {
-          Voxel* voxel = voxels[c];
+        const VoteRun* runs = &vote_runs_[r * cols];
+        for (size_t i = 0; i < row_runs_[r]; ++i) {
+          const VoteRun& run = runs[i];
           // 4 KiB regions: voxels sharing a cache line nearly always have the same owner.
-          if (!voxel || (reinterpret_cast<uintptr_t>(voxel) >> 12) % threads != t) continue;
-          ++my_added;
-          my_evicted += addVote(voxel, label_row[c * stride]);
+          if ((reinterpret_cast<uintptr_t>(run.voxel) >> 12) % threads != t) continue;
+          my_added += run.count;
+          my_evicted += addVotes(run.voxel, run.label, run.count);
         }
       }
     }

@@ -153,19 +153,19 @@ FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_
   stats.T_W_C = T_W_C;
   const auto t0 = Clock::now();
   stats.tracking_ms = stats.tracked ? ms(t_start, t0) : 0.0;
-  const FrameSegmentation segmentation =
-      segmenter_->segment(frame, config_.fusion.geometry_only ? nullptr : panoptic);
+  FrameSegmentation& segmentation = segmentation_;
+  segmenter_->segment(frame, config_.fusion.geometry_only ? nullptr : panoptic, &segmentation);
   const auto t1 = Clock::now();
   // Association runs on one thread, so the occupancy update (which needs only the frame and
   // its pose) takes the other one meanwhile.
-  FrameAssociation association;
+  FrameAssociation& association = association_;
   std::exception_ptr failures[2];
   pool_->parallelFor(2, [&](size_t begin, size_t end, int) {
     for (size_t task = begin; task < end; ++task) {
       try {
         const auto start = Clock::now();
         if (task == 0) {
-          association = tracker_->associate(segmentation, frame, T_W_C, *map_);
+          tracker_->associate(segmentation, frame, T_W_C, *map_, &association);
           stats.superpoints_ms = ms(start, Clock::now());
         } else if (occupancy_) {
           occupancy_->integrate(frame, T_W_C);

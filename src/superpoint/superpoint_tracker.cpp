@@ -120,16 +120,26 @@ size_t SuperpointTracker::forgetUnvoted(const std::vector<uint8_t>& has_votes) {
 FrameAssociation SuperpointTracker::associate(const FrameSegmentation& segmentation,
                                               const RgbdFrame& frame,
                                               const Eigen::Isometry3d& T_W_C, const TsdfMap& map) {
-  ++frames_;
+  FrameAssociation out;
+  associate(segmentation, frame, T_W_C, map, &out);
+  return out;
+}
+
+void SuperpointTracker::associate(const FrameSegmentation& segmentation, const RgbdFrame& frame,
+                                  const Eigen::Isometry3d& T_W_C, const TsdfMap& map,
+                                  FrameAssociation* result) {
   const auto& surfaces = segmentation.surface_list;
   const size_t n = surfaces.size();
   const int w = frame.camera.width, h = frame.camera.height;
   if (segmentation.surfaces.width() != w || segmentation.surfaces.height() != h) {
     throw Error("superpoints: segmentation size differs from the frame's");
   }
-  FrameAssociation out;
+  ++frames_;
+  FrameAssociation& out = *result;
   out.surface_labels.assign(n, 0);
   out.surface_instances.assign(n, 0);
+  out.new_labels = 0;
+  out.merges = 0;
 
   // Pi_s(L_S, s_i): votes of the voxels the surface's points fall in (Eq. 2 per voxel).
   std::vector<int> samples(n, 0);
@@ -144,7 +154,8 @@ FrameAssociation SuperpointTracker::associate(const FrameSegmentation& segmentat
   // Neighbouring samples mostly see the same surface and super-point: count runs, and touch
   // the per-surface maps once per run instead of once per sample.
   int run_sid = 0, run_count = 0;
-  int32_t run_label = 0;
+  int32_t run_label = 0, last_label = 0;
+  const Voxel* last_voxel = nullptr;
   auto flush = [&] {
     if (run_count > 0) overlap[run_sid - 1][run_label] += run_count;
     run_count = 0;
@@ -159,7 +170,13 @@ FrameAssociation SuperpointTracker::associate(const FrameSegmentation& segmentat
       const Voxel* voxel =
           lookup.find(T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d));
       if (!voxel) continue;
-      const int32_t label = argmaxLabel(*voxel, resolve);
+      // Neighbouring samples often share a voxel: its label is found once (nothing changes
+      // the map or the labels during this loop).
+      if (voxel != last_voxel) {
+        last_voxel = voxel;
+        last_label = argmaxLabel(*voxel, resolve);
+      }
+      const int32_t label = last_label;
       if (label <= 0) continue;
       if (run_count == 0 || sid != run_sid || label != run_label) {
         flush();
@@ -215,13 +232,16 @@ FrameAssociation SuperpointTracker::associate(const FrameSegmentation& segmentat
 
   associateInstances(segmentation, &out);
 
-  out.pixel_labels = LabelImage(w, h, 0);
-  for (size_t i = 0; i < out.pixel_labels.size(); ++i) {
-    const int32_t sid = segmentation.surfaces.data()[i];
-    if (sid > 0 && static_cast<size_t>(sid) <= n)
-      out.pixel_labels.data()[i] = out.surface_labels[sid - 1];
+  if (out.pixel_labels.width() != w || out.pixel_labels.height() != h) {
+    out.pixel_labels = LabelImage(w, h);
   }
-  return out;
+  // Every pixel is written, so the reused image needs no clearing.
+  const int32_t* sids = segmentation.surfaces.data();
+  int32_t* pixel_labels = out.pixel_labels.data();
+  for (size_t i = 0; i < out.pixel_labels.size(); ++i) {
+    const int32_t sid = sids[i];
+    pixel_labels[i] = sid > 0 && static_cast<size_t>(sid) <= n ? out.surface_labels[sid - 1] : 0;
+  }
 }
 
 void SuperpointTracker::associateInstances(const FrameSegmentation& segmentation,

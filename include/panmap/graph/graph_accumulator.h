@@ -79,8 +79,8 @@ class GraphAccumulator {
 
   /// A sampled pixel's mask, the voxel its ray reaches and that voxel's super-point.
   struct Hit {
-    int32_t mask;
     uint64_t voxel;
+    int32_t mask;
     int32_t label;
     bool operator<(const Hit& o) const {
       return mask < o.mask || (mask == o.mask && voxel < o.voxel);
@@ -92,6 +92,7 @@ class GraphAccumulator {
   ThreadPool* pool_ = nullptr;
   std::vector<std::vector<Hit>> thread_hits_;            // scratch, one per thread
   std::vector<Hit> hits_;                                // scratch
+  std::vector<Hit> merged_;                              // scratch
   std::map<int32_t, std::map<int32_t, double>> scores_;  // label -> class -> P_nu
   std::map<std::pair<int32_t, int32_t>, std::map<int32_t, double>>
       edges_;  // (a<b) -> class -> P_eps

@@ -8,6 +8,7 @@
 #include "panmap/core/frame.h"
 #include "panmap/core/image.h"
 #include "panmap/core/thread_pool.h"
+#include "panmap/map/internal/vote_rows.h"
 #include "panmap/map/tsdf_map.h"
 
 namespace panmap {
@@ -60,10 +61,11 @@ class ProjectiveIntegrator {
 
   IntegratorConfig config_;
   ThreadPool* pool_;
-  Image<float> depth_m_;             // scratch: depth in metres, 0 = invalid
-  std::vector<uint64_t> keys_;       // scratch: block keys seen this frame
-  std::vector<Block*> blocks_;       // scratch: blocks in view
-  std::vector<Voxel*> vote_voxels_;  // scratch: each voting pixel's voxel (null: no vote)
+  Image<float> depth_m_;            // scratch: depth in metres, 0 = invalid
+  std::vector<uint64_t> keys_;      // scratch: block keys seen this frame
+  std::vector<Block*> blocks_;      // scratch: blocks in view
+  std::vector<VoteRun> vote_runs_;  // scratch: each image row's runs of votes, `cols` apart
+  std::vector<size_t> row_runs_;    // scratch: runs found in each row
 };
 
 }  // namespace panmap

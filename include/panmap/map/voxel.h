@@ -26,14 +26,15 @@ struct Voxel {
 };
 static_assert(sizeof(Voxel) == 44, "keep voxels lean (<= 64 bytes with votes)");
 
-/// Adds one vote for `label`: increments its slot, or fills an empty one, or evicts the
-/// weakest slot (lowest count, first on ties). Returns true when a vote was evicted.
-inline bool addVote(Voxel* voxel, int32_t label) {
+/// Adds `n` votes for `label` (n >= 1), exactly as n calls adding one vote each would:
+/// increments its slot (saturating), or fills an empty one, or evicts the weakest slot (lowest
+/// count, first on ties). Returns true when a vote was evicted.
+inline bool addVotes(Voxel* voxel, int32_t label, uint32_t n) {
   int empty = -1, weakest = 0;
   for (int i = 0; i < kVoteSlots; ++i) {
     LabelVote& v = voxel->votes[i];
     if (v.label == label && v.count > 0) {
-      if (v.count < UINT32_MAX) ++v.count;
+      v.count = v.count > UINT32_MAX - n ? UINT32_MAX : v.count + n;
       return false;
     }
     if (v.count == 0) {
@@ -43,12 +44,15 @@ inline bool addVote(Voxel* voxel, int32_t label) {
     }
   }
   if (empty >= 0) {
-    voxel->votes[empty] = LabelVote{label, 1};
+    voxel->votes[empty] = LabelVote{label, n};
     return false;
   }
-  voxel->votes[weakest] = LabelVote{label, 1};
+  voxel->votes[weakest] = LabelVote{label, n};
   return true;
 }
+
+/// Adds one vote for `label` (see addVotes). Returns true when a vote was evicted.
+inline bool addVote(Voxel* voxel, int32_t label) { return addVotes(voxel, label, 1); }
 
 /// Eq. 2: the voxel's super-point label, argmax of its votes after mapping every stored label
 /// through `resolve` (merged super-points pool their votes). 0 when the voxel has no vote.

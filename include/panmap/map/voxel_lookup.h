@@ -23,19 +23,32 @@ class VoxelLookupT {
 
   /// The voxel containing p_W, or null when its block is not allocated.
   VoxelPtr find(const Eigen::Vector3f& p_W) {
-    const int gx = static_cast<int>(std::floor(p_W.x() * inv_voxel_));
-    const int gy = static_cast<int>(std::floor(p_W.y() * inv_voxel_));
-    const int gz = static_cast<int>(std::floor(p_W.z() * inv_voxel_));
+    return findGrid(static_cast<int>(std::floor(p_W.x() * inv_voxel_)),
+                    static_cast<int>(std::floor(p_W.y() * inv_voxel_)),
+                    static_cast<int>(std::floor(p_W.z() * inv_voxel_)));
+  }
+
+  /// The voxel with global integer coordinates (gx, gy, gz), or null when its block is not
+  /// allocated.
+  VoxelPtr findGrid(int gx, int gy, int gz) {
     static_assert(kBlockSide == 8, "shifts assume 8 voxels per block side");
-    const BlockIndex b(gx >> 3, gy >> 3, gz >> 3);
-    if (!valid_ || b != last_index_) {
-      last_ = map_.findBlock(b);
-      last_index_ = b;
+    const BlockPtr block = findBlock(gx >> 3, gy >> 3, gz >> 3);
+    last_voxel_ = Eigen::Vector3i(gx, gy, gz);
+    return block ? &block->at(gx & 7, gy & 7, gz & 7) : nullptr;
+  }
+
+  /// The block with index (bx, by, bz), or null when it is not allocated.
+  BlockPtr findBlock(int bx, int by, int bz) {
+    if (!valid_ || bx != last_index_.x() || by != last_index_.y() || bz != last_index_.z()) {
+      last_index_ = BlockIndex(bx, by, bz);
+      last_ = map_.findBlock(last_index_);
       valid_ = true;
     }
-    last_voxel_ = Eigen::Vector3i(gx, gy, gz);
-    return last_ ? &last_->at(gx & 7, gy & 7, gz & 7) : nullptr;
+    return last_;
   }
+
+  /// 1 / voxel size, as find() scales points by it.
+  float inverseVoxelSize() const { return inv_voxel_; }
 
   /// Global integer coordinates of the voxel of the last find().
   const Eigen::Vector3i& lastVoxel() const { return last_voxel_; }

@@ -163,6 +163,8 @@ class Mapper {
   std::vector<StampedPose> trajectory_;
   int64_t frames_ = 0;
   uint64_t vote_evictions_ = 0;
+  FrameSegmentation segmentation_;  // scratch, reused every frame
+  FrameAssociation association_;    // scratch, reused every frame
   uint64_t superpoints_forgotten_ = 0;
 };
 

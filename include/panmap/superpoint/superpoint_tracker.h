@@ -73,6 +73,11 @@ class SuperpointTracker {
   FrameAssociation associate(const FrameSegmentation& segmentation, const RgbdFrame& frame,
                              const Eigen::Isometry3d& T_W_C, const TsdfMap& map);
 
+  /// Like associate() above, into `out`, whose buffers are reused (a mapper calls this every
+  /// frame: no per-frame allocation of the pixel label image).
+  void associate(const FrameSegmentation& segmentation, const RgbdFrame& frame,
+                 const Eigen::Isometry3d& T_W_C, const TsdfMap& map, FrameAssociation* out);
+
   /// Forgets super-points that no voxel votes for any more (their votes were all evicted by
   /// stronger labels): their frame counts and co-observations. They can never be associated
   /// again, and on long runs they would outnumber the live ones many times over.

@@ -1,0 +1,46 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include <Eigen/Geometry>
+
+#include "panmap/core/image.h"
+#include "panmap/map/voxel_lookup.h"
+
+namespace panmap {
+
+/// n consecutive votes of one image row for one voxel and label.
+struct VoteRun {
+  Voxel* voxel;
+  int32_t label;
+  uint32_t count;
+};
+
+namespace internal {
+
+/// Pinhole intrinsics in single precision, pixels.
+struct RowCamera {
+  float fx, fy, cx, cy;
+};
+
+/// Phase 1 of the label votes for image row v: the voxel each labelled pixel's measured point
+/// falls in (pixels u = 0, stride, 2 stride, ...), as runs of consecutive votes for one voxel
+/// and label (n votes in a row add up exactly as one vote of n does, see addVotes). Pixels
+/// without a label, depth or allocated voxel cast no vote. Writes at most width / stride runs
+/// to `out` and returns how many. Uses 8-wide AVX2 for stride 1 when the CPU has it, with
+/// bitwise the same result as findRowVotesScalar.
+size_t findRowVotes(const Image<float>& depth_m, const LabelImage& labels, int v, int stride,
+                    const Eigen::Isometry3f& T_W_C, const RowCamera& cam,
+                    MutableVoxelLookup* lookup, VoteRun* out);
+
+/// The reference: one pixel at a time through Eigen, portable.
+size_t findRowVotesScalar(const Image<float>& depth_m, const LabelImage& labels, int v, int stride,
+                          const Eigen::Isometry3f& T_W_C, const RowCamera& cam,
+                          MutableVoxelLookup* lookup, VoteRun* out);
+
+/// True when findRowVotes runs the AVX2 path on this CPU.
+bool voteRowsUseAvx2();
+
+}  // namespace internal
+}  // namespace panmap

@@ -1,0 +1,137 @@
+#include "panmap/map/internal/vote_rows.h"
+
+#include <cmath>
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define PANMAP_HAVE_AVX2_PATH 1
+#endif
+
+namespace panmap {
+namespace internal {
+
+namespace {
+
+// Appends one vote for (voxel, label) to the open run, or closes it and opens another.
+inline void addToRun(Voxel* voxel, int32_t label, VoteRun* run, VoteRun** out) {
+  if (voxel == run->voxel && label == run->label) {
+    ++run->count;
+    return;
+  }
+  if (run->count > 0) *(*out)++ = *run;
+  *run = VoteRun{voxel, label, 1};
+}
+
+#ifdef PANMAP_HAVE_AVX2_PATH
+// Stride 1, eight pixels at a time: back-projection, the rigid transform and floor() in AVX2
+// with the scalar path's operations in its order (Eigen multiplies the homogeneous 4x4 matrix
+// row by row, ((r0 x + r1 y) + r2 z) + t, and nothing is contracted into FMA), so every pixel
+// lands in the same voxel. Block lookups and runs stay scalar.
+__attribute__((target("avx2"))) size_t findRowVotesAvx2(const Image<float>& depth_m,
+                                                        const LabelImage& labels, int v,
+                                                        const Eigen::Isometry3f& T_W_C,
+                                                        const RowCamera& cam,
+                                                        MutableVoxelLookup* lookup, VoteRun* out) {
+  VoteRun* const first = out;
+  VoteRun run{nullptr, 0, 0};
+  const int width = depth_m.width();
+  const float* depth_row = &depth_m(0, v);
+  const int32_t* label_row = &labels(0, v);
+  const Eigen::Matrix4f& M = T_W_C.matrix();
+  const __m256 cx = _mm256_set1_ps(cam.cx), fx = _mm256_set1_ps(cam.fx);
+  const __m256 fy = _mm256_set1_ps(cam.fy);
+  const __m256 v_minus_cy = _mm256_set1_ps(static_cast<float>(v) - cam.cy);
+  const __m256 inv_voxel = _mm256_set1_ps(lookup->inverseVoxelSize());
+  const __m256 lanes = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256 zero = _mm256_setzero_ps();
+  __m256 m[3][4];
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) m[r][c] = _mm256_set1_ps(M(r, c));
+  }
+  alignas(32) int32_t block_index[3][8];
+  alignas(32) int32_t voxel_offset[8];
+  const __m256i seven = _mm256_set1_epi32(7);
+  int u = 0;
+  for (; u + 8 <= width; u += 8) {
+    const __m256i label = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(label_row + u));
+    const __m256 d = _mm256_loadu_ps(depth_row + u);
+    const __m256 has_label = _mm256_castsi256_ps(_mm256_cmpgt_epi32(label, _mm256_setzero_si256()));
+    int valid = _mm256_movemask_ps(_mm256_and_ps(has_label, _mm256_cmp_ps(d, zero, _CMP_GT_OQ)));
+    if (valid == 0) continue;
+    // Integers below 2^24 are exact in float: u + lane is static_cast<float>(u + lane).
+    const __m256 uf = _mm256_add_ps(_mm256_set1_ps(static_cast<float>(u)), lanes);
+    const __m256 x = _mm256_div_ps(_mm256_mul_ps(_mm256_sub_ps(uf, cx), d), fx);
+    const __m256 y = _mm256_div_ps(_mm256_mul_ps(v_minus_cy, d), fy);
+    // Voxel grid coordinates, split into block index (g >> 3) and place in the block.
+    __m256i offset = _mm256_setzero_si256();
+    for (int r = 0; r < 3; ++r) {
+      const __m256 p = _mm256_add_ps(
+          _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[r][0], x), _mm256_mul_ps(m[r][1], y)),
+                        _mm256_mul_ps(m[r][2], d)),
+          m[r][3]);
+      const __m256i g = _mm256_cvttps_epi32(_mm256_floor_ps(_mm256_mul_ps(p, inv_voxel)));
+      _mm256_store_si256(reinterpret_cast<__m256i*>(block_index[r]), _mm256_srai_epi32(g, 3));
+      offset = _mm256_add_epi32(offset, _mm256_slli_epi32(_mm256_and_si256(g, seven), 3 * r));
+    }
+    _mm256_store_si256(reinterpret_cast<__m256i*>(voxel_offset), offset);
+    static_assert(kBlockSide == 8, "block index and offset assume 8 voxels per block side");
+    for (; valid != 0; valid &= valid - 1) {
+      const int k = __builtin_ctz(static_cast<unsigned>(valid));
+      Block* block = lookup->findBlock(block_index[0][k], block_index[1][k], block_index[2][k]);
+      if (block) addToRun(&block->voxels[voxel_offset[k]], label_row[u + k], &run, &out);
+    }
+  }
+  for (; u < width; ++u) {  // the last pixels of a row not a multiple of 8 wide
+    const int32_t label = label_row[u];
+    const float d = depth_row[u];
+    if (label <= 0 || d <= 0.0f) continue;
+    Voxel* voxel = lookup->find(
+        T_W_C * Eigen::Vector3f((u - cam.cx) * d / cam.fx, (v - cam.cy) * d / cam.fy, d));
+    if (voxel) addToRun(voxel, label, &run, &out);
+  }
+  if (run.count > 0) *out++ = run;
+  return static_cast<size_t>(out - first);
+}
+#endif
+
+}  // namespace
+
+size_t findRowVotesScalar(const Image<float>& depth_m, const LabelImage& labels, int v, int stride,
+                          const Eigen::Isometry3f& T_W_C, const RowCamera& cam,
+                          MutableVoxelLookup* lookup, VoteRun* out) {
+  VoteRun* const first = out;
+  VoteRun run{nullptr, 0, 0};
+  for (int u = 0; u < depth_m.width(); u += stride) {
+    const int32_t label = labels(u, v);
+    const float d = depth_m(u, v);
+    if (label <= 0 || d <= 0.0f) continue;
+    Voxel* voxel = lookup->find(
+        T_W_C * Eigen::Vector3f((u - cam.cx) * d / cam.fx, (v - cam.cy) * d / cam.fy, d));
+    if (voxel) addToRun(voxel, label, &run, &out);
+  }
+  if (run.count > 0) *out++ = run;
+  return static_cast<size_t>(out - first);
+}
+
+bool voteRowsUseAvx2() {
+#ifdef PANMAP_HAVE_AVX2_PATH
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+#else
+  return false;
+#endif
+}
+
+size_t findRowVotes(const Image<float>& depth_m, const LabelImage& labels, int v, int stride,
+                    const Eigen::Isometry3f& T_W_C, const RowCamera& cam,
+                    MutableVoxelLookup* lookup, VoteRun* out) {
+#ifdef PANMAP_HAVE_AVX2_PATH
+  if (stride == 1 && voteRowsUseAvx2()) {
+    return findRowVotesAvx2(depth_m, labels, v, T_W_C, cam, lookup, out);
+  }
+#endif
+  return findRowVotesScalar(depth_m, labels, v, stride, T_W_C, cam, lookup, out);
+}
+
+}  // namespace internal
+}  // namespace panmap
