@@ -1,3 +1,4 @@
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -152,6 +153,22 @@ TEST(VoteRows, AddVotesEqualsRepeatedAddVote) {
   full.votes[0] = LabelVote{3, UINT32_MAX - 2};
   addVotes(&full, 3, 10);
   EXPECT_EQ(full.votes[0].count, UINT32_MAX);
+}
+
+// The lookups' floor must agree with std::floor everywhere a voxel index can be.
+TEST(VoxelLookup, FloorToIntMatchesStdFloor) {
+  const float edges[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, -0.5f, -1e-30f, 1e-30f, -0.99999994f,
+                         2.5f, -2.5f, 8388607.5f, -8388607.5f, 16777217.0f, -16777216.0f,
+                         2.0e9f, -2.0e9f};
+  for (float x : edges) {
+    EXPECT_EQ(MutableVoxelLookup::floorToInt(x), static_cast<int>(std::floor(x))) << x;
+  }
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> wide(-1e6f, 1e6f), narrow(-3.0f, 3.0f);
+  for (int i = 0; i < 200000; ++i) {
+    const float x = i % 2 ? wide(rng) : narrow(rng);
+    ASSERT_EQ(MutableVoxelLookup::floorToInt(x), static_cast<int>(std::floor(x))) << x;
+  }
 }
 
 }  // namespace

@@ -23,9 +23,15 @@ class VoxelLookupT {
 
   /// The voxel containing p_W, or null when its block is not allocated.
   VoxelPtr find(const Eigen::Vector3f& p_W) {
-    return findGrid(static_cast<int>(std::floor(p_W.x() * inv_voxel_)),
-                    static_cast<int>(std::floor(p_W.y() * inv_voxel_)),
-                    static_cast<int>(std::floor(p_W.z() * inv_voxel_)));
+    return findGrid(floorToInt(p_W.x() * inv_voxel_), floorToInt(p_W.y() * inv_voxel_),
+                    floorToInt(p_W.z() * inv_voxel_));
+  }
+
+  /// static_cast<int>(std::floor(x)) for |x| < 2^31, without the library call that baseline
+  /// x86-64 (no SSE4.1 rounding) makes for std::floor: truncate, then step down below zero.
+  static int floorToInt(float x) {
+    const int i = static_cast<int>(x);
+    return i - (x < static_cast<float>(i) ? 1 : 0);
   }
 
   /// The voxel with global integer coordinates (gx, gy, gz), or null when its block is not
