@@ -104,10 +104,15 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
   // Depth in metres with the range limits applied once.
   if (depth_m_.width() != w || depth_m_.height() != h) depth_m_ = Image<float>(w, h);
   const float scale = static_cast<float>(frame.depth_scale_m);
-  for (size_t i = 0; i < depth_m_.size(); ++i) {
-    const float d = frame.depth.data()[i] * scale;
-    depth_m_.data()[i] = (d >= config_.min_depth_m && d <= config_.max_depth_m) ? d : 0.0f;
-  }
+  const float min_depth_m = config_.min_depth_m, max_depth_m = config_.max_depth_m;
+  pool_->parallelFor(static_cast<size_t>(h), [&](size_t v0, size_t v1, int) {
+    const uint16_t* raw = frame.depth.data() + v0 * w;
+    float* metres = depth_m_.data() + v0 * w;
+    for (size_t i = 0; i < (v1 - v0) * w; ++i) {
+      const float d = raw[i] * scale;
+      metres[i] = (d >= min_depth_m && d <= max_depth_m) ? d : 0.0f;
+    }
+  });
 
   // Blocks near the surface: sample the truncation band of every few pixels' rays (the
   // stride keeps neighbouring samples well under a block apart at the far range).
