@@ -2,10 +2,7 @@
 
 #include <algorithm>
 
-#if defined(__x86_64__) && defined(__GNUC__)
-#include <immintrin.h>
-#define PANMAP_HAVE_AVX2_PATH 1
-#endif
+#include "panmap/core/cpu_features.h"
 
 namespace panmap {
 namespace internal {
@@ -218,14 +215,7 @@ size_t updateBlockScalar(const BlockUpdateParams& p, const Eigen::Vector3f& orig
   return updated;
 }
 
-bool blockUpdateUsesAvx2() {
-#ifdef PANMAP_HAVE_AVX2_PATH
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
-#else
-  return false;
-#endif
-}
+bool blockUpdateUsesAvx2() { return cpuHasAvx2(); }
 
 size_t updateBlock(const BlockUpdateParams& p, const Eigen::Vector3f& origin_C, Block* block) {
 #ifdef PANMAP_HAVE_AVX2_PATH

@@ -2,10 +2,7 @@
 
 #include <cmath>
 
-#if defined(__x86_64__) && defined(__GNUC__)
-#include <immintrin.h>
-#define PANMAP_HAVE_AVX2_PATH 1
-#endif
+#include "panmap/core/cpu_features.h"
 
 namespace panmap {
 namespace internal {
@@ -20,6 +17,18 @@ inline void addToRun(Voxel* voxel, int32_t label, VoteRun* run, VoteRun** out) {
   }
   if (run->count > 0) *(*out)++ = *run;
   *run = VoteRun{voxel, label, 1};
+}
+
+// Pixel (u, v) one at a time through Eigen: its vote, if it casts one, joins the open run.
+inline void votePixel(const Image<float>& depth_m, const LabelImage& labels, int u, int v,
+                      const Eigen::Isometry3f& T_W_C, const RowCamera& cam,
+                      MutableVoxelLookup* lookup, VoteRun* run, VoteRun** out) {
+  const int32_t label = labels(u, v);
+  const float d = depth_m(u, v);
+  if (label <= 0 || d <= 0.0f) return;
+  Voxel* voxel = lookup->find(
+      T_W_C * Eigen::Vector3f((u - cam.cx) * d / cam.fx, (v - cam.cy) * d / cam.fy, d));
+  if (voxel) addToRun(voxel, label, run, out);
 }
 
 #ifdef PANMAP_HAVE_AVX2_PATH
@@ -82,12 +91,7 @@ __attribute__((target("avx2"))) size_t findRowVotesAvx2(const Image<float>& dept
     }
   }
   for (; u < width; ++u) {  // the last pixels of a row not a multiple of 8 wide
-    const int32_t label = label_row[u];
-    const float d = depth_row[u];
-    if (label <= 0 || d <= 0.0f) continue;
-    Voxel* voxel = lookup->find(
-        T_W_C * Eigen::Vector3f((u - cam.cx) * d / cam.fx, (v - cam.cy) * d / cam.fy, d));
-    if (voxel) addToRun(voxel, label, &run, &out);
+    votePixel(depth_m, labels, u, v, T_W_C, cam, lookup, &run, &out);
   }
   if (run.count > 0) *out++ = run;
   return static_cast<size_t>(out - first);
@@ -102,25 +106,13 @@ size_t findRowVotesScalar(const Image<float>& depth_m, const LabelImage& labels,
   VoteRun* const first = out;
   VoteRun run{nullptr, 0, 0};
   for (int u = 0; u < depth_m.width(); u += stride) {
-    const int32_t label = labels(u, v);
-    const float d = depth_m(u, v);
-    if (label <= 0 || d <= 0.0f) continue;
-    Voxel* voxel = lookup->find(
-        T_W_C * Eigen::Vector3f((u - cam.cx) * d / cam.fx, (v - cam.cy) * d / cam.fy, d));
-    if (voxel) addToRun(voxel, label, &run, &out);
+    votePixel(depth_m, labels, u, v, T_W_C, cam, lookup, &run, &out);
   }
   if (run.count > 0) *out++ = run;
   return static_cast<size_t>(out - first);
 }
 
-bool voteRowsUseAvx2() {
-#ifdef PANMAP_HAVE_AVX2_PATH
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
-#else
-  return false;
-#endif
-}
+bool voteRowsUseAvx2() { return cpuHasAvx2(); }
 
 size_t findRowVotes(const Image<float>& depth_m, const LabelImage& labels, int v, int stride,
                     const Eigen::Isometry3f& T_W_C, const RowCamera& cam,

@@ -1,0 +1,23 @@
+#pragma once
+
+// PANMAP_HAVE_AVX2_PATH: this compiler can build functions for AVX2 next to the baseline
+// x86-64 ones (with __attribute__((target("avx2"))) and <immintrin.h>); cpuHasAvx2() tells at
+// run time whether this CPU may call them.
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define PANMAP_HAVE_AVX2_PATH 1
+#endif
+
+namespace panmap {
+
+/// True when the CPU running this has AVX2 (checked once).
+inline bool cpuHasAvx2() {
+#ifdef PANMAP_HAVE_AVX2_PATH
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+#else
+  return false;
+#endif
+}
+
+}  // namespace panmap
