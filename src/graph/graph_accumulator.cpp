@@ -9,7 +9,7 @@
 #include "panmap/core/container_memory.h"
 #include "panmap/core/error.h"
 #include "panmap/map/voxel.h"
-#include "panmap/map/voxel_lookup.h"
+#include "panmap/map/voxel_label_sampler.h"
 
 namespace panmap {
 
@@ -92,8 +92,6 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   // are split between threads; concatenated in row order they are what one thread would find.
   const Eigen::Isometry3f T = T_W_C.cast<float>();
   const float scale = static_cast<float>(frame.depth_scale_m);
-  const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
-  const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
   const LabelRegistry& registry = tracker.labels();
   registry.flatten();  // resolve() only reads from here on: safe on every thread
   auto resolve = [&registry](int32_t l) { return registry.resolve(l); };
@@ -103,9 +101,7 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   // hits would give (equal hits are identical: one voxel has one super-point here).
   auto collect = [&](size_t r0, size_t r1, std::vector<Hit>* out) {
     out->clear();
-    VoxelLookup lookup(map);
-    const Voxel* last_voxel = nullptr;
-    int32_t last_label = 0;
+    VoxelLabelSampler sampler(map, T, cam, resolve);
     for (size_t r = r0; r < r1; ++r) {
       const int v = static_cast<int>(r) * stride;
       for (int u = 0; u < cam.width; u += stride) {
@@ -113,16 +109,9 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
         if (id <= 0 || !isKnown(id)) continue;
         const float d = frame.depth(u, v) * scale;
         if (d <= 0.0f) continue;
-        const Voxel* voxel =
-            lookup.find(T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d));
-        if (!voxel) continue;
-        if (voxel != last_voxel) {
-          last_voxel = voxel;
-          last_label = argmaxLabel(*voxel, resolve);
-        }
-        const int32_t label = last_label;
+        const int32_t label = sampler.label(u, v, d);
         if (label <= 0) continue;
-        const Eigen::Vector3i& g = lookup.lastVoxel();
+        const Eigen::Vector3i& g = sampler.lastVoxel();
         const uint64_t key = (static_cast<uint64_t>(g.x() & 0x1FFFFF) << 42) |
                              (static_cast<uint64_t>(g.y() & 0x1FFFFF) << 21) |
                              static_cast<uint64_t>(g.z() & 0x1FFFFF);

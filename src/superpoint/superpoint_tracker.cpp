@@ -6,7 +6,7 @@
 #include "panmap/core/container_memory.h"
 #include "panmap/core/error.h"
 #include "panmap/map/voxel.h"
-#include "panmap/map/voxel_lookup.h"
+#include "panmap/map/voxel_label_sampler.h"
 
 namespace panmap {
 
@@ -144,18 +144,14 @@ void SuperpointTracker::associate(const FrameSegmentation& segmentation, const R
   // Pi_s(L_S, s_i): votes of the voxels the surface's points fall in (Eq. 2 per voxel).
   std::vector<int> samples(n, 0);
   std::vector<std::map<int32_t, int>> overlap(n);
-  const Eigen::Isometry3f T = T_W_C.cast<float>();
   const float scale = static_cast<float>(frame.depth_scale_m);
-  const float fx = static_cast<float>(frame.camera.fx), fy = static_cast<float>(frame.camera.fy);
-  const float cx = static_cast<float>(frame.camera.cx), cy = static_cast<float>(frame.camera.cy);
-  VoxelLookup lookup(map);
-  auto resolve = [this](int32_t l) { return labels_.resolve(l); };
+  VoxelLabelSampler sampler(map, T_W_C.cast<float>(), frame.camera,
+                            [this](int32_t l) { return labels_.resolve(l); });
   const int stride = config_.sample_stride_px;
   // Neighbouring samples mostly see the same surface and super-point: count runs, and touch
   // the per-surface maps once per run instead of once per sample.
   int run_sid = 0, run_count = 0;
-  int32_t run_label = 0, last_label = 0;
-  const Voxel* last_voxel = nullptr;
+  int32_t run_label = 0;
   auto flush = [&] {
     if (run_count > 0) overlap[run_sid - 1][run_label] += run_count;
     run_count = 0;
@@ -167,16 +163,8 @@ void SuperpointTracker::associate(const FrameSegmentation& segmentation, const R
       const float d = frame.depth(u, v) * scale;
       if (d <= 0.0f) continue;
       ++samples[sid - 1];
-      const Voxel* voxel =
-          lookup.find(T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d));
-      if (!voxel) continue;
-      // Neighbouring samples often share a voxel: its label is found once (nothing changes
-      // the map or the labels during this loop).
-      if (voxel != last_voxel) {
-        last_voxel = voxel;
-        last_label = argmaxLabel(*voxel, resolve);
-      }
-      const int32_t label = last_label;
+      // Nothing changes the map or the labels during this loop, as the sampler needs.
+      const int32_t label = sampler.label(u, v, d);
       if (label <= 0) continue;
       if (run_count == 0 || sid != run_sid || label != run_label) {
         flush();
