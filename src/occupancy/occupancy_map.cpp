@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include <octomap/octomap_utils.h>
@@ -176,6 +177,37 @@ void OccupancyMap::addMisses(const DepthImage& depth, double depth_scale_m,
     return static_cast<double>(depth(ui, vi));
   };
 
+  // True when every cell of the block whose first cell centre is first_C fails the centre
+  // test below: the depth wherever the block projects is nearer than its nearest cell centre,
+  // and so nearer than any cell's far_m. Such blocks (behind walls, inside furniture) are
+  // most of a room's frustum and are skipped whole.
+  if (config_.skip_hidden_blocks) depth_tiles_.build(depth);
+  auto behindSurface = [&](const Eigen::Vector3d& first_C) {
+    double z_min = std::numeric_limits<double>::infinity();
+    double u_min = z_min, v_min = z_min, u_max = -z_min, v_max = -z_min;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d p_C =
+          first_C +
+          steps_C * Eigen::Vector3d((c & 1) ? 7.0 : 0.0, (c & 2) ? 7.0 : 0.0, (c & 4) ? 7.0 : 0.0);
+      if (p_C.z() <= 0.0) return false;
+      z_min = std::min(z_min, p_C.z());
+      const double u = camera.fx * p_C.x() / p_C.z() + camera.cx;
+      const double v = camera.fy * p_C.y() / p_C.z() + camera.cy;
+      u_min = std::min(u_min, u);
+      u_max = std::max(u_max, u);
+      v_min = std::min(v_min, v);
+      v_max = std::max(v_max, v);
+    }
+    // The cells' centres project inside the corners' hull; one pixel of margin each side
+    // absorbs rounding, and clamping matches depthAt's.
+    auto pixel = [](double x, int size) {
+      return static_cast<int>(std::clamp(std::floor(x + 0.5), 0.0, size - 1.0));
+    };
+    const uint16_t deepest = depth_tiles_.maxOver(pixel(u_min - 1.0, w), pixel(v_min - 1.0, h),
+                                                  pixel(u_max + 1.0, w), pixel(v_max + 1.0, h));
+    return deepest <= z_min * inv_scale;
+  };
+
   CellKey lo, hi;
   frustumKeys(grid_, camera, T_W_C, config_.max_depth_m, &lo, &hi);  // in range: validated
   for (int bz = lo.z() >> 3; bz <= hi.z() >> 3; ++bz) {
@@ -189,6 +221,10 @@ void OccupancyMap::addMisses(const DepthImage& depth, double depth_scale_m,
         bool outside = false;
         for (const Eigen::Vector3d& n : planes) outside |= n.dot(centre_C) < -block_radius_m;
         if (outside) continue;
+        if (config_.skip_hidden_blocks && behindSurface(first_C)) {
+          ++stats->blocks_skipped;
+          continue;
+        }
         OccupancyBlock* block = nullptr;  // allocated on its first free cell
         for (int k = 0; k < 8; ++k) {
           const double dz_W = std::abs(first_W.z() + k * res);
