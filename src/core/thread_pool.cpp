@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 
 namespace panmap {
 
@@ -21,6 +22,24 @@ ThreadPool::~ThreadPool() {
 }
 
 namespace {
+
+// How long a thread polls for work, or for the others to finish, before it sleeps.
+constexpr auto kSpin = std::chrono::microseconds(50);
+
+// Polls done() until it holds or kSpin has passed; returns done().
+template <typename Done>
+bool spinUntil(const Done& done) {
+  const auto until = std::chrono::steady_clock::now() + kSpin;
+  while (!done()) {
+    for (int i = 0; i < 64; ++i) {
+#if defined(__x86_64__) || defined(__i386__)
+      __builtin_ia32_pause();
+#endif
+    }
+    if (std::chrono::steady_clock::now() > until) return done();
+  }
+  return true;
+}
 
 void runSlice(const std::function<void(size_t, size_t, int)>& fn, size_t n, int threads, int t) {
   const size_t begin = n * static_cast<size_t>(t) / static_cast<size_t>(threads);
@@ -44,6 +63,7 @@ void ThreadPool::parallelFor(size_t n, const std::function<void(size_t, size_t, 
   }
   start_cv_.notify_all();
   runSlice(fn, n, size(), 0);
+  spinUntil([this] { return pending_.load(std::memory_order_acquire) == 0; });
   std::unique_lock<std::mutex> lock(mutex_);
   done_cv_.wait(lock, [this] { return pending_ == 0; });
   job_ = nullptr;
@@ -69,6 +89,7 @@ void ThreadPool::workerLoop(int index) {
   while (true) {
     const std::function<void(size_t, size_t, int)>* job;
     size_t n;
+    spinUntil([&] { return generation_.load(std::memory_order_acquire) != seen; });
     {
       std::unique_lock<std::mutex> lock(mutex_);
       start_cv_.wait(lock, [&] { return stop_ || generation_ != seen; });

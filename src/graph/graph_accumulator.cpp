@@ -9,9 +9,15 @@
 #include "panmap/core/container_memory.h"
 #include "panmap/core/error.h"
 #include "panmap/map/voxel.h"
-#include "panmap/map/voxel_label_sampler.h"
 
 namespace panmap {
+
+namespace {
+
+// Image rows a thread takes at a time when sampling a frame's masks.
+constexpr size_t kRowsPerChunk = 8;
+
+}  // namespace
 
 void GraphConfig::check() const {
   if (!(spatial_scale_m > 0.0)) throw Error("graph spatial_scale_m must be > 0");
@@ -97,45 +103,66 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   auto resolve = [&registry](int32_t l) { return registry.resolve(l); };
   const int stride = config_.sample_stride_px;
   const size_t rows = static_cast<size_t>((cam.height + stride - 1) / stride);
-  // Each thread sorts and dedupes its own rows' hits; merged, they are what one sort of all
-  // hits would give (equal hits are identical: one voxel has one super-point here).
-  auto collect = [&](size_t r0, size_t r1, std::vector<Hit>* out) {
-    out->clear();
+  // Rows go to whichever thread is free (rows with masks cost far more than rows without).
+  // Each thread sorts and dedupes its own hits; merged, they are what one sort of all hits
+  // would give, whichever rows each thread took (equal hits are identical: one voxel has one
+  // super-point here).
+  auto collect = [&](size_t r0, size_t r1, ThreadScratch* scratch) {
+    std::vector<Hit>& out = scratch->hits;
     VoxelLabelSampler sampler(map, T, cam, resolve);
     for (size_t r = r0; r < r1; ++r) {
       const int v = static_cast<int>(r) * stride;
+      scratch->samples.clear();
+      scratch->masks.clear();
       for (int u = 0; u < cam.width; u += stride) {
         const int32_t id = panoptic.segment_ids(u, v);
         if (id <= 0 || !isKnown(id)) continue;
         const float d = frame.depth(u, v) * scale;
         if (d <= 0.0f) continue;
-        const int32_t label = sampler.label(u, v, d);
+        scratch->samples.push_back({u, d});
+        scratch->masks.push_back(id);
+      }
+      const size_t n = scratch->samples.size();
+      scratch->labels.resize(n);
+      scratch->voxels.resize(n);
+      sampler.labelRow(v, scratch->samples, scratch->labels.data(), scratch->voxels.data());
+      for (size_t k = 0; k < n; ++k) {
+        const int32_t label = scratch->labels[k];
         if (label <= 0) continue;
-        const Eigen::Vector3i& g = sampler.lastVoxel();
+        const int32_t id = scratch->masks[k];
+        const Eigen::Vector3i& g = scratch->voxels[k];
         const uint64_t key = (static_cast<uint64_t>(g.x() & 0x1FFFFF) << 42) |
                              (static_cast<uint64_t>(g.y() & 0x1FFFFF) << 21) |
                              static_cast<uint64_t>(g.z() & 0x1FFFFF);
         // Neighbouring pixels often repeat the last hit: keep the sort below small.
-        if (!out->empty() && out->back().mask == id && out->back().voxel == key) continue;
-        out->push_back({key, id, label});
+        if (!out.empty() && out.back().mask == id && out.back().voxel == key) continue;
+        out.push_back({key, id, label});
       }
     }
-    std::sort(out->begin(), out->end());
-    out->erase(std::unique(out->begin(), out->end()), out->end());
+  };
+  auto sortHits = [](std::vector<Hit>* hits) {
+    std::sort(hits->begin(), hits->end());
+    hits->erase(std::unique(hits->begin(), hits->end()), hits->end());
   };
   const int threads = pool_ ? pool_->size() : 1;
-  thread_hits_.resize(static_cast<size_t>(threads));
+  thread_scratch_.resize(static_cast<size_t>(threads));
+  for (ThreadScratch& scratch : thread_scratch_) scratch.hits.clear();
   if (pool_) {
-    pool_->parallelFor(rows, [&](size_t r0, size_t r1, int t) {
-      collect(r0, r1, &thread_hits_[static_cast<size_t>(t)]);
+    pool_->parallelForDynamic(rows, kRowsPerChunk, [&](size_t r0, size_t r1, int t) {
+      collect(r0, r1, &thread_scratch_[static_cast<size_t>(t)]);
+    });
+    pool_->parallelFor(thread_scratch_.size(), [&](size_t t0, size_t t1, int) {
+      for (size_t t = t0; t < t1; ++t) sortHits(&thread_scratch_[t].hits);
     });
   } else {
-    collect(0, rows, &thread_hits_[0]);
+    collect(0, rows, &thread_scratch_[0]);
+    sortHits(&thread_scratch_[0].hits);
   }
   // N^S_o counts unique voxels: many pixels see the same voxel up close.
   std::vector<Hit>& hits = hits_;
   hits.clear();
-  for (std::vector<Hit>& part : thread_hits_) {
+  for (ThreadScratch& scratch : thread_scratch_) {
+    std::vector<Hit>& part = scratch.hits;
     merged_.resize(hits.size() + part.size());
     std::merge(hits.begin(), hits.end(), part.begin(), part.end(), merged_.begin());
     merged_.erase(std::unique(merged_.begin(), merged_.end()), merged_.end());
@@ -182,7 +209,10 @@ size_t GraphAccumulator::memoryBytes() const {
   size_t bytes = mapNodesBytes(scores_) + mapNodesBytes(edges_);
   for (const auto& [label, by_class] : scores_) bytes += mapNodesBytes(by_class);
   for (const auto& [pair, by_class] : edges_) bytes += mapNodesBytes(by_class);
-  for (const auto& part : thread_hits_) bytes += vectorBytes(part);
+  for (const ThreadScratch& scratch : thread_scratch_) {
+    bytes += vectorBytes(scratch.hits) + vectorBytes(scratch.samples) + vectorBytes(scratch.masks) +
+             vectorBytes(scratch.labels) + vectorBytes(scratch.voxels);
+  }
   return bytes + vectorBytes(hits_) + vectorBytes(merged_);
 }
 

@@ -28,6 +28,9 @@ ProjectiveIntegrator::ProjectiveIntegrator(const IntegratorConfig& config, Threa
 
 namespace {
 
+// Image rows a thread takes at a time when finding votes.
+constexpr size_t kVoteRowsPerChunk = 16;
+
 BlockIndex unpackKey(uint64_t key) {
   auto field = [](uint64_t v) {
     const int x = static_cast<int>(v & 0x1FFFFF);
@@ -55,7 +58,9 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
   const size_t cols = (cam.width + stride - 1) / stride, rows = (cam.height + stride - 1) / stride;
   vote_runs_.resize(cols * rows);
   row_runs_.resize(rows);
-  pool_->parallelFor(rows, [&](size_t r0, size_t r1, int) {
+  // Rows differ a lot in cost (invalid depth, blocks missed by the cache): whichever thread is
+  // free takes the next few; each row's runs land in its own slot.
+  pool_->parallelForDynamic(rows, kVoteRowsPerChunk, [&](size_t r0, size_t r1, int) {
     MutableVoxelLookup lookup(*map);
     for (size_t r = r0; r < r1; ++r) {
       row_runs_[r] = internal::findRowVotes(depth_m_, labels, static_cast<int>(r) * stride, stride,

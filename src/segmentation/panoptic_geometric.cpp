@@ -24,6 +24,10 @@ constexpr int kMaxThreads = 64;
 // The normal estimator's box sums stay exact up to this window (see depth_normals.cpp).
 constexpr int kMaxWindowPx = 127;
 
+// Image rows a thread takes at a time for normals and edges: large enough that restarting the
+// window sums at each chunk costs little.
+constexpr size_t kRowsPerChunk = 48;
+
 void requireOddWindow(int value_px, const char* field) {
   if (value_px < 3 || value_px > kMaxWindowPx || value_px % 2 == 0) {
     throw Error(std::string("DepthSegmentationConfig.") + field +
@@ -178,12 +182,15 @@ void PanopticGeometricSegmenter::segment(const RgbdFrame& frame, const PanopticF
     internal::markDiscontinuityRows(self->depth_config.depth_discontinuity_ratio,
                                     static_cast<int>(v0), static_cast<int>(v1), &self->geometry);
   });
-  impl.pool.parallelFor(height, [self](size_t v0, size_t v1, int thread) {
+  // Normals and edges cost more where the depth is valid, so rows are handed out in chunks to
+  // whichever thread is free; each chunk restarts its window sums, exactly (see
+  // depth_normals.cpp), so results do not depend on the split.
+  impl.pool.parallelForDynamic(height, kRowsPerChunk, [self](size_t v0, size_t v1, int thread) {
     self->normal_estimators[thread].computeRows(self->depth_config.normals_window_px,
                                                 static_cast<int>(v0), static_cast<int>(v1),
                                                 &self->geometry);
   });
-  impl.pool.parallelFor(height, [self](size_t v0, size_t v1, int thread) {
+  impl.pool.parallelForDynamic(height, kRowsPerChunk, [self](size_t v0, size_t v1, int thread) {
     internal::computeEdgeRows(self->geometry, self->depth_config, static_cast<int>(v0),
                               static_cast<int>(v1), &self->edge_scratch[thread], &self->edges);
   });

@@ -157,14 +157,22 @@ void SuperpointTracker::associate(const FrameSegmentation& segmentation, const R
     run_count = 0;
   };
   for (int v = 0; v < h; v += stride) {
+    row_samples_.clear();
+    row_surfaces_.clear();
     for (int u = 0; u < w; u += stride) {
       const int32_t sid = segmentation.surfaces(u, v);
       if (sid <= 0 || static_cast<size_t>(sid) > n) continue;
       const float d = frame.depth(u, v) * scale;
       if (d <= 0.0f) continue;
       ++samples[sid - 1];
-      // Nothing changes the map or the labels during this loop, as the sampler needs.
-      const int32_t label = sampler.label(u, v, d);
+      row_samples_.push_back({u, d});
+      row_surfaces_.push_back(sid);
+    }
+    row_labels_.resize(row_samples_.size());
+    // Nothing changes the map or the labels during this loop, as the sampler needs.
+    sampler.labelRow(v, row_samples_, row_labels_.data(), nullptr);
+    for (size_t k = 0; k < row_samples_.size(); ++k) {
+      const int32_t sid = row_surfaces_[k], label = row_labels_[k];
       if (label <= 0) continue;
       if (run_count == 0 || sid != run_sid || label != run_label) {
         flush();

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <functional>
 #include <mutex>
@@ -42,8 +43,11 @@ class ThreadPool {
   std::condition_variable done_cv_;
   const std::function<void(size_t, size_t, int)>* job_ = nullptr;
   size_t job_size_ = 0;
-  uint64_t generation_ = 0;
-  int pending_ = 0;
+  // Written under mutex_; atomic so that waiting threads can poll them briefly before
+  // sleeping on a condition variable (a frame runs a dozen short ranges, and waking a
+  // sleeping thread costs tens of microseconds).
+  std::atomic<uint64_t> generation_{0};
+  std::atomic<int> pending_{0};
   bool stop_ = false;
 };
 

@@ -11,6 +11,7 @@
 #include "panmap/core/thread_pool.h"
 #include "panmap/graph/superpoint_graph.h"
 #include "panmap/map/tsdf_map.h"
+#include "panmap/map/voxel_label_sampler.h"
 #include "panmap/superpoint/superpoint_tracker.h"
 
 namespace panmap {
@@ -88,9 +89,17 @@ class GraphAccumulator {
     bool operator==(const Hit& o) const { return mask == o.mask && voxel == o.voxel; }
   };
 
+  /// Per-thread scratch of the sampling pass.
+  struct ThreadScratch {
+    std::vector<Hit> hits;
+    std::vector<RowSample> samples;  // one row's
+    std::vector<int32_t> masks, labels;
+    std::vector<Eigen::Vector3i> voxels;
+  };
+
   GraphConfig config_;
   ThreadPool* pool_ = nullptr;
-  std::vector<std::vector<Hit>> thread_hits_;            // scratch, one per thread
+  std::vector<ThreadScratch> thread_scratch_;            // one per thread
   std::vector<Hit> hits_;                                // scratch
   std::vector<Hit> merged_;                              // scratch
   std::map<int32_t, std::map<int32_t, double>> scores_;  // label -> class -> P_nu

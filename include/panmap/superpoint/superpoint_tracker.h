@@ -9,6 +9,7 @@
 
 #include "panmap/core/frame.h"
 #include "panmap/map/tsdf_map.h"
+#include "panmap/map/voxel_label_sampler.h"
 #include "panmap/segmentation/panoptic_geometric.h"
 #include "panmap/superpoint/label_registry.h"
 
@@ -127,6 +128,9 @@ class SuperpointTracker {
   std::map<int32_t, SuperpointState> states_;               // by root label
   std::map<std::pair<int32_t, int32_t>, int> co_observed_;  // M, by root labels (a < b)
   std::vector<SuperpointMerge> merge_log_;
+  std::vector<RowSample> row_samples_;  // scratch of associate(): one row's samples,
+  std::vector<int32_t> row_surfaces_;   // their surfaces
+  std::vector<int32_t> row_labels_;     // and their voxels' labels
   int32_t next_instance_ = 1;
   int64_t frames_ = 0;
 };
