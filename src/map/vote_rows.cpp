@@ -9,14 +9,15 @@ namespace internal {
 
 namespace {
 
-// Appends one vote for (voxel, label) to the open run, or closes it and opens another.
-inline void addToRun(Voxel* voxel, int32_t label, VoteRun* run, VoteRun** out) {
+// Appends n votes for (voxel, label) to the open run, or closes it and opens another: the
+// runs n calls with one vote each would give.
+inline void addToRun(Voxel* voxel, int32_t label, VoteRun* run, VoteRun** out, uint32_t n = 1) {
   if (voxel == run->voxel && label == run->label) {
-    ++run->count;
+    run->count += n;
     return;
   }
   if (run->count > 0) *(*out)++ = *run;
-  *run = VoteRun{voxel, label, 1};
+  *run = VoteRun{voxel, label, n};
 }
 
 // Pixel (u, v) one at a time through Eigen: its vote, if it casts one, joins the open run.
@@ -32,6 +33,10 @@ inline void votePixel(const Image<float>& depth_m, const LabelImage& labels, int
 }
 
 #ifdef PANMAP_HAVE_AVX2_PATH
+__attribute__((target("avx2"))) inline __m256i notEqual(__m256i a, __m256i b) {
+  return _mm256_xor_si256(_mm256_cmpeq_epi32(a, b), _mm256_set1_epi32(-1));
+}
+
 // Stride 1, eight pixels at a time: back-projection, the rigid transform and floor() in AVX2
 // with the scalar path's operations in its order (Eigen multiplies the homogeneous 4x4 matrix
 // row by row, ((r0 x + r1 y) + r2 z) + t, and nothing is contracted into FMA), so every pixel
@@ -60,6 +65,7 @@ __attribute__((target("avx2"))) size_t findRowVotesAvx2(const Image<float>& dept
   alignas(32) int32_t block_index[3][8];
   alignas(32) int32_t voxel_offset[8];
   const __m256i seven = _mm256_set1_epi32(7);
+  const __m256i previous_lane = _mm256_setr_epi32(0, 0, 1, 2, 3, 4, 5, 6);
   int u = 0;
   for (; u + 8 <= width; u += 8) {
     const __m256i label = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(label_row + u));
@@ -73,17 +79,40 @@ __attribute__((target("avx2"))) size_t findRowVotesAvx2(const Image<float>& dept
     const __m256 y = _mm256_div_ps(_mm256_mul_ps(v_minus_cy, d), fy);
     // Voxel grid coordinates, split into block index (g >> 3) and place in the block.
     __m256i offset = _mm256_setzero_si256();
+    // Lanes whose block index, voxel or label differ from the lane before.
+    __m256i differs = notEqual(label, _mm256_permutevar8x32_epi32(label, previous_lane));
     for (int r = 0; r < 3; ++r) {
       const __m256 p = _mm256_add_ps(
           _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[r][0], x), _mm256_mul_ps(m[r][1], y)),
                         _mm256_mul_ps(m[r][2], d)),
           m[r][3]);
       const __m256i g = _mm256_cvttps_epi32(_mm256_floor_ps(_mm256_mul_ps(p, inv_voxel)));
-      _mm256_store_si256(reinterpret_cast<__m256i*>(block_index[r]), _mm256_srai_epi32(g, 3));
+      const __m256i b = _mm256_srai_epi32(g, 3);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(block_index[r]), b);
+      differs =
+          _mm256_or_si256(differs, notEqual(b, _mm256_permutevar8x32_epi32(b, previous_lane)));
       offset = _mm256_add_epi32(offset, _mm256_slli_epi32(_mm256_and_si256(g, seven), 3 * r));
     }
+    differs = _mm256_or_si256(differs,
+                              notEqual(offset, _mm256_permutevar8x32_epi32(offset, previous_lane)));
     _mm256_store_si256(reinterpret_cast<__m256i*>(voxel_offset), offset);
     static_assert(kBlockSide == 8, "block index and offset assume 8 voxels per block side");
+    if (valid == 0xFF) {
+      // Every pixel votes: one lookup per stretch of lanes with the same voxel and label
+      // (voxels wider than a pixel make these long), not one per lane.
+      int starts = _mm256_movemask_ps(_mm256_castsi256_ps(differs)) | 1;
+      while (starts != 0) {
+        const int k = __builtin_ctz(static_cast<unsigned>(starts));
+        starts &= starts - 1;
+        const int end = starts != 0 ? __builtin_ctz(static_cast<unsigned>(starts)) : 8;
+        Block* block = lookup->findBlock(block_index[0][k], block_index[1][k], block_index[2][k]);
+        if (block) {
+          addToRun(&block->voxels[voxel_offset[k]], label_row[u + k], &run, &out,
+                   static_cast<uint32_t>(end - k));
+        }
+      }
+      continue;
+    }
     for (; valid != 0; valid &= valid - 1) {
       const int k = __builtin_ctz(static_cast<unsigned>(valid));
       Block* block = lookup->findBlock(block_index[0][k], block_index[1][k], block_index[2][k]);
