@@ -96,7 +96,9 @@ struct PanopticGeometricSegmenter::Impl {
   internal::DepthGeometry geometry;
   internal::EdgeMaps edges;
   internal::SurfaceFuser fuser;
-  std::vector<int32_t> component_area_px;
+  std::vector<std::vector<int32_t>> component_area_px;     ///< per thread
+  std::vector<std::vector<size_t>> component_first_px;     ///< per thread: first pixel index
+  std::vector<std::pair<size_t, size_t>> component_order;  ///< (first pixel, component)
   std::vector<int32_t> component_to_segment;
 };
 
@@ -123,25 +125,52 @@ void PanopticGeometricSegmenter::Impl::checkInputs(const RgbdFrame& frame,
 
 // Connected components (4-connected) of the non-edge pixels; components smaller than
 // min_segment_px are dropped and the rest numbered from 1 in raster order of their first
-// pixel, so ids do not depend on OpenCV's labelling algorithm or its threads.
+// pixel, so ids do not depend on OpenCV's labelling algorithm or its threads. The counting and
+// relabelling passes run on the pool: each thread counts areas and first pixels of its rows,
+// and the parts combine exactly (sums and minima).
 void PanopticGeometricSegmenter::Impl::geometricSegments(LabelImage* geometric) {
   const int width = geometry.width;
   const int height = geometry.height;
   cv::Mat mask(height, width, CV_8UC1, edges.segmentable.data());
   cv::Mat labels(height, width, CV_32SC1, geometric->data());
-  const int num_labels = cv::connectedComponents(mask, labels, 4, CV_32S);
+  const size_t num_labels = static_cast<size_t>(cv::connectedComponents(mask, labels, 4, CV_32S));
   int32_t* label = geometric->data();
   const size_t n = geometric->size();
-  component_area_px.assign(num_labels, 0);
-  for (size_t i = 0; i < n; ++i) ++component_area_px[label[i]];
-  component_to_segment.assign(num_labels, -1);
-  component_to_segment[0] = 0;
-  int32_t next_id = 0;
-  for (size_t i = 0; i < n; ++i) {
-    int32_t& id = component_to_segment[label[i]];
-    if (id < 0) id = component_area_px[label[i]] >= depth_config.min_segment_px ? ++next_id : 0;
-    label[i] = id;
+  const size_t threads = static_cast<size_t>(pool.size());
+  component_area_px.resize(threads);
+  component_first_px.resize(threads);
+  pool.parallelFor(threads, [&](size_t t0, size_t t1, int) {
+    for (size_t t = t0; t < t1; ++t) {
+      std::vector<int32_t>& area = component_area_px[t];
+      std::vector<size_t>& first = component_first_px[t];
+      area.assign(num_labels, 0);
+      first.assign(num_labels, n);
+      for (size_t i = n * t / threads; i < n * (t + 1) / threads; ++i) {
+        const size_t l = static_cast<size_t>(label[i]);
+        if (area[l]++ == 0) first[l] = i;
+      }
+    }
+  });
+  // Components in raster order of their first pixel; label 0 (edges) stays 0.
+  component_order.clear();
+  for (size_t l = 1; l < num_labels; ++l) {
+    int32_t area = 0;
+    size_t first = n;
+    for (size_t t = 0; t < threads; ++t) {
+      area += component_area_px[t][l];
+      first = std::min(first, component_first_px[t][l]);
+    }
+    if (area >= depth_config.min_segment_px) component_order.emplace_back(first, l);
   }
+  std::sort(component_order.begin(), component_order.end());
+  component_to_segment.assign(num_labels, 0);
+  for (size_t k = 0; k < component_order.size(); ++k) {
+    component_to_segment[component_order[k].second] = static_cast<int32_t>(k) + 1;
+  }
+  const int32_t* to_segment = component_to_segment.data();
+  pool.parallelFor(n, [label, to_segment](size_t begin, size_t end, int) {
+    for (size_t i = begin; i < end; ++i) label[i] = to_segment[label[i]];
+  });
 }
 
 PanopticGeometricSegmenter::PanopticGeometricSegmenter(const DepthSegmentationConfig& depth_config,
@@ -203,7 +232,7 @@ void PanopticGeometricSegmenter::segment(const RgbdFrame& frame, const PanopticF
     out->surfaces = LabelImage(width, height);
   }
   impl.geometricSegments(&out->geometric);
-  impl.fuser.fuse(panoptic, impl.fusion_config, out);
+  impl.fuser.fuse(panoptic, impl.fusion_config, out, &impl.pool);
 }
 
 Eigen::Vector3f PanopticGeometricSegmenter::normal(int u, int v) const {

@@ -76,7 +76,7 @@ int32_t SurfaceFuser::findOrAddPair(int32_t geometric, int32_t segment_index, in
 }
 
 void SurfaceFuser::fuse(const PanopticFrame* panoptic, const SurfaceFusionConfig& config,
-                        FrameSegmentation* out) {
+                        FrameSegmentation* out, ThreadPool* pool) {
   const bool use_masks = panoptic != nullptr && !config.geometry_only;
   if (use_masks) {
     indexSegments(*panoptic);
@@ -149,8 +149,16 @@ void SurfaceFuser::fuse(const PanopticFrame* panoptic, const SurfaceFusionConfig
   }
 
   // Pass 2: pair -> surface id (0 for dropped pairs).
-  for (size_t i = 0; i < surfaces.size(); ++i) {
-    pair_of[i] = pair_of[i] > 0 ? pair_to_surface_[pair_of[i] - 1] : 0;
+  const int32_t* surface_of = pair_to_surface_.data();
+  auto relabel = [pair_of, surface_of](size_t begin, size_t end, int) {
+    for (size_t i = begin; i < end; ++i) {
+      pair_of[i] = pair_of[i] > 0 ? surface_of[pair_of[i] - 1] : 0;
+    }
+  };
+  if (pool) {
+    pool->parallelFor(surfaces.size(), relabel);
+  } else {
+    relabel(0, surfaces.size(), 0);
   }
 }
 

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "panmap/core/frame.h"
+#include "panmap/core/thread_pool.h"
 #include "panmap/segmentation/panoptic_geometric.h"
 
 namespace panmap {
@@ -25,8 +26,9 @@ class SurfaceFuser {
   /// Surface ids run from 1 in order of (geometric segment, panoptic segment id).
   /// @param panoptic null or geometry-only: every surface is background
   /// Throws Error when a listed segment id is not positive or listed twice.
+  /// @param pool threads for the final relabelling pass (not owned; null: the caller's thread)
   void fuse(const PanopticFrame* panoptic, const SurfaceFusionConfig& config,
-            FrameSegmentation* out);
+            FrameSegmentation* out, ThreadPool* pool = nullptr);
 
  private:
   struct Pair {
