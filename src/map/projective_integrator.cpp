@@ -67,9 +67,13 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
                                             T_W_C, row_cam, &lookup, &vote_runs_[r * cols]);
     }
   });
-  const size_t threads = static_cast<size_t>(pool_->size());
+  // Owners by a mask, not a modulo (an integer division per run): the largest power of two
+  // not above the thread count; with 3 threads one stays idle here.
+  size_t owners = 1;
+  while (owners * 2 <= static_cast<size_t>(pool_->size())) owners *= 2;
+  const uintptr_t owner_mask = owners - 1;
   std::atomic<size_t> added{0}, evicted{0};
-  pool_->parallelFor(threads, [&](size_t t0, size_t t1, int) {
+  pool_->parallelFor(owners, [&](size_t t0, size_t t1, int) {
     size_t my_added = 0, my_evicted = 0;
     for (size_t t = t0; t < t1; ++t) {
       for (size_t r = 0; r < rows; ++r) {
@@ -77,7 +81,7 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
         for (size_t i = 0; i < row_runs_[r]; ++i) {
           const VoteRun& run = runs[i];
           // 4 KiB regions: voxels sharing a cache line nearly always have the same owner.
-          if ((reinterpret_cast<uintptr_t>(run.voxel) >> 12) % threads != t) continue;
+          if (((reinterpret_cast<uintptr_t>(run.voxel) >> 12) & owner_mask) != t) continue;
           my_added += run.count;
           my_evicted += addVotes(run.voxel, run.label, run.count);
         }
@@ -111,11 +115,14 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
   const float scale = static_cast<float>(frame.depth_scale_m);
   const float min_depth_m = config_.min_depth_m, max_depth_m = config_.max_depth_m;
   pool_->parallelFor(static_cast<size_t>(h), [&](size_t v0, size_t v1, int) {
+    // Copies the compiler knows no store can change, so the loop vectorises.
+    const float s = scale, lo = min_depth_m, hi = max_depth_m;
     const uint16_t* raw = frame.depth.data() + v0 * w;
     float* metres = depth_m_.data() + v0 * w;
-    for (size_t i = 0; i < (v1 - v0) * w; ++i) {
-      const float d = raw[i] * scale;
-      metres[i] = (d >= min_depth_m && d <= max_depth_m) ? d : 0.0f;
+    const size_t n = (v1 - v0) * w;
+    for (size_t i = 0; i < n; ++i) {
+      const float d = raw[i] * s;
+      metres[i] = (d >= lo && d <= hi) ? d : 0.0f;
     }
   });
 
@@ -124,12 +131,15 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
   const Eigen::Isometry3f T_W_Cf = T_W_C.cast<float>();
   const int stride =
       std::clamp(static_cast<int>(map->blockSize() * cam.fx / config_.max_depth_m / 2.0), 1, 8);
-  keys_.clear();
+  // Tens of thousands of samples hit a few hundred blocks: a hash set drops the repeats, so
+  // only the distinct keys are sorted.
+  key_set_.clear();
   const float inv_block = 1.0f / map->blockSize();
   auto addKey = [&](const Eigen::Vector3f& p_W) {
-    keys_.push_back(TsdfMap::key(BlockIndex(static_cast<int>(std::floor(p_W.x() * inv_block)),
-                                            static_cast<int>(std::floor(p_W.y() * inv_block)),
-                                            static_cast<int>(std::floor(p_W.z() * inv_block)))));
+    // floorToInt: std::floor is a library call on baseline x86-64.
+    key_set_.insert(TsdfMap::key(BlockIndex(VoxelLookup::floorToInt(p_W.x() * inv_block),
+                                            VoxelLookup::floorToInt(p_W.y() * inv_block),
+                                            VoxelLookup::floorToInt(p_W.z() * inv_block))));
   };
   for (int v = 0; v < h; v += stride) {
     for (int u = 0; u < w; u += stride) {
@@ -145,8 +155,8 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
     }
   }
   // Sorted and unique: allocation order, and so the whole map, is the same on every run.
+  keys_.assign(key_set_.begin(), key_set_.end());
   std::sort(keys_.begin(), keys_.end());
-  keys_.erase(std::unique(keys_.begin(), keys_.end()), keys_.end());
   blocks_.clear();
   const size_t before = map->numBlocks();
   for (uint64_t key : keys_) blocks_.push_back(map->allocateBlock(unpackKey(key)));

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <vector>
 
+#include <absl/container/flat_hash_set.h>
 #include <Eigen/Geometry>
 
 #include "panmap/core/frame.h"
@@ -61,11 +62,12 @@ class ProjectiveIntegrator {
 
   IntegratorConfig config_;
   ThreadPool* pool_;
-  Image<float> depth_m_;            // scratch: depth in metres, 0 = invalid
-  std::vector<uint64_t> keys_;      // scratch: block keys seen this frame
-  std::vector<Block*> blocks_;      // scratch: blocks in view
-  std::vector<VoteRun> vote_runs_;  // scratch: each image row's runs of votes, `cols` apart
-  std::vector<size_t> row_runs_;    // scratch: runs found in each row
+  Image<float> depth_m_;                   // scratch: depth in metres, 0 = invalid
+  absl::flat_hash_set<uint64_t> key_set_;  // scratch: block keys seen this frame
+  std::vector<uint64_t> keys_;             // scratch: the same, sorted
+  std::vector<Block*> blocks_;             // scratch: blocks in view
+  std::vector<VoteRun> vote_runs_;         // scratch: each image row's runs of votes, `cols` apart
+  std::vector<size_t> row_runs_;           // scratch: runs found in each row
 };
 
 }  // namespace panmap
