@@ -39,15 +39,23 @@ BlockIndex unpackKey(uint64_t key) {
   return BlockIndex(field(key >> 42), field(key >> 21), field(key));
 }
 
+// The thread that applies votes to `voxel`: by 4 KiB region (voxels sharing a cache line
+// nearly always have the same owner), hashed so that regions spread evenly.
+uint32_t voteOwner(const Voxel* voxel, size_t owners) {
+  const uint64_t region = reinterpret_cast<uintptr_t>(voxel) >> 12;
+  return static_cast<uint32_t>(((region * 0x9E3779B97F4A7C15ull) >> 32) * owners >> 32);
+}
+
 }  // namespace
 
 // Pi_V (Eq. 2's counts): every labelled pixel votes for its label in the voxel its measured
 // point falls in, as in the paper (a vote per point, not per projected voxel: projective
 // distances stretch at grazing angles and would miss the surface voxels there).
 // Two passes so both can run on every thread and still give the single-threaded result: first
-// each pixel's voxel is looked up (rows split between threads, the map is only read), then
-// every thread walks all pixels in order but applies only the votes for voxels it owns (by
-// address), so each voxel sees its votes in pixel order whatever the thread count.
+// each pixel's voxel is looked up (rows split between threads, the map is only read), and each
+// row's runs of votes are grouped by the thread that owns their voxel (by address); then every
+// thread applies its own runs row by row, so each voxel sees its votes in pixel order whatever
+// the thread count.
 void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isometry3f& T_W_C,
                                       const LabelImage& labels, TsdfMap* map,
                                       IntegrationStats* stats) {
@@ -56,34 +64,52 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
                                     static_cast<float>(cam.cx), static_cast<float>(cam.cy)};
   const int stride = config_.vote_stride_px;
   const size_t cols = (cam.width + stride - 1) / stride, rows = (cam.height + stride - 1) / stride;
+  const size_t owners = static_cast<size_t>(pool_->size());
   vote_runs_.resize(cols * rows);
-  row_runs_.resize(rows);
+  owner_begin_.resize(rows * (owners + 1));
+  row_scratch_.resize(owners);
   // Rows differ a lot in cost (invalid depth, blocks missed by the cache): whichever thread is
   // free takes the next few; each row's runs land in its own slot.
-  pool_->parallelForDynamic(rows, kVoteRowsPerChunk, [&](size_t r0, size_t r1, int) {
+  pool_->parallelForDynamic(rows, kVoteRowsPerChunk, [&](size_t r0, size_t r1, int thread) {
     MutableVoxelLookup lookup(*map);
+    RowScratch& scratch = row_scratch_[thread];
+    scratch.runs.resize(cols);
+    scratch.owner.resize(cols);
+    scratch.next.resize(owners);
     for (size_t r = r0; r < r1; ++r) {
-      row_runs_[r] = internal::findRowVotes(depth_m_, labels, static_cast<int>(r) * stride, stride,
-                                            T_W_C, row_cam, &lookup, &vote_runs_[r * cols]);
+      size_t* begin = &owner_begin_[r * (owners + 1)];
+      VoteRun* slot = &vote_runs_[r * cols];
+      if (owners == 1) {
+        begin[0] = 0;
+        begin[1] = internal::findRowVotes(depth_m_, labels, static_cast<int>(r) * stride, stride,
+                                          T_W_C, row_cam, &lookup, slot);
+        continue;
+      }
+      const VoteRun* found = scratch.runs.data();
+      uint32_t* owner = scratch.owner.data();
+      const size_t n = internal::findRowVotes(depth_m_, labels, static_cast<int>(r) * stride,
+                                              stride, T_W_C, row_cam, &lookup, scratch.runs.data());
+      // Stable counting sort by owner: each owner's runs stay in pixel order.
+      std::fill(begin, begin + owners + 1, size_t{0});
+      for (size_t i = 0; i < n; ++i) {
+        owner[i] = voteOwner(found[i].voxel, owners);
+        ++begin[owner[i] + 1];
+      }
+      for (size_t t = 0; t < owners; ++t) begin[t + 1] += begin[t];
+      std::copy(begin, begin + owners, scratch.next.begin());
+      for (size_t i = 0; i < n; ++i) slot[scratch.next[owner[i]]++] = found[i];
     }
   });
-  // Owners by a mask, not a modulo (an integer division per run): the largest power of two
-  // not above the thread count; with 3 threads one stays idle here.
-  size_t owners = 1;
-  while (owners * 2 <= static_cast<size_t>(pool_->size())) owners *= 2;
-  const uintptr_t owner_mask = owners - 1;
   std::atomic<size_t> added{0}, evicted{0};
   pool_->parallelFor(owners, [&](size_t t0, size_t t1, int) {
     size_t my_added = 0, my_evicted = 0;
     for (size_t t = t0; t < t1; ++t) {
       for (size_t r = 0; r < rows; ++r) {
         const VoteRun* runs = &vote_runs_[r * cols];
-        for (size_t i = 0; i < row_runs_[r]; ++i) {
-          const VoteRun& run = runs[i];
-          // 4 KiB regions: voxels sharing a cache line nearly always have the same owner.
-          if (((reinterpret_cast<uintptr_t>(run.voxel) >> 12) & owner_mask) != t) continue;
-          my_added += run.count;
-          my_evicted += addVotes(run.voxel, run.label, run.count);
+        const size_t* begin = &owner_begin_[r * (owners + 1)];
+        for (size_t i = begin[t]; i < begin[t + 1]; ++i) {
+          my_added += runs[i].count;
+          my_evicted += addVotes(runs[i].voxel, runs[i].label, runs[i].count);
         }
       }
     }

@@ -67,7 +67,15 @@ class ProjectiveIntegrator {
   std::vector<uint64_t> keys_;             // scratch: the same, sorted
   std::vector<Block*> blocks_;             // scratch: blocks in view
   std::vector<VoteRun> vote_runs_;         // scratch: each image row's runs of votes, `cols` apart
-  std::vector<size_t> row_runs_;           // scratch: runs found in each row
+  // scratch: where each owner's runs start in each row's slot (owners + 1 entries per row)
+  std::vector<size_t> owner_begin_;
+  /// Per-thread scratch of the vote lookup: one row's runs before they are grouped by owner.
+  struct RowScratch {
+    std::vector<VoteRun> runs;
+    std::vector<uint32_t> owner;  // of each run
+    std::vector<size_t> next;     // next free place of each owner in the row's slot
+  };
+  std::vector<RowScratch> row_scratch_;
 };
 
 }  // namespace panmap
