@@ -157,32 +157,42 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
   const Eigen::Isometry3f T_W_Cf = T_W_C.cast<float>();
   const int stride =
       std::clamp(static_cast<int>(map->blockSize() * cam.fx / config_.max_depth_m / 2.0), 1, 8);
-  // Tens of thousands of samples hit a few hundred blocks: a hash set drops the repeats, so
-  // only the distinct keys are sorted.
-  key_set_.clear();
+  // Tens of thousands of samples hit a few hundred blocks: per-thread hash sets drop the
+  // repeats, so only the distinct keys are sorted.
   const float inv_block = 1.0f / map->blockSize();
-  auto addKey = [&](const Eigen::Vector3f& p_W) {
-    // floorToInt: std::floor is a library call on baseline x86-64.
-    key_set_.insert(TsdfMap::key(BlockIndex(VoxelLookup::floorToInt(p_W.x() * inv_block),
-                                            VoxelLookup::floorToInt(p_W.y() * inv_block),
-                                            VoxelLookup::floorToInt(p_W.z() * inv_block))));
-  };
-  for (int v = 0; v < h; v += stride) {
-    for (int u = 0; u < w; u += stride) {
-      const float d = depth_m_(u, v);
-      if (d <= 0.0f) continue;
-      const Eigen::Vector3f ray_C((u - static_cast<float>(cam.cx)) / static_cast<float>(cam.fx),
-                                  (v - static_cast<float>(cam.cy)) / static_cast<float>(cam.fy),
-                                  1.0f);
-      const float near = config_.space_carving ? config_.min_depth_m : std::max(d - trunc, 0.0f);
-      const float step = std::min(map->blockSize() * 0.5f, trunc);
-      for (float z = near; z < d + trunc; z += step) addKey(T_W_Cf * (ray_C * z));
-      addKey(T_W_Cf * (ray_C * (d + trunc)));
+  const float step = std::min(map->blockSize() * 0.5f, trunc);
+  const size_t sample_rows = static_cast<size_t>((h + stride - 1) / stride);
+  key_sets_.resize(static_cast<size_t>(pool_->size()));
+  // Emptied element by element: clear() would free a large table, reallocated every frame.
+  for (absl::flat_hash_set<uint64_t>& set : key_sets_) set.erase(set.begin(), set.end());
+  pool_->parallelFor(sample_rows, [&](size_t r0, size_t r1, int thread) {
+    absl::flat_hash_set<uint64_t>& set = key_sets_[thread];
+    auto addKey = [&](const Eigen::Vector3f& p_W) {
+      // floorToInt: std::floor is a library call on baseline x86-64.
+      set.insert(TsdfMap::key(BlockIndex(VoxelLookup::floorToInt(p_W.x() * inv_block),
+                                         VoxelLookup::floorToInt(p_W.y() * inv_block),
+                                         VoxelLookup::floorToInt(p_W.z() * inv_block))));
+    };
+    for (int v = static_cast<int>(r0) * stride; v < static_cast<int>(r1) * stride; v += stride) {
+      for (int u = 0; u < w; u += stride) {
+        const float d = depth_m_(u, v);
+        if (d <= 0.0f) continue;
+        const Eigen::Vector3f ray_C((u - static_cast<float>(cam.cx)) / static_cast<float>(cam.fx),
+                                    (v - static_cast<float>(cam.cy)) / static_cast<float>(cam.fy),
+                                    1.0f);
+        const float near = config_.space_carving ? config_.min_depth_m : std::max(d - trunc, 0.0f);
+        for (float z = near; z < d + trunc; z += step) addKey(T_W_Cf * (ray_C * z));
+        addKey(T_W_Cf * (ray_C * (d + trunc)));
+      }
     }
-  }
+  });
   // Sorted and unique: allocation order, and so the whole map, is the same on every run.
-  keys_.assign(key_set_.begin(), key_set_.end());
+  keys_.clear();
+  for (const absl::flat_hash_set<uint64_t>& set : key_sets_) {
+    keys_.insert(keys_.end(), set.begin(), set.end());
+  }
   std::sort(keys_.begin(), keys_.end());
+  keys_.erase(std::unique(keys_.begin(), keys_.end()), keys_.end());
   blocks_.clear();
   const size_t before = map->numBlocks();
   for (uint64_t key : keys_) blocks_.push_back(map->allocateBlock(unpackKey(key)));

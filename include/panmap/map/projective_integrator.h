@@ -62,11 +62,11 @@ class ProjectiveIntegrator {
 
   IntegratorConfig config_;
   ThreadPool* pool_;
-  Image<float> depth_m_;                   // scratch: depth in metres, 0 = invalid
-  absl::flat_hash_set<uint64_t> key_set_;  // scratch: block keys seen this frame
-  std::vector<uint64_t> keys_;             // scratch: the same, sorted
-  std::vector<Block*> blocks_;             // scratch: blocks in view
-  std::vector<VoteRun> vote_runs_;         // scratch: each image row's runs of votes, `cols` apart
+  Image<float> depth_m_;                                 // scratch: depth in metres, 0 = invalid
+  std::vector<absl::flat_hash_set<uint64_t>> key_sets_;  // scratch: block keys seen, per thread
+  std::vector<uint64_t> keys_;                           // scratch: the same, sorted
+  std::vector<Block*> blocks_;                           // scratch: blocks in view
+  std::vector<VoteRun> vote_runs_;  // scratch: each image row's runs of votes, `cols` apart
   // scratch: where each owner's runs start in each row's slot (owners + 1 entries per row)
   std::vector<size_t> owner_begin_;
   /// Per-thread scratch of the vote lookup: one row's runs before they are grouped by owner.
