@@ -122,12 +122,18 @@ TEST(Integrator, VotesGoToSurfaceVoxelsAndSameInputGivesSameMap) {
     for (int k = 0; k < 3; ++k) integrator.integrate(frame, T, &labels, map.get());
     return map;
   };
-  const auto one = run(1), two = run(2);
-  ASSERT_EQ(one->numBlocks(), two->numBlocks());
-  for (size_t b = 0; b < one->numBlocks(); ++b) {
-    ASSERT_EQ(one->blocks()[b]->index, two->blocks()[b]->index);
-    EXPECT_EQ(
-        std::memcmp(one->blocks()[b]->voxels, two->blocks()[b]->voxels, sizeof(Block::voxels)), 0);
+  // Three threads as well: votes are grouped by owner for any thread count, not only two.
+  const auto one = run(1);
+  for (int threads : {2, 3}) {
+    const auto other = run(threads);
+    ASSERT_EQ(one->numBlocks(), other->numBlocks()) << threads << " threads";
+    for (size_t b = 0; b < one->numBlocks(); ++b) {
+      ASSERT_EQ(one->blocks()[b]->index, other->blocks()[b]->index);
+      EXPECT_EQ(
+          std::memcmp(one->blocks()[b]->voxels, other->blocks()[b]->voxels, sizeof(Block::voxels)),
+          0)
+          << threads << " threads, block " << b;
+    }
   }
   // The camera looks along +x with x_C = -y_W: image left (u < 320) is world +y.
   const Voxel* left = one->findVoxel({2.0f, 0.5f, 0.1f});
