@@ -24,8 +24,6 @@ std::string reasonOf(const std::string& what) {
   return colon == std::string::npos ? what : what.substr(0, colon);
 }
 
-namespace {}  // namespace
-
 MappingSession::MappingSession(const SessionOptions& options, Mapper* mapper)
     : options_(options), mapper_(mapper), sync_(options.sync) {
   if (!mapper_) throw Error("MappingSession: no mapper");

@@ -85,10 +85,10 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
                                           T_W_C, row_cam, &lookup, slot);
         continue;
       }
-      const VoteRun* found = scratch.runs.data();
+      VoteRun* found = scratch.runs.data();
       uint32_t* owner = scratch.owner.data();
       const size_t n = internal::findRowVotes(depth_m_, labels, static_cast<int>(r) * stride,
-                                              stride, T_W_C, row_cam, &lookup, scratch.runs.data());
+                                              stride, T_W_C, row_cam, &lookup, found);
       // Stable counting sort by owner: each owner's runs stay in pixel order.
       std::fill(begin, begin + owners + 1, size_t{0});
       for (size_t i = 0; i < n; ++i) {
