@@ -5,10 +5,12 @@
 //   panmap-bench-memory [--room N] [--frames N] [--voxel-size M] [--threads N] [--every N]
 //                       [--json FILE]
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <set>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -23,6 +25,15 @@
 namespace {
 
 constexpr double kMiB = 1024.0 * 1024.0;
+
+// Median of the times collected since the last sample; empties them.
+double takeMedian(std::vector<double>* times) {
+  if (times->empty()) return 0.0;
+  std::sort(times->begin(), times->end());
+  const double median = (*times)[times->size() / 2];
+  times->clear();
+  return median;
+}
 
 // Super-points that still hold a vote in some voxel (the rest only live in the bookkeeping).
 size_t superpointsWithVotes(const panmap::Mapper& mapper) {
@@ -72,13 +83,17 @@ int main(int argc, char** argv) {
                  synth.size(), voxel * 100.0, threads);
     std::printf(
         "| frame | resident MiB | TSDF MiB | occupancy MiB | graph MiB | other MiB | blocks | "
-        "super-points (with votes) | co-observed pairs | graph edges |\n"
-        "|---|---|---|---|---|---|---|---|---|---|\n");
+        "super-points (with votes) | co-observed pairs | graph edges | graph ms | total ms |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     nlohmann::json samples = nlohmann::json::array();
     const auto start = std::chrono::steady_clock::now();
+    std::vector<double> graph_ms, total_ms;  // since the last sample
     for (size_t k = 0; k < synth.size(); ++k) {
       const panmap::SynthFrame f = synth.frame(k);
-      mapper.integrate(f.rgbd, f.gt_pose.T_W_C, &f.panoptic, panmap::PoseSource::kGroundTruth);
+      const panmap::FrameStats stats =
+          mapper.integrate(f.rgbd, f.gt_pose.T_W_C, &f.panoptic, panmap::PoseSource::kGroundTruth);
+      graph_ms.push_back(stats.graph_ms);
+      total_ms.push_back(stats.total_ms);
       if ((k + 1) % static_cast<size_t>(every) != 0 && k + 1 != synth.size()) continue;
       const size_t rss = panmap::residentBytes();
       const size_t tsdf = mapper.map().memoryBytes();
@@ -88,11 +103,15 @@ int main(int argc, char** argv) {
           mapper.graphAccumulator().memoryBytes() + mapper.superpoints().memoryBytes();
       const double other = (static_cast<double>(rss) - tsdf - occupancy - graph) / kMiB;
       const size_t with_votes = superpointsWithVotes(mapper);
-      std::printf("| %zu | %.1f | %.1f | %.1f | %.1f | %.1f | %zu | %zu (%zu) | %zu | %zu |\n",
-                  k + 1, rss / kMiB, tsdf / kMiB, occupancy / kMiB, graph / kMiB, other,
-                  mapper.map().numBlocks(), mapper.superpoints().states().size(), with_votes,
-                  mapper.superpoints().coObservations().size(),
-                  mapper.graphAccumulator().numEdges());
+      const double graph_median_ms = takeMedian(&graph_ms);
+      const double total_median_ms = takeMedian(&total_ms);
+      std::printf(
+          "| %zu | %.1f | %.1f | %.1f | %.1f | %.1f | %zu | %zu (%zu) | %zu | %zu | %.1f | %.1f "
+          "|\n",
+          k + 1, rss / kMiB, tsdf / kMiB, occupancy / kMiB, graph / kMiB, other,
+          mapper.map().numBlocks(), mapper.superpoints().states().size(), with_votes,
+          mapper.superpoints().coObservations().size(), mapper.graphAccumulator().numEdges(),
+          graph_median_ms, total_median_ms);
       std::fflush(stdout);
       const double elapsed_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -106,7 +125,9 @@ int main(int argc, char** argv) {
                          {"superpoints", mapper.superpoints().states().size()},
                          {"superpoints_with_votes", with_votes},
                          {"co_observed_pairs", mapper.superpoints().coObservations().size()},
-                         {"graph_edges", mapper.graphAccumulator().numEdges()}});
+                         {"graph_edges", mapper.graphAccumulator().numEdges()},
+                         {"graph_median_ms", graph_median_ms},
+                         {"total_median_ms", total_median_ms}});
     }
     std::fprintf(stderr, "\n");
     if (!json_path.empty()) {

@@ -35,14 +35,16 @@ const std::map<int32_t, double>& GraphAccumulator::scores(int32_t label) const {
   return it == scores_.end() ? kEmpty : it->second;
 }
 
-const std::map<int32_t, double>& GraphAccumulator::confidences(int32_t a, int32_t b) const {
-  static const std::map<int32_t, double> kEmpty;
-  const auto it = edges_.find(std::minmax(a, b));
-  return it == edges_.end() ? kEmpty : it->second;
+std::map<int32_t, double> GraphAccumulator::confidences(int32_t a, int32_t b) const {
+  const auto [lo, hi] = std::minmax(a, b);
+  const EdgeTable::Classes* classes = edges_.find(lo, hi);
+  if (!classes) return {};
+  return std::map<int32_t, double>(classes->begin(), classes->end());
 }
 
 void GraphAccumulator::applyMerges(const SuperpointTracker& tracker) {
   const auto& merges = tracker.merges();
+  const size_t first_merge = merges_applied_;
   for (; merges_applied_ < merges.size(); ++merges_applied_) {
     const int32_t kept = merges[merges_applied_].kept, gone = merges[merges_applied_].removed;
     // Scores of merged super-points add up.
@@ -52,22 +54,9 @@ void GraphAccumulator::applyMerges(const SuperpointTracker& tracker) {
       for (const auto& [cls, score] : it->second) target[cls] += score;
       scores_.erase(it);
     }
-    // Edges of the removed one move to the survivor; the edge between them disappears.
-    std::vector<std::pair<std::pair<int32_t, int32_t>, std::map<int32_t, double>>> moved;
-    for (auto e = edges_.begin(); e != edges_.end();) {
-      if (e->first.first == gone || e->first.second == gone) {
-        const int32_t other = e->first.first == gone ? e->first.second : e->first.first;
-        if (other != kept) moved.emplace_back(std::minmax(kept, other), std::move(e->second));
-        e = edges_.erase(e);
-      } else {
-        ++e;
-      }
-    }
-    for (auto& [key, conf] : moved) {
-      auto& target = edges_[key];
-      for (const auto& [cls, c] : conf) target[cls] += c;
-    }
   }
+  // Edges of the removed ones move to the survivors; the edge between the two disappears.
+  edges_.applyMerges(merges, first_merge, merges.size());
 }
 
 void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
@@ -198,7 +187,7 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
         const double distance =
             (i->second.second / i->second.first - j->second.second / j->second.first).norm();
         const double p_s = 1.0 / (1.0 + distance / config_.spatial_scale_m);
-        edges_[{i->first, j->first}][cls] += p_o * p_s * std::min(i->second.first, j->second.first);
+        edges_.add(i->first, j->first, cls, p_o * p_s * std::min(i->second.first, j->second.first));
       }
     }
     begin = end;
@@ -206,9 +195,8 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
 }
 
 size_t GraphAccumulator::memoryBytes() const {
-  size_t bytes = mapNodesBytes(scores_) + mapNodesBytes(edges_);
+  size_t bytes = mapNodesBytes(scores_) + edges_.memoryBytes();
   for (const auto& [label, by_class] : scores_) bytes += mapNodesBytes(by_class);
-  for (const auto& [pair, by_class] : edges_) bytes += mapNodesBytes(by_class);
   for (const ThreadScratch& scratch : thread_scratch_) {
     bytes += vectorBytes(scratch.hits) + vectorBytes(scratch.samples) + vectorBytes(scratch.masks) +
              vectorBytes(scratch.labels) + vectorBytes(scratch.voxels);
@@ -225,9 +213,7 @@ void GraphAccumulator::forgetUnvoted(const std::vector<uint8_t>& has_votes,
   for (auto it = scores_.begin(); it != scores_.end();) {
     it = voted(it->first) ? std::next(it) : scores_.erase(it);
   }
-  for (auto it = edges_.begin(); it != edges_.end();) {
-    it = voted(it->first.first) && voted(it->first.second) ? std::next(it) : edges_.erase(it);
-  }
+  edges_.keepIf(voted);
 }
 
 SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
@@ -267,16 +253,17 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
     if (s != scores_.end()) vertex.scores = s->second;
     g.vertices.push_back(vertex);
   }
-  for (const auto& [key, conf] : edges_) {
+  // In pair order, so that equal pairs below are summed in the same order on every run.
+  edges_.forEachSorted([&](int32_t first, int32_t second, const EdgeTable::Classes& conf) {
     // Edges only between live super-points (merges are folded in at the next update).
-    const int32_t a = tracker.labels().resolve(key.first), b = tracker.labels().resolve(key.second);
-    if (a == b || a == 0 || b == 0) continue;
+    const int32_t a = tracker.labels().resolve(first), b = tracker.labels().resolve(second);
+    if (a == b || a == 0 || b == 0) return;
     GraphEdge e;
     e.a = std::min(a, b);
     e.b = std::max(a, b);
-    e.confidences = conf;
-    g.edges.push_back(e);
-  }
+    e.confidences = std::map<int32_t, double>(conf.begin(), conf.end());
+    g.edges.push_back(std::move(e));
+  });
   std::sort(g.edges.begin(), g.edges.end(), [](const GraphEdge& x, const GraphEdge& y) {
     return std::tie(x.a, x.b) < std::tie(y.a, y.b);
   });

@@ -9,6 +9,7 @@
 
 #include "panmap/core/frame.h"
 #include "panmap/core/thread_pool.h"
+#include "panmap/graph/internal/edge_table.h"
 #include "panmap/graph/superpoint_graph.h"
 #include "panmap/map/tsdf_map.h"
 #include "panmap/map/voxel_label_sampler.h"
@@ -53,25 +54,25 @@ class GraphAccumulator {
 
   /// P_nu^C of a super-point (merges resolved by the caller), empty if never seen.
   const std::map<int32_t, double>& scores(int32_t label) const;
-  /// P_eps^C of a pair (a < b), empty if never co-observed.
-  const std::map<int32_t, double>& confidences(int32_t a, int32_t b) const;
+  /// P_eps^C of a pair (either order), empty if never co-observed.
+  std::map<int32_t, double> confidences(int32_t a, int32_t b) const;
   /// Number of edges.
   size_t numEdges() const { return edges_.size(); }
-  /// Estimated heap bytes of the scores and edges (std::map nodes).
+  /// Estimated heap bytes of the scores (std::map nodes), the edge table and the scratch.
   size_t memoryBytes() const;
 
   /// Full state for saving and restoring a map.
   struct Snapshot {
     std::map<int32_t, std::map<int32_t, double>> scores;
-    std::map<std::pair<int32_t, int32_t>, std::map<int32_t, double>> edges;
+    EdgeTable::OrderedEdges edges;
     uint64_t merges_applied = 0;
   };
   /// Copies the state out.
-  Snapshot snapshot() const { return Snapshot{scores_, edges_, merges_applied_}; }
+  Snapshot snapshot() const { return Snapshot{scores_, edges_.toOrdered(), merges_applied_}; }
   /// Replaces the state.
   void restore(const Snapshot& s) {
     scores_ = s.scores;
-    edges_ = s.edges;
+    edges_.assign(s.edges);
     merges_applied_ = static_cast<size_t>(s.merges_applied);
   }
 
@@ -103,8 +104,7 @@ class GraphAccumulator {
   std::vector<Hit> hits_;                                // scratch
   std::vector<Hit> merged_;                              // scratch
   std::map<int32_t, std::map<int32_t, double>> scores_;  // label -> class -> P_nu
-  std::map<std::pair<int32_t, int32_t>, std::map<int32_t, double>>
-      edges_;  // (a<b) -> class -> P_eps
+  EdgeTable edges_;                                      // (a<b) -> class -> P_eps
   size_t merges_applied_ = 0;
 };
 
