@@ -16,6 +16,8 @@ namespace {
 
 // Image rows a thread takes at a time when sampling a frame's masks.
 constexpr size_t kRowsPerChunk = 8;
+// Edge pairs between fetching a pair's slot and updating it.
+constexpr size_t kPrefetchPairs = 16;
 
 }  // namespace
 
@@ -172,22 +174,36 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
     size_t end = begin;
     while (end < hits.size() && hits[end].mask == hits[begin].mask) ++end;
     const auto [cls, p_o] = masks.at(hits[begin].mask);
-    // N^S_o and the centroid of those voxels, per super-point.
-    std::map<int32_t, std::pair<int, Eigen::Vector3d>> groups;
+    // N^S_o and the centroid of those voxels, per super-point, in label order.
+    groups_.clear();
+    group_index_.clear();
     for (size_t i = begin; i < end; ++i) {
-      auto& g = groups.try_emplace(hits[i].label, 0, Eigen::Vector3d::Zero()).first->second;
-      ++g.first;
-      g.second += centre(hits[i].voxel);
+      const auto [it, added] = group_index_.try_emplace(hits[i].label, groups_.size());
+      if (added) groups_.push_back({hits[i].label, 0, Eigen::Vector3d::Zero(), {}});
+      Group& g = groups_[it->second];
+      ++g.count;
+      g.sum += centre(hits[i].voxel);
     }
+    std::sort(groups_.begin(), groups_.end(),
+              [](const Group& x, const Group& y) { return x.label < y.label; });
+    for (Group& g : groups_) g.centroid = g.sum / g.count;
     // Eq. 5: P_nu^C(L_S) += P_o * N^S_o.
-    for (const auto& [label, g] : groups) scores_[label][cls] += p_o * g.first;
-    // Eq. 6: P_eps^C(S1, S2) += P_o * P_s * min(N^S1_o, N^S2_o), for every pair under o.
-    for (auto i = groups.begin(); i != groups.end(); ++i) {
-      for (auto j = std::next(i); j != groups.end(); ++j) {
-        const double distance =
-            (i->second.second / i->second.first - j->second.second / j->second.first).norm();
+    for (const Group& g : groups_) scores_[g.label][cls] += p_o * g.count;
+    // Eq. 6: P_eps^C(S1, S2) += P_o * P_s * min(N^S1_o, N^S2_o), for every pair under o. On a
+    // long run the table is far larger than the cache: each pair's slot is fetched a few pairs
+    // ahead.
+    const size_t n = groups_.size();
+    for (size_t i = 0; i < n; ++i) {
+      const Group& gi = groups_[i];
+      for (size_t j = i + 1; j < std::min(n, i + 1 + kPrefetchPairs); ++j) {
+        edges_.prefetch(gi.label, groups_[j].label);
+      }
+      for (size_t j = i + 1; j < n; ++j) {
+        if (j + kPrefetchPairs < n) edges_.prefetch(gi.label, groups_[j + kPrefetchPairs].label);
+        const Group& gj = groups_[j];
+        const double distance = (gi.centroid - gj.centroid).norm();
         const double p_s = 1.0 / (1.0 + distance / config_.spatial_scale_m);
-        edges_.add(i->first, j->first, cls, p_o * p_s * std::min(i->second.first, j->second.first));
+        edges_.add(gi.label, gj.label, cls, p_o * p_s * std::min(gi.count, gj.count));
       }
     }
     begin = end;
@@ -201,6 +217,8 @@ size_t GraphAccumulator::memoryBytes() const {
     bytes += vectorBytes(scratch.hits) + vectorBytes(scratch.samples) + vectorBytes(scratch.masks) +
              vectorBytes(scratch.labels) + vectorBytes(scratch.voxels);
   }
+  bytes += vectorBytes(groups_) +
+           group_index_.capacity() * (sizeof(std::pair<const int32_t, size_t>) + 1);
   return bytes + vectorBytes(hits_) + vectorBytes(merged_);
 }
 

@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include <absl/container/flat_hash_map.h>
 #include <Eigen/Geometry>
 
 #include "panmap/core/frame.h"
@@ -98,11 +99,21 @@ class GraphAccumulator {
     std::vector<Eigen::Vector3i> voxels;
   };
 
+  /// The voxels one mask reaches of one super-point: N^S_o and their centroid.
+  struct Group {
+    int32_t label;
+    int count;
+    Eigen::Vector3d sum;
+    Eigen::Vector3d centroid;
+  };
+
   GraphConfig config_;
   ThreadPool* pool_ = nullptr;
   std::vector<ThreadScratch> thread_scratch_;            // one per thread
   std::vector<Hit> hits_;                                // scratch
   std::vector<Hit> merged_;                              // scratch
+  std::vector<Group> groups_;                            // one mask's, scratch
+  absl::flat_hash_map<int32_t, size_t> group_index_;     // label -> groups_ index, scratch
   std::map<int32_t, std::map<int32_t, double>> scores_;  // label -> class -> P_nu
   EdgeTable edges_;                                      // (a<b) -> class -> P_eps
   size_t merges_applied_ = 0;
