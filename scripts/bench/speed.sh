@@ -124,8 +124,11 @@ Targets of roadmap issue 9 (2 threads, median total): <= 33 ms at 1 cm, <= 15 ms
 \`panmap-bench-memory --room 1 --frames 3000 --voxel-size 0.02\`: a 100 s walk (30 Hz)
 through one room, rendered in-process and mapped frame by frame with its masks. Resident
 memory against what the map holds: TSDF blocks, occupancy cells and the super-point graph
-with its bookkeeping (estimated from its std::map nodes); \`other\` is the rest of the
-process (the renderer and its room, libraries, scratch buffers), which must stay flat.
+with its bookkeeping (estimated from its table slots and std::map nodes); \`other\` is the
+rest of the process (the renderer and its room, libraries, scratch buffers), which must stay
+flat. The graph grows with the pairs of super-points seen under one mask (Eq. 6 keeps an edge
+for every such pair). \`graph ms\` and \`total ms\` are the medians of the graph update and
+the whole frame over the 250 frames before each sample (2 threads, with rendering in between).
 
 ${memory_rows}
 
