@@ -130,9 +130,20 @@ TEST(EdgeTable, VisitsInPairOrderAndRoundTripsThroughAnOrderedMap) {
       {1, 9}, {2, 3}, {2, 10}, {100000, 2000000}};
   EXPECT_EQ(order, expected_order);
   EXPECT_EQ(t.toOrdered(), edges);
-  // One slot per pair in the table, and the pair with two classes keeps them on the heap.
-  EXPECT_GE(t.memoryBytes(), t.size() * sizeof(std::pair<const uint64_t, EdgeTable::Classes>) +
-                                 2 * sizeof(EdgeTable::Classes::value_type));
+}
+
+TEST(EdgeTable, MemoryCountsSlotsAndTheClassesOfPairsWithMoreThanOne) {
+  EdgeTable one, two;
+  one.add(1, 2, 1, 1.0);
+  one.add(3, 4, 1, 1.0);
+  two.add(1, 2, 1, 1.0);
+  two.add(1, 2, 2, 1.0);
+  two.add(3, 4, 1, 1.0);
+  const size_t slot = sizeof(std::pair<const uint64_t, EdgeTable::Classes>) + 1;
+  EXPECT_GE(one.memoryBytes(), 2 * slot);
+  // Same pairs, same table; the second class of (1, 2) moves both to a malloc'd block of two
+  // 16-byte entries (32 bytes + 8 of header, rounded to 48).
+  EXPECT_EQ(two.memoryBytes() - one.memoryBytes(), 48u);
 }
 
 }  // namespace
