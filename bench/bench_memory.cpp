@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
       const size_t rss = panmap::residentBytes();
       const size_t tsdf = mapper.map().memoryBytes();
       const size_t occupancy = mapper.occupancy() ? mapper.occupancy()->grid().memoryBytes() : 0;
-      // Super-point graph and bookkeeping: estimated from their std::map nodes.
+      // Super-point graph and bookkeeping: estimated from their table slots and std::map nodes.
       const size_t graph =
           mapper.graphAccumulator().memoryBytes() + mapper.superpoints().memoryBytes();
       const double other = (static_cast<double>(rss) - tsdf - occupancy - graph) / kMiB;

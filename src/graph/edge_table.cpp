@@ -4,6 +4,8 @@
 
 #include <absl/container/flat_hash_set.h>
 
+#include "panmap/core/container_memory.h"
+
 namespace panmap {
 
 void EdgeTable::addTo(Classes* classes, int32_t cls, double value) {
@@ -106,9 +108,9 @@ size_t EdgeTable::memoryBytes() const {
   using Slot = std::pair<const uint64_t, Classes>;
   size_t bytes = table_.capacity() * (sizeof(Slot) + 1);
   for (const auto& entry : table_) {
-    // Pairs seen under more than one class keep their classes on the heap (malloc-rounded).
+    // Pairs seen under more than one class keep their classes on the heap.
     if (entry.second.capacity() > 1) {
-      bytes += ((entry.second.capacity() * sizeof(Classes::value_type) + 8 + 15) / 16) * 16;
+      bytes += mallocBytes(entry.second.capacity() * sizeof(Classes::value_type));
     }
   }
   return bytes;
