@@ -13,6 +13,7 @@
 
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
+#include "panmap/eval/diagnostics.h"
 #include "panmap/eval/evaluation.h"
 #include "panmap/eval/ground_truth_input.h"
 #include "panmap/eval/trajectory_error.h"
@@ -97,6 +98,55 @@ json toJson(const panmap::EvalResult& r) {
           {"iou_ls_best", number(r.iou_ls_best)},
           {"miou", number(r.miou)},
           {"classes", classes}};
+}
+
+json toJson(const panmap::SceneDiagnostics& d) {
+  json mix = json::array();
+  for (const auto& [cls, share] : d.largest_class_mix) {
+    mix.push_back({{"class_id", cls}, {"name", panmap::nyu40Name(cls)}, {"share", share}});
+  }
+  json objects = json::array();
+  for (const auto& o : d.objects) {
+    objects.push_back({{"id", o.id},
+                       {"class_id", o.class_id},
+                       {"confidence", o.confidence},
+                       {"vertices", o.vertices},
+                       {"void_vertices", o.void_vertices},
+                       {"best_iou", o.best_iou},
+                       {"matched", o.matched},
+                       {"unverifiable", o.unverifiable}});
+  }
+  json bins = json::array();
+  for (const auto& b : d.reliability) {
+    bins.push_back({{"low", b.low},
+                    {"high", b.high},
+                    {"count", b.count},
+                    {"matched", b.matched},
+                    {"mean_confidence", b.mean_confidence}});
+  }
+  return {{"superpoint_purity", number(d.superpoint_purity)},
+          {"superpoint_class_purity", number(d.superpoint_class_purity)},
+          {"num_superpoints", d.num_superpoints},
+          {"num_bridging_superpoints", d.num_bridging_superpoints},
+          {"bridge_share", d.bridge_share},
+          {"worst_second_class_share", d.worst_second_class_share},
+          {"largest_superpoint",
+           {{"id", d.largest_superpoint},
+            {"vertices", d.largest_vertices},
+            {"unannotated_vertices", d.largest_unannotated_vertices},
+            {"gt_objects", d.largest_gt_instances},
+            {"class_mix", mix}}},
+          {"wall_iou", number(d.wall_iou)},
+          {"floor_iou", number(d.floor_iou)},
+          {"ceiling_iou", number(d.ceiling_iou)},
+          {"num_objects", d.num_objects},
+          {"num_gt_things", d.gt_things.size()},
+          {"objects_per_gt_instance", number(d.objects_per_gt_instance)},
+          {"confident_objects", d.confident_objects},
+          {"confident_precision", number(d.confident_precision)},
+          {"confident_recall", number(d.confident_recall)},
+          {"reliability", bins},
+          {"objects", objects}};
 }
 
 /// Error statistics; null values when there were no errors to summarise.
@@ -240,9 +290,16 @@ int main(int argc, char** argv) {
           loadGroundTruth(gt_path, scannet_dir, scannet_labels, gt_instances_path);
       std::map<int32_t, double> confidences;
       if (!confidences_path.empty()) confidences = readConfidences(confidences_path);
-      const panmap::EvalResult result = panmap::evaluate(gt, pred, confidences, config);
+      const panmap::TransferredLabels transferred =
+          panmap::transferLabels(pred, gt.vertices, config.max_distance_m);
+      const panmap::EvalResult result =
+          panmap::evaluateTransferred(gt, transferred, confidences, config);
       std::printf("%s", panmap::formatEvalTable(result).c_str());
       out = toJson(result);
+      const panmap::SceneDiagnostics diagnostics =
+          panmap::diagnose(gt, transferred, confidences);
+      std::printf("%s", panmap::formatDiagnostics(diagnostics).c_str());
+      out["diagnostics"] = toJson(diagnostics);
     }
     if (!traj_path.empty()) {
       const panmap::TrajectoryError error =

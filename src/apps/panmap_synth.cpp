@@ -19,6 +19,7 @@
 #include "panmap/lcm/log_writer.h"
 #include "panmap/sim/procedural_room.h"
 #include "panmap/sim/sequence.h"
+#include "panmap/sim/unannotation.h"
 
 namespace {
 
@@ -57,6 +58,10 @@ json masksJson(const panmap::SegmenterNoiseConfig& c) {
           {"split_probability", c.split_probability},
           {"split_min_extent_m", c.split_min_extent_m},
           {"false_positives_per_frame", c.false_positives_per_frame},
+          {"clutter_stuff_probability", c.clutter_stuff_probability},
+          {"clutter_thing_probability", c.clutter_thing_probability},
+          {"clutter_thing_classes", c.clutter_thing_classes},
+          {"clutter_thing_weights", c.clutter_thing_weights},
           {"sample_scores", c.sample_scores},
           {"true_score_beta", {c.true_score_alpha, c.true_score_beta}},
           {"wrong_score_beta", {c.wrong_score_alpha, c.wrong_score_beta}}};
@@ -124,6 +129,8 @@ int main(int argc, char** argv) {
   uint64_t seed = 1;
   bool quiet = false, no_depth_noise = false;
   int preview_every = 0;
+  panmap::UnannotateConfig unannotate_config;
+  std::string unannotated_masks = "painted";
   auto* source = app.add_option_group("source", "ground-truth mesh (one of)");
   source->add_option("--room", room_seed, "procedural room with this seed");
   source->add_option("--scannet", scannet_dir,
@@ -150,6 +157,17 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "seed of trajectory, noise, masks and drift")
       ->capture_default_str();
   app.add_flag("--no-depth-noise", no_depth_noise, "exact depth (quantised to 1 mm)");
+  app.add_option("--unannotate", unannotate_config.fraction,
+                 "leave this share of the ground truth's vertices without a class (whole objects "
+                 "and clutter patches, drawn with --seed; vertices already without one count)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.95));
+  app.add_option("--unannotated-masks", unannotated_masks,
+                 "what the simulated network does on unannotated surfaces: painted (a network "
+                 "labels stripped objects as what they are and clutter per the preset's clutter "
+                 "rates) or empty (no mask on anything unannotated)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"painted", "empty"}));
   app.add_option("--out", out_dir, "output folder")->required();
   app.add_option(
       "--preview-every", preview_every,
@@ -174,6 +192,11 @@ int main(int argc, char** argv) {
       source_json = {
           {"type", "scannet"}, {"dir", scannet_dir}, {"unknown_labels", gt.unknown_labels}};
     }
+
+    // The world the network sees and the annotation evaluation sees (docs/SIMULATION.md).
+    const panmap::UnannotatedMesh scene = panmap::unannotate(mesh, unannotate_config, seed);
+    const panmap::LabelledMesh& gt_mesh = scene.ground_truth;
+    mesh = unannotated_masks == "painted" ? scene.world : scene.ground_truth;
 
     panmap::SynthConfig config;
     config.seed = seed;
@@ -216,8 +239,8 @@ int main(int argc, char** argv) {
     }
     progress.finish();
 
-    panmap::writePly(out_dir + "/gt/mesh.ply", mesh);
-    panmap::writeScanNetInstanceFile(out_dir + "/gt/instances.txt", mesh);
+    panmap::writePly(out_dir + "/gt/mesh.ply", gt_mesh);
+    panmap::writeScanNetInstanceFile(out_dir + "/gt/instances.txt", gt_mesh);
     panmap::writeTumTrajectory(out_dir + "/gt/trajectory_gt.txt", synth.groundTruthTrajectory());
     panmap::writeTumTrajectory(out_dir + "/gt/trajectory_input.txt", synth.inputTrajectory());
 
@@ -251,6 +274,13 @@ int main(int argc, char** argv) {
          {{"source", trajectory_file.empty() ? "survey" : trajectory_file},
           {"min_clearance_m", panmap::minClearance(synth.groundTruthTrajectory(), mesh)}}},
         {"masks", masksJson(config.masks)},
+        {"unannotation",
+         {{"fraction_requested", unannotate_config.fraction},
+          {"fraction", scene.unannotated_fraction},
+          {"stripped_instances", scene.stripped_instances},
+          {"clutter_patches", scene.clutter_patches},
+          {"clutter_instances", scene.clutter_instances},
+          {"masks", unannotated_masks}}},
         {"poses", posesJson(config.poses)},
         {"depth_noise", depthJson(config.depth)},
         {"coverage",
@@ -267,6 +297,9 @@ int main(int argc, char** argv) {
           {"merge_rate", seg.mergeRate()},
           {"split_rate", seg.splitRate()},
           {"false_positives_per_frame", seg.falsePositivesPerFrame()},
+          {"clutter_seen", seg.clutter_seen},
+          {"clutter_stuff_rate", seg.clutterStuffRate()},
+          {"clutter_thing_rate", seg.clutterThingRate()},
           {"mean_boundary_error_px", seg.meanBoundaryErrorPx()}}},
         {"log_bytes", log.bytes()},
         {"seconds", seconds}};

@@ -23,6 +23,8 @@ namespace {
 using internal::segmenter::Blob;
 using internal::segmenter::FrameContext;
 using internal::segmenter::hashOf;
+using internal::segmenter::kClutter;
+using internal::segmenter::kClutterClass;
 using internal::segmenter::kConfuse;
 using internal::segmenter::kConfuseClass;
 using internal::segmenter::key;
@@ -57,6 +59,9 @@ struct Unit {
   double cx = 0.0, cy = 0.0, ax = 1.0, ay = 0.0;  // split line: centroid and major axis
   int32_t seg = 0;
   int32_t seg2 = 0;  // second half of a split
+  bool clutter = false;      // class 0 with an instance id: unannotated clutter
+  int32_t paint_stuff = 0;   // clutter painted into this stuff unit (0 = not)
+  int32_t paint_class = 0;   // clutter painted as a thing of this class (0 = not)
 };
 
 int32_t findRoot(std::vector<Unit>& units, int32_t k) {
@@ -122,7 +127,9 @@ PanopticFrame SegmenterNoise::segment(const LabelImage& instances, const LabelIm
   const FrameContext ctx(c, seed_, frame_index);
   const size_t n = instances.size();
 
-  // 1. Compact labels: unit 0 = nothing, one unit per thing instance, one per stuff class.
+  const bool paint_clutter = c.clutter_stuff_probability + c.clutter_thing_probability > 0.0;
+  // 1. Compact labels: unit 0 = nothing, one unit per thing instance, one per stuff class, one
+  // per clutter instance.
   std::vector<Unit> units(1);
   std::vector<int32_t> stuff_unit(kMaxNyu40Class + 1, -1);
   std::unordered_map<int32_t, int32_t> unit_of_instance;
@@ -153,7 +160,15 @@ PanopticFrame SegmenterNoise::segment(const LabelImage& instances, const LabelIm
       }
       index = stuffUnit(info.semantic);
       units[index].stuff_instances.push_back(id);
-    } else if (info.semantic != kUnknownClass) {
+    } else if (info.semantic == kUnknownClass) {
+      if (paint_clutter) {
+        index = static_cast<int32_t>(units.size());
+        Unit unit;
+        unit.instance = id;
+        unit.clutter = true;
+        units.push_back(unit);
+      }
+    } else {
       index = static_cast<int32_t>(units.size());
       Unit unit;
       unit.instance = id;
@@ -188,7 +203,11 @@ PanopticFrame SegmenterNoise::segment(const LabelImage& instances, const LabelIm
   }
   const int32_t unit_count = static_cast<int32_t>(units.size());
   std::vector<uint8_t> is_thing(unit_count, 0);
-  for (int32_t k = 1; k < unit_count; ++k) is_thing[k] = !units[k].stuff;
+  bool any_clutter = false;
+  for (int32_t k = 1; k < unit_count; ++k) {
+    is_thing[k] = !units[k].stuff && !units[k].clutter;
+    any_clutter = any_clutter || units[k].clutter;
+  }
 
   // 2. Boundary error.
   std::vector<int32_t> warped_storage;
@@ -230,11 +249,52 @@ PanopticFrame SegmenterNoise::segment(const LabelImage& instances, const LabelIm
     }
   }
 
-  // 4. Per-instance decisions: miss, then class confusion.
+  // 3b. Which stuff each clutter instance touches in the image, to be painted into.
+  std::map<std::pair<int32_t, int32_t>, int> clutter_contacts;  // (clutter, stuff) -> pixel edges
+  if (any_clutter) {
+    for (int v = 0; v < height; ++v) {
+      for (int u = 0; u < width; ++u) {
+        const size_t i = static_cast<size_t>(v) * width + u;
+        const int32_t a = gt[i];
+        const int32_t right = u + 1 < width ? gt[i + 1] : 0;
+        const int32_t down = v + 1 < height ? gt[i + width] : 0;
+        for (const int32_t b : {right, down}) {
+          if (units[a].clutter && units[b].stuff) ++clutter_contacts[{a, b}];
+          if (units[b].clutter && units[a].stuff) ++clutter_contacts[{b, a}];
+        }
+      }
+    }
+  }
+
+  // 4. Per-instance decisions: miss, then class confusion; clutter: how it is painted.
+  double clutter_weight_sum = 0.0;
+  for (double w : c.clutter_thing_weights) clutter_weight_sum += w;
   for (int32_t k = 1; k < unit_count; ++k) {
     Unit& unit = units[k];
     unit.parent = k;
     if (unit.stuff) continue;
+    if (unit.clutter) {
+      const uint64_t subject = key(unit.instance);
+      const double draw = ctx.draw(subject, kClutter);
+      if (draw < c.clutter_stuff_probability) {
+        int best = 0;
+        for (auto it = clutter_contacts.lower_bound({k, 0});
+             it != clutter_contacts.end() && it->first.first == k; ++it) {
+          if (it->second > best) best = it->second, unit.paint_stuff = it->first.second;
+        }
+      } else if (draw < c.clutter_stuff_probability + c.clutter_thing_probability) {
+        double pick = toUnit(ctx.windowHash(subject, kClutter, kClutterClass)) * clutter_weight_sum;
+        unit.paint_class = c.clutter_thing_classes.back();
+        for (size_t j = 0; j < c.clutter_thing_classes.size(); ++j) {
+          if (pick < c.clutter_thing_weights[j]) {
+            unit.paint_class = c.clutter_thing_classes[j];
+            break;
+          }
+          pick -= c.clutter_thing_weights[j];
+        }
+      }
+      continue;
+    }
     const uint64_t subject = key(unit.instance);
     unit.missed = ctx.draw(subject, kMiss) < missProbability(c, unit.gt_px, unit.occluded);
     if (unit.missed) continue;
@@ -314,6 +374,17 @@ PanopticFrame SegmenterNoise::segment(const LabelImage& instances, const LabelIm
         ctx.draw(key(r.instance), kSplit) < c.split_probability) {
       r.split = true;
       split_unit[rep] = 1;
+    }
+  }
+  // Clutter painted into stuff takes that stuff's segment; painted as a thing, its own.
+  for (int32_t k = 1; k < unit_count; ++k) {
+    Unit& r = units[k];
+    if (!r.clutter) continue;
+    if (r.paint_stuff > 0) {
+      lut[k] = units[r.paint_stuff].seg;
+    } else if (r.paint_class > 0) {
+      lut[k] = r.seg = newDraft(r.paint_class, true, hashOf({4, key(r.instance)}));
+      drafts.back().origin.clutter = true;
     }
   }
   std::vector<int32_t> lut2(unit_count, 0);
@@ -458,7 +529,7 @@ PanopticFrame SegmenterNoise::segment(const LabelImage& instances, const LabelIm
   for (Draft& d : drafts) {
     if (d.px == 0) continue;
     const SegmentOrigin& o = d.origin;
-    const bool wrong = o.confused || o.merged || o.split || o.false_positive;
+    const bool wrong = o.confused || o.merged || o.split || o.false_positive || o.clutter;
     if (c.sample_scores) {
       SegmenterRng rng(hashOf({seed_, kScore, key(frame_index), d.score_key}));
       const double score = wrong ? rng.beta(c.wrong_score_alpha, c.wrong_score_beta)
@@ -476,6 +547,11 @@ PanopticFrame SegmenterNoise::segment(const LabelImage& instances, const LabelIm
   ++s.frames;
   for (int32_t k = 1; k < unit_count; ++k) {
     const Unit& r = units[k];
+    if (r.clutter && r.gt_px >= c.stats_min_px) {
+      ++s.clutter_seen;
+      s.clutter_stuff += r.paint_stuff > 0;
+      s.clutter_thing += r.paint_class > 0;
+    }
     if (!is_thing[k]) continue;
     const bool detected = !r.missed && r.warped_px > 0;
     if (!detected && trace) trace->missed.push_back(r.instance);

@@ -69,6 +69,29 @@ void SegmenterNoiseConfig::check() const {
   if (false_positive_max_area_px < false_positive_min_area_px) {
     throw Error("segmenter noise: false_positive_max_area_px is below false_positive_min_area_px");
   }
+  checkProbability(clutter_stuff_probability, "clutter_stuff_probability");
+  checkProbability(clutter_thing_probability, "clutter_thing_probability");
+  if (clutter_stuff_probability + clutter_thing_probability > 1.0) {
+    throw Error("segmenter noise: clutter_stuff_probability + clutter_thing_probability > 1");
+  }
+  if (clutter_thing_classes.empty() ||
+      clutter_thing_classes.size() != clutter_thing_weights.size()) {
+    throw Error("segmenter noise: clutter_thing_classes and clutter_thing_weights must be "
+                "non-empty and equally long");
+  }
+  double weight_sum = 0.0;
+  for (size_t k = 0; k < clutter_thing_classes.size(); ++k) {
+    const int32_t c = clutter_thing_classes[k];
+    if (c < 1 || c > kMaxNyu40Class || isStuffClass(c)) {
+      throw Error("segmenter noise: clutter_thing_classes holds " + std::to_string(c) +
+                  ", not a NYU40 thing class");
+    }
+    if (!(clutter_thing_weights[k] >= 0.0 && std::isfinite(clutter_thing_weights[k]))) {
+      throw Error("segmenter noise: clutter_thing_weights must be finite and >= 0");
+    }
+    weight_sum += clutter_thing_weights[k];
+  }
+  if (!(weight_sum > 0.0)) throw Error("segmenter noise: clutter_thing_weights sum to 0");
   checkPositive(true_score_alpha, "true_score_alpha");
   checkPositive(true_score_beta, "true_score_beta");
   checkPositive(wrong_score_alpha, "wrong_score_alpha");
@@ -90,6 +113,10 @@ SegmenterNoiseConfig SegmenterNoiseConfig::fromPreset(const std::string& name) {
     c.merge_probability = 0.2;
     c.split_probability = 0.1;
     c.false_positives_per_frame = 0.5;
+    // docs/SIMULATION.md, "Unannotated surfaces": half painted into the touching stuff,
+    // a quarter as a low-score thing, a quarter void.
+    c.clutter_stuff_probability = 0.5;
+    c.clutter_thing_probability = 0.25;
     c.sample_scores = true;
     return c;
   }
@@ -103,6 +130,8 @@ SegmenterNoiseConfig SegmenterNoiseConfig::fromPreset(const std::string& name) {
     c.merge_probability = 0.4;
     c.split_probability = 0.2;
     c.false_positives_per_frame = 1.0;
+    c.clutter_stuff_probability = 0.5;
+    c.clutter_thing_probability = 0.4;
     c.sample_scores = true;
     return c;
   }
@@ -122,6 +151,8 @@ double SegmenterNoiseStats::splitRate() const { return ratio(split, split_candid
 double SegmenterNoiseStats::falsePositivesPerFrame() const {
   return ratio(false_positives, frames);
 }
+double SegmenterNoiseStats::clutterStuffRate() const { return ratio(clutter_stuff, clutter_seen); }
+double SegmenterNoiseStats::clutterThingRate() const { return ratio(clutter_thing, clutter_seen); }
 double SegmenterNoiseStats::meanBoundaryErrorPx() const {
   return boundary_length_px > 0.0 ? boundary_error_area_px / boundary_length_px : 0.0;
 }

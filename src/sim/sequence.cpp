@@ -101,7 +101,10 @@ SynthFrame SequenceSynthesizer::frame(size_t k) {
   const double cos_distinct = std::cos(config_.distinct_view_deg * M_PI / 180.0);
   for (const auto& [id, count] : pixels) {
     const auto info = infos_.find(id);
-    if (count < config_.min_view_px || info == infos_.end() || info->second.is_stuff) continue;
+    if (count < config_.min_view_px || info == infos_.end() || info->second.is_stuff ||
+        info->second.semantic == 0) {
+      continue;
+    }
     const Eigen::Vector3d dir = (gt_[k].T_W_C.translation() - centroids_[id]).normalized();
     auto& seen = views_[id];
     bool distinct = true;
@@ -114,7 +117,7 @@ SynthFrame SequenceSynthesizer::frame(size_t k) {
 CoverageStats SequenceSynthesizer::coverage() const {
   CoverageStats stats;
   for (const auto& [id, info] : infos_) {
-    if (info.is_stuff) continue;
+    if (info.is_stuff || info.semantic == 0) continue;  // stuff, unannotated clutter
     ++stats.thing_instances;
     const auto it = views_.find(id);
     if (it == views_.end()) continue;

@@ -60,7 +60,18 @@ struct SegmenterNoiseConfig {
   int false_positive_min_area_px = 500;
   int false_positive_max_area_px = 5000;
 
-  // Scores: Beta-distributed; wrong = confused class, merged, split or false positive.
+  // Unannotated clutter: surfaces of class 0 that still carry an instance id (things a scene's
+  // annotation left without a class). A network paints them anyway; per instance and window
+  // each is drawn as: painted into the stuff segment it touches most in the image (no stuff
+  // in contact: void), painted as a thing of one of clutter_thing_classes (weighted by
+  // clutter_thing_weights) with a wrong-detection score, or left void (the rest). Class-0
+  // pixels without an instance id are always void.
+  double clutter_stuff_probability = 0.0;
+  double clutter_thing_probability = 0.0;
+  std::vector<int32_t> clutter_thing_classes = {40, 39};  ///< otherprop, otherfurniture
+  std::vector<double> clutter_thing_weights = {2.0, 1.0};
+
+  // Scores: Beta-distributed; wrong = confused class, merged, split, false positive or clutter.
   bool sample_scores = false;  ///< false: every score is 1
   double true_score_alpha = 8.0;
   double true_score_beta = 2.0;
@@ -95,6 +106,9 @@ struct SegmenterNoiseStats {
   int64_t split_candidates = 0;  ///< detected, unmerged things longer than split_min_extent_m
   int64_t split = 0;             ///< of those, split in two segments
   int64_t false_positives = 0;   ///< false-positive segments emitted
+  int64_t clutter_seen = 0;      ///< unannotated clutter instances in view (stats_min_px)
+  int64_t clutter_stuff = 0;     ///< of those, painted into a stuff segment
+  int64_t clutter_thing = 0;     ///< of those, painted as a thing
   /// Pixels in the symmetric difference of ground-truth and warped thing masks.
   double boundary_error_area_px = 0.0;
   /// Ground-truth thing outline pixels (4-neighbour of another label inside the image).
@@ -114,6 +128,10 @@ struct SegmenterNoiseStats {
   double splitRate() const;
   /// false_positives / frames.
   double falsePositivesPerFrame() const;
+  /// clutter_stuff / clutter_seen.
+  double clutterStuffRate() const;
+  /// clutter_thing / clutter_seen.
+  double clutterThingRate() const;
   /// Area between true and warped outlines over outline length: the mean normal displacement
   /// actually applied to thing boundaries, pixels.
   double meanBoundaryErrorPx() const;
@@ -128,6 +146,7 @@ struct SegmentOrigin {
   bool merged = false;          ///< several instances in one mask
   bool split = false;           ///< one of the two halves of a split instance
   bool false_positive = false;  ///< hallucinated on stuff
+  bool clutter = false;         ///< an unannotated clutter surface painted as a thing
 };
 
 /// Per-frame record of the simulated errors.
@@ -152,7 +171,8 @@ class SegmenterNoise {
   ///     so stuff without instance ids still becomes a stuff segment.
   /// @param frame_index position in the sequence: errors persist over neighbouring indices.
   /// @param infos every instance id present in `instances`; throws Error for a missing one.
-  ///     Instances of class 0 (unknown) get no segment.
+  ///     Instances of class 0 (unknown) are unannotated clutter: painted per the clutter_*
+  ///     rates (void when they are 0).
   /// @param trace when not null, receives where each segment came from.
   /// @return segment ids at the size of `instances` (0 = no segment), frame_id = frame_index,
   ///     utime 0 (the caller's).

@@ -24,6 +24,8 @@ enum Kind : uint64_t {
   kFalsePositiveShape,
   kBoundary,
   kScore,
+  kClutter,
+  kClutterClass,
 };
 
 /// splitmix64's finaliser (core splitmix64 without its increment): a bijective, well-mixing

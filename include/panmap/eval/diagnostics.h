@@ -1,0 +1,100 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "panmap/core/labelled_mesh.h"
+#include "panmap/eval/label_transfer.h"
+
+namespace panmap {
+
+/// What explains a score: how pure the super-points are, how the largest one is made up,
+/// how many objects came out per ground-truth object, the stuff classes' IoU, and how well
+/// instance confidences predict a match. All counts are over ground-truth vertices after the
+/// label transfer; unannotated GT vertices (class 0) are left out of every share.
+struct SceneDiagnostics {
+  /// Vertex-weighted share of each super-point's majority GT identity (a thing instance, or a
+  /// stuff class: walls split into pieces by the annotation are one identity), over the
+  /// annotated GT vertices that carry a super-point. 1 = no super-point spans two objects.
+  double superpoint_purity = 0.0;
+  /// Vertex-weighted share of each super-point's majority GT class (the same, by class).
+  double superpoint_class_purity = 0.0;
+  int64_t num_superpoints = 0;  ///< super-points on at least one annotated GT vertex
+
+  /// Super-points where two GT classes each hold more than `bridge_share` of its annotated
+  /// vertices (only super-points of at least `min_superpoint_vertices` annotated vertices).
+  int num_bridging_superpoints = 0;
+  double bridge_share = 0.1;
+  int64_t min_superpoint_vertices = 100;
+  /// Largest share of a second GT class in any such super-point.
+  double worst_second_class_share = 0.0;
+
+  /// The super-point on the most GT vertices (annotated or not).
+  int32_t largest_superpoint = 0;
+  int64_t largest_vertices = 0;             ///< all GT vertices it carries
+  int64_t largest_unannotated_vertices = 0;  ///< of those, on unannotated GT
+  /// Its annotated vertices by GT class, largest first: (NYU40 id, share).
+  std::vector<std::pair<int32_t, double>> largest_class_mix;
+  int largest_gt_instances = 0;  ///< GT identities it holds at least 1 % of
+
+  /// Per-vertex IoU of the stuff classes, over annotated GT vertices (NaN without GT vertex of
+  /// the class).
+  double wall_iou = 0.0, floor_iou = 0.0, ceiling_iou = 0.0;
+
+  /// One predicted object (an instance id on the predicted mesh or in the object list).
+  struct ObjectMatch {
+    int32_t id = 0;
+    int32_t class_id = 0;       ///< majority predicted class of its vertices
+    double confidence = 1.0;    ///< from the object list; 1 when absent
+    int64_t vertices = 0;       ///< GT vertices carrying it
+    int64_t void_vertices = 0;  ///< of those, on unannotated GT
+    double best_iou = 0.0;      ///< best IoU with a GT thing instance of the same class
+    int32_t best_gt = -1;       ///< index into gt_things, -1 when none overlaps
+    bool matched = false;       ///< best_iou > 0.5
+    /// Most of it on unannotated GT: nothing to check it against, left out of calibration.
+    bool unverifiable = false;
+  };
+  std::vector<ObjectMatch> objects;
+  /// GT thing instances (class > 0, not stuff, any size): (class, instance id, vertices).
+  struct GtThing {
+    int32_t class_id = 0;
+    int32_t instance_id = 0;
+    int64_t vertices = 0;
+  };
+  std::vector<GtThing> gt_things;
+  int num_objects = 0;  ///< predicted objects (object list entries, else mesh instances)
+  /// num_objects / gt_things.size() (NaN without GT things).
+  double objects_per_gt_instance = 0.0;
+
+  /// Reliability of the confidences: objects (verifiable ones) binned by confidence.
+  struct ReliabilityBin {
+    double low = 0.0, high = 0.0;  ///< [low, high), the last bin includes 1
+    int count = 0;
+    int matched = 0;
+    double mean_confidence = 0.0;
+  };
+  std::vector<ReliabilityBin> reliability;
+  /// Objects with confidence >= 0.5 (verifiable), and the share of them that match.
+  int confident_objects = 0;
+  double confident_precision = 0.0;  ///< NaN without confident objects
+  /// Share of GT thing instances matched by an object with confidence >= 0.5.
+  double confident_recall = 0.0;
+};
+
+/// Computes the diagnostics of transferred labels against a GT mesh.
+/// @param gt ground-truth mesh with semantic and instance labels (throws Error without them)
+/// @param pred predicted labels per GT vertex (transferLabels; superpoint may be all 0)
+/// @param objects instance id -> confidence of the object list; empty = every predicted
+///     instance on the mesh with confidence 1. Ids in the list that no GT vertex carries are
+///     objects too (unmatched).
+/// @param num_bins reliability bins over [0, 1]
+SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
+                          const std::map<int32_t, double>& objects, int num_bins = 5);
+
+/// A few lines of text: purity, the largest super-point, objects, stuff IoU, reliability.
+std::string formatDiagnostics(const SceneDiagnostics& d);
+
+}  // namespace panmap

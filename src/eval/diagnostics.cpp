@@ -1,0 +1,250 @@
+#include "panmap/eval/diagnostics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "panmap/core/classes.h"
+#include "panmap/core/error.h"
+#include "panmap/eval/instance_matching.h"
+
+namespace panmap {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// What a GT vertex belongs to for purity: a thing instance, or a stuff class as a whole (the
+// annotation cuts walls into pieces where they meet; a super-point may span them).
+std::pair<int32_t, int32_t> identity(int32_t cls, int32_t instance) {
+  return {cls, isStuffClass(cls) ? 0 : instance};
+}
+
+double stuffIoU(const LabelledMesh& gt, const TransferredLabels& pred, int32_t c) {
+  int64_t tp = 0, fp = 0, fn = 0;
+  for (size_t v = 0; v < gt.numVertices(); ++v) {
+    if (gt.semantic[v] <= 0) continue;
+    if (gt.semantic[v] == c) {
+      (pred.semantic[v] == c ? tp : fn) += 1;
+    } else if (pred.semantic[v] == c) {
+      ++fp;
+    }
+  }
+  return tp + fp + fn > 0 ? static_cast<double>(tp) / static_cast<double>(tp + fp + fn) : kNaN;
+}
+
+}  // namespace
+
+SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
+                          const std::map<int32_t, double>& objects, int num_bins) {
+  const size_t n = gt.numVertices();
+  if (gt.semantic.size() != n || gt.instance.size() != n) {
+    throw Error("diagnose: ground-truth mesh lacks semantic or instance labels");
+  }
+  if (pred.semantic.size() != n || pred.instance.size() != n || pred.superpoint.size() != n) {
+    throw Error("diagnose: transferred labels do not match the ground-truth vertex count");
+  }
+  if (num_bins < 1) throw Error("diagnose: num_bins must be >= 1");
+  SceneDiagnostics d;
+
+  // Super-points: identities and classes of their annotated vertices.
+  std::map<int32_t, std::map<std::pair<int32_t, int32_t>, int64_t>> sp_identities;
+  std::map<int32_t, std::map<int32_t, int64_t>> sp_classes;
+  std::map<int32_t, std::pair<int64_t, int64_t>> sp_size;  // all, unannotated
+  for (size_t v = 0; v < n; ++v) {
+    const int32_t s = pred.superpoint[v];
+    if (s == 0) continue;
+    auto& size = sp_size[s];
+    ++size.first;
+    if (gt.semantic[v] <= 0) {
+      ++size.second;
+      continue;
+    }
+    ++sp_identities[s][identity(gt.semantic[v], gt.instance[v])];
+    ++sp_classes[s][gt.semantic[v]];
+  }
+  int64_t total = 0, majority = 0, class_majority = 0;
+  for (const auto& [s, ids] : sp_identities) {
+    int64_t sum = 0, best = 0;
+    for (const auto& [id, count] : ids) sum += count, best = std::max(best, count);
+    total += sum;
+    majority += best;
+    std::vector<int64_t> counts;
+    for (const auto& [cls, count] : sp_classes[s]) counts.push_back(count);
+    std::sort(counts.rbegin(), counts.rend());
+    class_majority += counts[0];
+    if (sum >= d.min_superpoint_vertices && counts.size() > 1) {
+      const double second = static_cast<double>(counts[1]) / static_cast<double>(sum);
+      d.worst_second_class_share = std::max(d.worst_second_class_share, second);
+      if (second > d.bridge_share) ++d.num_bridging_superpoints;
+    }
+  }
+  d.num_superpoints = static_cast<int64_t>(sp_identities.size());
+  d.superpoint_purity = total ? static_cast<double>(majority) / static_cast<double>(total) : kNaN;
+  d.superpoint_class_purity =
+      total ? static_cast<double>(class_majority) / static_cast<double>(total) : kNaN;
+
+  for (const auto& [s, size] : sp_size) {
+    if (size.first > d.largest_vertices) {
+      d.largest_superpoint = s;
+      d.largest_vertices = size.first;
+      d.largest_unannotated_vertices = size.second;
+    }
+  }
+  if (d.largest_superpoint != 0) {
+    const int64_t annotated = d.largest_vertices - d.largest_unannotated_vertices;
+    for (const auto& [cls, count] : sp_classes[d.largest_superpoint]) {
+      d.largest_class_mix.emplace_back(cls, static_cast<double>(count) / annotated);
+    }
+    std::stable_sort(d.largest_class_mix.begin(), d.largest_class_mix.end(),
+                     [](const auto& a, const auto& b) { return a.second > b.second; });
+    for (const auto& [id, count] : sp_identities[d.largest_superpoint]) {
+      d.largest_gt_instances += 100 * count >= annotated;
+    }
+  }
+
+  d.wall_iou = stuffIoU(gt, pred, 1);
+  d.floor_iou = stuffIoU(gt, pred, 2);
+  d.ceiling_iou = stuffIoU(gt, pred, 22);
+
+  // GT things of at least ScanNet's minimum region size.
+  std::map<std::pair<int32_t, int32_t>, int64_t> thing_size;
+  for (size_t v = 0; v < n; ++v) {
+    const int32_t c = gt.semantic[v];
+    if (c > 0 && gt.instance[v] > 0 && !isStuffClass(c)) ++thing_size[{c, gt.instance[v]}];
+  }
+  std::map<std::pair<int32_t, int32_t>, int> thing_index;
+  for (const auto& [key, count] : thing_size) {
+    if (count < kScanNetMinRegionSize) continue;
+    thing_index[key] = static_cast<int>(d.gt_things.size());
+    d.gt_things.push_back({key.first, key.second, count});
+  }
+
+  // Predicted objects: their vertices, classes, void share and overlaps with GT things.
+  std::map<int32_t, std::map<int32_t, int64_t>> pred_classes;
+  std::map<int32_t, std::map<int, int64_t>> overlaps;
+  std::map<int32_t, std::pair<int64_t, int64_t>> pred_size;  // all, on unannotated GT
+  for (size_t v = 0; v < n; ++v) {
+    const int32_t p = pred.instance[v];
+    if (p <= 0) continue;
+    auto& size = pred_size[p];
+    ++size.first;
+    ++pred_classes[p][pred.semantic[v]];
+    if (gt.semantic[v] <= 0) {
+      ++size.second;
+      continue;
+    }
+    const auto it = thing_index.find({gt.semantic[v], gt.instance[v]});
+    if (it != thing_index.end()) ++overlaps[p][it->second];
+  }
+  std::map<int32_t, double> listed = objects;
+  if (listed.empty()) {
+    for (const auto& [p, size] : pred_size) listed[p] = 1.0;
+  }
+  for (const auto& [id, confidence] : listed) {
+    SceneDiagnostics::ObjectMatch o;
+    o.id = id;
+    o.confidence = confidence;
+    const auto size = pred_size.find(id);
+    if (size != pred_size.end()) {
+      o.vertices = size->second.first;
+      o.void_vertices = size->second.second;
+      int64_t best = -1;
+      for (const auto& [cls, count] : pred_classes[id]) {
+        if (count > best) o.class_id = cls, best = count;  // ties: the smaller class id
+      }
+      for (const auto& [g, inter] : overlaps[id]) {
+        const SceneDiagnostics::GtThing& t = d.gt_things[g];
+        if (t.class_id != o.class_id) continue;
+        const double iou =
+            static_cast<double>(inter) / static_cast<double>(t.vertices + o.vertices - inter);
+        if (iou > o.best_iou) o.best_iou = iou, o.best_gt = g;
+      }
+    }
+    o.matched = o.best_iou > 0.5;
+    o.unverifiable = o.vertices > 0 && 2 * o.void_vertices > o.vertices;
+    d.objects.push_back(o);
+  }
+  d.num_objects = static_cast<int>(d.objects.size());
+  d.objects_per_gt_instance =
+      d.gt_things.empty() ? kNaN : static_cast<double>(d.num_objects) / d.gt_things.size();
+
+  d.reliability.resize(num_bins);
+  for (int b = 0; b < num_bins; ++b) {
+    d.reliability[b].low = static_cast<double>(b) / num_bins;
+    d.reliability[b].high = static_cast<double>(b + 1) / num_bins;
+  }
+  std::vector<bool> covered(d.gt_things.size(), false);
+  int confident_matched = 0;
+  for (const SceneDiagnostics::ObjectMatch& o : d.objects) {
+    if (o.unverifiable) continue;
+    const double c = std::min(1.0, std::max(0.0, o.confidence));
+    const int b = std::min(num_bins - 1, static_cast<int>(c * num_bins));
+    SceneDiagnostics::ReliabilityBin& bin = d.reliability[b];
+    ++bin.count;
+    bin.matched += o.matched;
+    bin.mean_confidence += c;
+    if (c >= 0.5) {
+      ++d.confident_objects;
+      confident_matched += o.matched;
+      if (o.matched) covered[o.best_gt] = true;
+    }
+  }
+  for (SceneDiagnostics::ReliabilityBin& bin : d.reliability) {
+    if (bin.count > 0) bin.mean_confidence /= bin.count;
+  }
+  d.confident_precision = d.confident_objects > 0
+                              ? static_cast<double>(confident_matched) / d.confident_objects
+                              : kNaN;
+  d.confident_recall =
+      d.gt_things.empty()
+          ? kNaN
+          : static_cast<double>(std::count(covered.begin(), covered.end(), true)) /
+                static_cast<double>(d.gt_things.size());
+  return d;
+}
+
+std::string formatDiagnostics(const SceneDiagnostics& d) {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof(line),
+                "super-points: purity %.3f (by class %.3f) over %lld; %d span two classes by "
+                "> %.0f %% each (worst second class %.2f)\n",
+                d.superpoint_purity, d.superpoint_class_purity,
+                static_cast<long long>(d.num_superpoints), d.num_bridging_superpoints,
+                100 * d.bridge_share, d.worst_second_class_share);
+  out += line;
+  std::string mix;
+  for (size_t k = 0; k < d.largest_class_mix.size() && k < 5; ++k) {
+    char part[64];
+    std::snprintf(part, sizeof(part), "%s%s %.0f %%", k ? ", " : "",
+                  nyu40Name(d.largest_class_mix[k].first).c_str(),
+                  100 * d.largest_class_mix[k].second);
+    mix += part;
+  }
+  std::snprintf(line, sizeof(line),
+                "largest super-point %d: %lld GT vertices (%lld unannotated), %d GT objects, "
+                "classes %s\n",
+                d.largest_superpoint, static_cast<long long>(d.largest_vertices),
+                static_cast<long long>(d.largest_unannotated_vertices), d.largest_gt_instances,
+                mix.c_str());
+  out += line;
+  std::snprintf(line, sizeof(line),
+                "objects: %d for %zu GT thing instances (%.2f each); confidence >= 0.5: %d, "
+                "%.2f of them match, covering %.2f of the GT things\n",
+                d.num_objects, d.gt_things.size(), d.objects_per_gt_instance, d.confident_objects,
+                d.confident_precision, d.confident_recall);
+  out += line;
+  std::snprintf(line, sizeof(line), "stuff IoU: wall %.3f, floor %.3f, ceiling %.3f\n",
+                d.wall_iou, d.floor_iou, d.ceiling_iou);
+  out += line;
+  out += "reliability:";
+  for (const SceneDiagnostics::ReliabilityBin& b : d.reliability) {
+    std::snprintf(line, sizeof(line), " [%.1f,%.1f) %d/%d", b.low, b.high, b.matched, b.count);
+    out += line;
+  }
+  out += "\n";
+  return out;
+}
+
+}  // namespace panmap

@@ -1,0 +1,118 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "panmap/core/error.h"
+#include "panmap/eval/diagnostics.h"
+
+namespace panmap {
+namespace {
+
+// GT: 100 wall vertices (two annotation pieces, instances 1 and 2), 100 floor, 200 chair A
+// (instance 3), 150 chair B (instance 4), 50 unannotated.
+struct Case {
+  LabelledMesh gt;
+  TransferredLabels pred;
+  void add(int count, int32_t cls, int32_t inst, int32_t p_cls, int32_t p_inst, int32_t sp) {
+    for (int k = 0; k < count; ++k) {
+      gt.vertices.emplace_back(0.0f, 0.0f, 0.0f);
+      gt.semantic.push_back(cls);
+      gt.instance.push_back(inst);
+      pred.semantic.push_back(p_cls);
+      pred.instance.push_back(p_inst);
+      pred.superpoint.push_back(sp);
+    }
+  }
+};
+
+Case makeCase() {
+  Case c;
+  // Walls: super-point 1 spans both annotation pieces (pure: one stuff identity).
+  c.add(50, 1, 1, 1, 0, 1);
+  c.add(50, 1, 2, 1, 0, 1);
+  // Floor: super-point 2, of which 20 vertices are labelled wall.
+  c.add(80, 2, 5, 2, 0, 2);
+  c.add(20, 2, 5, 1, 0, 2);
+  // Chair A: object 7 (180 vertices, super-point 3) + 20 vertices in super-point 2 as floor.
+  c.add(180, 5, 3, 5, 7, 3);
+  c.add(20, 5, 3, 2, 0, 2);
+  // Chair B: object 8 covers only 60 of 150 (IoU 0.4), the rest object 9 (90, IoU 0.6).
+  c.add(60, 5, 4, 5, 8, 4);
+  c.add(90, 5, 4, 5, 9, 5);
+  // Unannotated: 40 carry object 10 (a clutter object), 10 are in super-point 3.
+  c.add(40, 0, 0, 39, 10, 6);
+  c.add(10, 0, 0, 5, 7, 3);
+  return c;
+}
+
+TEST(Diagnostics, HandComputedCase) {
+  const Case c = makeCase();
+  const std::map<int32_t, double> objects = {{7, 0.9}, {8, 0.7}, {9, 0.3}, {10, 0.95}, {11, 0.6}};
+  const SceneDiagnostics d = diagnose(c.gt, c.pred, objects);
+  // Purity: sp1 100/100, sp2 100 floor of 120 annotated (20 chair A), sp3 180/180, sp4 60/60,
+  // sp5 90/90; sp6 has no annotated vertex. (100 + 100 + 180 + 60 + 90) / (100 + 120 + 180 +
+  // 60 + 90) = 530 / 550.
+  EXPECT_NEAR(d.superpoint_purity, 530.0 / 550.0, 1e-12);
+  EXPECT_NEAR(d.superpoint_class_purity, 530.0 / 550.0, 1e-12);
+  EXPECT_EQ(d.num_superpoints, 5);
+  // sp2 (120 annotated >= 100) has 20 / 120 = 0.167 chair: one bridging super-point.
+  EXPECT_EQ(d.num_bridging_superpoints, 1);
+  EXPECT_NEAR(d.worst_second_class_share, 20.0 / 120.0, 1e-12);
+  // Largest: sp3 with 190 vertices, 10 unannotated, all chair.
+  EXPECT_EQ(d.largest_superpoint, 3);
+  EXPECT_EQ(d.largest_vertices, 190);
+  EXPECT_EQ(d.largest_unannotated_vertices, 10);
+  ASSERT_EQ(d.largest_class_mix.size(), 1u);
+  EXPECT_EQ(d.largest_class_mix[0].first, 5);
+  EXPECT_EQ(d.largest_gt_instances, 1);
+  // Wall IoU: tp 100, fp 20 (floor labelled wall), fn 0. Floor: tp 80, fn 20, fp 20 (chair).
+  EXPECT_NEAR(d.wall_iou, 100.0 / 120.0, 1e-12);
+  EXPECT_NEAR(d.floor_iou, 80.0 / 120.0, 1e-12);
+  EXPECT_TRUE(std::isnan(d.ceiling_iou));
+  // Objects: 5 listed for 2 GT things.
+  ASSERT_EQ(d.gt_things.size(), 2u);
+  EXPECT_EQ(d.num_objects, 5);
+  EXPECT_NEAR(d.objects_per_gt_instance, 2.5, 1e-12);
+  std::map<int32_t, SceneDiagnostics::ObjectMatch> by_id;
+  for (const auto& o : d.objects) by_id[o.id] = o;
+  // Object 7: 190 vertices (10 void), IoU with chair A = 180 / (200 + 190 - 180).
+  EXPECT_NEAR(by_id[7].best_iou, 180.0 / 210.0, 1e-12);
+  EXPECT_TRUE(by_id[7].matched);
+  EXPECT_NEAR(by_id[8].best_iou, 0.4, 1e-12);
+  EXPECT_FALSE(by_id[8].matched);
+  EXPECT_NEAR(by_id[9].best_iou, 0.6, 1e-12);
+  EXPECT_TRUE(by_id[9].matched);
+  EXPECT_TRUE(by_id[10].unverifiable);  // all on unannotated GT
+  EXPECT_EQ(by_id[11].vertices, 0);     // listed, on no GT vertex: unmatched
+  EXPECT_FALSE(by_id[11].matched);
+  // Confident (>= 0.5, verifiable): 7 (match), 8 (no), 11 (no) -> 1/3; they cover chair A only.
+  EXPECT_EQ(d.confident_objects, 3);
+  EXPECT_NEAR(d.confident_precision, 1.0 / 3.0, 1e-12);
+  EXPECT_NEAR(d.confident_recall, 0.5, 1e-12);
+  // Reliability, 5 bins: 9 (0.3) in [0.2, 0.4) matched; 8 (0.7), 11 (0.6) in [0.6, 0.8) none;
+  // 7 (0.9) in [0.8, 1] matched.
+  ASSERT_EQ(d.reliability.size(), 5u);
+  EXPECT_EQ(d.reliability[1].count, 1);
+  EXPECT_EQ(d.reliability[1].matched, 1);
+  EXPECT_EQ(d.reliability[3].count, 2);
+  EXPECT_EQ(d.reliability[3].matched, 0);
+  EXPECT_NEAR(d.reliability[3].mean_confidence, 0.65, 1e-12);
+  EXPECT_EQ(d.reliability[4].count, 1);
+  EXPECT_EQ(d.reliability[4].matched, 1);
+}
+
+TEST(Diagnostics, WithoutAnObjectListEveryMeshInstanceIsAnObject) {
+  const Case c = makeCase();
+  const SceneDiagnostics d = diagnose(c.gt, c.pred, {});
+  EXPECT_EQ(d.num_objects, 4);  // 7, 8, 9, 10
+  EXPECT_EQ(d.confident_objects, 3);  // 10 is unverifiable
+}
+
+TEST(Diagnostics, RefusesMismatchedInput) {
+  Case c = makeCase();
+  c.pred.superpoint.pop_back();
+  EXPECT_THROW(diagnose(c.gt, c.pred, {}), Error);
+}
+
+}  // namespace
+}  // namespace panmap
