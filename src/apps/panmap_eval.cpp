@@ -116,6 +116,14 @@ json toJson(const panmap::SceneDiagnostics& d) {
                        {"matched", o.matched},
                        {"unverifiable", o.unverifiable}});
   }
+  json bridges = json::array();
+  for (const auto& b : d.bridges) {
+    json classes = json::array();
+    for (const auto& [cls, share] : b.class_mix) {
+      classes.push_back({{"class_id", cls}, {"name", panmap::nyu40Name(cls)}, {"share", share}});
+    }
+    bridges.push_back({{"superpoint", b.superpoint}, {"vertices", b.vertices}, {"classes", classes}});
+  }
   json bins = json::array();
   for (const auto& b : d.reliability) {
     bins.push_back({{"low", b.low},
@@ -130,6 +138,7 @@ json toJson(const panmap::SceneDiagnostics& d) {
           {"num_bridging_superpoints", d.num_bridging_superpoints},
           {"bridge_share", d.bridge_share},
           {"worst_second_class_share", d.worst_second_class_share},
+          {"bridges", bridges},
           {"largest_superpoint",
            {{"id", d.largest_superpoint},
             {"vertices", d.largest_vertices},

@@ -69,16 +69,24 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
     for (const auto& [id, count] : ids) sum += count, best = std::max(best, count);
     total += sum;
     majority += best;
-    std::vector<int64_t> counts;
-    for (const auto& [cls, count] : sp_classes[s]) counts.push_back(count);
-    std::sort(counts.rbegin(), counts.rend());
-    class_majority += counts[0];
-    if (sum >= d.min_superpoint_vertices && counts.size() > 1) {
-      const double second = static_cast<double>(counts[1]) / static_cast<double>(sum);
-      d.worst_second_class_share = std::max(d.worst_second_class_share, second);
-      if (second > d.bridge_share) ++d.num_bridging_superpoints;
+    std::vector<std::pair<int32_t, int64_t>> counts(sp_classes[s].begin(), sp_classes[s].end());
+    std::stable_sort(counts.begin(), counts.end(),
+                     [](const auto& a, const auto& b) { return a.second > b.second; });
+    class_majority += counts[0].second;
+    std::vector<std::pair<int32_t, double>> mix;
+    for (const auto& [cls, count] : counts) {
+      mix.emplace_back(cls, static_cast<double>(count) / static_cast<double>(sum));
+    }
+    if (sum >= d.min_superpoint_vertices && mix.size() > 1) {
+      d.worst_second_class_share = std::max(d.worst_second_class_share, mix[1].second);
+      if (mix[1].second > d.bridge_share) {
+        ++d.num_bridging_superpoints;
+        d.bridges.push_back({s, sum, mix});
+      }
     }
   }
+  std::stable_sort(d.bridges.begin(), d.bridges.end(),
+                   [](const auto& a, const auto& b) { return a.vertices > b.vertices; });
   d.num_superpoints = static_cast<int64_t>(sp_identities.size());
   d.superpoint_purity = total ? static_cast<double>(majority) / static_cast<double>(total) : kNaN;
   d.superpoint_class_purity =

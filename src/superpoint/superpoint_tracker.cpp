@@ -33,6 +33,15 @@ int32_t SuperpointState::semanticClass() const {
   return best;
 }
 
+int32_t SuperpointState::labelledClass() const {
+  int32_t best = 0;
+  double best_count = 0.0;
+  for (const auto& [cls, count] : class_counts) {
+    if (cls > 0 && count > best_count) best = cls, best_count = count;  // ties: smaller id
+  }
+  return best;
+}
+
 int32_t SuperpointState::instance() const {
   int32_t best = 0, best_count = 0;
   for (const auto& [id, count] : instance_counts) {
@@ -53,10 +62,16 @@ const SuperpointState* SuperpointTracker::state(int32_t label) const {
 bool SuperpointTracker::consistent(int32_t a, int32_t b) const {
   if (!config_.semantic_consistency) return true;
   const auto ia = states_.find(a), ib = states_.find(b);
-  const int32_t ca = ia == states_.end() ? 0 : ia->second.semanticClass();
-  const int32_t cb = ib == states_.end() ? 0 : ib->second.semanticClass();
-  // Paper III-B: the same class, or at least one is background C_0.
-  return ca == cb || ca == 0 || cb == 0;
+  const int32_t ca = ia == states_.end() ? 0 : ia->second.labelledClass();
+  const int32_t cb = ib == states_.end() ? 0 : ib->second.labelledClass();
+  // The paper's III-B also lets any super-point merge with a background one. Unlabelled
+  // surface is not "any class": with it as a joker, a wall, an unlabelled chair and the floor
+  // chain into one super-point, merge after merge (issue 19: one super-point held floor,
+  // walls, cabinets, a bed and a curtain). Unlabelled super-points merge only among
+  // themselves; labelled surfaces claim their voxels by votes when the network labels them.
+  // Background counts do not dilute a labelled class either, or a chair seen mostly without a
+  // mask would count as background and chain the same way.
+  return ca == cb;
 }
 
 void SuperpointTracker::mergeLabels(int32_t a, int32_t b, FrameAssociation* out) {

@@ -44,6 +44,24 @@ class WallScene : public ::testing::Test {
     if (split < 640) seg.surface_list.push_back(Surface{2, 1, b ? 2 : 0, b, b > 3, 0.9f, count[1]});
     return seg;
   }
+  // Surfaces as vertical stripes: (first column past the stripe, category) per stripe.
+  FrameSegmentation stripes(const std::vector<std::pair<int, int32_t>>& parts) const {
+    FrameSegmentation seg;
+    seg.geometric = LabelImage(640, 480, 1);
+    seg.surfaces = LabelImage(640, 480, 0);
+    int start = 0;
+    for (size_t k = 0; k < parts.size(); ++k) {
+      const auto [end, category] = parts[k];
+      const int32_t id = static_cast<int32_t>(k) + 1;
+      for (int v = 0; v < 480; ++v) {
+        for (int u = start; u < end; ++u) seg.surfaces(u, v) = id;
+      }
+      seg.surface_list.push_back(Surface{id, 1, category ? id : 0, category, category > 3, 0.9f,
+                                         (end - start) * 480});
+      start = end;
+    }
+    return seg;
+  }
   FrameAssociation step(SuperpointTracker* tracker, TsdfMap* map, const FrameSegmentation& seg) {
     FrameAssociation a = tracker->associate(seg, frame_, T_W_C_, *map);
     integrator_.integrate(frame_, T_W_C_, &a.pixel_labels, map);
@@ -109,6 +127,64 @@ TEST_F(WallScene, SemanticConsistencyPreventsWallBedMerge) {
       EXPECT_EQ(tracker.state(2), tracker.state(1));
     }
   }
+}
+
+// Issue 19: an unlabelled super-point between a wall and a floor (here: stripes of a plane)
+// that unlabelled surfaces keep spanning. With the paper's rule (one of the two may be
+// background) it merges with the wall and then with the floor, chaining two classes into one
+// super-point; unlabelled super-points now merge only with unlabelled ones.
+TEST_F(WallScene, UnlabelledSuperpointsDoNotChainClasses) {
+  TsdfMap map(TsdfMap::Config{0.05f});
+  SuperpointTracker tracker(SuperpointConfig{});
+  const auto clean = stripes({{220, 1}, {420, 0}, {640, 2}});  // wall | unlabelled | floor
+  const auto left = stripes({{420, 0}, {640, 2}});             // spans wall and unlabelled
+  const auto right = stripes({{220, 1}, {640, 0}});            // spans unlabelled and floor
+  step(&tracker, &map, clean);
+  step(&tracker, &map, clean);
+  int merges = 0;
+  for (int k = 0; k < 6; ++k) {
+    merges += step(&tracker, &map, clean).merges;
+    merges += step(&tracker, &map, left).merges;
+    merges += step(&tracker, &map, right).merges;
+  }
+  EXPECT_EQ(merges, 0);
+  EXPECT_EQ(tracker.states().size(), 3u);
+  EXPECT_GT(tracker.coObservations().at({1, 2}), 3);  // spatially connected, kept apart
+  EXPECT_GT(tracker.coObservations().at({2, 3}), 3);
+  EXPECT_EQ(tracker.state(1)->labelledClass(), 1);
+  EXPECT_EQ(tracker.state(2)->labelledClass(), 0);
+  EXPECT_EQ(tracker.state(3)->labelledClass(), 2);
+}
+
+// Two unlabelled pieces of one surface merge like labelled ones; a super-point the network
+// labelled once stays labelled however often it was seen unlabelled, and does not merge with
+// an unlabelled neighbour.
+TEST_F(WallScene, UnlabelledPiecesMergeOnlyAmongThemselves) {
+  TsdfMap map(TsdfMap::Config{0.05f});
+  SuperpointTracker tracker(SuperpointConfig{});
+  step(&tracker, &map, stripes({{320, 0}, {640, 0}}));
+  step(&tracker, &map, stripes({{320, 0}, {640, 0}}));
+  int merges = 0;
+  for (int k = 0; k < 4; ++k) {
+    merges += step(&tracker, &map, stripes({{320, 0}, {640, 0}})).merges;
+    merges += step(&tracker, &map, stripes({{640, 0}})).merges;
+  }
+  EXPECT_EQ(merges, 1);
+  EXPECT_EQ(tracker.labels().resolve(2), 1);
+
+  TsdfMap map2(TsdfMap::Config{0.05f});
+  SuperpointTracker labelled(SuperpointConfig{});
+  step(&labelled, &map2, stripes({{320, 5}, {640, 0}}));  // a chair once, then never again
+  for (int k = 0; k < 3; ++k) step(&labelled, &map2, stripes({{320, 0}, {640, 0}}));
+  merges = 0;
+  for (int k = 0; k < 6; ++k) {
+    merges += step(&labelled, &map2, stripes({{320, 0}, {640, 0}})).merges;
+    merges += step(&labelled, &map2, stripes({{640, 0}})).merges;
+  }
+  EXPECT_EQ(merges, 0);
+  EXPECT_GT(labelled.coObservations().at({1, 2}), 3);
+  EXPECT_EQ(labelled.state(1)->semanticClass(), 0);  // mostly seen unlabelled
+  EXPECT_EQ(labelled.state(1)->labelledClass(), 5);  // but the network called it a chair
 }
 
 TEST_F(WallScene, SameClassPiecesMergeAndPoolTheirCounts) {

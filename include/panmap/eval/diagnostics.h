@@ -31,6 +31,14 @@ struct SceneDiagnostics {
   int64_t min_superpoint_vertices = 100;
   /// Largest share of a second GT class in any such super-point.
   double worst_second_class_share = 0.0;
+  /// One super-point that spans two classes: its id, annotated vertices and class mix
+  /// (NYU40 id, share), largest first.
+  struct Bridge {
+    int32_t superpoint = 0;
+    int64_t vertices = 0;
+    std::vector<std::pair<int32_t, double>> class_mix;
+  };
+  std::vector<Bridge> bridges;  ///< the bridging super-points, largest first
 
   /// The super-point on the most GT vertices (annotated or not).
   int32_t largest_superpoint = 0;

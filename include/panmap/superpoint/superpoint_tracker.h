@@ -24,8 +24,9 @@ struct SuperpointConfig {
   float significant_overlap = 0.2f;
   /// theta_merge: super-points merge once co-observed in more than this many surfaces.
   int merge_threshold = 3;
-  /// Merge only semantically consistent super-points (same class or one is background).
-  /// false: spatial-only merging as in Voxblox++ (ablation "w/o III-B").
+  /// Merge only semantically consistent super-points: the same labelled class
+  /// (SuperpointState::labelledClass), unlabelled ones only with unlabelled ones. false:
+  /// spatial-only merging as in Voxblox++ (ablation "w/o III-B").
   bool semantic_consistency = true;
   /// Pixels between overlap samples (1 = every pixel).
   int sample_stride_px = 2;
@@ -41,6 +42,9 @@ struct SuperpointState {
   std::map<int32_t, int> instance_counts;  ///< frames that assigned it to each global instance
   /// C(L_S) from frame counting: the most frequent class (0 = background / none).
   int32_t semanticClass() const;
+  /// The most frequent class other than background (0 when no surface of it was labelled):
+  /// what the network said the super-point is, whenever it said anything.
+  int32_t labelledClass() const;
   /// Its global instance from frame counting (0 = none).
   int32_t instance() const;
 };
