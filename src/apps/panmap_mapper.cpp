@@ -238,6 +238,8 @@ int main(int argc, char** argv) {
                        {"optimised", true},
                        {"optimise_ms", optimise_ms},
                        {"solve_ms", labels.solve_ms},
+                       {"fragments_folded", labels.fragments_folded},
+                       {"fragments_dropped", labels.fragments_dropped},
                        {"regularise", optimiser.regularise},
                        {"refine", optimiser.refine}};
       writeJson(out_dir + "/report.json", json);
@@ -321,7 +323,9 @@ int main(int argc, char** argv) {
     json.update(mapJson(*mapper, outputs));
     json["graph"] = {{"optimised", labels.has_value()},
                      {"optimise_ms", optimise_ms},
-                     {"solve_ms", labels ? labels->solve_ms : 0.0}};
+                     {"solve_ms", labels ? labels->solve_ms : 0.0},
+                     {"fragments_folded", labels ? labels->fragments_folded : 0},
+                     {"fragments_dropped", labels ? labels->fragments_dropped : 0}};
     writeJson(out_dir + "/report.json", json);
     std::printf(
         "mapped %lld of %lld frames received (%lld dropped behind) in %.1f s: %zu "

@@ -237,6 +237,7 @@ void GraphAccumulator::forgetUnvoted(const std::vector<uint8_t>& has_votes,
 SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
                                         const SuperpointTracker& tracker) const {
   SuperpointGraph g;
+  g.voxel_size_m = map.voxelSize();
   for (int32_t c = 1; c <= kMaxNyu40Class; ++c) g.classes.push_back(c);
   for (int32_t c = 1; c <= kMaxNyu40Class; ++c) {
     if (isStuffClass(c)) g.background.push_back(c);

@@ -28,6 +28,10 @@ void checkGraph(const SuperpointGraph& graph) {
     throw Error("SuperpointGraph.classes: empty for a graph of " +
                 std::to_string(graph.vertices.size()) + " vertices");
   }
+  if (!(std::isfinite(graph.voxel_size_m) && graph.voxel_size_m >= 0.0)) {
+    throw Error("SuperpointGraph.voxel_size_m: " + std::to_string(graph.voxel_size_m) +
+                " (must be finite, >= 0; 0 = unknown)");
+  }
   for (size_t i = 0; i < graph.vertices.size(); ++i) {
     const GraphVertex& v = graph.vertices[i];
     const std::string field = "SuperpointGraph.vertices[" + std::to_string(i) + "]";

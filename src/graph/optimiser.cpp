@@ -10,6 +10,7 @@
 #include "panmap/graph/internal/alpha_beta_swap.h"
 #include "panmap/graph/internal/graph_check.h"
 #include "panmap/graph/internal/instance_refinement.h"
+#include "panmap/graph/internal/object_consolidation.h"
 #include "panmap/graph/internal/semantic_energy.h"
 
 namespace panmap {
@@ -49,6 +50,13 @@ void OptimiserConfig::check() const {
                 " (must be >= 1; set refine = false to skip)");
   }
   checkThresholds(default_thresholds, "OptimiserConfig.default_thresholds");
+  if (!(std::isfinite(objects.min_area_m2) && objects.min_area_m2 >= 0.0)) {
+    throw Error("OptimiserConfig.objects.min_area_m2: " + std::to_string(objects.min_area_m2) +
+                " (must be finite, >= 0)");
+  }
+  for (const double w : {objects.bias, objects.area, objects.support, objects.share}) {
+    if (!std::isfinite(w)) throw Error("OptimiserConfig.objects: confidence weights must be finite");
+  }
   for (const auto& [c, t] : class_thresholds) {
     checkThresholds(t, "OptimiserConfig.class_thresholds[" + std::to_string(c) + "]");
   }
@@ -77,11 +85,17 @@ GraphLabels optimise(const SuperpointGraph& graph, const OptimiserConfig& config
   const internal::InstanceLabels instances = config.refine
                                                  ? internal::refineInstances(graph, classes, config)
                                                  : internal::initialInstances(graph, classes);
+  // Objects: fragments folded or left out, calibrated confidences.
+  const internal::ConsolidatedObjects objects =
+      internal::consolidateObjects(graph, classes, instances.instance, config.objects);
   for (size_t i = 0; i < graph.vertices.size(); ++i) {  // ids ascending: append at the end
     out.semantic.emplace_hint(out.semantic.end(), graph.vertices[i].id, classes[i]);
-    out.instance.emplace_hint(out.instance.end(), graph.vertices[i].id, instances.instance[i]);
+    out.instance.emplace_hint(out.instance.end(), graph.vertices[i].id, objects.instance[i]);
   }
-  out.instance_confidence = instances.confidence;
+  out.instance_confidence = objects.confidence;
+  out.instance_evidence = objects.evidence;
+  out.fragments_folded = objects.folded;
+  out.fragments_dropped = objects.dropped;
   out.solve_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return out;

@@ -35,6 +35,7 @@ superpoint_graph_t toMessage(const SuperpointGraph& graph, int64_t utime, int64_
   superpoint_graph_t msg;
   msg.utime = utime;
   msg.request_id = request_id;
+  msg.voxel_size_m = graph.voxel_size_m;
   msg.num_classes = static_cast<int32_t>(graph.classes.size());
   msg.classes = graph.classes;
   msg.num_background = static_cast<int32_t>(graph.background.size());
@@ -71,6 +72,7 @@ SuperpointGraph fromMessage(const superpoint_graph_t& msg) {
   SuperpointGraph g;
   g.classes = msg.classes;
   g.background = msg.background;
+  g.voxel_size_m = msg.voxel_size_m;
   std::set<int32_t> ids;
   for (const superpoint_t& m : msg.vertices) {
     if (m.id <= 0 || (!g.vertices.empty() && m.id <= g.vertices.back().id)) {
@@ -115,8 +117,15 @@ graph_labels_t toMessage(const GraphLabels& labels, int64_t utime, int64_t reque
   for (const auto& [id, conf] : labels.instance_confidence) {
     msg.instance_ids.push_back(id);
     msg.instance_confidence.push_back(conf);
+    const auto e = labels.instance_evidence.find(id);
+    const ObjectEvidence evidence = e == labels.instance_evidence.end() ? ObjectEvidence() : e->second;
+    msg.instance_area_m2.push_back(evidence.area_m2);
+    msg.instance_support.push_back(evidence.support);
+    msg.instance_class_share.push_back(evidence.class_share);
   }
   msg.num_instances = static_cast<int32_t>(msg.instance_ids.size());
+  msg.fragments_folded = labels.fragments_folded;
+  msg.fragments_dropped = labels.fragments_dropped;
   msg.solve_ms = labels.solve_ms;
   return msg;
 }
@@ -126,7 +135,10 @@ GraphLabels fromMessage(const graph_labels_t& msg) {
   if (msg.num_superpoints < 0 || msg.superpoints.size() != n || msg.semantic.size() != n ||
       msg.instance.size() != n || msg.num_instances < 0 ||
       msg.instance_ids.size() != static_cast<size_t>(msg.num_instances) ||
-      msg.instance_confidence.size() != msg.instance_ids.size()) {
+      msg.instance_confidence.size() != msg.instance_ids.size() ||
+      msg.instance_area_m2.size() != msg.instance_ids.size() ||
+      msg.instance_support.size() != msg.instance_ids.size() ||
+      msg.instance_class_share.size() != msg.instance_ids.size()) {
     throw Error("labels message: arrays disagree with their counts");
   }
   GraphLabels labels;
@@ -136,7 +148,11 @@ GraphLabels fromMessage(const graph_labels_t& msg) {
   }
   for (size_t i = 0; i < msg.instance_ids.size(); ++i) {
     labels.instance_confidence[msg.instance_ids[i]] = msg.instance_confidence[i];
+    labels.instance_evidence[msg.instance_ids[i]] = {
+        msg.instance_area_m2[i], msg.instance_support[i], msg.instance_class_share[i]};
   }
+  labels.fragments_folded = msg.fragments_folded;
+  labels.fragments_dropped = msg.fragments_dropped;
   labels.solve_ms = msg.solve_ms;
   return labels;
 }

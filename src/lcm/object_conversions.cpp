@@ -26,6 +26,9 @@ object_list_t toMessage(const std::vector<MappedObject>& objects, int64_t utime)
     m.id = o.id;
     m.category = o.class_id;
     m.confidence = o.confidence;
+    m.area_m2 = o.evidence.area_m2;
+    m.support = o.evidence.support;
+    m.class_share = o.evidence.class_share;
     m.num_voxels = o.num_voxels;
     put3(o.centroid_W, m.centroid);
     put3(o.aabb_min_W, m.aabb_min);
@@ -59,6 +62,7 @@ std::vector<MappedObject> fromMessage(const object_list_t& msg) {
     o.id = m.id;
     o.class_id = m.category;
     o.confidence = m.confidence;
+    o.evidence = {m.area_m2, m.support, m.class_share};
     o.num_voxels = m.num_voxels;
     o.centroid_W = get3(m.centroid);
     o.aabb_min_W = get3(m.aabb_min);

@@ -63,7 +63,7 @@ PanmapConfig loadConfig(const std::string& path) {
   const cv::FileNode root = fs.root();
   const std::set<std::string> sections = {
       "map",   "integrator", "depth_segmentation", "fusion",    "superpoints",
-      "graph", "occupancy",  "tracking",           "optimiser", "threads"};
+      "graph", "occupancy",  "tracking",           "optimiser", "objects",     "threads"};
   for (auto it = root.begin(); it != root.end(); ++it) {
     if (!sections.count((*it).name())) throw Error(path + ": unknown section " + (*it).name());
   }
@@ -195,6 +195,17 @@ PanmapConfig loadConfig(const std::string& path) {
     }
     s.finish();
   }
+  {
+    OptimiserConfig::Objects& o = c.optimiser.objects;
+    Section s(root["objects"], "objects", path);
+    s.read("consolidate", &o.consolidate);
+    s.read("min_area_m2", &o.min_area_m2);
+    s.read("confidence_bias", &o.bias);
+    s.read("confidence_area", &o.area);
+    s.read("confidence_support", &o.support);
+    s.read("confidence_share", &o.share);
+    s.finish();
+  }
   if (!root["threads"].empty()) {
     if (!root["threads"].isInt()) throw Error(path + ": threads must be an integer");
     m.num_threads = static_cast<int>(root["threads"]);
@@ -299,6 +310,16 @@ std::string configToYaml(const PanmapConfig& c) {
       << ", theta_L: " << t.theta_L << " }\n";
   }
   if (o.class_thresholds.empty()) y << "      []\n";
+  const OptimiserConfig::Objects& ob = o.objects;
+  y << "objects:\n"
+    << "   consolidate: " << ob.consolidate
+    << "   # fold fragments into their neighbours or leave them out (0/1)\n"
+    << "   min_area_m2: " << ob.min_area_m2 << "   # smaller instances are fragments\n"
+    << "   confidence_bias: " << ob.bias
+    << "   # confidence = logistic(bias + area log10(m2) + support log2(obs/voxel) + share)\n"
+    << "   confidence_area: " << ob.area << "\n"
+    << "   confidence_support: " << ob.support << "\n"
+    << "   confidence_share: " << ob.share << "\n";
   y << "threads: " << m.num_threads << "\n";
   return y.str();
 }

@@ -221,6 +221,8 @@ std::vector<MappedObject> computeObjects(const TsdfMap& map, const SuperpointTra
     if (labels) {
       const auto c = labels->instance_confidence.find(id);
       if (c != labels->instance_confidence.end()) o.confidence = c->second;
+      const auto e = labels->instance_evidence.find(id);
+      if (e != labels->instance_evidence.end()) o.evidence = e->second;
     }
     fitBoxes(inst.centres_W, map.voxelSize(), &o);
     objects.push_back(std::move(o));
@@ -248,7 +250,11 @@ void writeObjectsJson(const std::string& path, const std::vector<MappedObject>& 
                     {"obb_center", vec3(o.obb_center_W)},
                     {"obb_orientation_wxyz", json::array({q.w(), q.x(), q.y(), q.z()})},
                     {"obb_extent", vec3(o.obb_extent_m)},
-                    {"superpoints", o.superpoints}});
+                    {"superpoints", o.superpoints},
+                    {"evidence",
+                     {{"area_m2", o.evidence.area_m2},
+                      {"support", o.evidence.support},
+                      {"class_share", o.evidence.class_share}}}});
   }
   const json root = {{"utime", utime}, {"objects", list}};
   std::ofstream out(path);
@@ -292,6 +298,13 @@ std::vector<MappedObject> readObjectsJson(const std::string& path, int64_t* utim
     o.obb_extent_m = readVec3(j, "obb_extent", where);
     if (!j.contains("superpoints") || !j["superpoints"].is_array()) {
       throw Error(where + ": 'superpoints' must be an array");
+    }
+    if (j.contains("evidence")) {
+      const json& e = j["evidence"];
+      const std::string at = where + ": evidence";
+      o.evidence.area_m2 = static_cast<float>(readNumber<double>(e, "area_m2", at));
+      o.evidence.support = static_cast<float>(readNumber<double>(e, "support", at));
+      o.evidence.class_share = static_cast<float>(readNumber<double>(e, "class_share", at));
     }
     for (const json& s : j["superpoints"]) {
       if (!s.is_number_integer()) throw Error(where + ": 'superpoints' must hold integers");

@@ -31,6 +31,24 @@ struct OptimiserConfig {
   };
   Thresholds default_thresholds;
   std::map<int32_t, Thresholds> class_thresholds;
+  /// What is reported as an object (after III-D): fragments are folded into the instance of
+  /// their class they are most strongly linked to, or left out and counted; every object gets
+  /// a calibrated confidence.
+  struct Objects {
+    bool consolidate = true;  ///< false: every instance is an object (no folding)
+    /// Instances covering less surface than this (num_voxels * voxel_size_m^2) are fragments.
+    double min_area_m2 = 0.04;
+    /// Confidence = 1 / (1 + exp(-(bias + area * log10(area_m2) + support * log2(support) +
+    /// share * class_share))), InstanceEvidence's support and class share; a logistic model
+    /// fitted by scripts/bench/calibrate_confidence.py on the tuning scenes
+    /// (docs/TUNING.md) so that about a share c of the objects reported with confidence c
+    /// match a real object.
+    double bias = 0.0;
+    double area = 2.0;
+    double support = 1.0;
+    double share = 2.0;
+  };
+  Objects objects;
   /// Throws Error naming the bad field.
   void check() const;
   /// The thresholds of a class (class_thresholds entry, else default_thresholds).

@@ -30,15 +30,31 @@ struct GraphEdge {
 struct SuperpointGraph {
   std::vector<int32_t> classes;     ///< the label space the optimiser may assign (NYU40 ids)
   std::vector<int32_t> background;  ///< classes counted as background C_0 (stuff)
+  /// Edge of the map's voxels, metres: num_voxels * voxel_size_m^2 is about a surface area.
+  double voxel_size_m = 0.0;
   std::vector<GraphVertex> vertices;  ///< sorted by id
   std::vector<GraphEdge> edges;       ///< sorted by (a, b)
+};
+
+/// What the graph says about one reported object (InstanceEvidence, in physical units).
+struct ObjectEvidence {
+  float area_m2 = 0.0f;      ///< surface it covers: voxels * voxel_size_m^2
+  float support = 0.0f;      ///< score-weighted observations as its class per voxel
+  float class_share = 0.0f;  ///< share of its observations that said its class
+  bool operator==(const ObjectEvidence& o) const {
+    return area_m2 == o.area_m2 && support == o.support && class_share == o.class_share;
+  }
 };
 
 /// What the optimisation decided.
 struct GraphLabels {
   std::map<int32_t, int32_t> semantic;  ///< super-point id -> class
   std::map<int32_t, int32_t> instance;  ///< super-point id -> instance (0 = none)
-  std::map<int32_t, float> instance_confidence;  ///< instance id -> P_O normalised to [0, 1]
+  /// instance id -> confidence in [0, 1] that it is a real object (OptimiserConfig::Objects)
+  std::map<int32_t, float> instance_confidence;
+  std::map<int32_t, ObjectEvidence> instance_evidence;  ///< instance id -> its evidence
+  int fragments_folded = 0;   ///< fragment instances folded into a neighbouring instance
+  int fragments_dropped = 0;  ///< fragment instances left out (their super-points: instance 0)
   double solve_ms = 0.0;
 };
 

@@ -39,6 +39,8 @@ struct MappedObject {
   /// Oriented box side lengths along B's x, y, z, metres; x is the longer horizontal side.
   Eigen::Vector3d obb_extent_m = Eigen::Vector3d::Zero();
   std::vector<int32_t> superpoints;  ///< live super-point ids with counted voxels, ascending
+  /// What the confidence was computed from (labels->instance_evidence; zero without labels).
+  ObjectEvidence evidence;
 
   /// Exact equality of every field (round trips through files and messages are exact).
   bool operator==(const MappedObject& o) const {
@@ -46,7 +48,7 @@ struct MappedObject {
            num_voxels == o.num_voxels && centroid_W == o.centroid_W && aabb_min_W == o.aabb_min_W &&
            aabb_max_W == o.aabb_max_W && obb_center_W == o.obb_center_W &&
            q_W_B.coeffs() == o.q_W_B.coeffs() && obb_extent_m == o.obb_extent_m &&
-           superpoints == o.superpoints;
+           superpoints == o.superpoints && evidence == o.evidence;
   }
 };
 
