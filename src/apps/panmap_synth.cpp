@@ -137,6 +137,12 @@ int main(int argc, char** argv) {
                      "ScanNet scene folder (<scene>_vh_clean_2.ply, .aggregation.json, "
                      "_vh_clean_2.0.010000.segs.json)");
   source->require_option(1);
+  std::string room_style = "boxes";
+  app.add_option("--room-style", room_style,
+                 "procedural room style: boxes (furniture only) or scannet (30-60 instances, small "
+                 "objects, clutter against furniture and walls, unannotated piles)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"boxes", "scannet"}));
   app.add_option("--scannet-labels", scannet_labels, "ScanNet label table (tsv)")
       ->capture_default_str();
   app.add_option("--trajectory", trajectory_file, "TUM trajectory to follow instead of a survey");
@@ -148,6 +154,11 @@ int main(int argc, char** argv) {
                  "frame rate of the survey (a lower rate covers more of the room per frame)")
       ->capture_default_str()
       ->check(CLI::Range(0.5, 120.0));
+  int laps = 1;
+  app.add_option("--laps", laps,
+                 "times the survey passes every area (odd laps forward, even laps backward)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 20));
   app.add_option("--masks", masks, "segmenter noise preset: clean, m2f, hard")
       ->capture_default_str()
       ->check(CLI::IsMember({"clean", "m2f", "hard"}));
@@ -180,9 +191,12 @@ int main(int argc, char** argv) {
     panmap::LabelledMesh mesh;
     json source_json;
     if (room_seed >= 0) {
-      const panmap::ProceduralRoom room = panmap::generateRoom(static_cast<uint64_t>(room_seed));
+      const panmap::ProceduralRoom room = panmap::generateRoom(
+          static_cast<uint64_t>(room_seed),
+          room_style == "scannet" ? panmap::RoomConfig::scanNetLike() : panmap::RoomConfig());
       mesh = room.mesh;
-      source_json = {{"type", "procedural_room"}, {"room_seed", room_seed}};
+      source_json = {
+          {"type", "procedural_room"}, {"room_seed", room_seed}, {"room_style", room_style}};
     } else {
       const auto table = panmap::ScanNetLabelTable::load(scannet_labels);
       const auto gt = panmap::loadScanNetGroundTruth(
@@ -207,6 +221,7 @@ int main(int argc, char** argv) {
     panmap::SurveyConfig survey;
     survey.num_frames = frames;
     survey.rate_hz = rate_hz;
+    survey.laps = laps;
     if (!trajectory_file.empty()) {
       trajectory = panmap::readTumTrajectory(trajectory_file);
       if (static_cast<int>(trajectory.size()) > frames)
@@ -272,6 +287,9 @@ int main(int argc, char** argv) {
           {"instances", synth.instances().size()}}},
         {"trajectory",
          {{"source", trajectory_file.empty() ? "survey" : trajectory_file},
+          {"laps", trajectory_file.empty() ? laps : 0},
+          {"walk_length_m",
+           trajectory_file.empty() ? panmap::planSurveyPath(mesh, survey, seed).length_m : 0.0},
           {"min_clearance_m", panmap::minClearance(synth.groundTruthTrajectory(), mesh)}}},
         {"masks", masksJson(config.masks)},
         {"unannotation",

@@ -9,8 +9,9 @@
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
 #include "panmap/core/random.h"
-#include "panmap/sim/internal/room_geometry.h"
+#include "panmap/sim/internal/room_clutter.h"
 #include "panmap/sim/internal/room_layout.h"
+#include "panmap/sim/internal/room_mesh.h"
 #include "panmap/sim/internal/room_parts.h"
 #include "panmap/sim/internal/room_random.h"
 #include "panmap/sim/internal/room_shape.h"
@@ -19,9 +20,8 @@ namespace panmap {
 
 namespace {
 
-using Eigen::Vector2f;
 using Eigen::Vector3f;
-using internal::room::Box2;
+using internal::room::addLooseObjects;
 using internal::room::Box3;
 using internal::room::drawShape;
 using internal::room::furnish;
@@ -30,12 +30,12 @@ using internal::room::kCeiling;
 using internal::room::kFloor;
 using internal::room::kWall;
 using internal::room::Layout;
-using internal::room::MeshWriter;
 using internal::room::Part;
 using internal::room::RoomRng;
 using internal::room::RoomShape;
-using internal::room::Solid;
+using internal::room::StuffColours;
 using internal::room::tint;
+using internal::room::writeRoomMesh;
 
 constexpr int kMaxAttempts = 40;
 
@@ -75,8 +75,17 @@ void RoomConfig::check() const {
   }
 }
 
+RoomConfig RoomConfig::scanNetLike() {
+  RoomConfig config;
+  config.min_width_m = 4.0f;
+  config.max_width_m = 8.0f;
+  config.style = RoomStyle::kScanNetLike;
+  return config;
+}
+
 ProceduralRoom generateRoom(uint64_t seed, const RoomConfig& config) {
   config.check();
+  const bool scannet = config.style == RoomStyle::kScanNetLike;
   // The floor plan depends on the seed alone; furnishing retries draw from their own streams.
   RoomRng shape_rng(splitmix64(seed));
   const RoomShape shape = drawShape(&shape_rng, config);
@@ -87,11 +96,16 @@ ProceduralRoom generateRoom(uint64_t seed, const RoomConfig& config) {
     stream = splitmix64(seed ^ splitmix64(0xF0123456789ull + static_cast<uint64_t>(attempt)));
     RoomRng rng(stream);
     layout = furnish(shape, ceiling_m, config, &rng);
+    if (layout && scannet && !addLooseObjects(layout.get(), &rng, config.max_edge_m)) {
+      layout.reset();
+    }
   }
   if (!layout) {
-    throw Error("min_classes: " + std::to_string(config.min_classes) +
-                " evaluated classes do not fit in the " + metres(shape.width_m) + " x " +
-                metres(shape.depth_m) + " m room of seed " + std::to_string(seed));
+    const std::string what =
+        scannet ? " evaluated classes (or a ScanNet-like room's instances)" : " evaluated classes";
+    throw Error("min_classes: " + std::to_string(config.min_classes) + what +
+                " do not fit in the " + metres(shape.width_m) + " x " + metres(shape.depth_m) +
+                " m room of seed " + std::to_string(seed));
   }
   RoomRng colour_rng(splitmix64(stream + 1));
 
@@ -100,52 +114,24 @@ ProceduralRoom generateRoom(uint64_t seed, const RoomConfig& config) {
   room.ceiling_height_m = ceiling_m;
   room.floor_polygon = shape.polygon;
   room.clear_floor = layout->clearFloor();
+  // Separate statements: the order of the draws is part of the room a seed gives.
+  StuffColours colours;
+  colours.wall = tint(&colour_rng, 225, 220, 210, 25);
+  colours.floor = tint(&colour_rng, 150, 115, 80, 40);
+  colours.ceiling = tint(&colour_rng, 240, 240, 238, 8);
+  writeRoomMesh(shape, ceiling_m, config.max_edge_m, layout->items(), colours, &room.mesh);
 
-  std::vector<Solid> solids;
-  for (const Item& item : layout->items()) {
-    for (const Part& p : item.parts) solids.push_back(Solid{p.box, p.cylinder});
-  }
-  MeshWriter writer(shape, ceiling_m, config.max_edge_m, solids, &room.mesh);
   const float w = shape.width_m, d = shape.depth_m, h = ceiling_m;
-
-  writer.setLabel(1, kWall, tint(&colour_rng, 225, 220, 210, 25));
-  for (size_t i = 0; i < shape.polygon.size(); ++i) {
-    const Vector2f a = shape.polygon[i];
-    const Vector2f b = shape.polygon[(i + 1) % shape.polygon.size()];
-    // z x (b - a) is the inward normal of a counter-clockwise outline.
-    writer.addRect({a.x(), a.y(), 0.0f}, {a.x(), a.y(), h}, {b.x(), b.y(), 0.0f}, -1);
-  }
-  writer.setLabel(2, kFloor, tint(&colour_rng, 150, 115, 80, 40));
-  for (const Box2& t : shape.tiles) {
-    const Vector2f a = t.min(), b = t.max();
-    writer.addRect({a.x(), a.y(), 0.0f}, {b.x(), a.y(), 0.0f}, {a.x(), b.y(), 0.0f}, -1);
-  }
-  writer.setLabel(3, kCeiling, tint(&colour_rng, 240, 240, 238, 8));
-  for (const Box2& t : shape.tiles) {
-    const Vector2f a = t.min(), b = t.max();
-    writer.addRect({a.x(), a.y(), h}, {a.x(), b.y(), h}, {b.x(), a.y(), h}, -1);
-  }
   room.objects.push_back(
       RoomObject{1, kWall, "wall", Box3(Vector3f::Zero(), Vector3f(w, d, h)), {}});
   room.objects.push_back(
       RoomObject{2, kFloor, "floor", Box3(Vector3f::Zero(), Vector3f(w, d, 0.0f)), {}});
   room.objects.push_back(
       RoomObject{3, kCeiling, "ceiling", Box3(Vector3f(0.0f, 0.0f, h), Vector3f(w, d, h)), {}});
-
-  int solid = 0;
   int32_t instance = 4;
   for (const Item& item : layout->items()) {
-    writer.setLabel(instance, item.semantic, item.color);
     RoomObject object{instance, item.semantic, item.name, item.bounds(), {}};
-    for (const Part& p : item.parts) {
-      if (p.cylinder) {
-        writer.addCylinder(p.box, solid);
-      } else {
-        writer.addBox(p.box, solid);
-      }
-      object.parts.push_back(p.box);
-      ++solid;
-    }
+    for (const Part& p : item.parts) object.parts.push_back(p.box);
     room.objects.push_back(std::move(object));
     ++instance;
   }

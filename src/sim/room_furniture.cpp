@@ -335,6 +335,12 @@ Module buildGroup(Group g, RoomRng* rng, const BuildContext& ctx) {
       return buildToilet(rng, ctx);
     case Group::kOther:
       return buildOtherFurniture(rng, ctx);
+    case Group::kDresser:
+      return buildDresser(rng, ctx);
+    case Group::kWallShelf:
+      return buildWallShelf(rng, ctx);
+    case Group::kWallBoard:
+      return buildWallBoard(rng, ctx);
   }
   return Module();
 }

@@ -205,22 +205,12 @@ bool Layout::tryCommit(const Module& world, bool island) {
     items_.push_back(item);
     blockers_.push_back(item.bounds());
   }
-  for (const Box3& r : world.reserved) blockers_.push_back(r);
+  for (const Box3& r : world.reserved) {
+    blockers_.push_back(r);
+    reserved_.push_back(r);
+  }
   return true;
 }
-
-namespace {
-
-// Tries a few freshly drawn variants of a module (sizes differ) along the walls.
-template <typename Build>
-bool placeSome(Layout* layout, RoomRng* rng, Build build, int tries = 3) {
-  for (int t = 0; t < tries; ++t) {
-    if (layout->placeOnWall(rng, build())) return true;
-  }
-  return false;
-}
-
-}  // namespace
 
 std::unique_ptr<Layout> furnish(const RoomShape& shape, float ceiling_m, const RoomConfig& config,
                                 RoomRng* rng) {
@@ -248,6 +238,9 @@ std::unique_ptr<Layout> furnish(const RoomShape& shape, float ceiling_m, const R
   if (!placeSome(layout.get(), rng, [&] { return buildWindow(rng, ctx, true); }) &&
       !placeSome(layout.get(), rng, [&] { return buildWindow(rng, ctx, false); })) {
     return nullptr;
+  }
+  if (config.style == RoomStyle::kScanNetLike) {
+    return furnishScanNetLike(layout.get(), rng, config) ? std::move(layout) : nullptr;
   }
 
   // Optional groups in random order until the drawn number of classes is reached (the

@@ -28,6 +28,7 @@ void SurveyConfig::check() const {
   if (!(grid_m > 0)) throw Error("survey grid_m must be > 0");
   if (num_waypoints < 2) throw Error("survey num_waypoints must be >= 2");
   if (!(view_max_m > view_min_m)) throw Error("survey view_max_m must exceed view_min_m");
+  if (laps < 1 || laps > 20) throw Error("survey laps must be in [1, 20]");
 }
 
 namespace {
@@ -207,12 +208,26 @@ std::vector<Cell> chooseWaypoints(const FreeSpace& fs, int count, Rng* rng) {
   return tour;
 }
 
-// A closed, smoothed loop through the waypoints, as world x, y points.
-std::vector<Eigen::Vector2d> planLoop(const FreeSpace& fs, const std::vector<Cell>& stops) {
-  std::vector<Cell> cells;
+// The walk through the waypoints: `laps` rounds of the loop, odd ones backward, smoothed and
+// closed, as world x, y points.
+SurveyPath planWalk(const FreeSpace& fs, const std::vector<Cell>& stops, int laps) {
+  std::vector<Cell> lap;
   for (size_t k = 0; k < stops.size(); ++k) {
     const auto leg = shortestPath(fs, stops[k], stops[(k + 1) % stops.size()]);
-    cells.insert(cells.end(), leg.begin(), leg.empty() ? leg.end() : leg.end() - 1);
+    lap.insert(lap.end(), leg.begin(), leg.empty() ? leg.end() : leg.end() - 1);
+  }
+  // A backward lap starts where the forward one ended (its first cell) and retraces it, so the
+  // same surfaces come back into view from the other side.
+  std::vector<Cell> cells = lap;
+  std::vector<size_t> lap_begin = {0};
+  for (int k = 1; k < laps && !lap.empty(); ++k) {
+    lap_begin.push_back(cells.size());
+    if (k % 2 == 1) {
+      cells.push_back(lap.front());
+      cells.insert(cells.end(), lap.rbegin(), lap.rend() - 1);
+    } else {
+      cells.insert(cells.end(), lap.begin(), lap.end());
+    }
   }
   std::vector<Eigen::Vector2d> points;
   for (const Cell& c : cells) points.push_back(fs.centre(c.first, c.second));
@@ -235,20 +250,53 @@ std::vector<Eigen::Vector2d> planLoop(const FreeSpace& fs, const std::vector<Cel
     points = smooth;
   }
   // Smoothing can stack points; zero-length segments would have no heading.
-  std::vector<Eigen::Vector2d> distinct;
-  for (const Eigen::Vector2d& p : points) {
-    if (distinct.empty() || (p - distinct.back()).norm() > 1e-4) distinct.push_back(p);
+  SurveyPath path;
+  std::vector<size_t> origin;  // index in `cells` of each kept point
+  for (size_t k = 0; k < points.size(); ++k) {
+    if (path.points.empty() || (points[k] - path.points.back()).norm() > 1e-4) {
+      path.points.push_back(points[k]);
+      origin.push_back(k);
+    }
   }
-  while (distinct.size() > 1 && (distinct.front() - distinct.back()).norm() <= 1e-4)
-    distinct.pop_back();
-  if (distinct.size() < 4) throw Error("survey: the free space is too small for a loop");
-  return distinct;
+  while (path.points.size() > 1 && (path.points.front() - path.points.back()).norm() <= 1e-4) {
+    path.points.pop_back();
+    origin.pop_back();
+  }
+  if (path.points.size() < 4) throw Error("survey: the free space is too small for a loop");
+  std::vector<double> arc = {0.0};
+  for (size_t k = 1; k <= path.points.size(); ++k) {
+    arc.push_back(arc.back() + (path.points[k % path.points.size()] - path.points[k - 1]).norm());
+  }
+  path.length_m = arc.back();
+  for (size_t begin : lap_begin) {
+    const size_t k = std::lower_bound(origin.begin(), origin.end(), begin) - origin.begin();
+    path.lap_start_m.push_back(arc[k]);
+  }
+  return path;
+}
+
+double wrapAngle(double a) {
+  while (a > M_PI) a -= 2 * M_PI;
+  while (a < -M_PI) a += 2 * M_PI;
+  return a;
 }
 
 struct Target {
   Eigen::Vector3d centre;
   int looks = 0;
+  std::vector<double> bearings;  // horizontal direction it was looked at from, each look
 };
+
+// Looks from bearings closer than this count as the same viewpoint (SynthConfig's default for
+// distinct views).
+constexpr double kSameViewRad = 20.0 * M_PI / 180.0;
+
+// Earlier looks at the target from about this bearing.
+int looksFrom(const Target& tg, double bearing) {
+  int n = 0;
+  for (double b : tg.bearings) n += std::abs(wrapAngle(b - bearing)) < kSameViewRad ? 1 : 0;
+  return n;
+}
 
 std::vector<Target> objectTargets(const LabelledMesh& mesh) {
   std::map<int32_t, std::pair<Eigen::Vector3d, int>> sums;
@@ -263,15 +311,9 @@ std::vector<Target> objectTargets(const LabelledMesh& mesh) {
   }
   std::vector<Target> targets;
   for (const auto& [id, s] : sums) {
-    if (s.second >= 20) targets.push_back({s.first / s.second, 0});
+    if (s.second >= 20) targets.push_back({s.first / s.second, 0, {}});
   }
   return targets;
-}
-
-double wrapAngle(double a) {
-  while (a > M_PI) a -= 2 * M_PI;
-  while (a < -M_PI) a += 2 * M_PI;
-  return a;
 }
 
 }  // namespace
@@ -282,7 +324,7 @@ std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig
   Rng rng(hashSeed(seed, 0x5u));
   const FreeSpace fs = buildFreeSpace(mesh, config);
   const std::vector<Eigen::Vector2d> loop =
-      planLoop(fs, chooseWaypoints(fs, config.num_waypoints, &rng));
+      planWalk(fs, chooseWaypoints(fs, config.num_waypoints, &rng), config.laps).points;
   std::vector<double> arc = {0.0};
   for (size_t k = 1; k <= loop.size(); ++k)
     arc.push_back(arc.back() + (loop[k % loop.size()] - loop[k - 1]).norm());
@@ -322,7 +364,10 @@ std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig
           std::abs(wrapAngle(std::atan2(d.y(), d.x()) - std::atan2(heading.y(), heading.x())));
       if (range < config.view_min_m * 0.5 || range > config.view_max_m * 1.5 || off > 0.6 * M_PI)
         return false;
-      *score = -tg.looks - 0.3 * std::abs(range - 0.5 * (config.view_min_m + config.view_max_m)) -
+      // Revisiting surveys prefer what was not looked at from here: the laps exist for new
+      // viewpoints (a single lap keeps the head schedule its rooms were measured with).
+      const int seen = config.laps > 1 ? looksFrom(tg, std::atan2(d.y(), d.x())) : tg.looks;
+      *score = -seen - 0.3 * std::abs(range - 0.5 * (config.view_min_m + config.view_max_m)) -
                0.5 * off + 0.01 * rng.uniform();
       return true;
     };
@@ -340,6 +385,8 @@ std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig
         if (best != target && best >= 0) {
           target = best;
           ++targets[best].looks;
+          const Eigen::Vector3d d = targets[best].centre - eye;
+          targets[best].bearings.push_back(std::atan2(d.y(), d.x()));
           look_timer = 0.0;
         } else if (best < 0) {
           target = -1;
@@ -379,6 +426,14 @@ std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig
     out.push_back(pose);
   }
   return out;
+}
+
+SurveyPath planSurveyPath(const LabelledMesh& mesh, const SurveyConfig& config, uint64_t seed) {
+  config.check();
+  // The same stream as planSurvey's: its first draws choose the stops.
+  Rng rng(hashSeed(seed, 0x5u));
+  const FreeSpace fs = buildFreeSpace(mesh, config);
+  return planWalk(fs, chooseWaypoints(fs, config.num_waypoints, &rng), config.laps);
 }
 
 double minClearance(const std::vector<StampedPose>& trajectory, const LabelledMesh& mesh) {

@@ -21,6 +21,17 @@ struct RoomObject {
   std::vector<Eigen::AlignedBox3f> parts;
 };
 
+/// What a procedural room is furnished with.
+enum class RoomStyle {
+  /// Furniture of real sizes and the hard cases of the paper, nothing loose: the rooms the
+  /// accuracy suite was first measured on (a seed's room never changes).
+  kBoxes,
+  /// kBoxes' furniture plus what a real ScanNet scan carries: 30-60 instances of 15 or more
+  /// classes, small objects on every surface and on the floor, clutter pushed against walls,
+  /// furniture and each other, and unannotated (class 0) piles on 5-10 % of the vertices.
+  kScanNetLike,
+};
+
 /// Parameters of the procedural room generator.
 struct RoomConfig {
   float min_width_m = 3.0f;    ///< room side lengths are drawn from [min, max]; >= 2 m
@@ -32,8 +43,12 @@ struct RoomConfig {
   float l_shape_probability = 0.4f;
   float max_edge_m = 0.05f;  ///< every triangle edge is at most this long (dense GT vertices)
   int min_classes = 12;      ///< distinct evaluated classes (of the 18) to include, 0..18
+  RoomStyle style = RoomStyle::kBoxes;  ///< what the room is furnished with
   /// Throws Error naming the bad field.
   void check() const;
+  /// A ScanNet-like room (RoomStyle::kScanNetLike) 4-8 m wide: smaller rooms leave too few
+  /// surfaces for the loose objects, larger ones too few instances per square metre.
+  static RoomConfig scanNetLike();
 };
 
 /// A generated room: the labelled mesh and what is in it.
@@ -57,7 +72,9 @@ struct ProceduralRoom {
 
 /// Generates a furnished room. The same seed and config give the identical mesh (bit for bit
 /// on one platform: sizes come from std::mt19937_64's raw output, not from std distributions).
-/// Throws Error naming `min_classes` when that many evaluated classes do not fit in the room.
+/// Unannotated clutter of a ScanNet-like room has class 0 and an instance of its own (listed in
+/// `objects` as "clutter"). Throws Error naming `min_classes` when that many evaluated classes
+/// (or, for a ScanNet-like room, its instances and classes) do not fit in the room.
 ProceduralRoom generateRoom(uint64_t seed, const RoomConfig& config = RoomConfig());
 
 }  // namespace panmap

@@ -27,16 +27,34 @@ struct SurveyConfig {
   double view_min_m = 0.8;           ///< preferred distance to the object being looked at
   double view_max_m = 3.5;
   double min_look_s = 1.5;  ///< keep looking at a target at least this long, seconds
+  /// Times the walk passes every area, 1..20, as a handheld scan revisits: the loop through the
+  /// stops forward in odd laps and backward in even ones, the head preferring objects it has not
+  /// looked at from about where it stands (20 degrees) to those looked at least, so later laps
+  /// see the other sides. 1 walks the one loop over and over with the head schedule of before.
+  int laps = 1;
   /// Throws Error naming the bad field.
   void check() const;
 };
 
+/// The walk of a survey: `laps` rounds of one loop through the stops, one after the other.
+struct SurveyPath {
+  /// World x, y of the walk, metres; closed: the last point leads back to the first.
+  std::vector<Eigen::Vector2d> points;
+  std::vector<double> lap_start_m;  ///< arc length at which each lap starts, metres (0 first)
+  double length_m = 0.0;            ///< arc length of the whole walk, back to its start, metres
+};
+
 /// Plans a smooth survey of a labelled mesh (z up): a loop through free space at least
 /// clearance_m from every surface, at min..max height above the floor, turning to look at
-/// the labelled objects from several sides. Deterministic for a seed. Throws Error when the
-/// mesh has no free space large enough to walk in.
+/// the labelled objects from several sides. The camera walks planSurveyPath's walk at
+/// speed_mps from its start and starts over at its end: laps the frames do not reach are left
+/// out. Deterministic for a seed. Throws Error when the mesh has no free space large enough to
+/// walk in.
 std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& config,
                                     uint64_t seed);
+
+/// The walk planSurvey follows for the same mesh, config and seed (to tell its laps apart).
+SurveyPath planSurveyPath(const LabelledMesh& mesh, const SurveyConfig& config, uint64_t seed);
 
 /// Smallest distance from any trajectory position to the mesh's vertices, metres (the mesh
 /// is dense, so this bounds the distance to its surfaces within half an edge length).

@@ -69,8 +69,31 @@ Module buildDesk(RoomRng* rng, const BuildContext& ctx);
 /// A sofa against the wall, sometimes with a coffee table in front.
 Module buildSofa(RoomRng* rng, const BuildContext& ctx);
 
+/// A dresser with drawers, sometimes with a television standing on it.
+Module buildDresser(RoomRng* rng, const BuildContext& ctx);
+
+/// A shelf board on two brackets, hung on the wall between knee and head height.
+Module buildWallShelf(RoomRng* rng, const BuildContext& ctx);
+
+/// A whiteboard with a pen tray, or a mirror: flat objects on the wall like pictures.
+Module buildWallBoard(RoomRng* rng, const BuildContext& ctx);
+
 /// The optional groups a room may get, beyond the compulsory door, table, cabinets and window.
-enum class Group { kCounter, kFridge, kDesk, kBookshelf, kSofa, kBed, kBath, kToilet, kOther };
+/// Box rooms draw from the first nine only; ScanNet-like rooms from all.
+enum class Group {
+  kCounter,
+  kFridge,
+  kDesk,
+  kBookshelf,
+  kSofa,
+  kBed,
+  kBath,
+  kToilet,
+  kOther,
+  kDresser,
+  kWallShelf,
+  kWallBoard
+};
 
 /// Builds one optional group.
 Module buildGroup(Group g, RoomRng* rng, const BuildContext& ctx);

@@ -24,6 +24,9 @@ constexpr int32_t kWall = 1, kFloor = 2, kCabinet = 3, kBed = 4, kChair = 5, kSo
                   kCurtain = 16, kPillow = 18, kCeiling = 22, kBooks = 23, kRefrigerator = 24,
                   kShowerCurtain = 28, kBox = 29, kNightStand = 32, kToilet = 33, kSink = 34,
                   kLamp = 35, kBathtub = 36, kOtherFurniture = 39, kOtherProp = 40;
+// Only ScanNet-like rooms have these; class 0 is unannotated clutter.
+constexpr int32_t kUnannotated = 0, kShelves = 15, kDresser = 17, kMirror = 19, kClothes = 21,
+                  kTelevision = 25, kPaper = 26, kTowel = 27, kWhiteboard = 30, kBag = 37;
 
 // Slack of geometric comparisons, metres: coordinates come from float sums of sizes.
 constexpr float kTolM = 1e-4f;
