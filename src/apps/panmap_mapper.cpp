@@ -23,6 +23,7 @@
 #include "panmap/lcm/object_conversions.h"
 #include "panmap/lcm/offline_mapping.h"
 #include "panmap/mapper/config_file.h"
+#include "panmap/mapper/graph_json.h"
 #include "panmap/mapper/objects.h"
 #include "panmap/mapper/outputs.h"
 #include "panmap/octomap_t.hpp"
@@ -140,6 +141,10 @@ int main(int argc, char** argv) {
   app.add_option("--channel-pose", options.channel_pose)->capture_default_str();
   app.add_option("--channel-panoptic", options.channel_panoptic)->capture_default_str();
   app.add_flag("--no-snapshots", no_snapshots, "skip the overview PNGs");
+  std::string graph_json;
+  app.add_option("--graph-json", graph_json,
+                 "offline and --export-only: also write the super-point graph with its final "
+                 "labels to this JSON file (why a super-point got its class or instance)");
   app.add_flag("-q,--quiet", quiet, "no progress line");
   auto* live_group = app.add_option_group("live", "live LCM mode");
   live_group->add_option("--lcm-url", lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's own)");
@@ -224,6 +229,7 @@ int main(int argc, char** argv) {
       const panmap::SuperpointGraph graph = mapper->graph();
       const panmap::GraphLabels labels = panmap::optimise(graph, optimiser);
       const double optimise_ms = msSince(optimise_start);
+      if (!graph_json.empty()) panmap::writeGraphJson(graph_json, graph, labels);
       output_options.utime = report.last_frame_utime;
       const panmap::OutputSummary outputs =
           panmap::writeOutputs(out_dir, mapper.get(), &labels, optimiser, output_options);

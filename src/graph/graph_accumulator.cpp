@@ -24,6 +24,7 @@ constexpr size_t kPrefetchPairs = 16;
 void GraphConfig::check() const {
   if (!(spatial_scale_m > 0.0)) throw Error("graph spatial_scale_m must be > 0");
   if (sample_stride_px < 1) throw Error("graph sample_stride_px must be >= 1");
+  if (!(separation_radius_m >= 0.0)) throw Error("graph separation_radius_m must be >= 0");
 }
 
 GraphAccumulator::GraphAccumulator(const GraphConfig& config, ThreadPool* pool)
@@ -40,8 +41,36 @@ const std::map<int32_t, double>& GraphAccumulator::scores(int32_t label) const {
 std::map<int32_t, double> GraphAccumulator::confidences(int32_t a, int32_t b) const {
   const auto [lo, hi] = std::minmax(a, b);
   const EdgeTable::Classes* classes = edges_.find(lo, hi);
-  if (!classes) return {};
-  return std::map<int32_t, double>(classes->begin(), classes->end());
+  std::map<int32_t, double> out;
+  if (classes) {
+    for (const auto& [cls, value] : *classes) {
+      if (cls > 0) out[cls] = value;
+    }
+  }
+  return out;
+}
+
+double GraphAccumulator::apart(int32_t a, int32_t b) const {
+  const auto [lo, hi] = std::minmax(a, b);
+  const EdgeTable::Classes* classes = edges_.find(lo, hi);
+  if (classes) {
+    for (const auto& [cls, value] : *classes) {
+      if (cls == 0) return value;
+    }
+  }
+  return 0.0;
+}
+
+std::map<int32_t, double> GraphAccumulator::separations(int32_t a, int32_t b) const {
+  const auto [lo, hi] = std::minmax(a, b);
+  const EdgeTable::Classes* classes = edges_.find(lo, hi);
+  std::map<int32_t, double> out;
+  if (classes) {
+    for (const auto& [cls, value] : *classes) {
+      if (cls < 0) out[-cls] = value;
+    }
+  }
+  return out;
 }
 
 void GraphAccumulator::applyMerges(const SuperpointTracker& tracker) {
@@ -71,10 +100,17 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   }
   // Masks with a known class and their confidence P_o (Eq. 1).
   std::map<int32_t, std::pair<int32_t, float>> masks;  // id -> (class, P_o)
+  std::map<int32_t, int> things_per_class;
   for (const PanopticSegment& s : panoptic.segments) {
     if (s.category <= 0) continue;
     masks[s.id] = {s.category, s.is_thing ? s.score : stuff_confidence};
+    if (s.is_thing) ++things_per_class[s.category];
   }
+  std::map<int32_t, bool> is_thing_mask;  // thing masks of a class with two or more things
+  for (const PanopticSegment& s : panoptic.segments) {
+    if (s.category > 0 && s.is_thing && things_per_class[s.category] > 1) is_thing_mask[s.id] = true;
+  }
+  mask_groups_.clear();
   if (masks.empty()) return;
   // Per-pixel membership test without a tree lookup: ids are small in practice (a network's
   // segments of one frame); larger ones fall back to the map.
@@ -206,7 +242,43 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
         edges_.add(gi.label, gj.label, cls, p_o * p_s * std::min(gi.count, gj.count));
       }
     }
+    mask_groups_.push_back({cls, p_o, is_thing_mask.count(hits[begin].mask) > 0, groups_});
     begin = end;
+  }
+
+  // Evidence of two segments: S1 under mask o1 and S2 under another mask o2 of the frame.
+  // P_apart(S1, S2) += min(P_o1, P_o2) * min(N^S1_o1, N^S2_o2) for pairs already co-observed
+  // under one mask (only those have a P_eps to weigh it against; the table does not grow),
+  // stored under class 0. For two masks of one thing class C also P_sep^C, the same sum times
+  // P_s, for every pair within separation_radius_m (two chairs seen apart for a hundred frames
+  // before a mask first merges them must not look like one chair), stored under class -C.
+  // Masks in id order, groups in label order: the same sums every run.
+  for (size_t m1 = 0; m1 < mask_groups_.size(); ++m1) {
+    for (size_t m2 = m1 + 1; m2 < mask_groups_.size(); ++m2) {
+      const MaskGroups& o1 = mask_groups_[m1];
+      const MaskGroups& o2 = mask_groups_[m2];
+      const double p_o = std::min(o1.p_o, o2.p_o);
+      const bool same_thing_class = o1.thing && o2.thing && o1.cls == o2.cls;
+      for (const Group& g1 : o1.groups) {
+        for (const Group& g2 : o2.groups) {
+          if (g1.label == g2.label) continue;
+          const auto [lo, hi] = std::minmax(g1.label, g2.label);
+          const double n = std::min(g1.count, g2.count);
+          if (same_thing_class) {
+            const double distance = (g1.centroid - g2.centroid).norm();
+            if (distance <= config_.separation_radius_m) {
+              const double p_s = 1.0 / (1.0 + distance / config_.spatial_scale_m);
+              edges_.add(lo, hi, -o1.cls, p_o * p_s * n);
+            }
+          }
+          const EdgeTable::Classes* known = edges_.find(lo, hi);
+          // Classes are sorted: a co-observation under one mask is a positive last key.
+          if (known && !known->empty() && known->back().first > 0) {
+            edges_.add(lo, hi, 0, p_o * n);
+          }
+        }
+      }
+    }
   }
 }
 
@@ -280,7 +352,15 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
     GraphEdge e;
     e.a = std::min(a, b);
     e.b = std::max(a, b);
-    e.confidences = std::map<int32_t, double>(conf.begin(), conf.end());
+    for (const auto& [cls, value] : conf) {
+      if (cls > 0) {
+        e.confidences[cls] = value;
+      } else if (cls < 0) {
+        e.separations[-cls] = value;
+      } else {
+        e.apart = value;
+      }
+    }
     g.edges.push_back(std::move(e));
   });
   std::sort(g.edges.begin(), g.edges.end(), [](const GraphEdge& x, const GraphEdge& y) {
@@ -291,6 +371,8 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
   for (GraphEdge& e : g.edges) {
     if (!merged.empty() && merged.back().a == e.a && merged.back().b == e.b) {
       for (const auto& [cls, c] : e.confidences) merged.back().confidences[cls] += c;
+      for (const auto& [cls, c] : e.separations) merged.back().separations[cls] += c;
+      merged.back().apart += e.apart;
     } else {
       merged.push_back(std::move(e));
     }

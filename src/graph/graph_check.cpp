@@ -59,6 +59,10 @@ void checkGraph(const SuperpointGraph& graph) {
       }
     }
     checkValues(e.confidences, field + ".confidences");
+    checkValues(e.separations, field + ".separations");
+    if (!(std::isfinite(e.apart) && e.apart >= 0.0)) {
+      throw Error(field + ".apart: " + std::to_string(e.apart) + " (must be finite, >= 0)");
+    }
   }
 }
 

@@ -9,6 +9,7 @@
 #include "panmap/core/error.h"
 #include "panmap/graph/internal/alpha_beta_swap.h"
 #include "panmap/graph/internal/graph_check.h"
+#include "panmap/graph/internal/instance_clustering.h"
 #include "panmap/graph/internal/instance_refinement.h"
 #include "panmap/graph/internal/object_consolidation.h"
 #include "panmap/graph/internal/semantic_energy.h"
@@ -50,6 +51,8 @@ void OptimiserConfig::check() const {
                 " (must be >= 1; set refine = false to skip)");
   }
   checkThresholds(default_thresholds, "OptimiserConfig.default_thresholds");
+  checkFraction(join_affinity, "OptimiserConfig.join_affinity");
+  checkFraction(min_coverage, "OptimiserConfig.min_coverage");
   if (!(std::isfinite(objects.min_area_m2) && objects.min_area_m2 >= 0.0)) {
     throw Error("OptimiserConfig.objects.min_area_m2: " + std::to_string(objects.min_area_m2) +
                 " (must be finite, >= 0)");
@@ -82,9 +85,11 @@ GraphLabels optimise(const SuperpointGraph& graph, const OptimiserConfig& config
   for (size_t i = 0; i < labels.size(); ++i) classes[i] = problem.labels[labels[i]];
 
   // III-D: instances.
-  const internal::InstanceLabels instances = config.refine
-                                                 ? internal::refineInstances(graph, classes, config)
-                                                 : internal::initialInstances(graph, classes);
+  const internal::InstanceLabels instances =
+      !config.refine ? internal::initialInstances(graph, classes)
+      : config.refinement == OptimiserConfig::Refinement::kClustering
+          ? internal::clusterInstances(graph, classes, config)
+          : internal::refineInstances(graph, classes, config);
   // Objects: fragments folded or left out, calibrated confidences.
   const internal::ConsolidatedObjects objects =
       internal::consolidateObjects(graph, classes, instances.instance, config.objects);

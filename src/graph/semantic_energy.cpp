@@ -22,6 +22,16 @@ double sumOver(const std::map<int32_t, double>& values, const ClassSet& classes)
   return sum;
 }
 
+/// Eq. 9's sum_C P_eps^C of an edge, discounted by how often the two super-points were seen
+/// under two different masks instead (P_apart; off with discount_apart = false): a chair and
+/// the floor it stands on share the chair's mask wherever its outline bleeds onto the floor,
+/// but are apart in nearly every frame that shows both.
+double edgeEvidence(const GraphEdge& e, const ClassSet& classes, const OptimiserConfig& config) {
+  const double same = sumOver(e.confidences, classes);
+  if (!config.discount_apart || !(same > 0.0)) return same;
+  return same * same / (same + e.apart);
+}
+
 /// The value of class c, 0 when absent or outside `classes`.
 double valueOf(const std::map<int32_t, double>& values, const ClassSet& classes, int32_t c) {
   if (!classes.contains(c)) return 0.0;
@@ -95,7 +105,7 @@ LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConf
     const int a = index(e.a);
     const int b = index(e.b);
     const double factor = edgeFactor(
-        normalisedConfidence(sumOver(e.confidences, classes), score_sum[a], score_sum[b]),
+        normalisedConfidence(edgeEvidence(e, classes, config), score_sum[a], score_sum[b]),
         config.theta);
     if (factor <= 0.0) continue;
     problem.edge_a.push_back(a);
@@ -165,7 +175,8 @@ double semanticEnergy(const SuperpointGraph& graph, const std::map<int32_t, int3
     const int a = index(e.a);
     const int b = index(e.b);
     const double factor = internal::edgeFactor(
-        internal::normalisedConfidence(internal::sumOver(e.confidences, classes), sums[a], sums[b]),
+        internal::normalisedConfidence(internal::edgeEvidence(e, classes, config), sums[a],
+                                       sums[b]),
         config.theta);
     energy += internal::pairwisePotential(label[a], label[b], normalised[a], normalised[b], factor,
                                           config.K_C);

@@ -57,6 +57,8 @@ superpoint_graph_t toMessage(const SuperpointGraph& graph, int64_t utime, int64_
     m.a = e.a;
     m.b = e.b;
     putClassMap(e.confidences, &m.num_confidences, &m.classes, &m.confidences);
+    putClassMap(e.separations, &m.num_separations, &m.separation_classes, &m.separations);
+    m.apart = e.apart;
     msg.edges.push_back(m);
   }
   return msg;
@@ -98,6 +100,9 @@ SuperpointGraph fromMessage(const superpoint_graph_t& msg) {
     e.a = m.a;
     e.b = m.b;
     e.confidences = getClassMap(m.num_confidences, m.classes, m.confidences, "graph message edge");
+    e.separations = getClassMap(m.num_separations, m.separation_classes, m.separations,
+                                "graph message edge separations");
+    e.apart = m.apart;
     g.edges.push_back(std::move(e));
   }
   return g;

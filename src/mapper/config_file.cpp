@@ -32,6 +32,17 @@ class Section {
       *value = static_cast<T>(static_cast<double>(n));
     }
   }
+  /// A string value (quoted or not; OpenCV keeps a trailing comment in an unquoted one).
+  void readString(const char* key, std::string* value) {
+    seen_.insert(key);
+    const cv::FileNode n = node_[key];
+    if (n.empty()) return;
+    if (!n.isString()) fail(name_ + "." + key + " must be a string");
+    std::string text = static_cast<std::string>(n);
+    text = text.substr(0, text.find('#'));
+    text.erase(text.find_last_not_of(" \t") + 1);
+    *value = text;
+  }
   const cv::FileNode& node() const { return node_; }
   void markSeen(const char* key) { seen_.insert(key); }
   void finish() {
@@ -173,6 +184,18 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("K_C", &o.K_C);
     s.read("theta", &o.theta);
     s.read("max_sweeps", &o.max_sweeps);
+    s.read("discount_apart", &o.discount_apart);
+    std::string refinement = o.refinement == OptimiserConfig::Refinement::kPaperRules
+                                 ? "paper"
+                                 : "clustering";
+    s.readString("refinement", &refinement);
+    if (refinement != "clustering" && refinement != "paper") {
+      s.fail("optimiser.refinement must be clustering or paper");
+    }
+    o.refinement = refinement == "paper" ? OptimiserConfig::Refinement::kPaperRules
+                                         : OptimiserConfig::Refinement::kClustering;
+    s.read("join_affinity", &o.join_affinity);
+    s.read("min_coverage", &o.min_coverage);
     s.read("theta_D", &o.default_thresholds.theta_D);
     s.read("theta_O", &o.default_thresholds.theta_O);
     s.read("theta_L", &o.default_thresholds.theta_L);
@@ -301,6 +324,15 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   K_C: " << o.K_C << "\n"
     << "   theta: " << o.theta << "\n"
     << "   max_sweeps: " << o.max_sweeps << "\n"
+    << "   discount_apart: " << o.discount_apart
+    << "   # Eq. 9 co-observation times P_eps / (P_eps + P_apart) (0/1)\n"
+    << "   refinement: \""
+    << (o.refinement == OptimiserConfig::Refinement::kPaperRules ? "paper" : "clustering")
+    << "\"   # III-D: clustering by one-mask / two-mask evidence, or the paper's rules\n"
+    << "   join_affinity: " << o.join_affinity
+    << "   # clustering: join when P_eps / (P_eps + P_sep) reaches this\n"
+    << "   min_coverage: " << o.min_coverage
+    << "   # clustering: and P_eps reaches this share of the smaller one's P_nu\n"
     << "   theta_D: " << o.default_thresholds.theta_D << "   # defaults for classes not listed\n"
     << "   theta_O: " << o.default_thresholds.theta_O << "\n"
     << "   theta_L: " << o.default_thresholds.theta_L << "\n";

@@ -129,6 +129,49 @@ TEST_F(WallGraph, MergedSuperpointsAddTheirScoresAndEdges) {
   for (const GraphVertex& v : g.vertices) EXPECT_NE(v.id, 2);
 }
 
+// Two chair masks side by side over super-points 1 and 2: the network saw two objects. Each
+// pair under two masks of one thing class gets P_sep^C (with P_s), and P_apart (without P_s)
+// once the pair has been under one mask; stuff masks only count towards P_apart.
+TEST_F(WallGraph, TwoMasksGiveSeparationAndApartEvidence) {
+  TsdfMap map(TsdfMap::Config{0.05f});
+  SuperpointTracker tracker(SuperpointConfig{});
+  step(&tracker, &map, columns(384, 640, 5, 5, 0));  // super-points 1 (60 %) and 2 (40 %)
+  // A gap without mask keeps each mask's rays on its own super-point's voxels.
+  PanopticFrame two;
+  two.segment_ids = LabelImage(640, 480, 0);
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 640; ++u) two.segment_ids(u, v) = u < 340 ? 1 : (u >= 430 ? 2 : 0);
+  }
+  two.segments = {PanopticSegment{1, 5, 5, true, 0.8f}, PanopticSegment{2, 5, 5, true, 0.6f}};
+  GraphAccumulator graph(GraphConfig{});
+  graph.update(frame_, T_W_C_, two, map, tracker);
+  const double s1 = graph.scores(1).at(5) / 0.8, s2 = graph.scores(2).at(5) / 0.6;  // N^S_o
+  EXPECT_TRUE(graph.confidences(1, 2).empty());  // never under one mask
+  // P_sep^5 = min(0.8, 0.6) * P_s * min(N1, N2), P_s as in Eq. 6 (centroids 1.217 m apart).
+  // Columns 340 and 430 are at y = 0.187 and -0.104 m: centroids 1.394 m apart.
+  const double p_s = 1.0 / (1.0 + 1.394 / 0.5);
+  EXPECT_NEAR(graph.separations(1, 2).at(5), 0.6 * p_s * std::min(s1, s2), 0.02 * s2);
+  EXPECT_EQ(graph.apart(1, 2), 0.0);  // no P_eps to weigh it against yet
+  // One mask over both, then two masks again: P_apart now grows, without P_s.
+  graph.update(frame_, T_W_C_, wholeMask(), map, tracker);
+  graph.update(frame_, T_W_C_, two, map, tracker);
+  // P_o are floats: 0.6f, not 0.6.
+  EXPECT_NEAR(graph.apart(1, 2), 0.6 * std::min(s1, s2), 1e-6 * s2);
+  EXPECT_NEAR(graph.separations(1, 2).at(5), 2 * 0.6 * p_s * std::min(s1, s2), 0.04 * s2);
+  // A wall (stuff) mask beside a chair mask: P_apart only.
+  PanopticFrame mixed = two;
+  mixed.segments[1] = PanopticSegment{2, 1, 1, false, 1.0f};
+  const double before = graph.separations(1, 2).at(5);
+  graph.update(frame_, T_W_C_, mixed, map, tracker);
+  EXPECT_DOUBLE_EQ(graph.separations(1, 2).at(5), before);
+  EXPECT_NEAR(graph.apart(1, 2), 1.1 * std::min(s1, s2), 1e-6 * s2);
+  const SuperpointGraph g = graph.graph(map, tracker);
+  ASSERT_EQ(g.edges.size(), 1u);
+  EXPECT_DOUBLE_EQ(g.edges[0].apart, graph.apart(1, 2));
+  EXPECT_DOUBLE_EQ(g.edges[0].separations.at(5), before);
+  EXPECT_EQ(g.edges[0].confidences.count(0), 0u);  // the keys below 1 stay out of P_eps
+}
+
 TEST(GraphAccumulator, RejectsBadInput) {
   GraphConfig bad;
   bad.spatial_scale_m = 0.0;

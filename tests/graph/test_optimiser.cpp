@@ -15,10 +15,12 @@
 namespace panmap {
 namespace {
 
-// The refinement expectations below are computed by hand for the starting thresholds
-// theta_D 0.1, theta_O 0.1, theta_L 0.5 (the tuned defaults of docs/TUNING.md never split).
+// The refinement expectations below are computed by hand for the paper's rules with the
+// starting thresholds theta_D 0.1, theta_O 0.1, theta_L 0.5 (tests/graph/test_clustering.cpp
+// pins the clustering that is the default).
 OptimiserConfig handConfig() {
   OptimiserConfig config;
+  config.refinement = OptimiserConfig::Refinement::kPaperRules;
   config.default_thresholds = {0.1, 0.1, 0.5};
   return config;
 }

@@ -25,12 +25,18 @@ struct GraphConfig {
   /// inverse distance"; this form is 1 for touching parts and halves at spatial_scale_m).
   double spatial_scale_m = 0.5;
   int sample_stride_px = 2;  ///< pixels between ray samples (1 = every pixel)
+  /// Separation evidence (P_sep^C, not in the paper) is kept for pairs of super-points under
+  /// two masks of one thing class in a frame whose voxels' centroids are at most this far
+  /// apart: farther pairs are never candidates for one instance anyway.
+  double separation_radius_m = 1.5;
   /// Throws Error naming the bad field.
   void check() const;
 };
 
-/// Accumulates the super-point graph frame by frame: vertex scores P_nu^C (Eq. 5) and edge
-/// confidences P_eps^C (Eq. 6). Keyed by live super-points; merges fold scores and edges
+/// Accumulates the super-point graph frame by frame: vertex scores P_nu^C (Eq. 5), edge
+/// confidences P_eps^C (Eq. 6), and their counterpart P_sep^C: the evidence that two
+/// super-points seen in one frame under two different masks of one thing class belong to
+/// different objects (Eq. 6 with the two masks' smaller confidence). Keyed by live super-points; merges fold scores and edges
 /// together, so the cost of an update does not grow with the number of frames seen.
 class GraphAccumulator {
  public:
@@ -57,6 +63,10 @@ class GraphAccumulator {
   const std::map<int32_t, double>& scores(int32_t label) const;
   /// P_eps^C of a pair (either order), empty if never co-observed.
   std::map<int32_t, double> confidences(int32_t a, int32_t b) const;
+  /// P_sep^C of a pair (either order), empty if never seen apart.
+  std::map<int32_t, double> separations(int32_t a, int32_t b) const;
+  /// P_apart of a pair (either order): seen under two different masks of any classes.
+  double apart(int32_t a, int32_t b) const;
   /// Number of edges.
   size_t numEdges() const { return edges_.size(); }
   /// Estimated heap bytes of the scores (std::map nodes), the edge table and the scratch.
@@ -113,9 +123,17 @@ class GraphAccumulator {
   std::vector<Hit> hits_;                                // scratch
   std::vector<Hit> merged_;                              // scratch
   std::vector<Group> groups_;                            // one mask's, scratch
+  /// Groups of every mask of the frame, for the evidence of two segments.
+  struct MaskGroups {
+    int32_t cls;
+    float p_o;
+    bool thing;  ///< a thing mask of a class with two or more things in the frame
+    std::vector<Group> groups;
+  };
+  std::vector<MaskGroups> mask_groups_;  // scratch
   absl::flat_hash_map<int32_t, size_t> group_index_;     // label -> groups_ index, scratch
   std::map<int32_t, std::map<int32_t, double>> scores_;  // label -> class -> P_nu
-  EdgeTable edges_;                                      // (a<b) -> class -> P_eps
+  EdgeTable edges_;  // (a<b) -> class C -> P_eps^C, -C -> P_sep^C, 0 -> P_apart
   size_t merges_applied_ = 0;
 };
 

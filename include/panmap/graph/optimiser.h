@@ -13,6 +13,9 @@ struct OptimiserConfig {
   bool refine = true;      ///< III-D instance refinement (off: initial instances)
   double K_C = 15.0;       ///< pairwise weight (Eq. 9)
   double theta = 0.5;      ///< pairwise bandwidth (Eq. 9)
+  /// Discount Eq. 9's co-observation sum_C P_eps^C by P_eps / (P_eps + P_apart): how often the
+  /// two super-points were under one mask rather than two (not in the paper).
+  bool discount_apart = true;
   int max_sweeps = 10;     ///< alpha-beta swap sweeps over all class pairs at most
   /// Floor of the normalised score P_nu^C / sum_C' P_nu^C' in the unary (Eq. 8): a class
   /// without score costs -log(score_floor) (13.8 for 1e-6) instead of infinity.
@@ -31,6 +34,14 @@ struct OptimiserConfig {
   };
   Thresholds default_thresholds;
   std::map<int32_t, Thresholds> class_thresholds;
+  /// How III-D refines instances: clustering by the network's one-mask / two-mask verdicts
+  /// (internal/instance_clustering.h), or the paper's rules with the thresholds above.
+  enum class Refinement : int8_t { kClustering = 0, kPaperRules = 1 };
+  Refinement refinement = Refinement::kClustering;
+  /// Clustering: clusters join when P_eps / (P_eps + P_sep) between them reaches this.
+  double join_affinity = 0.5;
+  /// Clustering: and P_eps between them reaches this share of the smaller one's P_nu.
+  double min_coverage = 0.1;
   /// What is reported as an object (after III-D): fragments are folded into the instance of
   /// their class they are most strongly linked to, or left out and counted; every object gets
   /// a calibrated confidence.

@@ -24,6 +24,12 @@ struct GraphEdge {
   int32_t a = 0;  ///< super-point id, a < b
   int32_t b = 0;
   std::map<int32_t, double> confidences;  ///< P_eps^C(a, b) per class C (Eq. 6); absent = 0
+  /// P_sep^C(a, b) per thing class C: the same sum over frames that showed a and b under two
+  /// different masks of class C (evidence of two objects; not in the paper); absent = 0.
+  std::map<int32_t, double> separations;
+  /// P_apart(a, b): the same sum (without P_s) over frames that showed a and b under two
+  /// different masks of any classes, for pairs co-observed under one mask (not in the paper).
+  double apart = 0.0;
 };
 
 /// The super-point graph handed to the final optimisation.
