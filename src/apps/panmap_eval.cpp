@@ -124,6 +124,15 @@ json toJson(const panmap::SceneDiagnostics& d) {
     }
     bridges.push_back({{"superpoint", b.superpoint}, {"vertices", b.vertices}, {"classes", classes}});
   }
+  json things = json::array();
+  for (const auto& t : d.gt_things) {
+    things.push_back({{"class_id", t.class_id},
+                      {"instance_id", t.instance_id},
+                      {"vertices", t.vertices},
+                      {"best_object", t.best_object},
+                      {"best_object_class", t.best_object_class},
+                      {"best_iou", t.best_iou}});
+  }
   json bins = json::array();
   for (const auto& b : d.reliability) {
     bins.push_back({{"low", b.low},
@@ -155,6 +164,7 @@ json toJson(const panmap::SceneDiagnostics& d) {
           {"confident_precision", number(d.confident_precision)},
           {"confident_recall", number(d.confident_recall)},
           {"reliability", bins},
+          {"gt_things", things},
           {"objects", objects}};
 }
 

@@ -145,6 +145,19 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
     const auto it = thing_index.find({gt.semantic[v], gt.instance[v]});
     if (it != thing_index.end()) ++overlaps[p][it->second];
   }
+  for (const auto& [p, by_gt] : overlaps) {
+    int32_t cls = 0;
+    int64_t best = -1;
+    for (const auto& [c, count] : pred_classes[p]) {
+      if (count > best) cls = c, best = count;
+    }
+    for (const auto& [g, inter] : by_gt) {
+      SceneDiagnostics::GtThing& t = d.gt_things[g];
+      const double iou = static_cast<double>(inter) /
+                         static_cast<double>(t.vertices + pred_size[p].first - inter);
+      if (iou > t.best_iou) t.best_iou = iou, t.best_object = p, t.best_object_class = cls;
+    }
+  }
   std::map<int32_t, double> listed = objects;
   if (listed.empty()) {
     for (const auto& [p, size] : pred_size) listed[p] = 1.0;

@@ -71,6 +71,9 @@ struct SceneDiagnostics {
     int32_t class_id = 0;
     int32_t instance_id = 0;
     int64_t vertices = 0;
+    int32_t best_object = 0;       ///< the object overlapping it with the best IoU, any class
+    int32_t best_object_class = 0;  ///< that object's class
+    double best_iou = 0.0;          ///< its IoU (0 when no object overlaps)
   };
   std::vector<GtThing> gt_things;
   int num_objects = 0;  ///< predicted objects (object list entries, else mesh instances)
