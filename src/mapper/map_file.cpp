@@ -15,7 +15,7 @@ namespace {
 constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 // 2: occupancy cells, pose refinement state and the trajectory.
 // 3: the pose refinement's weak_direction_damping.
-constexpr uint32_t kVersion = 3;
+constexpr uint32_t kVersion = 4;
 
 void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put(c.map.voxel_size_m);
@@ -159,6 +159,12 @@ void putSnapshot(BinaryWriter* w, const SuperpointTracker::Snapshot& s) {
     w->put<int32_t>(key.second);
     w->put<int32_t>(count);
   }
+  w->put<uint64_t>(s.apart.size());
+  for (const auto& [key, count] : s.apart) {
+    w->put<int32_t>(key.first);
+    w->put<int32_t>(key.second);
+    w->put<int32_t>(count);
+  }
   w->put<uint64_t>(s.merges.size());
   for (const SuperpointMerge& m : s.merges) {
     w->put<int32_t>(m.kept);
@@ -191,6 +197,11 @@ SuperpointTracker::Snapshot getSnapshot(BinaryReader* r) {
   for (uint64_t i = 0; i < pairs; ++i) {
     const int32_t a = r->get<int32_t>(), b = r->get<int32_t>();
     s.co_observed[{a, b}] = r->get<int32_t>();
+  }
+  const uint64_t apart = r->getCount(12);
+  for (uint64_t i = 0; i < apart; ++i) {
+    const int32_t a = r->get<int32_t>(), b = r->get<int32_t>();
+    s.apart[{a, b}] = r->get<int32_t>();
   }
   const uint64_t merges = r->getCount(16);
   for (uint64_t i = 0; i < merges; ++i) {

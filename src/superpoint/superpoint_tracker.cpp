@@ -1,6 +1,7 @@
 #include "panmap/superpoint/superpoint_tracker.h"
 
 #include <algorithm>
+#include <set>
 #include <tuple>
 
 #include "panmap/core/container_memory.h"
@@ -74,6 +75,12 @@ bool SuperpointTracker::consistent(int32_t a, int32_t b) const {
   return ca == cb;
 }
 
+bool SuperpointTracker::seenApart(const std::pair<int32_t, int32_t>& key, int m) const {
+  if (!config_.semantic_consistency) return false;
+  const auto it = apart_.find(key);
+  return it != apart_.end() && it->second >= m;
+}
+
 void SuperpointTracker::mergeLabels(int32_t a, int32_t b, FrameAssociation* out) {
   const int32_t ra = labels_.resolve(a), rb = labels_.resolve(b);
   if (ra == rb) return;
@@ -86,25 +93,28 @@ void SuperpointTracker::mergeLabels(int32_t a, int32_t b, FrameAssociation* out)
     for (const auto& [id, count] : it->second.instance_counts) kept.instance_counts[id] += count;
     states_.erase(it);
   }
-  // Co-observations of the removed super-point now belong to the survivor.
-  std::map<std::pair<int32_t, int32_t>, int> moved;
-  for (auto m = co_observed_.begin(); m != co_observed_.end();) {
-    if (m->first.first == gone || m->first.second == gone) {
-      const int32_t other = m->first.first == gone ? m->first.second : m->first.first;
-      if (other != keep) moved[std::minmax(keep, other)] += m->second;
-      m = co_observed_.erase(m);
-    } else {
-      ++m;
+  // Co-observations and apart counts of the removed super-point now belong to the survivor.
+  for (auto* counts : {&co_observed_, &apart_}) {
+    std::map<std::pair<int32_t, int32_t>, int> moved;
+    for (auto m = counts->begin(); m != counts->end();) {
+      if (m->first.first == gone || m->first.second == gone) {
+        const int32_t other = m->first.first == gone ? m->first.second : m->first.first;
+        if (other != keep) moved[std::minmax(keep, other)] += m->second;
+        m = counts->erase(m);
+      } else {
+        ++m;
+      }
     }
+    counts->erase(std::minmax(keep, gone));
+    for (const auto& [key, count] : moved) (*counts)[key] += count;
   }
-  co_observed_.erase(std::minmax(keep, gone));
-  for (const auto& [key, count] : moved) co_observed_[key] += count;
   merge_log_.push_back({keep, gone, frames_});
   ++out->merges;
 }
 
 size_t SuperpointTracker::memoryBytes() const {
-  size_t bytes = mapNodesBytes(states_) + mapNodesBytes(co_observed_) + vectorBytes(merge_log_) +
+  size_t bytes = mapNodesBytes(states_) + mapNodesBytes(co_observed_) + mapNodesBytes(apart_) +
+                 vectorBytes(merge_log_) +
                  vectorBytes(labels_.parents());
   for (const auto& [label, state] : states_) {
     bytes += mapNodesBytes(state.class_counts) + mapNodesBytes(state.instance_counts);
@@ -126,8 +136,10 @@ size_t SuperpointTracker::forgetUnvoted(const std::vector<uint8_t>& has_votes) {
       ++forgotten;
     }
   }
-  for (auto it = co_observed_.begin(); it != co_observed_.end();) {
-    it = voted(it->first.first) && voted(it->first.second) ? std::next(it) : co_observed_.erase(it);
+  for (auto* counts : {&co_observed_, &apart_}) {
+    for (auto it = counts->begin(); it != counts->end();) {
+      it = voted(it->first.first) && voted(it->first.second) ? std::next(it) : counts->erase(it);
+    }
   }
   return forgotten;
 }
@@ -222,20 +234,49 @@ void SuperpointTracker::associate(const FrameSegmentation& segmentation, const R
     states_[out.surface_labels[s]].class_counts[surfaces[s].category] += 1.0;
   }
 
-  // Co-observation M (Eq. 3) of the super-points significantly overlapping each surface, and
-  // merging of spatially connected, semantically consistent ones.
+  // The super-points significantly overlapping each surface: L_N(s_i).
+  std::vector<std::vector<int32_t>> significant(n);
   for (size_t s = 0; s < n; ++s) {
-    std::vector<int32_t> significant;
     for (const auto& [label, count] : overlap[s]) {
-      if (count >= config_.significant_overlap * samples[s]) significant.push_back(label);
+      if (count >= config_.significant_overlap * samples[s]) significant[s].push_back(label);
     }
-    for (size_t i = 0; i < significant.size(); ++i) {
-      for (size_t j = i + 1; j < significant.size(); ++j) {
-        const int32_t a = labels_.resolve(significant[i]), b = labels_.resolve(significant[j]);
+  }
+  // Super-points the frame shows as two objects: significant in surfaces of two different
+  // thing masks of one class. Counted once per frame and pair, before this frame's merges.
+  std::set<std::pair<int32_t, int32_t>> apart;
+  for (size_t s1 = 0; s1 < n; ++s1) {
+    const Surface& a = surfaces[s1];
+    if (!a.is_thing || a.category <= 0 || a.panoptic_segment <= 0) continue;
+    for (size_t s2 = s1 + 1; s2 < n; ++s2) {
+      const Surface& b = surfaces[s2];
+      if (!b.is_thing || b.category != a.category || b.panoptic_segment == a.panoptic_segment ||
+          b.panoptic_segment <= 0) {
+        continue;
+      }
+      for (int32_t x : significant[s1]) {
+        for (int32_t y : significant[s2]) {
+          if (x != y) apart.insert(std::minmax(x, y));
+        }
+      }
+    }
+  }
+  for (const auto& key : apart) ++apart_[key];
+  // Co-observation M (Eq. 3) of the super-points significantly overlapping each surface, and
+  // merging of spatially connected, semantically consistent ones that the network did not
+  // see as two objects as often as it saw them as one surface (two touching cabinets of a
+  // row, one mask over both now and then).
+  for (size_t s = 0; s < n; ++s) {
+    for (size_t i = 0; i < significant[s].size(); ++i) {
+      for (size_t j = i + 1; j < significant[s].size(); ++j) {
+        const int32_t a = labels_.resolve(significant[s][i]);
+        const int32_t b = labels_.resolve(significant[s][j]);
         if (a == b) continue;
-        int& m = co_observed_[std::minmax(a, b)];
+        const auto key = std::minmax(a, b);
+        int& m = co_observed_[key];
         ++m;
-        if (m > config_.merge_threshold && consistent(a, b)) mergeLabels(a, b, &out);
+        if (m > config_.merge_threshold && consistent(a, b) && !seenApart(key, m)) {
+          mergeLabels(a, b, &out);
+        }
       }
     }
   }
@@ -301,6 +342,7 @@ SuperpointTracker::Snapshot SuperpointTracker::snapshot() const {
   s.parents = labels_.parents();
   s.states = states_;
   s.co_observed = co_observed_;
+  s.apart = apart_;
   s.merges = merge_log_;
   s.next_instance = next_instance_;
   s.frames = frames_;
@@ -314,6 +356,7 @@ void SuperpointTracker::restore(const Snapshot& snapshot) {
   }
   states_ = snapshot.states;
   co_observed_ = snapshot.co_observed;
+  apart_ = snapshot.apart;
   merge_log_ = snapshot.merges;
   next_instance_ = snapshot.next_instance;
   frames_ = snapshot.frames;

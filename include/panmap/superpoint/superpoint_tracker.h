@@ -102,6 +102,9 @@ class SuperpointTracker {
   int32_t numInstances() const { return next_instance_ - 1; }
   /// Co-observation counts M(L1, L2) of live super-points (L1 < L2).
   const std::map<std::pair<int32_t, int32_t>, int>& coObservations() const { return co_observed_; }
+  /// Frames that showed two live super-points (L1 < L2) as two objects: each significant in a
+  /// surface of a different thing mask of one class.
+  const std::map<std::pair<int32_t, int32_t>, int>& apartCounts() const { return apart_; }
   /// The config in use.
   const SuperpointConfig& config() const { return config_; }
   /// Estimated heap bytes of the super-point bookkeeping (states, co-observations, merge log,
@@ -113,6 +116,7 @@ class SuperpointTracker {
     std::vector<int32_t> parents;
     std::map<int32_t, SuperpointState> states;
     std::map<std::pair<int32_t, int32_t>, int> co_observed;
+    std::map<std::pair<int32_t, int32_t>, int> apart;
     std::vector<SuperpointMerge> merges;
     int32_t next_instance = 1;
     int64_t frames = 0;
@@ -124,6 +128,9 @@ class SuperpointTracker {
 
  private:
   bool consistent(int32_t a, int32_t b) const;
+  /// The network showed the pair (a < b) as two objects in at least as many frames as it
+  /// co-observed them in one surface (m): no merge (semantic consistency only).
+  bool seenApart(const std::pair<int32_t, int32_t>& key, int m) const;
   void mergeLabels(int32_t a, int32_t b, FrameAssociation* out);
   void associateInstances(const FrameSegmentation& segmentation, FrameAssociation* out);
 
@@ -131,6 +138,7 @@ class SuperpointTracker {
   LabelRegistry labels_;
   std::map<int32_t, SuperpointState> states_;               // by root label
   std::map<std::pair<int32_t, int32_t>, int> co_observed_;  // M, by root labels (a < b)
+  std::map<std::pair<int32_t, int32_t>, int> apart_;        // frames seen as two objects
   std::vector<SuperpointMerge> merge_log_;
   std::vector<RowSample> row_samples_;  // scratch of associate(): one row's samples,
   std::vector<int32_t> row_surfaces_;   // their surfaces
