@@ -109,6 +109,7 @@ TEST(ObjectConsolidation, OffOrWithoutAVoxelSizeKeepsEveryInstance) {
 
 TEST(ObjectConsolidation, ConfidenceRisesWithAreaSupportAndShare) {
   OptimiserConfig::Objects config;
+  config.share = 1.0;  // the default holds it at 0
   InstanceEvidence e;
   e.voxels = 1000;
   e.score = 8000.0;

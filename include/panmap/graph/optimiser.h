@@ -52,12 +52,13 @@ struct OptimiserConfig {
     /// Confidence = 1 / (1 + exp(-(bias + area * log10(area_m2) + support * log2(support) +
     /// share * class_share))), InstanceEvidence's support and class share; a logistic model
     /// fitted by scripts/bench/calibrate_confidence.py on the tuning scenes
-    /// (docs/TUNING.md) so that about a share c of the objects reported with confidence c
-    /// match a real object.
-    double bias = 0.0;
-    double area = 2.0;
-    double support = 1.0;
-    double share = 2.0;
+    /// (docs/CALIBRATION.md) so that about a share c of the objects reported with confidence
+    /// c match a real object. The class share did not help on scene kinds left out of the
+    /// fit: held at 0.
+    double bias = -1.621;
+    double area = 2.56;
+    double support = 1.264;
+    double share = 0.0;
   };
   Objects objects;
   /// Throws Error naming the bad field.

@@ -1,0 +1,244 @@
+"""The accuracy suite's sequences and runs, shared by accuracy.py (docs/RESULTS.md),
+tune_refinement.py and calibrate_confidence.py (docs/TUNING.md).
+
+A sequence is rendered once by panmap-synth (cached in WORK/seq by its parameters), mapped by
+panmap-mapper, every method variant exported from the maps, and each scored by panmap-eval.
+Three kinds of scenes:
+  scannet     a real ScanNet scene's mesh (panmap-synth --scannet DIR), as annotated or with a
+              quarter of it left unannotated (--unannotate 0.25), masks painted there or empty;
+  scannetlike a ScanNet-like procedural room (--room-style scannet, two laps: revisits);
+  room        a procedural box room (the suite before issue 19).
+"""
+import concurrent.futures
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+BUILD = os.path.join(ROOT, "build")
+SCANNET_LABELS = os.path.join(ROOT, "..", "shared", "data", "scannet-meta",
+                              "scannetv2-labels.combined.tsv")
+
+# Method variants: (name, map, optimiser flags). Map A: semantically consistent super-points
+# (III-B); map B: spatial-only merging. Both run the same per-frame pipeline otherwise.
+VARIANTS = [
+    ("full", "A", []),
+    ("w/o III-B", "B", []),
+    ("w/o III-C", "A", ["--no-regularise"]),
+    ("w/o III-D", "A", ["--no-refine"]),
+    ("w/o III-C & III-D", "A", ["--no-regularise", "--no-refine"]),
+    ("Voxblox++-like", "B", ["--no-regularise", "--no-refine"]),
+]
+REFINED = "full + pose refinement"
+
+# Annotation variants of a real scene: (name, panmap-synth flags).
+ANNOTATIONS = [
+    ("annotated", []),
+    ("25 % unannotated, painted", ["--unannotate", "0.25"]),
+    ("25 % unannotated, empty", ["--unannotate", "0.25", "--unannotated-masks", "empty"]),
+]
+
+
+def run(cmd, log=None):
+    """Runs a command; raises with its output on failure."""
+    result = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if log:
+        with open(log, "a") as f:
+            f.write("$ " + " ".join(cmd) + "\n" + result.stdout)
+    if result.returncode != 0:
+        raise RuntimeError("failed (%d): %s\n%s" % (result.returncode, " ".join(cmd),
+                                                    result.stdout[-2000:]))
+    return result.stdout
+
+
+def tool(name):
+    return os.path.join(BUILD, name)
+
+
+def mean(values):
+    values = [v for v in values if v is not None]
+    return sum(values) / len(values) if values else float("nan")
+
+
+class Spec:
+    """One sequence: what panmap-synth renders, and which runs it gets.
+
+    kind: scannet | scannetlike | room; source: scene folder or room seed; seed: trajectory,
+    noise, drift and unannotation seed; poses: gt | slam | slam-hard; masks: clean | m2f | hard;
+    annotation: a name of ANNOTATIONS (scannet) or of the room's own ("as generated", "empty");
+    runs: "all" (every variant, plus pose refinement when poses drift) or "full" (the full
+    method only; with drifting poses it runs with the default tracking).
+    """
+
+    def __init__(self, kind, source, seed, poses, masks, annotation="annotated", runs="all",
+                 frames=450, rate_hz=5.0):
+        self.kind, self.source, self.seed = kind, source, seed
+        self.poses, self.masks, self.annotation, self.runs = poses, masks, annotation, runs
+        self.frames, self.rate_hz = frames, rate_hz
+
+    def scene(self):
+        if self.kind == "scannet":
+            return os.path.basename(os.path.normpath(self.source))
+        return "%s%d" % ("sl" if self.kind == "scannetlike" else "room", self.source)
+
+    def name(self):
+        ann = {"annotated": "ann", "as generated": "ann", "empty": "empty",
+               "25 % unannotated, painted": "u25p", "25 % unannotated, empty": "u25e"}
+        return "%s_s%d_%s_%s_%s_%df" % (self.scene(), self.seed, ann[self.annotation], self.poses,
+                                        self.masks, self.frames)
+
+    def synth_args(self):
+        args = ["--seed", str(self.seed), "--frames", str(self.frames), "--rate-hz",
+                str(self.rate_hz), "--masks", self.masks, "--poses", self.poses]
+        if self.kind == "scannet":
+            args += ["--scannet", self.source, "--scannet-labels", SCANNET_LABELS]
+            args += dict(ANNOTATIONS)[self.annotation]
+        else:
+            args += ["--room", str(self.source)]
+            if self.kind == "scannetlike":
+                args += ["--room-style", "scannet", "--laps", "2"]
+                if self.annotation == "empty":
+                    args += ["--unannotated-masks", "empty"]
+        return args
+
+
+def render(work, spec):
+    """Renders (or reuses) one sequence; returns its folder."""
+    folder = os.path.join(work, "seq", spec.name())
+    if os.path.exists(os.path.join(folder, "info.json")):
+        return folder
+    shutil.rmtree(folder, ignore_errors=True)
+    run([tool("panmap-synth"), "-q", "--out", folder] + spec.synth_args())
+    return folder
+
+
+def evaluate(pred_dir, seq_dir):
+    """Scores a mapper output folder against the sequence's ground truth (eval.json)."""
+    cmd = [tool("panmap-eval"), "--pred", os.path.join(pred_dir, "mesh_instance.ply"),
+           "--gt", os.path.join(seq_dir, "gt", "mesh.ply"),
+           "--json", os.path.join(pred_dir, "eval.json")]
+    objects = os.path.join(pred_dir, "objects.json")
+    if os.path.exists(objects):
+        cmd += ["--confidences", objects]
+    run(cmd)
+    with open(os.path.join(pred_dir, "eval.json")) as f:
+        result = json.load(f)
+    # The evidence behind each object's confidence, for calibration.
+    if os.path.exists(objects):
+        with open(objects) as f:
+            evidence = {o["id"]: o.get("evidence") for o in json.load(f)["objects"]}
+        for o in result["diagnostics"]["objects"]:
+            o["evidence"] = evidence.get(o["id"])
+    return result
+
+
+def trajectory_ate(seq_dir, trajectory, target, log):
+    run([tool("panmap-eval"), "--traj", trajectory, "--gt-traj",
+         os.path.join(seq_dir, "gt", "trajectory_gt.txt"), "--json", target], log)
+    with open(target) as f:
+        return json.load(f)["trajectory"]["ate_m"]["rmse"]
+
+
+def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
+    """Maps one sequence (maps A and B as the variants need), exports every variant and
+    evaluates it. Returns {"results": {variant: eval}, "input_ate_m", "refined_ate_m", ...}."""
+    out = os.path.join(work, "runs", os.path.basename(seq_dir))
+    shutil.rmtree(out, ignore_errors=True)
+    os.makedirs(out)
+    log = os.path.join(out, "commands.log")
+    base = [tool("panmap-mapper"), "-q", "--voxel-size", str(voxel_m), "--threads", "1",
+            "--no-snapshots"]
+    extra = ["--config", config] if config else []
+    log_path = os.path.join(seq_dir, "sequence.lcmlog")
+    with open(os.path.join(seq_dir, "info.json")) as f:
+        info = json.load(f)
+    drifting = spec.poses != "gt"
+    results, ate = {}, {}
+    if spec.runs == "full":
+        # The full method as a user runs it: default tracking (refines drifting poses).
+        run(base + extra + ["--log", log_path, "--out", os.path.join(out, "A")], log)
+        results["full"] = evaluate(os.path.join(out, "A"), seq_dir)
+        if drifting:
+            ate["refined"] = trajectory_ate(seq_dir, os.path.join(out, "A", "trajectory.txt"),
+                                            os.path.join(out, "ate_refined.json"), log)
+    else:
+        wanted = [v for v in VARIANTS if variants is None or v[0] in variants]
+        if drifting:
+            refined = os.path.join(out, "A_refined")
+            run(base + extra + ["--tracking", "auto", "--log", log_path, "--out", refined], log)
+            results[REFINED] = evaluate(refined, seq_dir)
+            ate["refined"] = trajectory_ate(seq_dir, os.path.join(refined, "trajectory.txt"),
+                                            os.path.join(out, "ate_refined.json"), log)
+        fixed = base + extra + ["--tracking", "off", "--log", log_path]
+        if any(v[1] == "A" for v in wanted):
+            run(fixed + ["--out", os.path.join(out, "A")], log)
+        if any(v[1] == "B" for v in wanted):
+            run(fixed + ["--spatial-only", "--no-regularise", "--no-refine",
+                         "--out", os.path.join(out, "B")], log)
+        for variant, source, flags in wanted:
+            folder = os.path.join(out, variant.replace("/", "").replace(" ", "_")
+                                  .replace("&", "and").replace("+", "p"))
+            if source == "A" and not flags:
+                folder = os.path.join(out, "A")
+            elif source == "B" and flags:
+                folder = os.path.join(out, "B")
+            else:
+                run([tool("panmap-mapper"), "-q", "--no-snapshots", "--export-only", "--load",
+                     os.path.join(out, source, "map.panmap"), "--out", folder] + flags + extra,
+                    log)
+            results[variant] = evaluate(folder, seq_dir)
+    if drifting:
+        ate["input"] = trajectory_ate(seq_dir, os.path.join(seq_dir, "gt", "trajectory_input.txt"),
+                                      os.path.join(out, "ate_input.json"), log)
+    with open(os.path.join(out, "A" if os.path.exists(os.path.join(out, "A")) else "A_refined",
+                           "report.json")) as f:
+        report = json.load(f)
+    return {"results": results, "input_ate_m": info["measured"]["input_ate_rmse_m"],
+            "trajectory_ate_m": ate, "coverage": info["coverage"]["fraction_seen_from_3_views"],
+            "unannotated": info.get("unannotation", {}).get("fraction"),
+            "total_ms": report["timings"]["total"]["median_ms"]}
+
+
+def run_all(work, specs, voxel_m, jobs, keep_logs, config="", variants=None, label="suite"):
+    """Renders and maps every spec (jobs at a time). Returns {spec.name(): result}."""
+    def job(spec):
+        seq = render(work, spec)
+        out = map_sequence(work, seq, spec, voxel_m, config, variants)
+        if not keep_logs:
+            os.remove(os.path.join(seq, "sequence.lcmlog"))
+            os.rename(os.path.join(seq, "info.json"), os.path.join(seq, "info.json.done"))
+        full = out["results"].get("full") or out["results"].get(REFINED)
+        print("%s: %s: full mAP50 %.1f" % (label, spec.name(), 100 * (full["map50"] or 0)),
+              file=sys.stderr, flush=True)
+        return out
+    with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = {s.name(): pool.submit(job, s) for s in specs}
+        return {name: f.result() for name, f in futures.items()}
+
+
+# Sequences that choose defaults (tune_refinement.py, calibrate_confidence.py): other rooms
+# and other seeds than docs/RESULTS.md reports, never those.
+TUNING_SCANNET_SEEDS = [11, 12]
+TUNING_SCANNET_LIKE = [21, 22, 23]
+TUNING_ROOMS = [6, 7]
+
+
+def tuning_specs(scannet_dirs, poses=("gt", "slam"), frames_scannet=600, frames_like=600,
+                 frames_room=450):
+    """The tuning sequences: each real scene in its three annotation variants (seeds 11, 12),
+    ScanNet-like rooms 21-23 and box rooms 6, 7; m2f masks, the given poses; every variant
+    mapped so that the ablations can be re-exported."""
+    specs = []
+    for p in poses:
+        for d in scannet_dirs:
+            for annotation, _ in ANNOTATIONS:
+                for seed in TUNING_SCANNET_SEEDS:
+                    specs.append(Spec("scannet", d, seed, p, "m2f", annotation, "all",
+                                      frames_scannet))
+        for r in TUNING_SCANNET_LIKE:
+            specs.append(Spec("scannetlike", r, r, p, "m2f", "as generated", "all", frames_like))
+        for r in TUNING_ROOMS:
+            specs.append(Spec("room", r, r, p, "m2f", "annotated", "all", frames_room))
+    return specs
