@@ -1,213 +1,312 @@
 #!/usr/bin/env python3
-"""panmap's accuracy suite: seeded procedural rooms x {gt, slam} poses x {clean, m2f} masks x
-method variants (full, the paper's ablations, a Voxblox++-like baseline), scored with
-panmap-eval, written as docs/RESULTS.md in the layout of the paper's tables.
+"""panmap's accuracy suite: real ScanNet scene geometry (as annotated, and with a quarter of it
+left unannotated, masks painted there or empty), ScanNet-like procedural rooms, and the
+procedural box rooms; every method variant (full, the paper's ablations, a Voxblox++-like
+baseline), ground-truth and SLAM-like poses, m2f-like and clean masks, scored with panmap-eval
+and written as docs/RESULTS.md with the diagnostics that explain each score.
 
 Every number in docs/RESULTS.md comes from this script; rerun it to regenerate the file.
 Sequences are cached in the work folder (keyed by their parameters), maps are rebuilt.
 """
 import argparse
-import concurrent.futures
 import datetime
+import glob
 import json
 import os
-import platform
-import shutil
 import subprocess
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-BUILD = os.path.join(ROOT, "build")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import suite  # noqa: E402  (same folder)
+from suite import REFINED, VARIANTS, Spec, mean  # noqa: E402
 
-# Rooms whose numbers are reported. Rooms used to choose defaults (scripts/bench/tune_refinement.py)
-# are different seeds and never appear here.
+# Seeds whose numbers are reported. Tuning (tune_refinement.py, calibrate_confidence.py) uses
+# other seeds and other rooms, never these.
+REPORT_SEEDS = [1, 2]
+REPORT_SCANNET_LIKE = [31, 32, 33]
 REPORT_ROOMS = [3, 4, 5]
-POSES = ["gt", "slam"]
-MASKS = ["clean", "m2f"]
-# Variant -> (map, extra optimiser flags). Map A: semantically consistent super-points (III-B);
-# map B: spatial-only merging. Both run the same per-frame pipeline otherwise.
-VARIANTS = [
-    ("full", "A", []),
-    ("w/o III-B", "B", []),
-    ("w/o III-C", "A", ["--no-regularise"]),
-    ("w/o III-D", "A", ["--no-refine"]),
-    ("w/o III-C & III-D", "A", ["--no-regularise", "--no-refine"]),
-    ("Voxblox++-like", "B", ["--no-regularise", "--no-refine"]),
-]
-# Extra rows: the full method with pose refinement against the map (issue 8), run where the
-# poses drift; and a harder drift setting with the full method only.
-REFINED = "full + pose refinement"
-EXTRA_SETTINGS = [("slam-hard", "m2f")]
+DEFAULT_SCANNET = sorted(glob.glob(os.path.join(suite.ROOT, "..", "shared", "data", "scannet-gt",
+                                                "scene*")))
+ROOM_SETTINGS = [("gt", "clean"), ("gt", "m2f"), ("slam", "clean"), ("slam", "m2f")]
+ROOM_EXTRA = [("slam-hard", "m2f")]
 METRICS = [("mAP50", "map50", "pct"), ("mAP75", "map75", "pct"), ("N_TP50", "ntp50", "sum"),
            ("N_TP75", "ntp75", "sum"), ("PQ50", "pq50", "pct"), ("PQ75", "pq75", "pct"),
            ("IoU_LS", "iou_ls", "pct")]
+ABLATIONS = ["w/o III-B", "w/o III-C", "w/o III-D"]
 
 
-def run(cmd, log=None):
-    """Runs a command; raises with its output on failure."""
-    result = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    if log:
-        with open(log, "a") as f:
-            f.write("$ " + " ".join(cmd) + "\n" + result.stdout)
-    if result.returncode != 0:
-        raise RuntimeError("failed (%d): %s\n%s" % (result.returncode, " ".join(cmd),
-                                                    result.stdout[-2000:]))
-    return result.stdout
+def real_specs(dirs, seeds, frames):
+    specs = []
+    for d in dirs:
+        for annotation, _ in suite.ANNOTATIONS:
+            for seed in seeds:
+                specs.append(Spec("scannet", d, seed, "gt", "m2f", annotation, "all", frames))
+                specs.append(Spec("scannet", d, seed, "slam", "m2f", annotation, "tracked",
+                                  frames))
+                specs.append(Spec("scannet", d, seed, "gt", "clean", annotation, "full", frames))
+    return specs
 
 
-def tool(name):
-    return os.path.join(BUILD, name)
+def like_specs(rooms, frames):
+    specs = []
+    for r in rooms:
+        for annotation in ["as generated", "empty"]:
+            specs.append(Spec("scannetlike", r, r, "gt", "m2f", annotation, "all", frames))
+        specs.append(Spec("scannetlike", r, r, "slam", "m2f", "as generated", "tracked",
+                          frames))
+        specs.append(Spec("scannetlike", r, r, "gt", "clean", "as generated", "full", frames))
+    return specs
 
 
-def sequence(work, room, poses, masks, frames, rate_hz):
-    """Renders (or reuses) one sequence; returns its folder."""
-    name = "room%d_%s_%s_%df_%gHz" % (room, poses, masks, frames, rate_hz)
-    folder = os.path.join(work, "seq", name)
-    if os.path.exists(os.path.join(folder, "info.json")):
-        return folder
-    shutil.rmtree(folder, ignore_errors=True)
-    run([tool("panmap-synth"), "--room", str(room), "--seed", str(room), "--frames", str(frames),
-         "--rate-hz", str(rate_hz), "--masks", masks, "--poses", poses, "-q", "--out", folder])
-    return folder
+def room_specs(rooms, frames):
+    specs = []
+    for r in rooms:
+        for poses, masks in ROOM_SETTINGS:
+            specs.append(Spec("room", r, r, poses, masks, "annotated", "all", frames))
+        for poses, masks in ROOM_EXTRA:
+            specs.append(Spec("room", r, r, poses, masks, "annotated", "all", frames))
+    return specs
 
 
-def evaluate(pred_dir, seq_dir):
-    """Scores a mapper output folder against the sequence's ground truth."""
-    cmd = [tool("panmap-eval"), "--pred", os.path.join(pred_dir, "mesh_instance.ply"),
-           "--gt", os.path.join(seq_dir, "gt", "mesh.ply"),
-           "--json", os.path.join(pred_dir, "eval.json")]
-    objects = os.path.join(pred_dir, "objects.json")
-    if os.path.exists(objects):
-        cmd += ["--confidences", objects]
-    run(cmd)
-    with open(os.path.join(pred_dir, "eval.json")) as f:
-        return json.load(f)
+def pct(v):
+    return "-" if v is None or v != v else "%.1f" % (100 * v)
 
 
-def map_sequence(work, seq_dir, voxel_m, extra_mapper_flags, config):
-    """Maps one sequence twice (A, B), exports every variant, evaluates them."""
-    name = os.path.basename(seq_dir)
-    out = os.path.join(work, "runs", name)
-    shutil.rmtree(out, ignore_errors=True)
-    os.makedirs(out)
-    log = os.path.join(out, "commands.log")
-    base = [tool("panmap-mapper"), "-q", "--voxel-size", str(voxel_m), "--threads", "1",
-            "--no-snapshots", "--tracking", "off"] + extra_mapper_flags
-    if config:
-        base += ["--config", config]
-    log_path = os.path.join(seq_dir, "sequence.lcmlog")
-    with open(os.path.join(seq_dir, "info.json")) as f:
-        info = json.load(f)
-    drifting = info["poses"]["preset"] != "gt"
-    only_full = (info["poses"]["preset"], info["masks"]["preset"]) in EXTRA_SETTINGS
-    results = {}
-    trajectory = {}
-    if drifting:
-        refined = os.path.join(out, "A_refined")
-        run(base[:-2] + ["--tracking", "auto", "--log", log_path, "--out", refined], log)
-        results[REFINED] = evaluate(refined, seq_dir)
-        for name, traj in (("input", os.path.join(seq_dir, "gt", "trajectory_input.txt")),
-                           ("refined", os.path.join(refined, "trajectory.txt"))):
-            target = os.path.join(out, "ate_%s.json" % name)
-            run([tool("panmap-eval"), "--traj", traj, "--gt-traj",
-                 os.path.join(seq_dir, "gt", "trajectory_gt.txt"), "--json", target], log)
-            with open(target) as f:
-                trajectory[name] = json.load(f)["trajectory"]["ate_m"]["rmse"]
-    run(base + ["--log", log_path, "--out", os.path.join(out, "A")], log)
-    if not only_full:
-        run(base + ["--log", log_path, "--spatial-only", "--no-regularise", "--no-refine",
-                    "--out", os.path.join(out, "B")], log)
-    for variant, source, flags in VARIANTS:
-        if only_full and variant != "full":
-            continue
-        folder = os.path.join(out, variant.replace("/", "").replace(" ", "_").replace("&", "and"))
-        if source == "A" and not flags:
-            folder = os.path.join(out, "A")
-        elif source == "B" and flags:
-            folder = os.path.join(out, "B")
-        else:
-            cmd = [tool("panmap-mapper"), "-q", "--no-snapshots", "--export-only",
-                   "--load", os.path.join(out, source, "map.panmap"), "--out", folder] + flags
-            if config:
-                cmd += ["--config", config]
-            run(cmd, log)
-        results[variant] = evaluate(folder, seq_dir)
-    with open(os.path.join(out, "A", "report.json")) as f:
-        report = json.load(f)
-    return {"results": results, "input_ate_m": info["measured"]["input_ate_rmse_m"],
-            "trajectory_ate_m": trajectory,
-            "coverage": info["coverage"]["fraction_seen_from_3_views"],
-            "total_ms": report["timings"]["total"]["median_ms"]}
+class Rows:
+    """Results of one suite (real scenes or ScanNet-like rooms), averaged over seeds per
+    (scene, annotation)."""
+
+    def __init__(self, specs, results):
+        self.keys = []  # (scene, annotation) in spec order
+        self.by = {}    # (scene, annotation, poses, masks) -> [result, ...] over seeds
+        for s in specs:
+            key = (s.scene(), s.annotation)
+            if key not in self.keys:
+                self.keys.append(key)
+            self.by.setdefault(key + (s.poses, s.masks), []).append(results[s.name()])
+
+    def runs(self, key, poses="gt", masks="m2f", variant="full"):
+        return [r["results"][variant] for r in self.by.get(key + (poses, masks), [])
+                if variant in r["results"]]
+
+    def metric(self, key, name, **kw):
+        return mean([e[name] for e in self.runs(key, **kw)])
+
+    def diag(self, key, name, **kw):
+        return mean([e["diagnostics"][name] for e in self.runs(key, **kw)])
+
+    def all_mean(self, fn):
+        return mean([fn(k) for k in self.keys])
 
 
-def job(args, room, poses, masks):
-    start = time.time()
-    seq = sequence(args.work, room, poses, masks, args.frames, args.rate_hz)
-    out = map_sequence(args.work, seq, args.voxel_size, [], args.config)
-    if not args.keep_logs:
-        os.remove(os.path.join(seq, "sequence.lcmlog"))
-        os.rename(os.path.join(seq, "info.json"), os.path.join(seq, "info.json.done"))
-    print("accuracy: room %d, %s poses, %s masks: full mAP50 %.1f (%.0f s)" %
-          (room, poses, masks, 100 * (out["results"]["full"]["map50"] or 0), time.time() - start),
-          file=sys.stderr, flush=True)
-    return out
+def method_table(rows, poses="gt"):
+    heads = ["full"] + [v for v, _, _ in VARIANTS if v != "full"]
+    extra = ["full, `slam` poses", "full, clean masks"] if poses == "gt" else []
+    lines = ["| scene | annotation | " + " | ".join(heads + extra) + " |",
+             "|---|---|" + "---:|" * (len(heads) + len(extra))]
+
+    def cells(f):
+        return [f(v) for v in heads] + ([f("slam"), f("clean")] if extra else [])
+
+    def value(key, v):
+        if v == "slam":
+            return rows.metric(key, "map50", poses="slam")
+        if v == "clean":
+            return rows.metric(key, "map50", masks="clean")
+        return rows.metric(key, "map50", poses=poses, variant=v)
+    for key in rows.keys:
+        lines.append("| %s | %s | %s |" % (key[0], key[1], " | ".join(
+            pct(x) for x in cells(lambda v: value(key, v)))))
+    lines.append("| **mean** | | %s |" % " | ".join(
+        "**%s**" % pct(x) for x in cells(lambda v: rows.all_mean(lambda k: value(k, v)))))
+    return "\n".join(lines)
 
 
-def mean(values):
-    values = [v for v in values if v is not None]
-    return sum(values) / len(values) if values else float("nan")
+def quality_table(rows):
+    lines = ["| scene | annotation | mAP75 | PQ50 | mIoU | IoU_LS | wall IoU | floor IoU | "
+             "ceiling IoU |", "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for key in rows.keys:
+        lines.append("| %s | %s | %s |" % (key[0], key[1], " | ".join(pct(x) for x in [
+            rows.metric(key, "map75"), rows.metric(key, "pq50"), rows.metric(key, "miou"),
+            rows.metric(key, "iou_ls"), rows.diag(key, "wall_iou"), rows.diag(key, "floor_iou"),
+            rows.diag(key, "ceiling_iou")])))
+    return "\n".join(lines)
 
 
-def table(rows_by_variant, rooms):
+def largest(rows, key):
+    """The largest super-point of the first seed's run: size and class mix."""
+    runs = rows.runs(key)
+    if not runs:
+        return "-"
+    lg = runs[0]["diagnostics"]["largest_superpoint"]
+    mix = ", ".join("%s %.0f %%" % (m["name"], 100 * m["share"]) for m in lg["class_mix"][:3])
+    return "%d vertices: %s" % (lg["vertices"], mix)
+
+
+def diagnostics_table(rows):
+    lines = ["| scene | annotation | purity | bridging super-points | worst 2nd class | "
+             "largest super-point (seed 1) | objects / GT things | confidence >= 0.5: "
+             "precision | GT things covered |", "|---|---|---:|---:|---:|---|---:|---:|---:|"]
+    for key in rows.keys:
+        runs = rows.runs(key)
+        objects = mean([e["diagnostics"]["num_objects"] for e in runs])
+        things = mean([e["diagnostics"]["num_gt_things"] for e in runs])
+        lines.append("| %s | %s | %.3f | %.1f | %.2f | %s | %.0f / %.0f | %s | %s |" % (
+            key[0], key[1], rows.diag(key, "superpoint_purity"),
+            rows.diag(key, "num_bridging_superpoints"),
+            rows.diag(key, "worst_second_class_share"), largest(rows, key), objects, things,
+            pct(rows.diag(key, "confident_precision")), pct(rows.diag(key, "confident_recall"))))
+    return "\n".join(lines)
+
+
+def acceptance(rows):
+    """Issue 19's acceptance lines per (scene, annotation) and as the mean."""
+    points = lambda v: "%.1f" % (100 * v)  # noqa: E731
+    plain = lambda v: "%.2f" % v  # noqa: E731
+    checks = [
+        ("full >= 65 mAP50", lambda k: rows.metric(k, "map50"), points, lambda v: v >= 0.65),
+        ("full - Voxblox++-like >= 25", lambda k: rows.metric(k, "map50") -
+         rows.metric(k, "map50", variant="Voxblox++-like"), points, lambda v: v >= 0.25),
+        ("`slam` - GT poses within 2", lambda k: rows.metric(k, "map50", poses="slam") -
+         rows.metric(k, "map50"), points, lambda v: v >= -0.02),
+    ]
+    for ab in ABLATIONS:
+        checks.append(("full - %s >= 1.5" % ab, lambda k, ab=ab: rows.metric(k, "map50") -
+                       rows.metric(k, "map50", variant=ab), points, lambda v: v >= 0.015))
+    for ab in ABLATIONS:
+        checks.append(("`slam` poses: full - %s >= 1.5" % ab, lambda k, ab=ab: rows.metric(
+            k, "map50", poses="slam") - rows.metric(k, "map50", poses="slam", variant=ab),
+            points, lambda v: v >= 0.015))
+    checks += [
+        ("super-point purity >= 0.9", lambda k: rows.diag(k, "superpoint_purity"), plain,
+         lambda v: v >= 0.9),
+        ("super-points > 10 % of two classes: none", lambda k: rows.diag(
+            k, "num_bridging_superpoints"), plain, lambda v: v == 0),
+        ("objects / GT things <= 2", lambda k: rows.diag(k, "objects_per_gt_instance"), plain,
+         lambda v: v <= 2.0),
+        ("confidence >= 0.5: >= 70 % match", lambda k: rows.diag(k, "confident_precision"),
+         points, lambda v: v >= 0.7),
+        ("confidence >= 0.5: cover >= 50 % of GT things",
+         lambda k: rows.diag(k, "confident_recall"), points, lambda v: v >= 0.5),
+        ("clean masks >= 75 mAP50", lambda k: rows.metric(k, "map50", masks="clean"), points,
+         lambda v: v >= 0.75),
+    ]
+    lines = ["| check | " + " | ".join("%s, %s" % k for k in rows.keys) + " | mean |",
+             "|---|" + "---:|" * (len(rows.keys) + 1)]
+    for name, value, fmt, ok in checks:
+        cells = []
+        for v in [value(k) for k in rows.keys] + [rows.all_mean(value)]:
+            cells.append("-" if v != v else "%s %s" % (fmt(v), "yes" if ok(v) else "**no**"))
+        lines.append("| %s | %s |" % (name, " | ".join(cells)))
+    return "\n".join(lines)
+
+
+def reliability(rows_list):
+    """Pooled over the full method's runs (GT poses, m2f masks) of the given suites."""
+    bins = {}
+    for rows in rows_list:
+        for key in rows.keys:
+            for e in rows.runs(key):
+                for b in e["diagnostics"]["reliability"]:
+                    acc = bins.setdefault((b["low"], b["high"]), [0, 0, 0.0])
+                    acc[0] += b["count"]
+                    acc[1] += b["matched"]
+                    acc[2] += b["mean_confidence"] * b["count"]
+    lines = ["| confidence | objects | mean confidence | share matching a GT object (IoU > 0.5) |",
+             "|---|---:|---:|---:|"]
+    for (low, high), (count, matched, conf) in sorted(bins.items()):
+        lines.append("| %.1f-%.1f | %d | %s | %s |" % (
+            low, high, count, "%.2f" % (conf / count) if count else "-",
+            "%.2f" % (matched / count) if count else "-"))
+    return "\n".join(lines)
+
+
+def room_table(results, specs, poses, masks):
+    keyed = [results[s.name()] for s in specs if (s.poses, s.masks) == (poses, masks)]
     lines = ["| Method | " + " | ".join(m[0] for m in METRICS) + " |",
              "|---|" + "---:|" * len(METRICS)]
     for variant in [v for v, _, _ in VARIANTS] + [REFINED]:
-        if variant not in rows_by_variant:
+        if not all(variant in k["results"] for k in keyed):
             continue
         cells = []
         for _, key, kind in METRICS:
-            values = [rows_by_variant[variant][r][key] for r in rooms]
-            if kind == "sum":
-                cells.append("%d" % sum(v or 0 for v in values))
-            else:
-                cells.append("%.1f" % (100 * mean(values)))
+            values = [k["results"][variant][key] for k in keyed]
+            cells.append("%d" % sum(v or 0 for v in values) if kind == "sum" else
+                         "%.1f" % (100 * mean(values)))
         lines.append("| %s | %s |" % (variant, " | ".join(cells)))
     return "\n".join(lines)
 
 
+def room_section(results, specs):
+    md = []
+    titles = {"gt": "Ground-truth poses", "slam": "SLAM-like (`slam`) poses",
+              "slam-hard": "Harder drift (`slam-hard`) poses"}
+    for poses, masks in ROOM_SETTINGS + ROOM_EXTRA:
+        keyed = [(s, results[s.name()]) for s in specs if (s.poses, s.masks) == (poses, masks)]
+        if not keyed:
+            continue
+        md += ["### %s, %s masks" % (titles[poses], masks), ""]
+        if poses != "gt":
+            md += ["ATE (RMSE after rigid alignment, mean over rooms): input %.2f cm, refined "
+                   "against the map %.2f cm (%s)." % (
+                       100 * mean([k["trajectory_ate_m"]["input"] for _, k in keyed]),
+                       100 * mean([k["trajectory_ate_m"]["refined"] for _, k in keyed]),
+                       ", ".join("room %d: %.2f -> %.2f" % (
+                           s.source, 100 * k["trajectory_ate_m"]["input"],
+                           100 * k["trajectory_ate_m"]["refined"]) for s, k in keyed)), ""]
+        md += [room_table(results, specs, poses, masks), ""]
+    return md
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--work", default=os.path.join(BUILD, "accuracy"),
-                        help="folder for sequences and maps (default build/accuracy)")
-    parser.add_argument("--out", default=os.path.join(ROOT, "docs", "RESULTS.md"))
-    parser.add_argument("--rooms", default=",".join(map(str, REPORT_ROOMS)))
-    parser.add_argument("--frames", type=int, default=450)
+    parser.add_argument("--scannet", nargs="*", default=None, metavar="DIR",
+                        help="ScanNet scene folders (default: every ../shared/data/scannet-gt/"
+                             "scene*); give none to skip real scenes")
+    parser.add_argument("--scannet-like", default=",".join(map(str, REPORT_SCANNET_LIKE)),
+                        help="ScanNet-like procedural room seeds ('' to skip)")
+    parser.add_argument("--rooms", default=",".join(map(str, REPORT_ROOMS)),
+                        help="procedural box room seeds ('' to skip)")
+    parser.add_argument("--seeds", default=",".join(map(str, REPORT_SEEDS)),
+                        help="sequence seeds of each real scene")
+    parser.add_argument("--frames-scannet", type=int, default=600)
+    parser.add_argument("--frames-like", type=int, default=600)
+    parser.add_argument("--frames-room", type=int, default=450)
     parser.add_argument("--rate-hz", type=float, default=5.0)
     parser.add_argument("--voxel-size", type=float, default=0.02)
     parser.add_argument("--config", default="", help="YAML config for every mapper run")
+    parser.add_argument("--work", default=os.path.join(suite.BUILD, "accuracy"),
+                        help="folder for sequences and maps (default build/accuracy)")
+    parser.add_argument("--out", default=os.path.join(suite.ROOT, "docs", "RESULTS.md"))
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 2)
     parser.add_argument("--keep-logs", action="store_true",
                         help="keep the rendered logs (150 MB each) for reruns")
     args = parser.parse_args()
-    rooms = [int(r) for r in args.rooms.split(",")]
+    dirs = [os.path.abspath(d) for d in (DEFAULT_SCANNET if args.scannet is None
+                                         else args.scannet)]
+    for d in dirs:
+        if not os.path.isdir(d):
+            sys.exit("accuracy: %s is not a folder" % d)
+    seeds = [int(s) for s in args.seeds.split(",") if s]
+    like = [int(s) for s in args.scannet_like.split(",") if s]
+    rooms = [int(s) for s in args.rooms.split(",") if s]
     if args.config:
         args.config = os.path.abspath(args.config)
     start = time.time()
-    settings = [(p, m) for p in POSES for m in MASKS]
-    all_settings = settings + EXTRA_SETTINGS
-    futures = {}
-    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        for room in rooms:
-            for poses, masks in all_settings:
-                futures[(room, poses, masks)] = pool.submit(job, args, room, poses, masks)
-        results = {key: f.result() for key, f in futures.items()}
+    real = real_specs(dirs, seeds, args.frames_scannet)
+    likes = like_specs(like, args.frames_like)
+    boxes = room_specs(rooms, args.frames_room)
+    results = suite.run_all(args.work, real + likes + boxes, args.voxel_size, args.jobs,
+                            args.keep_logs, args.config, label="accuracy")
     minutes = (time.time() - start) / 60
+    with open(os.path.join(args.work, "results.json"), "w") as f:
+        json.dump(results, f, indent=1)
 
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
+    commit = subprocess.run(["git", "-C", suite.ROOT, "rev-parse", "--short", "HEAD"],
                             stdout=subprocess.PIPE, text=True).stdout.strip() or "unknown"
-    dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
-                           stdout=subprocess.PIPE, text=True).stdout.strip()
+    dirty = subprocess.run(["git", "-C", suite.ROOT, "status", "--porcelain",
+                            "--untracked-files=no"], stdout=subprocess.PIPE, text=True).stdout
     cpu = "unknown"
     with open("/proc/cpuinfo") as f:
         for line in f:
@@ -217,73 +316,66 @@ def main():
     md = ["# Accuracy", "",
           "Generated by `scripts/bench/accuracy.sh` (do not edit by hand) on %s, commit `%s`%s, "
           "%s, %d cores, in %.1f minutes." % (datetime.date.today().isoformat(), commit,
-                                               " (with local changes)" if dirty else "", cpu,
-                                               os.cpu_count(), minutes), "",
+                                               " (with local changes)" if dirty.strip() else "",
+                                               cpu, os.cpu_count(), minutes), "",
           "Command: `scripts/bench/accuracy.sh %s`" % " ".join(sys.argv[1:]), "",
-          "Sequences: `panmap-synth` procedural rooms %s (room seed = sequence seed), %d frames "
-          "at %g Hz (a %.0f s survey), 640x480 with depth noise; maps at %g cm voxels. "
           "Metrics from `panmap-eval` (ScanNet's `evaluate_semantic_instance` matching, the 18 "
-          "ScanNet classes, label transfer within 5 cm): mAP and PQ are class averages over "
-          "the rooms' mean, N_TP is summed over classes and rooms, all in percent except N_TP. "
-          "Rooms used to choose defaults (docs/TUNING.md) are other seeds." %
-          (", ".join(map(str, rooms)), args.frames, args.rate_hz, args.frames / args.rate_hz,
-           100 * args.voxel_size), "",
+          "ScanNet classes, label transfer within 5 cm), in percent: mAP and PQ are class "
+          "averages, then means over seeds and scenes; diagnostics (super-point purity, "
+          "bridging super-points, objects per GT thing instance, confidence precision and "
+          "coverage) are defined in `include/panmap/eval/diagnostics.h`. Maps at %g cm voxels. "
+          "Seeds, rooms and scenes used to choose defaults (docs/TUNING.md) are never the ones "
+          "reported here." % (100 * args.voxel_size), "",
           "Variants: **full** = semantically consistent super-points (III-B), graph "
-          "regularisation (III-C) and instance refinement (III-D); **w/o III-B** = spatial-only "
-          "super-point merging; **w/o III-C** = no semantic regularisation; **w/o III-D** = no "
-          "instance refinement; **Voxblox++-like** = spatial-only merging and frame-count labels, "
-          "no graph optimisation. All of these map the poses as given (`--tracking off`). "
-          "**%s** (not in the paper) = the full method refining each SLAM pose against the map "
-          "before integrating it (`--tracking auto`, the default for poses flagged as SLAM)." %
-          REFINED, ""]
-    for poses, masks in all_settings:
-        keyed = [results[(r, poses, masks)] for r in rooms]
-        rows = {v: {r: results[(r, poses, masks)]["results"][v] for r in rooms}
-                for v in keyed[0]["results"]}
-        title = {"gt": "Ground-truth poses", "slam": "SLAM-like (`slam`) poses",
-                 "slam-hard": "Harder drift (`slam-hard`) poses"}[poses]
-        md += ["## %s, %s masks" % (title, masks), ""]
-        if poses != "gt":
-            md += ["ATE (RMSE after rigid alignment, mean over rooms): input %.2f cm, refined "
-                   "against the map %.2f cm (%s)." % (
-                       100 * mean([k["trajectory_ate_m"]["input"] for k in keyed]),
-                       100 * mean([k["trajectory_ate_m"]["refined"] for k in keyed]),
-                       ", ".join("room %d: %.2f -> %.2f" % (
-                           r, 100 * k["trajectory_ate_m"]["input"],
-                           100 * k["trajectory_ate_m"]["refined"]) for r, k in zip(rooms, keyed))),
-                   ""]
-        md += [table(rows, rooms), ""]
-    # Drift: how much of the gap to ground-truth poses the refinement recovers.
-    md += ["## Pose refinement: the gap to ground-truth poses", "",
-           "mAP50 of the full method (m2f masks, mean over rooms); recovered = (refined - "
-           "drifting) / (ground truth - drifting).", "",
-           "| Poses | ground truth | drifting, as given | refined against the map | recovered |",
-           "|---|---:|---:|---:|---:|"]
-    gt_map = mean([results[(r, "gt", "m2f")]["results"]["full"]["map50"] for r in rooms])
-    for poses in ["slam", "slam-hard"]:
-        raw = mean([results[(r, poses, "m2f")]["results"]["full"]["map50"] for r in rooms])
-        ref = mean([results[(r, poses, "m2f")]["results"][REFINED]["map50"] for r in rooms])
-        gap = gt_map - raw
-        md.append("| %s | %.1f | %.1f | %.1f | %s |" % (
-            poses, 100 * gt_map, 100 * raw, 100 * ref,
-            "%.0f %%" % (100 * (ref - raw) / gap) if gap > 1e-9 else "-"))
-    md.append("")
-    md += ["## Per room (full method, mAP50 / PQ50)", "",
-           "| Room | " + " | ".join("%s, %s" % s for s in settings) + " | coverage | ms/frame |",
-           "|---|" + "---:|" * (len(settings) + 2)]
-    for r in rooms:
-        cells = ["%.1f / %.1f" % (100 * (results[(r, p, m)]["results"]["full"]["map50"] or 0),
-                                  100 * (results[(r, p, m)]["results"]["full"]["pq50"] or 0))
-                 for p, m in settings]
-        first = results[(r,) + settings[0]]
-        md.append("| %d | %s | %.2f | %.1f |" % (r, " | ".join(cells), first["coverage"],
-                                                  first["total_ms"]))
-    md.append("")
+          "regularisation (III-C), instance refinement (III-D), objects (fragments folded, "
+          "calibrated confidences); **w/o III-B** = spatial-only super-point merging; **w/o "
+          "III-C** = no semantic regularisation; **w/o III-D** = no instance refinement; "
+          "**Voxblox++-like** = spatial-only merging and frame-count labels, no graph "
+          "optimisation (same object output stage). These map the poses as given "
+          "(`--tracking off`); **full, `slam` poses** maps SLAM-like poses with the default "
+          "tracking (`auto`: each pose refined against the map).", ""]
+    for title, specs, intro in [
+            ("Real ScanNet scene geometry", real,
+             "`panmap-synth --scannet DIR` renders the scene's reconstructed mesh along a "
+             "survey (%d frames at %g Hz, seeds %s): depth noise, `m2f` masks, SLAM drift as "
+             "docs/SIMULATION.md describes. Each scene as annotated, and with 25 %% of its "
+             "vertices left unannotated (`--unannotate 0.25`: whole objects and clutter "
+             "patches), the simulated network painting those surfaces (`painted`) or leaving "
+             "them without a mask (`empty`)." % (args.frames_scannet, args.rate_hz,
+                                                  ", ".join(map(str, seeds)))),
+            ("ScanNet-like procedural rooms", likes,
+             "`panmap-synth --room S --room-style scannet --laps 2` (rooms %s, %d frames at "
+             "%g Hz): 30-60 instances of 24-27 classes, small objects on furniture, clutter "
+             "touching furniture and walls, unannotated clutter (class 0), a survey that "
+             "passes every area twice. `empty`: no mask on the unannotated clutter." % (
+                 ", ".join(map(str, like)), args.frames_like, args.rate_hz))]:
+        if not specs:
+            continue
+        rows = Rows(specs, results)
+        md += ["## %s" % title, "", intro, "",
+               "### mAP50 per method (ground-truth poses, `m2f` masks unless said)", "",
+               method_table(rows), "",
+               "### mAP50 per method (`slam` poses, each variant with the default tracking)", "",
+               method_table(rows, "slam"), "", "### Quality of the full method", "",
+               quality_table(rows), "", "### Diagnostics of the full method", "",
+               diagnostics_table(rows), "", "### Acceptance (issue 19)", "", acceptance(rows), ""]
+    suites = [Rows(s, results) for s in (real, likes) if s]
+    if suites:
+        md += ["## Confidence reliability", "",
+               "Objects of the full method (ground-truth poses, `m2f` masks) over every real "
+               "scene and ScanNet-like room above, by reported confidence; objects lying mostly "
+               "on unannotated ground truth cannot be checked and are left out.", "",
+               reliability(suites), ""]
+    if boxes:
+        md += ["## Procedural box rooms", "",
+               "`panmap-synth` box rooms %s (room seed = sequence seed), %d frames at %g Hz: "
+               "the suite before real geometry; all variants map the poses as given, **%s** "
+               "refines SLAM poses against the map." % (
+                   ", ".join(map(str, rooms)), args.frames_room, args.rate_hz, REFINED), ""]
+        md += room_section(results, boxes)
     os.makedirs(os.path.dirname(args.out), exist_ok=True)
     with open(args.out, "w") as f:
         f.write("\n".join(md))
-    with open(os.path.join(args.work, "results.json"), "w") as f:
-        json.dump({"%d_%s_%s" % k: v for k, v in results.items()}, f, indent=1)
     print("accuracy: wrote %s in %.1f minutes" % (args.out, minutes), file=sys.stderr)
 
 

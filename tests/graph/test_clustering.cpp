@@ -54,7 +54,9 @@ std::vector<int32_t> classesOf(const SuperpointGraph& g) {
 
 TEST(InstanceClustering, SplitsTouchingChairsAndKeepsPartsTogether) {
   const SuperpointGraph g = twoChairs();
-  OptimiserConfig config;
+  OptimiserConfig config;  // the hand computation below uses these thresholds, not defaults
+  config.join_affinity = 0.5;
+  config.min_coverage = 0.1;
   const internal::InstanceLabels out = internal::clusterInstances(g, classesOf(g), config);
   // Joins, best affinity first (ties: larger P_eps, then smaller ids): 4-5 (1.0, 75), then
   // 1-3 (1.0, 60); {4, 5} and 6 now share 25 + 5 = 30 against 1-3's 25 with 6: 6 joins B.
@@ -77,6 +79,7 @@ TEST(InstanceClustering, AFewSharedMasksAmongManyViewsJoinNothing) {
   g.vertices = {vertex(1, 100, 3), vertex(2, 100, 4)};
   g.edges = {edge(1, 2, 5, 0)};
   OptimiserConfig config;
+  config.min_coverage = 0.1;
   EXPECT_EQ(internal::clusterInstances(g, {5, 5}, config).instance,
             (std::vector<int32_t>{3, 4}));
   g.edges = {edge(1, 2, 20, 0)};

@@ -11,7 +11,7 @@ namespace panmap {
 struct OptimiserConfig {
   bool regularise = true;  ///< III-C semantic regularisation (off: argmax of the scores)
   bool refine = true;      ///< III-D instance refinement (off: initial instances)
-  double K_C = 15.0;       ///< pairwise weight (Eq. 9)
+  double K_C = 30.0;       ///< pairwise weight (Eq. 9; docs/TUNING.md)
   double theta = 0.5;      ///< pairwise bandwidth (Eq. 9)
   /// Discount Eq. 9's co-observation sum_C P_eps^C by P_eps / (P_eps + P_apart): how often the
   /// two super-points were under one mask rather than two (not in the paper).
@@ -38,10 +38,11 @@ struct OptimiserConfig {
   /// (internal/instance_clustering.h), or the paper's rules with the thresholds above.
   enum class Refinement : int8_t { kClustering = 0, kPaperRules = 1 };
   Refinement refinement = Refinement::kClustering;
-  /// Clustering: clusters join when P_eps / (P_eps + P_sep) between them reaches this.
-  double join_affinity = 0.5;
+  /// Clustering: clusters join when P_eps / (P_eps + P_sep) between them reaches this
+  /// (chosen with min_coverage and K_C by scripts/bench/tune_refinement.py, docs/TUNING.md).
+  double join_affinity = 0.6;
   /// Clustering: and P_eps between them reaches this share of the smaller one's P_nu.
-  double min_coverage = 0.1;
+  double min_coverage = 0.05;
   /// What is reported as an object (after III-D): fragments are folded into the instance of
   /// their class they are most strongly linked to, or left out and counted; every object gets
   /// a calibrated confidence.
