@@ -143,6 +143,14 @@ def trajectory_ate(seq_dir, trajectory, target, log):
         return json.load(f)["trajectory"]["ate_m"]["rmse"]
 
 
+def drop_map(folder):
+    """Removes an exported map file (the source map it was loaded from stays): re-exports
+    of every variant of every sequence would otherwise fill tens of GB."""
+    path = os.path.join(folder, "map.panmap")
+    if os.path.exists(path):
+        os.remove(path)
+
+
 def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
     """Maps one sequence (maps A and B as the variants need), exports every variant and
     evaluates it. Returns {"results": {variant: eval}, "input_ate_m", "refined_ate_m", ...}."""
@@ -195,6 +203,8 @@ def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
                      os.path.join(out, source, "map.panmap"), "--out", folder] + flags + extra,
                     log)
             results[variant] = evaluate(folder, seq_dir)
+            if folder not in (os.path.join(out, "A"), os.path.join(out, "B")):
+                drop_map(folder)
     if drifting:
         ate["input"] = trajectory_ate(seq_dir, os.path.join(seq_dir, "gt", "trajectory_input.txt"),
                                       os.path.join(out, "ate_input.json"), log)

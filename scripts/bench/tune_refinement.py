@@ -63,6 +63,7 @@ def main():
             suite.run([suite.tool("panmap-mapper"), "-q", "--no-snapshots", "--export-only",
                        "--load", map_file, "--config", cfg, "--out", folder])
             out[name] = suite.evaluate(folder, seq)
+            suite.drop_map(folder)
         return out
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         scores = list(pool.map(lambda it: score(*it), enumerate(grid)))

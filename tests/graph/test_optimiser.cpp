@@ -19,7 +19,8 @@ namespace {
 // starting thresholds theta_D 0.1, theta_O 0.1, theta_L 0.5 (tests/graph/test_clustering.cpp
 // pins the clustering that is the default).
 OptimiserConfig handConfig() {
-  OptimiserConfig config;
+  OptimiserConfig config;  // the paper's weights, which the hand computations below use
+  config.K_C = 15.0;
   config.refinement = OptimiserConfig::Refinement::kPaperRules;
   config.default_thresholds = {0.1, 0.1, 0.5};
   return config;
