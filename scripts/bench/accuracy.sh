@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The accuracy suite: renders real ScanNet scene geometry, ScanNet-like rooms and box rooms,
-# maps them with every method variant, scores them and regenerates docs/RESULTS.md (about an
-# hour on 2 cores with the one shipped scene). Options: see --help.
+# maps them with every method variant, scores them and regenerates docs/RESULTS.md (about
+# 40 minutes on 2 cores with the one shipped scene). Options: see --help.
 #   scripts/bench/accuracy.sh [--scannet DIR...] [--seeds 1,2] [--scannet-like 31,32,33]
-#                             [--rooms 3,4,5] [--jobs N] [--keep-logs]
+#                             [--rooms 3,4,5] [--jobs N] [--keep-logs] [--report-only]
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 [ -x build/panmap-mapper ] || scripts/setup.sh --skip-network
