@@ -58,7 +58,7 @@ def tool(name):
 
 
 def mean(values):
-    values = [v for v in values if v is not None]
+    values = [v for v in values if v is not None and v == v]  # missing runs: None or NaN
     return sum(values) / len(values) if values else float("nan")
 
 
