@@ -7,9 +7,7 @@ support log2(support) + share class_share)) to those outcomes. Writes docs/CALIB
 the fit and the reliability of the old and new weights on the tuning objects; the values it
 prints are the defaults in include/panmap/graph/optimiser.h.
 """
-import argparse
 import datetime
-import glob
 import math
 import os
 import sys
@@ -91,18 +89,7 @@ def log_loss(rows, w):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--scannet", nargs="*", default=None, metavar="DIR",
-                        help="ScanNet scene folders (default: every ../shared/data/scannet-gt/"
-                             "scene*)")
-    parser.add_argument("--work", default=os.path.join(suite.BUILD, "tuning"))
-    parser.add_argument("--out", default=os.path.join(suite.ROOT, "docs", "CALIBRATION.md"))
-    parser.add_argument("--voxel-size", type=float, default=0.02)
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 2)
-    parser.add_argument("--keep-logs", action="store_true")
-    args = parser.parse_args()
-    dirs = [os.path.abspath(d) for d in (args.scannet if args.scannet is not None else sorted(
-        glob.glob(os.path.join(suite.ROOT, "..", "shared", "data", "scannet-gt", "scene*"))))]
+    args, dirs = suite.tuning_args(__doc__.split("\n\n")[0], "CALIBRATION.md")
     start = time.time()
     # The full method as a user runs it: ground-truth poses, and SLAM poses refined by default.
     specs = []

@@ -9,7 +9,9 @@ Three kinds of scenes:
   scannetlike a ScanNet-like procedural room (--room-style scannet, two laps: revisits);
   room        a procedural box room (the suite before issue 19).
 """
+import argparse
 import concurrent.futures
+import glob
 import json
 import os
 import shutil
@@ -232,6 +234,26 @@ def run_all(work, specs, voxel_m, jobs, keep_logs, config="", variants=None, lab
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
         futures = {s.name(): pool.submit(job, s) for s in specs}
         return {name: f.result() for name, f in futures.items()}
+
+
+def tuning_args(description, out_name):
+    """Parses the options the tuning scripts share; returns (args, ScanNet scene folders)."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--scannet", nargs="*", default=None, metavar="DIR",
+                        help="ScanNet scene folders (default: every ../shared/data/scannet-gt/"
+                             "scene*)")
+    parser.add_argument("--work", default=os.path.join(BUILD, "tuning"))
+    parser.add_argument("--out", default=os.path.join(ROOT, "docs", out_name))
+    parser.add_argument("--voxel-size", type=float, default=0.02)
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 2)
+    parser.add_argument("--keep-logs", action="store_true")
+    args = parser.parse_args()
+    dirs = [os.path.abspath(d) for d in (args.scannet if args.scannet is not None else sorted(
+        glob.glob(os.path.join(ROOT, "..", "shared", "data", "scannet-gt", "scene*"))))]
+    for d in dirs:
+        if not os.path.isdir(d):
+            sys.exit("%s: %s is not a folder" % (os.path.basename(sys.argv[0]), d))
+    return args, dirs
 
 
 # Sequences that choose defaults (tune_refinement.py, calibrate_confidence.py): other rooms

@@ -5,10 +5,8 @@ rooms are held out) once with the full method, re-runs only the final optimisati
 point of a grid (panmap-mapper --export-only), scores each with panmap-eval, and writes
 docs/TUNING.md with the grid and the chosen defaults (include/panmap/graph/optimiser.h).
 """
-import argparse
 import concurrent.futures
 import datetime
-import glob
 import itertools
 import json
 import os
@@ -33,16 +31,7 @@ def config_yaml(path, t):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--scannet", nargs="*", default=None, metavar="DIR")
-    parser.add_argument("--work", default=os.path.join(suite.BUILD, "tuning"))
-    parser.add_argument("--out", default=os.path.join(suite.ROOT, "docs", "TUNING.md"))
-    parser.add_argument("--voxel-size", type=float, default=0.02)
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 2)
-    parser.add_argument("--keep-logs", action="store_true")
-    args = parser.parse_args()
-    dirs = [os.path.abspath(d) for d in (args.scannet if args.scannet is not None else sorted(
-        glob.glob(os.path.join(suite.ROOT, "..", "shared", "data", "scannet-gt", "scene*"))))]
+    args, dirs = suite.tuning_args(__doc__.split("\n\n")[0], "TUNING.md")
     start = time.time()
     specs = [Spec(s.kind, s.source, s.seed, s.poses, s.masks, s.annotation, "full", s.frames,
                   s.rate_hz) for s in suite.tuning_specs(dirs, poses=("gt",)) if s.kind != "room"]
