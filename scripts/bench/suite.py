@@ -248,12 +248,19 @@ def tuning_args(description, out_name):
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 2)
     parser.add_argument("--keep-logs", action="store_true")
     args = parser.parse_args()
-    dirs = [os.path.abspath(d) for d in (args.scannet if args.scannet is not None else sorted(
+    return args, scene_dirs(args.scannet)
+
+
+def scene_dirs(given):
+    """The ScanNet scene folders to use: those given (None: every scene in
+    ../shared/data/scannet-gt), as absolute paths; exits with a one-line reason on a missing
+    one."""
+    dirs = [os.path.abspath(d) for d in (given if given is not None else sorted(
         glob.glob(os.path.join(ROOT, "..", "shared", "data", "scannet-gt", "scene*"))))]
     for d in dirs:
         if not os.path.isdir(d):
             sys.exit("%s: %s is not a folder" % (os.path.basename(sys.argv[0]), d))
-    return args, dirs
+    return dirs
 
 
 # Sequences that choose defaults (tune_refinement.py, calibrate_confidence.py): other rooms
