@@ -156,7 +156,7 @@ start with a wrong class, "noisy": 22 %; target of roadmap issue 4: <= 100 ms), 
 ${optimiser}
 
 Pose refinement against the map (\`panmap-bench-tracking\`: 640x480 frames of a procedural
-room against its 1 cm TSDF, default config, strides 16 then 8 px; target of roadmap issue 8:
+room against its 1 cm TSDF, default config (its pixel strides: 16 then 8 px before issue 20, 20 then 10 since); target of roadmap issue 8:
 <= 15 ms), median:
 
 | benchmark | median ms | p95 ms |

@@ -1,12 +1,15 @@
 // panmap-import: a dataset folder (7-Scenes, ScanNet export, TUM RGB-D) -> an LCM log.
 #include <cstdio>
+#include <memory>
 #include <sstream>
 
 #include <CLI/CLI.hpp>
 
 #include "panmap/core/error.h"
 #include "panmap/core/progress.h"
+#include "panmap/io/tum_trajectory.h"
 #include "panmap/lcm/log_import.h"
+#include "panmap/sim/pose_drift.h"
 
 namespace {
 
@@ -29,7 +32,8 @@ int main(int argc, char** argv) {
       "+ camera-intrinsics.txt), scannet (SensReader export), tum (rgb.txt, depth.txt, "
       "groundtruth.txt)."};
   std::string dataset_dir, log_path, layout = "auto", intrinsics, registration = "reproject";
-  std::string invalid_poses = "auto", pose_source = "gt";
+  std::string invalid_poses = "auto", pose_source = "gt", drift, reference_path;
+  uint64_t drift_seed = 1;
   panmap::ImportOptions options;
   bool raw = false, quiet = false;
   app.add_option("dataset", dataset_dir, "dataset folder")->required();
@@ -62,6 +66,18 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"gt", "slam", "odometry", "unknown"}))
       ->capture_default_str();
   app.add_option("--max-frames", options.max_frames, "import at most N frames (0 = all)");
+  auto* drift_option = app.add_option(
+      "--drift", drift,
+      "inject SLAM-like drift into the recorded poses: light (1 %/m, 0.5 deg/m), heavy (3x), "
+      "slam, slam-hard or gt (docs/SIMULATION.md); poses are flagged slam unless "
+      "--pose-source says otherwise, the recorded ones are written as the reference");
+  app.add_option("--seed", drift_seed, "seed of the injected drift")
+      ->needs(drift_option)
+      ->capture_default_str();
+  app.add_option("--reference", reference_path,
+                 "with --drift: TUM file for the recorded poses (default: LOG minus .lcmlog + "
+                 ".reference.txt); the drifted ones go to .input.txt beside it")
+      ->needs(drift_option);
   app.add_flag("-q,--quiet", quiet, "no progress line");
   CLI11_PARSE(app, argc, argv);
 
@@ -78,6 +94,22 @@ int main(int argc, char** argv) {
                           : pose_source == "slam"     ? panmap::PoseSource::kSlam
                           : pose_source == "odometry" ? panmap::PoseSource::kOdometry
                                                       : panmap::PoseSource::kUnknown;
+    std::string input_path;
+    if (!drift.empty()) {
+      const panmap::PoseDriftConfig drift_config = panmap::PoseDriftConfig::fromPreset(drift);
+      auto model = std::make_shared<panmap::PoseDrift>(drift_config, drift_seed);
+      options.pose_filter = [model](const Eigen::Isometry3d& T_W_C) { return model->next(T_W_C); };
+      if (app.count("--pose-source") == 0) options.pose_source = panmap::PoseSource::kSlam;
+      std::string stem = log_path;
+      const std::string suffix = ".lcmlog";
+      if (stem.size() > suffix.size() &&
+          stem.compare(stem.size() - suffix.size(), suffix.size(), suffix) == 0) {
+        stem.resize(stem.size() - suffix.size());
+      }
+      if (reference_path.empty()) reference_path = stem + ".reference.txt";
+      input_path = stem + ".input.txt";
+      if (reference_path == input_path) input_path = reference_path + ".input.txt";
+    }
     if (raw) {
       options.encoding.color = panmap::image_t::COMPRESSION_NONE;
       options.encoding.depth = panmap::image_t::COMPRESSION_NONE;
@@ -91,6 +123,13 @@ int main(int argc, char** argv) {
     std::printf("wrote %s (%s layout): %zu frames, %zu poses, %zu panoptic, %.1f MB\n",
                 log_path.c_str(), s.layout.c_str(), s.frames_written, s.poses_written,
                 s.panoptic_written, s.bytes_written / 1e6);
+    if (!drift.empty()) {
+      panmap::writeTumTrajectory(reference_path, s.recorded_poses);
+      panmap::writeTumTrajectory(input_path, s.written_poses);
+      std::printf("drift %s, seed %llu: recorded poses -> %s, drifted -> %s\n", drift.c_str(),
+                  static_cast<unsigned long long>(drift_seed), reference_path.c_str(),
+                  input_path.c_str());
+    }
     if (s.skipped_invalid_pose) {
       std::printf("skipped %zu frames with invalid poses (first: %s)\n", s.skipped_invalid_pose,
                   s.first_skip_reason.c_str());

@@ -162,7 +162,7 @@ int main(int argc, char** argv) {
   app.add_option("--masks", masks, "segmenter noise preset: clean, m2f, hard")
       ->capture_default_str()
       ->check(CLI::IsMember({"clean", "m2f", "hard"}));
-  app.add_option("--poses", poses, "pose preset: gt, slam, slam-hard")
+  app.add_option("--poses", poses, "pose preset: gt, slam, slam-hard, light, heavy")
       ->capture_default_str()
       ->check(CLI::IsMember({"gt", "slam", "slam-hard"}));
   app.add_option("--seed", seed, "seed of trajectory, noise, masks and drift")

@@ -1,5 +1,7 @@
 #include "panmap/core/labelled_mesh.h"
 
+#include <Eigen/Geometry>
+
 namespace panmap {
 
 std::string LabelledMesh::check() const {
@@ -21,6 +23,17 @@ std::string LabelledMesh::check() const {
     }
   }
   return "";
+}
+
+double LabelledMesh::surfaceArea() const {
+  double area = 0.0;
+  for (const Eigen::Vector3i& f : faces) {
+    const Eigen::Vector3d a = vertices[static_cast<size_t>(f[0])].cast<double>();
+    const Eigen::Vector3d b = vertices[static_cast<size_t>(f[1])].cast<double>();
+    const Eigen::Vector3d c = vertices[static_cast<size_t>(f[2])].cast<double>();
+    area += 0.5 * (b - a).cross(c - a).norm();
+  }
+  return area;
 }
 
 }  // namespace panmap

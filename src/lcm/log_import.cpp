@@ -61,6 +61,9 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
       pose.frame_id = frame.rgbd.frame_id;
       pose.T_W_C = *frame.T_W_C;
       pose.source = options.pose_source;
+      stats.recorded_poses.push_back(pose);
+      if (options.pose_filter) pose.T_W_C = options.pose_filter(pose.T_W_C);
+      stats.written_poses.push_back(pose);
       writer.write(options.channel_pose, utime, toMessage(pose));
       ++stats.poses_written;
 

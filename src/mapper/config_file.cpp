@@ -73,8 +73,8 @@ PanmapConfig loadConfig(const std::string& path) {
   MapperConfig& m = c.mapper;
   const cv::FileNode root = fs.root();
   const std::set<std::string> sections = {
-      "map",   "integrator", "depth_segmentation", "fusion",    "superpoints",
-      "graph", "occupancy",  "tracking",           "optimiser", "objects",     "threads"};
+      "map",       "integrator", "depth_segmentation", "fusion",  "superpoints", "graph",
+      "occupancy", "tracking",   "optimiser",          "objects", "threads"};
   for (auto it = root.begin(); it != root.end(); ++it) {
     if (!sections.count((*it).name())) throw Error(path + ": unknown section " + (*it).name());
   }
@@ -164,6 +164,10 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("warmup_frames", &m.tracking_warmup_frames);
     s.read("max_iterations", &t.max_iterations);
     s.read("robust_scale_m", &t.robust_scale_m);
+    s.read("point_sigma_m", &t.point_sigma_m);
+    s.read("depth_noise_at_1m_m", &t.depth_noise_at_1m_m);
+    s.read("min_depth_m", &t.min_depth_m);
+    s.read("max_depth_m", &t.max_depth_m);
     s.read("prior_sigma_translation_m", &t.prior_sigma_translation_m);
     s.read("prior_sigma_rotation_rad", &t.prior_sigma_rotation_rad);
     s.read("min_points", &t.min_points);
@@ -174,6 +178,13 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("remap_degenerate", &t.remap_degenerate);
     s.read("max_correction_translation_m", &t.max_correction_translation_m);
     s.read("max_correction_rotation_rad", &t.max_correction_rotation_rad);
+    DriftFilter::Config& d = m.drift;
+    s.read("drift_per_m", &d.drift_per_m);
+    s.read("drift_deg_per_m", &d.drift_deg_per_m);
+    s.read("drift_deg_per_90deg", &d.drift_deg_per_90deg);
+    s.read("drift_correlation_m", &d.correlation_m);
+    s.read("measurement_sigma_m", &d.measurement_sigma_m);
+    s.read("measurement_sigma_deg", &d.measurement_sigma_deg);
     s.finish();
   }
   {
@@ -185,9 +196,8 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("theta", &o.theta);
     s.read("max_sweeps", &o.max_sweeps);
     s.read("discount_apart", &o.discount_apart);
-    std::string refinement = o.refinement == OptimiserConfig::Refinement::kPaperRules
-                                 ? "paper"
-                                 : "clustering";
+    std::string refinement =
+        o.refinement == OptimiserConfig::Refinement::kPaperRules ? "paper" : "clustering";
     s.readString("refinement", &refinement);
     if (refinement != "clustering" && refinement != "paper") {
       s.fail("optimiser.refinement must be clustering or paper");
@@ -303,8 +313,13 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   warmup_frames: " << m.tracking_warmup_frames << "   # frames mapped before refining\n"
     << "   max_iterations: " << t.max_iterations << "   # per pyramid level\n"
     << "   robust_scale_m: " << t.robust_scale_m << "   # Huber scale, metres\n"
+    << "   point_sigma_m: " << t.point_sigma_m << "   # a point's error at the best depth\n"
+    << "   depth_noise_at_1m_m: " << t.depth_noise_at_1m_m
+    << "   # sensor depth noise at 1 m, grows with z^2 (0: every point alike)\n"
+    << "   min_depth_m: " << t.min_depth_m << "\n"
+    << "   max_depth_m: " << t.max_depth_m << "\n"
     << "   prior_sigma_translation_m: " << t.prior_sigma_translation_m
-    << "   # prior on the correction\n"
+    << "   # weak prior of one alignment (a measurement for the drift filter)\n"
     << "   prior_sigma_rotation_rad: " << t.prior_sigma_rotation_rad << "\n"
     << "   min_points: " << t.min_points << "\n"
     << "   inlier_distance_m: " << t.inlier_distance_m << "\n"
@@ -316,7 +331,16 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   remap_degenerate: " << t.remap_degenerate
     << "   # correct only constrained directions (0: refuse)\n"
     << "   max_correction_translation_m: " << t.max_correction_translation_m << "\n"
-    << "   max_correction_rotation_rad: " << t.max_correction_rotation_rad << "\n";
+    << "   max_correction_rotation_rad: " << t.max_correction_rotation_rad << "\n"
+    << "   drift_per_m: " << m.drift.drift_per_m
+    << "   # drift the input may have: per metre travelled (random walk)\n"
+    << "   drift_deg_per_m: " << m.drift.drift_deg_per_m << "\n"
+    << "   drift_deg_per_90deg: " << m.drift.drift_deg_per_90deg << "   # per 90 degrees turned\n"
+    << "   drift_correlation_m: " << m.drift.correlation_m
+    << "   # the drift rate holds over this distance\n"
+    << "   measurement_sigma_m: " << m.drift.measurement_sigma_m
+    << "   # floor of one frame alignment's error\n"
+    << "   measurement_sigma_deg: " << m.drift.measurement_sigma_deg << "\n";
   const OptimiserConfig& o = c.optimiser;
   y << "optimiser:\n"
     << "   regularise: " << o.regularise << "   # III-C alpha-beta swap (0/1)\n"

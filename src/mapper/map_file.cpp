@@ -15,7 +15,9 @@ namespace {
 constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 // 2: occupancy cells, pose refinement state and the trajectory.
 // 3: the pose refinement's weak_direction_damping.
-constexpr uint32_t kVersion = 4;
+// 4: III-B apart counts.
+// 5: the drift filter (its config and state replace the last accepted correction).
+constexpr uint32_t kVersion = 5;
 
 void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put(c.map.voxel_size_m);
@@ -57,14 +59,20 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   for (int stride : t.level_strides_px) w->put<int32_t>(stride);
   w->put<int32_t>(t.max_iterations);
   w->put<int8_t>(static_cast<int8_t>(t.loss));
-  for (double v : {t.robust_scale_m, t.point_sigma_m, t.prior_sigma_translation_m,
-                   t.prior_sigma_rotation_rad, t.min_depth_m, t.max_depth_m, t.inlier_distance_m,
-                   t.min_inlier_ratio, t.min_relative_eigenvalue, t.max_correction_translation_m,
-                   t.max_correction_rotation_rad, t.weak_direction_damping}) {
+  for (double v :
+       {t.robust_scale_m, t.point_sigma_m, t.prior_sigma_translation_m, t.prior_sigma_rotation_rad,
+        t.min_depth_m, t.max_depth_m, t.inlier_distance_m, t.min_inlier_ratio,
+        t.min_relative_eigenvalue, t.max_correction_translation_m, t.max_correction_rotation_rad,
+        t.weak_direction_damping, t.depth_noise_at_1m_m}) {
     w->put(v);
   }
   w->put<int32_t>(t.min_points);
   w->put<uint8_t>(t.remap_degenerate);
+  const DriftFilter::Config& d = c.drift;
+  for (double v : {d.drift_per_m, d.drift_deg_per_m, d.drift_deg_per_90deg, d.correlation_m,
+                   d.measurement_sigma_m, d.measurement_sigma_deg}) {
+    w->put(v);
+  }
   w->put<int32_t>(c.num_threads);
 }
 
@@ -113,11 +121,16 @@ MapperConfig getConfig(BinaryReader* r) {
        {&t.robust_scale_m, &t.point_sigma_m, &t.prior_sigma_translation_m,
         &t.prior_sigma_rotation_rad, &t.min_depth_m, &t.max_depth_m, &t.inlier_distance_m,
         &t.min_inlier_ratio, &t.min_relative_eigenvalue, &t.max_correction_translation_m,
-        &t.max_correction_rotation_rad, &t.weak_direction_damping}) {
+        &t.max_correction_rotation_rad, &t.weak_direction_damping, &t.depth_noise_at_1m_m}) {
     *v = r->get<double>();
   }
   t.min_points = r->get<int32_t>();
   t.remap_degenerate = r->get<uint8_t>() != 0;
+  DriftFilter::Config& d = c.drift;
+  for (double* v : {&d.drift_per_m, &d.drift_deg_per_m, &d.drift_deg_per_90deg, &d.correlation_m,
+                    &d.measurement_sigma_m, &d.measurement_sigma_deg}) {
+    *v = r->get<double>();
+  }
   c.num_threads = r->get<int32_t>();
   return c;
 }
@@ -282,7 +295,11 @@ void Mapper::save(const std::string& path) const {
   }
   putSnapshot(&payload, tracker_->snapshot());
   putGraph(&payload, graph_->snapshot());
-  putPose(&payload, correction_);
+  const DriftFilter::State drift = drift_.state();
+  payload.put<uint8_t>(drift.started);
+  putPose(&payload, drift.input);
+  putPose(&payload, drift.correction);
+  for (int i = 0; i < 36; ++i) payload.put(drift.covariance.data()[i]);
   for (int64_t n : tracking_counts_) payload.put(n);
   payload.put<uint64_t>(trajectory_.size());
   for (const StampedPose& p : trajectory_) {
@@ -345,7 +362,12 @@ std::unique_ptr<Mapper> Mapper::load(const std::string& path) {
   }
   mapper->tracker_->restore(getSnapshot(&r));
   mapper->graph_->restore(getGraph(&r));
-  mapper->correction_ = getPose(&r);
+  DriftFilter::State drift;
+  drift.started = r.get<uint8_t>() != 0;
+  drift.input = getPose(&r);
+  drift.correction = getPose(&r);
+  for (int i = 0; i < 36; ++i) drift.covariance.data()[i] = r.get<double>();
+  mapper->drift_.restore(drift);
   for (int64_t& n : mapper->tracking_counts_) n = r.get<int64_t>();
   mapper->trajectory_.resize(r.getCount(17 + 12 * sizeof(double)));
   for (StampedPose& p : mapper->trajectory_) {

@@ -21,11 +21,12 @@ void MapperConfig::check() const {
   graph.check();
   occupancy.check();
   tracking.check();
+  drift.check();
   if (tracking_warmup_frames < 0) throw Error("mapper tracking_warmup_frames must be >= 0");
   if (num_threads < 1 || num_threads > 256) throw Error("mapper num_threads must be in [1, 256]");
 }
 
-Mapper::Mapper(const MapperConfig& config) : config_(config) {
+Mapper::Mapper(const MapperConfig& config) : config_(config), drift_(config.drift) {
   config_.check();
   pool_ = std::make_unique<ThreadPool>(config_.num_threads);
   map_ = std::make_unique<TsdfMap>(config_.map);
@@ -135,19 +136,19 @@ FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_
   const bool track = config_.tracking_mode == MapperConfig::TrackingMode::kOn ||
                      (config_.tracking_mode == MapperConfig::TrackingMode::kAuto &&
                       (source == PoseSource::kSlam || source == PoseSource::kOdometry));
-  if (track && frames_ >= config_.tracking_warmup_frames) {
-    const Eigen::Isometry3d prior = correction_ * T_W_C_given;
-    const AlignmentResult result = aligner_->align(*map_, frame, prior);
-    stats.tracked = true;
-    stats.tracking_status = result.status;
-    ++tracking_counts_[static_cast<size_t>(result.status)];
-    // A refused frame keeps the last accepted correction rather than jumping back to the raw
-    // pose, which would tear the map where it joins the corrected part.
-    T_W_C = result.accepted ? result.T_W_C : prior;
-    if (result.accepted) {
-      correction_ = T_W_C * T_W_C_given.inverse();
-      correction_.linear() =
-          Eigen::Quaterniond(correction_.rotation()).normalized().toRotationMatrix();
+  if (track) {
+    // The drift estimate follows every tracked frame (its uncertainty grows with the motion),
+    // the map corrects it once it has a model to align against.
+    const Eigen::Isometry3d prior = drift_.predict(T_W_C_given);
+    T_W_C = prior;
+    if (frames_ >= config_.tracking_warmup_frames) {
+      const AlignmentResult result = aligner_->align(*map_, frame, prior);
+      stats.tracked = true;
+      stats.tracking_status = result.status;
+      ++tracking_counts_[static_cast<size_t>(result.status)];
+      // A refused frame keeps the predicted correction rather than jumping back to the raw
+      // pose, which would tear the map where it joins the corrected part.
+      if (result.accepted) T_W_C = drift_.update(result.delta, result.information);
     }
   }
   stats.T_W_C = T_W_C;

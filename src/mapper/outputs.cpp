@@ -41,6 +41,7 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
   const LabelledMesh mesh = mapper->extractMesh(labels);
   summary.mesh_vertices = mesh.numVertices();
   summary.mesh_faces = mesh.numFaces();
+  summary.mesh_area_m2 = mesh.surfaceArea();
   std::set<int32_t> instances;
   for (int32_t id : mesh.instance) {
     if (id > 0) instances.insert(id);

@@ -204,6 +204,9 @@ void FrameToModelAligner::Config::check() const {
   if (max_iterations < 1) throw Error("tracking max_iterations must be >= 1");
   if (!(robust_scale_m > 0.0)) throw Error("tracking robust_scale_m must be > 0");
   if (!(point_sigma_m > 0.0)) throw Error("tracking point_sigma_m must be > 0");
+  if (!(depth_noise_at_1m_m >= 0.0 && std::isfinite(depth_noise_at_1m_m))) {
+    throw Error("tracking depth_noise_at_1m_m must be >= 0");
+  }
   if (!(prior_sigma_translation_m > 0.0)) {
     throw Error("tracking prior_sigma_translation_m must be > 0");
   }
@@ -230,14 +233,6 @@ void FrameToModelAligner::Config::check() const {
   if (!(max_correction_rotation_rad > 0.0)) {
     throw Error("tracking max_correction_rotation_rad must be > 0");
   }
-}
-
-FrameToModelAligner::Config FrameToModelAligner::Config::forSequences() {
-  Config config;
-  config.prior_sigma_translation_m = 0.01;
-  config.prior_sigma_rotation_rad = 0.01;
-  config.weak_direction_damping = 0.01;
-  return config;
 }
 
 FrameToModelAligner::FrameToModelAligner(const Config& config) : config_(config) {
@@ -279,6 +274,7 @@ AlignmentResult FrameToModelAligner::align(const TsdfMap& map, const DepthImage&
   options.loss = config_.loss;
   options.robust_scale_m = config_.robust_scale_m;
   options.point_sigma_m = config_.point_sigma_m;
+  options.depth_noise_at_1m_m = config_.depth_noise_at_1m_m;
   PriorCost prior(config_.prior_sigma_translation_m, config_.prior_sigma_rotation_rad);
 
   // The finest level first decides whether there is anything to align.
@@ -359,6 +355,17 @@ AlignmentResult FrameToModelAligner::align(const TsdfMap& map, const DepthImage&
   }
   result.solved_delta = delta;
   result.delta = delta;
+  result.median_residual_m = stats.median_abs_sdf_m;
+  {
+    Vector6d prior_information;
+    prior_information << Eigen::Vector3d::Constant(
+        1.0 / (config_.prior_sigma_translation_m * config_.prior_sigma_translation_m)),
+        Eigen::Vector3d::Constant(
+            1.0 / (config_.prior_sigma_rotation_rad * config_.prior_sigma_rotation_rad));
+    result.information =
+        stats.normal_matrix * (stats.weight_sum / (config_.point_sigma_m * config_.point_sigma_m));
+    result.information.diagonal() += prior_information;
+  }
   // Points that slid off the map count against the ratio: a fit that holds on to half of the
   // points by pushing the rest out of the band is no fit.
   result.inlier_ratio = static_cast<double>(stats.inliers) / result.points_used;

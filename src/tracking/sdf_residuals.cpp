@@ -30,8 +30,12 @@ SdfResiduals::SdfResiduals(const TsdfMap& map, const Eigen::Isometry3d& T_W_C_pr
                            const SdfResidualOptions& options)
     : sampler_(map), t_W_C_prior_(T_W_C_prior.translation()), options_(options) {
   rays_W_.reserve(points_C.size());
+  inv_scales_.reserve(points_C.size());
+  const double relative = options.depth_noise_at_1m_m / options.point_sigma_m;
   for (const Eigen::Vector3f& p_C : points_C) {
     rays_W_.push_back(T_W_C_prior.linear() * p_C.cast<double>());
+    const double z = p_C.z(), noise = relative * z * z;
+    inv_scales_.push_back(1.0 / std::sqrt(1.0 + noise * noise));
   }
 }
 
@@ -64,14 +68,15 @@ void SdfResiduals::update(const Vector6d& delta) {
         sampler_.sample((a_W + t_W).cast<float>(), &sample.sdf_m, &sample.gradient_W, &cells_[i]);
     if (!sample.in_map) continue;
     ++in_map_;
-    const double r = sample.sdf_m;
+    // In units of a point at the sensor's best depth: the loss and sigma apply to that.
+    const double r = sample.sdf_m * inv_scales_[i];
     double rho = 0.0, drho = 0.0;
     robustLoss(options_.loss, options_.robust_scale_m, r * r, &rho, &drho);
     const double root = std::sqrt(rho);
     residuals_[i] = std::copysign(root, r) * inv_sigma;
     // d r' / d r: rho' |r| / sqrt(rho), which tends to 1 at r = 0.
     const double scale = (root > 0.0 ? drho * std::abs(r) / root : 1.0) * inv_sigma;
-    const Eigen::Vector3d g_W = sample.gradient_W.cast<double>();
+    const Eigen::Vector3d g_W = sample.gradient_W.cast<double>() * inv_scales_[i];
     // d p_W / d dtheta = -[exp(dtheta) q]x J_l(dtheta), so g^T of that is (a x g)^T J_l.
     const Eigen::Vector3d d_theta = J_l.transpose() * a_W.cross(g_W);
     double* row = &jacobian_[6 * i];
@@ -91,6 +96,7 @@ int SdfResiduals::keepPointsInMap(const Vector6d& delta) {
   for (size_t i = 0; i < rays_W_.size(); ++i) {
     if (!samples_[i].in_map) continue;
     rays_W_[kept] = rays_W_[i];
+    inv_scales_[kept] = inv_scales_[i];
     samples_[kept] = samples_[i];
     cells_[kept] = cells_[i];
     residuals_[kept] = residuals_[i];
@@ -98,6 +104,7 @@ int SdfResiduals::keepPointsInMap(const Vector6d& delta) {
     ++kept;
   }
   rays_W_.resize(kept);
+  inv_scales_.resize(kept);
   samples_.resize(kept);
   cells_.resize(kept);
   residuals_.resize(kept);
@@ -112,24 +119,30 @@ SdfFitStats SdfResiduals::statistics(const Vector6d& delta, double inlier_distan
   const Eigen::Matrix3d R = expSo3(delta.tail<3>());
   double weight_sum = 0.0, range_sq_sum = 0.0;
   Matrix6d H = Matrix6d::Zero();
+  std::vector<float> abs_sdf;
+  abs_sdf.reserve(rays_W_.size());
   for (size_t i = 0; i < rays_W_.size(); ++i) {
     const Sample& sample = samples_[i];
     if (!sample.in_map) continue;
+    abs_sdf.push_back(std::abs(sample.sdf_m));
     const Eigen::Vector3d a_W = R * rays_W_[i];
     ++stats.points_in_map;
     stats.inliers += std::abs(sample.sdf_m) <= inlier_distance_m;
     range_sq_sum += a_W.squaredNorm();
     double rho = 0.0, w = 0.0;
-    robustLoss(options_.loss, options_.robust_scale_m,
-               static_cast<double>(sample.sdf_m) * sample.sdf_m, &rho, &w);
+    const double r = sample.sdf_m * inv_scales_[i];
+    robustLoss(options_.loss, options_.robust_scale_m, r * r, &rho, &w);
     // Tangent (left-perturbation) Jacobian at this pose: J_l drops out at zero increment.
     Vector6d J;
-    const Eigen::Vector3d g_W = sample.gradient_W.cast<double>();
+    const Eigen::Vector3d g_W = sample.gradient_W.cast<double>() * inv_scales_[i];
     J << g_W, a_W.cross(g_W);
     H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
     weight_sum += w;
   }
   if (stats.points_in_map > 0) {
+    auto middle = abs_sdf.begin() + static_cast<std::ptrdiff_t>(abs_sdf.size() / 2);
+    std::nth_element(abs_sdf.begin(), middle, abs_sdf.end());
+    stats.median_abs_sdf_m = *middle;
     stats.rms_range_m = std::sqrt(range_sq_sum / stats.points_in_map);
     stats.normal_matrix = H.selfadjointView<Eigen::Upper>();
     stats.normal_matrix /= weight_sum;

@@ -70,6 +70,21 @@ TEST(PoseDrift, DesignStartingValuesOvershoot) {
   RecordProperty("ate_design_starting_values_m", std::to_string(ate));
 }
 
+TEST(PoseDrift, StreamingEqualsBatchAndPresetsAreTheIssues) {
+  const auto gt = roomScan();
+  const auto batch = applyPoseDrift(gt, PoseDriftConfig::fromPreset("light"), 9);
+  PoseDrift stream(PoseDriftConfig::fromPreset("light"), 9);
+  for (size_t k = 0; k < 600; ++k) EXPECT_EQ(stream.next(gt[k]).matrix(), batch[k].matrix()) << k;
+  const PoseDriftConfig light = PoseDriftConfig::fromPreset("light");
+  const PoseDriftConfig heavy = PoseDriftConfig::fromPreset("heavy");
+  EXPECT_DOUBLE_EQ(light.translation_drift_per_m, 0.01);
+  EXPECT_DOUBLE_EQ(light.rotation_drift_deg_per_m, 0.5);
+  EXPECT_DOUBLE_EQ(heavy.translation_drift_per_m, 0.03);
+  EXPECT_DOUBLE_EQ(heavy.rotation_drift_deg_per_m, 1.5);
+  EXPECT_DOUBLE_EQ(heavy.jitter_translation_m, 3.0 * light.jitter_translation_m);
+  EXPECT_THROW(PoseDriftConfig::fromPreset("wobbly"), Error);
+}
+
 TEST(PoseDrift, DeterministicAndFirstPoseExact) {
   const auto gt = roomScan();
   const auto cfg = PoseDriftConfig::fromPreset("slam");

@@ -47,6 +47,23 @@ TEST_F(SphereResiduals, ZeroOnTheSurfaceAndTheDistanceOffIt) {
   }
 }
 
+TEST_F(SphereResiduals, DepthNoiseScalesResidualsWithDepthSquared) {
+  SdfResidualOptions options;
+  options.point_sigma_m = 0.5;
+  options.robust_scale_m = 10.0;  // quadratic
+  options.depth_noise_at_1m_m = 0.25;
+  const std::vector<Eigen::Vector3f> points_C = capPoints(0.02);
+  SdfResiduals residuals(map_, T_W_C_, points_C, options);
+  std::vector<double> r(residuals.size());
+  ASSERT_EQ(residuals.evaluate(Vector6d::Zero(), r.data(), nullptr), residuals.size());
+  for (size_t i = 0; i < r.size(); ++i) {
+    // sigma(z) = sqrt(0.5^2 + (0.25 z^2)^2): residual = sdf / sigma(z).
+    const double z = points_C[i].z();
+    const double sigma = std::sqrt(0.25 + std::pow(0.25 * z * z, 2));
+    EXPECT_NEAR(r[i], 0.02 / sigma, 5e-4 / sigma) << "z " << z;
+  }
+}
+
 TEST_F(SphereResiduals, JacobianMatchesFiniteDifferences) {
   for (RobustLoss loss : {RobustLoss::kHuber, RobustLoss::kCauchy}) {
     SdfResidualOptions options;

@@ -26,6 +26,9 @@ struct LabelledMesh {
   size_t numVertices() const { return vertices.size(); }
   /// Number of triangles.
   size_t numFaces() const { return faces.size(); }
+  /// Total area of the triangles, square metres. Of two maps of the same frames, the one from
+  /// the more consistent poses has less: misaligned frames double surfaces.
+  double surfaceArea() const;
   /// "" when every per-vertex array is empty or as long as `vertices` and every face index is
   /// in range; otherwise the first problem found.
   std::string check() const;

@@ -3,6 +3,9 @@
 #include <cstddef>
 #include <functional>
 #include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
 
 #include "panmap/core/pose.h"
 #include "panmap/io/dataset_reader.h"
@@ -22,6 +25,9 @@ struct ImportOptions {
   enum class InvalidPose { kAuto, kSkip, kError } invalid_pose = InvalidPose::kAuto;
   PoseSource pose_source = PoseSource::kGroundTruth;  ///< recorded in every pose message
   size_t max_frames = 0;                              ///< 0 = all
+  /// Applied to each recorded pose, in frame order, before it is written (e.g. injected
+  /// drift, panmap-import --drift); empty = written as recorded.
+  std::function<Eigen::Isometry3d(const Eigen::Isometry3d&)> pose_filter;
   std::string channel_rgbd = "CAMERA_RGBD";
   std::string channel_pose = "CAMERA_POSE";
   std::string channel_panoptic = "PANOPTIC";
@@ -40,6 +46,8 @@ struct ImportStats {
   size_t unmatched_frames = 0;  ///< e.g. TUM depth without colour in time
   size_t bytes_written = 0;
   std::string first_skip_reason;
+  std::vector<StampedPose> recorded_poses;  ///< every written frame's pose as recorded
+  std::vector<StampedPose> written_poses;   ///< as written (differs with a pose_filter)
 };
 
 /// Reads a dataset folder and writes an LCM log with CAMERA_RGBD, CAMERA_POSE and (with

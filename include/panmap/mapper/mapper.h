@@ -19,6 +19,7 @@
 #include "panmap/occupancy/occupancy_map.h"
 #include "panmap/segmentation/panoptic_geometric.h"
 #include "panmap/superpoint/superpoint_tracker.h"
+#include "panmap/tracking/drift_filter.h"
 #include "panmap/tracking/frame_to_model_aligner.h"
 
 namespace panmap {
@@ -43,8 +44,10 @@ struct MapperConfig {
   TrackingMode tracking_mode = TrackingMode::kAuto;
   /// Frames mapped with their given pose before refinement starts (the map needs a model).
   int tracking_warmup_frames = 5;
-  /// The aligner's sequence defaults (FrameToModelAligner::Config::forSequences()).
-  FrameToModelAligner::Config tracking = FrameToModelAligner::Config::forSequences();
+  /// The aligner: each frame's alignment is a measurement of the drift (FrameToModelAligner).
+  FrameToModelAligner::Config tracking;
+  /// The smooth drift estimate the alignments feed (DriftFilter).
+  DriftFilter::Config drift;
   int num_threads = 2;  ///< threads for segmentation and integration (association uses one)
   /// Throws Error naming the bad field.
   void check() const;
@@ -156,9 +159,8 @@ class Mapper {
   std::unique_ptr<GraphAccumulator> graph_;
   std::unique_ptr<OccupancyMap> occupancy_;
   std::unique_ptr<FrameToModelAligner> aligner_;
-  /// Refined pose = correction_ * given pose: the last accepted correction carries over to
-  /// the next frame, so drift that builds up slowly stays inside the aligner's reach.
-  Eigen::Isometry3d correction_ = Eigen::Isometry3d::Identity();
+  /// Refined pose = drift_.correction() * given pose: a smooth estimate of the input's drift.
+  DriftFilter drift_;
   std::array<int64_t, kAlignmentStatusCount> tracking_counts_{};
   std::vector<StampedPose> trajectory_;
   int64_t frames_ = 0;

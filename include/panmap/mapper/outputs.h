@@ -19,6 +19,7 @@ struct OutputOptions {
 struct OutputSummary {
   size_t mesh_vertices = 0;
   size_t mesh_faces = 0;
+  double mesh_area_m2 = 0.0;       ///< LabelledMesh::surfaceArea()
   size_t instances_in_mesh = 0;    ///< distinct instance ids > 0 on mesh vertices
   size_t objects = 0;              ///< entries of objects.json
   std::vector<std::string> files;  ///< file names written, in order

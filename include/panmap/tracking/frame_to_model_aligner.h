@@ -52,10 +52,18 @@ struct AlignmentResult {
   /// residuals.
   int points_used = 0;
   double inlier_ratio = 0.0;  ///< share of points_used within inlier_distance_m at the end
+  /// Median |point-to-model distance| of the finest level's in-map points at the end, metres
+  /// (0 when refused before the fit): how well the frame fits the map.
+  double median_residual_m = 0.0;
   /// Eigenvalues of the normalised, rotation-scaled normal matrix (degeneracy.h), ascending.
   Vector6d eigenvalues = Vector6d::Zero();
   double condition_number = 0.0;  ///< largest / smallest eigenvalue
   int unconstrained_directions = 0;
+  /// Gauss-Newton information of the solution (points and prior on the increment) at the end,
+  /// increment coordinates: its inverse is the solution's covariance if the points' errors were
+  /// independent (on real depth they are not: DriftFilter adds a floor). Zero when refused
+  /// before the fit.
+  Matrix6d information = Matrix6d::Zero();
   int iterations = 0;    ///< Ceres iterations over all levels
   double time_ms = 0.0;  ///< wall time of align()
 };
@@ -75,14 +83,20 @@ class FrameToModelAligner {
  public:
   /// Parameters; units in the names.
   struct Config {
-    /// Pixel strides of the levels, coarse to fine (the last sets the points used).
-    std::vector<int> level_strides_px = {16, 8};
+    /// Pixel strides of the levels, coarse to fine (the last sets the points used). 10 px:
+    /// about 3,000 points of a 640x480 frame; the drift filter weighs an alignment against a
+    /// floor of 1 cm / 0.5 deg anyway, so more points only cost time (8 px: 4,800 points,
+    /// 10-13 ms instead of 7 ms median on 7-Scenes at 1 cm, the same trajectories within 1.5 mm).
+    std::vector<int> level_strides_px = {20, 10};
     int max_iterations = 8;  ///< Ceres iterations per level
     RobustLoss loss = RobustLoss::kHuber;
     double robust_scale_m = 0.01;  ///< loss scale, metres
     /// Standard deviation of a point's distance to the model, metres: weighs the points
     /// against the prior.
     double point_sigma_m = 0.01;
+    /// Sensor depth noise at 1 m, metres; a point's sigma and loss scale grow with z^2 from
+    /// there (SdfResidualOptions::depth_noise_at_1m_m). 0 = every point alike.
+    double depth_noise_at_1m_m = 0.0;
     double prior_sigma_translation_m = 0.05;  ///< prior on the increment to the SLAM pose
     double prior_sigma_rotation_rad = 0.05;
     double min_depth_m = 0.1;  ///< depth outside [min, max] is ignored, metres
@@ -107,18 +121,6 @@ class FrameToModelAligner {
     double max_correction_rotation_rad = 0.1;
     /// Throws Error naming the bad field.
     void check() const;
-    /// The defaults for refining a sequence of SLAM poses (what the mapper uses), where each
-    /// frame's prior is the previous refined pose moved by the SLAM relative motion
-    /// (Mapper::integrate), so the prior is off by the SLAM pose's frame-to-frame error
-    /// (millimetres), not by its accumulated drift, and the correction of a direction carries
-    /// over to the next frames. Differs from the single-frame defaults in:
-    /// - prior_sigma_translation_m = prior_sigma_rotation_rad = 0.01 (frame-to-frame scale);
-    /// - weak_direction_damping = 0.01: weakly constrained directions follow the map over a
-    ///   few frames instead of jumping to what a handful of points say.
-    /// Measured on the accuracy suite's rooms 3-5 (m2f masks, 2 cm voxels), mean ATE: slam
-    /// 2.81 cm -> 0.72 refined (2.90 with the single-frame defaults, whose correction wanders
-    /// in room 5's near-degenerate stretch: 3.23 -> 6.00), slam-hard 8.42 -> 2.01 (3.42).
-    static Config forSequences();
   };
 
   /// Throws Error when the config is invalid.

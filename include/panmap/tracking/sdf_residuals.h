@@ -25,6 +25,11 @@ struct SdfResidualOptions {
   RobustLoss loss = RobustLoss::kHuber;
   double robust_scale_m = 0.01;  ///< loss scale, metres
   double point_sigma_m = 0.01;   ///< residuals are divided by this (information vs the prior)
+  /// Depth noise of the sensor at 1 m, metres; it grows with the square of the depth (structured
+  /// light and stereo: disparity noise), and a point at depth z counts as
+  /// sqrt(point_sigma^2 + (depth_noise_at_1m z^2)^2) / point_sigma times point_sigma_m, loss
+  /// scale included. 0 = every point alike.
+  double depth_noise_at_1m_m = 0.0;
 };
 
 /// What the points say at one pose increment.
@@ -32,6 +37,8 @@ struct SdfFitStats {
   int points_in_map = 0;     ///< points whose 8 surrounding voxels are all observed
   int inliers = 0;           ///< of those, |sdf| <= the inlier distance
   double rms_range_m = 0.0;  ///< RMS distance of the in-map points from the camera centre
+  /// Median |sdf| of the in-map points, metres: how well the frame fits the map at the pose.
+  double median_abs_sdf_m = 0.0;
   /// Robust-weighted sum of J^T J over the in-map points, divided by the sum of the weights
   /// (J = d sdf / d increment at the increment, without the point sigma): the shape of the
   /// information, for the degeneracy check.
@@ -89,6 +96,7 @@ class SdfResiduals {
   SdfSampler sampler_;
   Eigen::Vector3d t_W_C_prior_;
   std::vector<Eigen::Vector3d> rays_W_;  // R_W_C_prior p_C: the points about the camera centre
+  std::vector<double> inv_scales_;       // point_sigma / the point's sigma (depth noise)
   SdfResidualOptions options_;
   // The evaluation at delta_ (when valid_): samples, residuals, row-major Jacobian.
   bool valid_ = false;
