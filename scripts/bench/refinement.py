@@ -74,7 +74,7 @@ def map_run(log, out_dir, voxel, tracking):
     return report
 
 
-def one(work, name, folder, drift, seed, voxel):
+def one(work, name, drift, seed, voxel):
     """Maps with the default tracking (auto: the poses are flagged slam) and with
     tracking off; returns the row."""
     tag = "%s_%s_s%d" % (name, drift, seed)
@@ -180,12 +180,13 @@ def main():
         for voxel in voxels:
             for drift in args.drifts.split(","):
                 for seed in ([seeds[0]] if drift == "none" else seeds):
-                    jobs.append((name, folder, drift, seed, voxel))
+                    jobs.append((name, drift, seed, voxel))
+    folders = {name: folder for name, folder, _, _ in found}
     start = time.time()
     # Imports first (one per sequence, drift and seed), so parallel maps never race on a log.
-    imports = sorted({(j[0], j[1], j[2], j[3]) for j in jobs})
+    imports = sorted({j[:3] for j in jobs})
     with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
-        list(pool.map(lambda j: one_import(args.work, *j), imports))
+        list(pool.map(lambda j: one_import(args.work, j[0], folders[j[0]], *j[1:]), imports))
     rows = []
     with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
         futures = [pool.submit(one, args.work, *j) for j in jobs]

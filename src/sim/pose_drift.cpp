@@ -20,30 +20,28 @@ void PoseDriftConfig::check() const {
 PoseDriftConfig PoseDriftConfig::fromPreset(const std::string& name) {
   PoseDriftConfig c;
   c.preset = name;
+  // drift per metre, degrees per metre and per 90 degrees, jitter in metres and degrees; the
+  // second preset of each pair is 3x the first.
+  auto set = [&c](double k, double drift, double deg, double jitter_m, double jitter_deg) {
+    c.translation_drift_per_m = drift * k;
+    c.rotation_drift_deg_per_m = deg * k;
+    c.rotation_drift_deg_per_90deg = deg * k;
+    c.jitter_translation_m = jitter_m * k;
+    c.jitter_rotation_deg = jitter_deg * k;
+    return c;
+  };
   if (name == "gt") return c;
+  // DESIGN 10's starting values (1 %/m, 0.5 deg/m, 0.5 deg/90 deg) overshoot 3-8 cm several
+  // times on a 150 s room scan (PoseDrift.DesignStartingValuesOvershoot); a fifth of them
+  // lands in ORB-SLAM's 3-8 cm on ScanNet. The per-frame jitter is kept.
   if (name == "slam" || name == "slam-hard") {
-    // DESIGN 10's starting values (1 %/m, 0.5 deg/m, 0.5 deg/90 deg) overshoot 3-8 cm several
-    // times on a 150 s room scan (PoseDrift.DesignStartingValuesOvershoot); a fifth of them
-    // lands in ORB-SLAM's 3-8 cm on ScanNet. The per-frame jitter is kept.
-    const double k = name == "slam" ? 1.0 : 3.0;
-    c.translation_drift_per_m = 0.002 * k;
-    c.rotation_drift_deg_per_m = 0.1 * k;
-    c.rotation_drift_deg_per_90deg = 0.1 * k;
-    c.jitter_translation_m = 0.002 * k;
-    c.jitter_rotation_deg = 0.1 * k;
-    return c;
+    return set(name == "slam" ? 1.0 : 3.0, 0.002, 0.1, 0.002, 0.1);
   }
+  // The drift levels of issue 20 for recorded real sequences, DESIGN 10's starting values and
+  // three times them; the jitter is what published SLAM systems leave between frames
+  // (docs/SIMULATION.md, "Drift injected into real sequences").
   if (name == "light" || name == "heavy") {
-    // The drift levels of issue 20 for recorded real sequences, DESIGN 10's starting values
-    // and three times them; the jitter is what published SLAM systems leave between frames
-    // (docs/SIMULATION.md, "Drift injected into real sequences").
-    const double k = name == "light" ? 1.0 : 3.0;
-    c.translation_drift_per_m = 0.01 * k;
-    c.rotation_drift_deg_per_m = 0.5 * k;
-    c.rotation_drift_deg_per_90deg = 0.5 * k;
-    c.jitter_translation_m = 0.001 * k;
-    c.jitter_rotation_deg = 0.05 * k;
-    return c;
+    return set(name == "light" ? 1.0 : 3.0, 0.01, 0.5, 0.001, 0.05);
   }
   throw Error("unknown pose preset '" + name + "' (" + presetNames() + ")");
 }

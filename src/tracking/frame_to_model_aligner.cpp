@@ -355,7 +355,6 @@ AlignmentResult FrameToModelAligner::align(const TsdfMap& map, const DepthImage&
   }
   result.solved_delta = delta;
   result.delta = delta;
-  result.median_residual_m = stats.median_abs_sdf_m;
   {
     Vector6d prior_information;
     prior_information << Eigen::Vector3d::Constant(

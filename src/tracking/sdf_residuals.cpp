@@ -119,12 +119,9 @@ SdfFitStats SdfResiduals::statistics(const Vector6d& delta, double inlier_distan
   const Eigen::Matrix3d R = expSo3(delta.tail<3>());
   double weight_sum = 0.0, range_sq_sum = 0.0;
   Matrix6d H = Matrix6d::Zero();
-  std::vector<float> abs_sdf;
-  abs_sdf.reserve(rays_W_.size());
   for (size_t i = 0; i < rays_W_.size(); ++i) {
     const Sample& sample = samples_[i];
     if (!sample.in_map) continue;
-    abs_sdf.push_back(std::abs(sample.sdf_m));
     const Eigen::Vector3d a_W = R * rays_W_[i];
     ++stats.points_in_map;
     stats.inliers += std::abs(sample.sdf_m) <= inlier_distance_m;
@@ -140,9 +137,6 @@ SdfFitStats SdfResiduals::statistics(const Vector6d& delta, double inlier_distan
     weight_sum += w;
   }
   if (stats.points_in_map > 0) {
-    auto middle = abs_sdf.begin() + static_cast<std::ptrdiff_t>(abs_sdf.size() / 2);
-    std::nth_element(abs_sdf.begin(), middle, abs_sdf.end());
-    stats.median_abs_sdf_m = *middle;
     stats.rms_range_m = std::sqrt(range_sq_sum / stats.points_in_map);
     stats.normal_matrix = H.selfadjointView<Eigen::Upper>();
     stats.normal_matrix /= weight_sum;

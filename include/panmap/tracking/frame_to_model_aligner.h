@@ -52,9 +52,6 @@ struct AlignmentResult {
   /// residuals.
   int points_used = 0;
   double inlier_ratio = 0.0;  ///< share of points_used within inlier_distance_m at the end
-  /// Median |point-to-model distance| of the finest level's in-map points at the end, metres
-  /// (0 when refused before the fit): how well the frame fits the map.
-  double median_residual_m = 0.0;
   /// Eigenvalues of the normalised, rotation-scaled normal matrix (degeneracy.h), ascending.
   Vector6d eigenvalues = Vector6d::Zero();
   double condition_number = 0.0;  ///< largest / smallest eigenvalue

@@ -37,8 +37,6 @@ struct SdfFitStats {
   int points_in_map = 0;     ///< points whose 8 surrounding voxels are all observed
   int inliers = 0;           ///< of those, |sdf| <= the inlier distance
   double rms_range_m = 0.0;  ///< RMS distance of the in-map points from the camera centre
-  /// Median |sdf| of the in-map points, metres: how well the frame fits the map at the pose.
-  double median_abs_sdf_m = 0.0;
   /// Robust-weighted sum of J^T J over the in-map points, divided by the sum of the weights
   /// (J = d sdf / d increment at the increment, without the point sigma): the shape of the
   /// information, for the degeneracy check.
