@@ -16,6 +16,7 @@
 #include "panmap/core/process_memory.h"
 #include "panmap/io/dataset_reader.h"
 #include "panmap/lcm/offline_mapping.h"
+#include "panmap/mapper/config_file.h"
 #include "panmap/mapper/mapper.h"
 
 namespace {
@@ -71,12 +72,14 @@ class Recorder {
 
 int main(int argc, char** argv) {
   CLI::App app{"Time the mapping pipeline (no network) on every frame of a dataset or log."};
-  std::string data = "../shared/data/7scenes-200", json_path, log_path;
+  std::string data = "../shared/data/7scenes-200", json_path, log_path, config_path;
   panmap::MapperConfig config;
   int frames = 0, outputs_every = 30;
   bool markdown = false, slam = false;
   app.add_option("--data", data, "dataset folder (7-Scenes, ScanNet export or TUM)")
       ->capture_default_str();
+  app.add_option("--config", config_path,
+                 "mapper YAML config, applied first (--voxel-size and --threads override it)");
   app.add_option("--voxel-size", config.map.voxel_size_m, "metres")->capture_default_str();
   app.add_option("--threads", config.num_threads, "mapping threads")->capture_default_str();
   app.add_option("--frames", frames, "frames to map (0 = all)");
@@ -93,6 +96,13 @@ int main(int argc, char** argv) {
   app.add_flag("--markdown-row", markdown, "print one Markdown table row instead of JSON");
   CLI11_PARSE(app, argc, argv);
   try {
+    if (!config_path.empty()) {
+      const float voxel_m = config.map.voxel_size_m;
+      const int threads = config.num_threads;
+      config = panmap::loadConfig(config_path).mapper;
+      if (app.count("--voxel-size")) config.map.voxel_size_m = voxel_m;
+      if (app.count("--threads")) config.num_threads = threads;
+    }
     panmap::Mapper mapper(config);
     Recorder recorder(&mapper, outputs_every);
     if (!log_path.empty()) {

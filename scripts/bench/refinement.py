@@ -60,10 +60,15 @@ def ate(traj, reference):
     return float(m.group(1))
 
 
-def map_run(log, out_dir, voxel, tracking):
+# Pose correction models (tracking.correction): name -> extra panmap-mapper arguments.
+CORRECTIONS = {"per_frame": [],
+               "filter": ["--config", os.path.join(suite.ROOT, "configs", "drift_filter.yaml")]}
+
+
+def map_run(log, out_dir, voxel, tracking, extra=()):
     suite.run([suite.tool("panmap-mapper"), "--log", log, "--out", out_dir, "--voxel-size",
-               str(voxel), "--geometry-only", "--no-snapshots", "--tracking", tracking],
-              log=os.path.join(out_dir + ".log"))
+               str(voxel), "--geometry-only", "--no-snapshots", "--tracking", tracking] +
+              list(extra), log=os.path.join(out_dir + ".log"))
     with open(os.path.join(out_dir, "report.json")) as f:
         report = json.load(f)
     for name in ("map.panmap", "mesh_semantic.ply", "mesh_instance.ply", "mesh_superpoint.ply",
@@ -74,20 +79,21 @@ def map_run(log, out_dir, voxel, tracking):
     return report
 
 
-def one(work, name, drift, seed, voxel):
-    """Maps with the default tracking (auto: the poses are flagged slam) and with
+def one(work, name, drift, seed, voxel, correction):
+    """Maps with tracking auto (the poses are flagged slam) and the correction model, and with
     tracking off; returns the row."""
     tag = "%s_%s_s%d" % (name, drift, seed)
     log = os.path.join(work, tag + ".lcmlog")  # written by one_import()
     reference = os.path.join(work, tag + ".reference.txt")
-    base = os.path.join(work, "%s_%gcm" % (tag, voxel * 100))
-    refined = map_run(log, base + "_auto", voxel, "auto")
+    base = os.path.join(work, "%s_%gcm_%s" % (tag, voxel * 100, correction))
+    refined = map_run(log, base + "_auto", voxel, "auto", CORRECTIONS[correction])
     raw = map_run(log, base + "_off", voxel, "off")
     tracking = refined.get("tracking", {})
     corrected = tracking.get("accepted", 0) + tracking.get("accepted_partially", 0)
     kept = sum(tracking.values()) - corrected
     return {
         "sequence": name, "drift": drift, "seed": seed, "voxel_m": voxel,
+        "correction": correction,
         "input_ate_m": ate(os.path.join(work, tag + ".input.txt"), reference),
         "refined_ate_m": ate(os.path.join(base + "_auto", "trajectory.txt"), reference),
         "input_area_m2": raw["mesh"]["area_m2"], "refined_area_m2": refined["mesh"]["area_m2"],
@@ -111,7 +117,9 @@ def render(rows, skipped, layouts, seconds):
           "`python3 scripts/bench/refinement.py` (%.1f min on this machine): every real sequence "
           "in `../shared/data` with at least %d frames, its recorded poses replaced by "
           "`panmap-import --drift LEVEL --seed N` (none; light: 1 %%/m, 0.5 deg/m; heavy: 3x), "
-          "mapped geometry-only with the default tracking (`auto`, the poses are flagged SLAM) "
+          "mapped geometry-only with tracking `auto` (the poses are flagged SLAM), each "
+          "correction model (`per_frame`: the default, each aligned pose used as it is; "
+          "`filter`: `configs/drift_filter.yaml`, a smooth drift estimate, docs/MAPPING.md), "
           "and with `--tracking off`. ATE is against the recorded poses, **which are themselves "
           "estimates**: %s. The reference-free figure is the map's mesh surface area (less is "
           "more consistent: misaligned frames double surfaces); *reference map* is the map from "
@@ -123,17 +131,18 @@ def render(rows, skipped, layouts, seconds):
     if skipped:
         md += ["Skipped (fewer than %d frames): %s." % (
             MIN_FRAMES, ", ".join("%s (%d)" % (s[0], s[3]) for s in skipped)), ""]
-    md += ["| sequence | voxel | drift | seed | input ATE cm | refined ATE cm | target | "
-           "area m2: reference map / input / refined | corrected / kept | ms |",
-           "|---|---|---|---|---|---|---|---|---|---|"]
+    md += ["| sequence | voxel | drift | seed | correction | input ATE cm | refined ATE cm | "
+           "target | area m2: reference map / input / refined | corrected / kept | ms |",
+           "|---|---|---|---|---|---|---|---|---|---|---|"]
     reference_area = {(r["sequence"], r["voxel_m"]): r["input_area_m2"]
                       for r in rows if r["drift"] == "none"}
     for r in rows:
         ok, target = verdict(r)
-        md.append("| %s | %g cm | %s | %s | %.2f | %.2f | %s %s | %.2f / %.2f / %.2f | %d / %d "
-                  "| %.1f |" % (
+        md.append("| %s | %g cm | %s | %s | %s | %.2f | %.2f | %s %s | %.2f / %.2f / %.2f | "
+                  "%d / %d | %.1f |" % (
                       r["sequence"], r["voxel_m"] * 100, r["drift"],
-                      "-" if r["drift"] == "none" else r["seed"], r["input_ate_m"] * 100,
+                      "-" if r["drift"] == "none" else r["seed"], r["correction"],
+                      r["input_ate_m"] * 100,
                       r["refined_ate_m"] * 100, target, "yes" if ok else "**no**",
                       reference_area.get((r["sequence"], r["voxel_m"]), float("nan")),
                       r["input_area_m2"], r["refined_area_m2"], r["corrected"], r["kept"],
@@ -160,6 +169,7 @@ def main():
     parser.add_argument("--seeds", default="1,2,3")
     parser.add_argument("--voxels", default="0.01,0.02")
     parser.add_argument("--drifts", default="none,light,heavy")
+    parser.add_argument("--corrections", default="per_frame,filter")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--work", default=os.path.join(suite.BUILD, "refinement"))
     parser.add_argument("--out", default=os.path.join(suite.ROOT, "docs", "RESULTS.md"))
@@ -180,7 +190,8 @@ def main():
         for voxel in voxels:
             for drift in args.drifts.split(","):
                 for seed in ([seeds[0]] if drift == "none" else seeds):
-                    jobs.append((name, drift, seed, voxel))
+                    for correction in args.corrections.split(","):
+                        jobs.append((name, drift, seed, voxel, correction))
     folders = {name: folder for name, folder, _, _ in found}
     start = time.time()
     # Imports first (one per sequence, drift and seed), so parallel maps never race on a log.
@@ -193,8 +204,9 @@ def main():
         for n, future in enumerate(futures):
             rows.append(future.result())
             r = rows[-1]
-            print("refinement: %d/%d %s %s seed %d %g cm: ATE %.2f -> %.2f cm, area %.2f -> %.2f"
+            print("refinement: %d/%d %s %s seed %d %g cm %s: ATE %.2f -> %.2f cm, area %.2f -> %.2f"
                   % (n + 1, len(jobs), r["sequence"], r["drift"], r["seed"], r["voxel_m"] * 100,
+                     r["correction"],
                      r["input_ate_m"] * 100, r["refined_ate_m"] * 100, r["input_area_m2"],
                      r["refined_area_m2"]), file=sys.stderr)
     with open(os.path.join(args.work, "results.json"), "w") as f:

@@ -144,22 +144,36 @@ PanmapConfig loadConfig(const std::string& path) {
   {
     FrameToModelAligner::Config& t = m.tracking;
     Section s(root["tracking"], "tracking", path);
-    s.markSeen("mode");
-    const cv::FileNode mode = s.node().empty() ? cv::FileNode() : s.node()["mode"];
-    if (!mode.empty()) {
-      std::string text = mode.isString() ? static_cast<std::string>(mode) : "";
+    // A word value, or "" when the key is absent.
+    auto word = [&s](const char* key) {
+      s.markSeen(key);
+      const cv::FileNode node = s.node().empty() ? cv::FileNode() : s.node()[key];
+      if (node.empty()) return std::string();
+      std::string text = node.isString() ? static_cast<std::string>(node) : "?";
       // OpenCV keeps a trailing comment as part of an unquoted string.
       text = text.substr(0, text.find('#'));
       text.erase(text.find_last_not_of(" \t") + 1);
-      if (text == "off") {
-        m.tracking_mode = MapperConfig::TrackingMode::kOff;
-      } else if (text == "auto") {
-        m.tracking_mode = MapperConfig::TrackingMode::kAuto;
-      } else if (text == "on") {
-        m.tracking_mode = MapperConfig::TrackingMode::kOn;
-      } else {
-        s.fail("tracking.mode must be off, auto or on, not \"" + text + "\"");
-      }
+      return text;
+    };
+    const std::string mode = word("mode");
+    if (mode == "off") {
+      m.tracking_mode = MapperConfig::TrackingMode::kOff;
+    } else if (mode == "auto") {
+      m.tracking_mode = MapperConfig::TrackingMode::kAuto;
+    } else if (mode == "on") {
+      m.tracking_mode = MapperConfig::TrackingMode::kOn;
+    } else if (!mode.empty()) {
+      s.fail("tracking.mode must be off, auto or on, not \"" + mode + "\"");
+    }
+    const std::string correction = word("correction");
+    if (correction == "per_frame") {
+      m.tracking_correction = MapperConfig::PoseCorrection::kPerFrame;
+    } else if (correction == "filter") {
+      // The aligner's defaults follow the model; keys below override them.
+      m.tracking_correction = MapperConfig::PoseCorrection::kFilter;
+      t = FrameToModelAligner::Config::forDriftFilter();
+    } else if (!correction.empty()) {
+      s.fail("tracking.correction must be per_frame or filter, not \"" + correction + "\"");
     }
     s.read("warmup_frames", &m.tracking_warmup_frames);
     s.read("max_iterations", &t.max_iterations);
@@ -311,6 +325,10 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   mode: \"" << mode
     << "\"   # refine poses against the map - off, auto (SLAM or odometry poses) or on\n"
     << "   warmup_frames: " << m.tracking_warmup_frames << "   # frames mapped before refining\n"
+    << "   correction: \""
+    << (m.tracking_correction == MapperConfig::PoseCorrection::kFilter ? "filter" : "per_frame")
+    << "\"   # per_frame (aligned pose used as is) or filter (smooth drift estimate, "
+       "docs/MAPPING.md)\n"
     << "   max_iterations: " << t.max_iterations << "   # per pyramid level\n"
     << "   robust_scale_m: " << t.robust_scale_m << "   # Huber scale, metres\n"
     << "   point_sigma_m: " << t.point_sigma_m << "   # a point's error at the best depth\n"
@@ -319,7 +337,8 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   min_depth_m: " << t.min_depth_m << "\n"
     << "   max_depth_m: " << t.max_depth_m << "\n"
     << "   prior_sigma_translation_m: " << t.prior_sigma_translation_m
-    << "   # weak prior of one alignment (a measurement for the drift filter)\n"
+    << "   # prior on one alignment's increment (per_frame 0.01: frame-to-frame error; filter "
+       "0.05)\n"
     << "   prior_sigma_rotation_rad: " << t.prior_sigma_rotation_rad << "\n"
     << "   min_points: " << t.min_points << "\n"
     << "   inlier_distance_m: " << t.inlier_distance_m << "\n"

@@ -16,7 +16,7 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 // 2: occupancy cells, pose refinement state and the trajectory.
 // 3: the pose refinement's weak_direction_damping.
 // 4: III-B apart counts.
-// 5: the drift filter (its config and state replace the last accepted correction).
+// 5: the pose correction model, the drift filter's config and state.
 constexpr uint32_t kVersion = 5;
 
 void putConfig(BinaryWriter* w, const MapperConfig& c) {
@@ -54,6 +54,7 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put<int32_t>(o.pixel_stride);
   w->put<int8_t>(static_cast<int8_t>(c.tracking_mode));
   w->put<int32_t>(c.tracking_warmup_frames);
+  w->put<int8_t>(static_cast<int8_t>(c.tracking_correction));
   const FrameToModelAligner::Config& t = c.tracking;
   w->put<uint64_t>(t.level_strides_px.size());
   for (int stride : t.level_strides_px) w->put<int32_t>(stride);
@@ -112,6 +113,7 @@ MapperConfig getConfig(BinaryReader* r) {
   o.pixel_stride = r->get<int32_t>();
   c.tracking_mode = static_cast<MapperConfig::TrackingMode>(r->get<int8_t>());
   c.tracking_warmup_frames = r->get<int32_t>();
+  c.tracking_correction = static_cast<MapperConfig::PoseCorrection>(r->get<int8_t>());
   FrameToModelAligner::Config& t = c.tracking;
   t.level_strides_px.resize(r->getCount(sizeof(int32_t)));
   for (int& stride : t.level_strides_px) stride = r->get<int32_t>();

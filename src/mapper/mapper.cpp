@@ -148,7 +148,11 @@ FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_
       ++tracking_counts_[static_cast<size_t>(result.status)];
       // A refused frame keeps the predicted correction rather than jumping back to the raw
       // pose, which would tear the map where it joins the corrected part.
-      if (result.accepted) T_W_C = drift_.update(result.delta, result.information);
+      if (result.accepted) {
+        T_W_C = config_.tracking_correction == MapperConfig::PoseCorrection::kFilter
+                    ? drift_.update(result.delta, result.information)
+                    : drift_.adopt(result.T_W_C);
+      }
     }
   }
   stats.T_W_C = T_W_C;

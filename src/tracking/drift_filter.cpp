@@ -78,6 +78,13 @@ Eigen::Isometry3d DriftFilter::predict(const Eigen::Isometry3d& T_W_C_input) {
   return current();
 }
 
+Eigen::Isometry3d DriftFilter::adopt(const Eigen::Isometry3d& T_W_C_refined) {
+  if (T_W_C_refined.matrix().allFinite()) {
+    correction_ = orthonormalised(T_W_C_refined * input_.inverse());
+  }
+  return current();
+}
+
 Eigen::Isometry3d DriftFilter::update(const Vector6d& delta, const Matrix6d& information) {
   if (!delta.allFinite() || !information.allFinite()) return current();
   // The alignment's covariance plus the floor of what a real-depth alignment is good to.

@@ -235,6 +235,20 @@ void FrameToModelAligner::Config::check() const {
   }
 }
 
+FrameToModelAligner::Config FrameToModelAligner::Config::forSequences() {
+  Config config;
+  config.prior_sigma_translation_m = 0.01;
+  config.prior_sigma_rotation_rad = 0.01;
+  config.weak_direction_damping = 0.01;
+  return config;
+}
+
+FrameToModelAligner::Config FrameToModelAligner::Config::forDriftFilter() {
+  Config config;
+  config.level_strides_px = {20, 10};
+  return config;
+}
+
 FrameToModelAligner::FrameToModelAligner(const Config& config) : config_(config) {
   config_.check();
 }

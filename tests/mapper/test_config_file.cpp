@@ -64,6 +64,27 @@ TEST(ConfigFile, TrackingAndOccupancySections) {
       {"resolution"});
 }
 
+TEST(ConfigFile, DriftFilterCorrectionSwitchesTheAlignerDefaults) {
+  test::TempDir dir;
+  EXPECT_EQ(MapperConfig().tracking_correction, MapperConfig::PoseCorrection::kPerFrame);
+  EXPECT_DOUBLE_EQ(MapperConfig().tracking.prior_sigma_translation_m, 0.01);
+  const PanmapConfig c = loadConfig(write(dir,
+                                          "%YAML:1.0\n---\ntracking:\n   correction: filter\n"
+                                          "   max_iterations: 5\n   measurement_sigma_m: 0.02\n"));
+  EXPECT_EQ(c.mapper.tracking_correction, MapperConfig::PoseCorrection::kFilter);
+  EXPECT_EQ(c.mapper.tracking.level_strides_px, (std::vector<int>{20, 10}));
+  EXPECT_DOUBLE_EQ(c.mapper.tracking.prior_sigma_translation_m, 0.05);
+  EXPECT_DOUBLE_EQ(c.mapper.tracking.weak_direction_damping, 0.0);
+  EXPECT_EQ(c.mapper.tracking.max_iterations, 5);  // keys after the switch still apply
+  EXPECT_DOUBLE_EQ(c.mapper.drift.measurement_sigma_m, 0.02);
+  test::expectError(
+      [&] { loadConfig(write(dir, "%YAML:1.0\n---\ntracking:\n   correction: smooth\n")); },
+      {"tracking.correction", "smooth"});
+  test::expectError(
+      [&] { loadConfig(write(dir, "%YAML:1.0\n---\ntracking:\n   drift_per_m: -1\n")); },
+      {"drift_per_m"});
+}
+
 TEST(ConfigFile, BadKeysAndValuesNameTheKey) {
   test::TempDir dir;
   auto error = [&](const std::string& text) {

@@ -89,7 +89,7 @@ TEST(Aligner, RecoversAKnownOffsetInTheRoom) {
     EXPECT_EQ(r.status, AlignmentStatus::kAccepted) << k << ": " << r.reason;
     EXPECT_TRUE(r.accepted);
     EXPECT_EQ(r.unconstrained_directions, 0);
-    EXPECT_GT(r.points_used, 2500) << k;  // of 3,072 pixels at the 10 px stride
+    EXPECT_GT(r.points_used, 4000) << k;
     EXPECT_GT(r.inlier_ratio, 0.95) << k;
     EXPECT_LT(translationError(r.T_W_C, T_true), 0.001) << k;
     EXPECT_LT(rotationError(r.T_W_C, T_true), 0.1 * kDeg) << k;
@@ -276,7 +276,7 @@ TEST_F(SingleWall, NothingToAlignIsRefusedAndKeepsThePrior) {
   r = aligner.align(map_, renderDepth(MeshRenderer(mesh), away, false, 0), test::kinectCamera(),
                     away);
   EXPECT_EQ(r.status, AlignmentStatus::kTooFewPoints);
-  EXPECT_GT(r.points_selected, 2500);  // of 3,072 pixels at the 10 px stride
+  EXPECT_GT(r.points_selected, 4000);
   EXPECT_EQ(r.points_used, 0);
   EXPECT_EQ(r.T_W_C.matrix(), away.matrix());
   EXPECT_EQ(aligner.counts()[static_cast<int>(AlignmentStatus::kTooFewPoints)], 3);

@@ -123,6 +123,15 @@ TEST(DriftFilter, IgnoresNonFiniteMeasurementsAndRejectsBadConfigs) {
   EXPECT_THROW(DriftFilter{bad}, Error);
 }
 
+TEST(DriftFilter, AdoptTakesTheRefinedPoseAsItIs) {
+  DriftFilter filter(DriftFilter::Config{});
+  filter.predict(at(1, 0, 0));
+  const Eigen::Isometry3d refined = at(1.02, -0.01, 0.0);
+  EXPECT_TRUE(filter.adopt(refined).isApprox(refined, 1e-12));
+  // The correction carries over: the next input moved by 1 m lands 1 m from the refined pose.
+  EXPECT_TRUE(filter.predict(at(2, 0, 0)).isApprox(at(2.02, -0.01, 0.0), 1e-12));
+}
+
 TEST(DriftFilter, StateRoundTrips) {
   DriftFilter a(DriftFilter::Config{});
   a.predict(at(0, 0, 0));

@@ -44,9 +44,19 @@ struct MapperConfig {
   TrackingMode tracking_mode = TrackingMode::kAuto;
   /// Frames mapped with their given pose before refinement starts (the map needs a model).
   int tracking_warmup_frames = 5;
-  /// The aligner: each frame's alignment is a measurement of the drift (FrameToModelAligner).
-  FrameToModelAligner::Config tracking;
-  /// The smooth drift estimate the alignments feed (DriftFilter).
+  /// How an accepted alignment corrects the poses.
+  enum class PoseCorrection : int8_t {
+    /// The aligned pose is used as it is and its correction carries over to the next frame
+    /// (best on rendered sequences: it also removes per-frame jitter).
+    kPerFrame = 0,
+    /// Alignments are measurements of a smooth drift correction (DriftFilter): the SLAM
+    /// motion is kept (better on real depth, whose per-frame alignments are biased).
+    kFilter = 1,
+  };
+  PoseCorrection tracking_correction = PoseCorrection::kPerFrame;
+  /// The aligner; use FrameToModelAligner::Config::forDriftFilter() with kFilter.
+  FrameToModelAligner::Config tracking = FrameToModelAligner::Config::forSequences();
+  /// The smooth drift estimate (kFilter).
   DriftFilter::Config drift;
   int num_threads = 2;  ///< threads for segmentation and integration (association uses one)
   /// Throws Error naming the bad field.
@@ -159,7 +169,8 @@ class Mapper {
   std::unique_ptr<GraphAccumulator> graph_;
   std::unique_ptr<OccupancyMap> occupancy_;
   std::unique_ptr<FrameToModelAligner> aligner_;
-  /// Refined pose = drift_.correction() * given pose: a smooth estimate of the input's drift.
+  /// Refined pose = drift_.correction() * given pose: the last accepted correction
+  /// (kPerFrame) or a smooth estimate of the input's drift (kFilter).
   DriftFilter drift_;
   std::array<int64_t, kAlignmentStatusCount> tracking_counts_{};
   std::vector<StampedPose> trajectory_;

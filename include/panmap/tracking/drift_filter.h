@@ -11,11 +11,11 @@ namespace panmap {
 /// walk whose variance grows with the distance travelled and the angle turned), estimated by a
 /// Kalman filter from per-frame alignments against the map.
 ///
-/// Why a filter and not a free pose per frame: on real depth a frame's alignment against the
-/// map disagrees with good poses by about a centimetre and half a degree, correlated over
-/// seconds (7-Scenes, docs/MAPPING.md "Pose refinement"); fed back frame by frame those errors
-/// add up like a visual odometry's. The SLAM's frame-to-frame motion is far better than that,
-/// so it is kept as a strong prior, and only the slow part of the error is corrected.
+/// Why: on real depth a frame's alignment against the map disagrees with good poses by about
+/// a centimetre and half a degree, correlated over seconds (7-Scenes, docs/MAPPING.md); the
+/// SLAM's frame-to-frame motion is better than that, so the filter keeps it as a strong prior
+/// and corrects only the slow part of the error. Measured so far it has not beaten
+/// frame-by-frame refinement (docs/MAPPING.md, "Real depth"), so it is opt-in.
 ///
 /// The state is C (mean) and its covariance in increment coordinates at the current camera
 /// pose (pose_increment.h: world-frame translation, rotation about the camera centre); moving
@@ -55,6 +55,10 @@ class DriftFilter {
   /// @param information its Gauss-Newton information (AlignmentResult::information)
   /// Returns the refined pose of the current frame.
   Eigen::Isometry3d update(const Vector6d& delta, const Matrix6d& information);
+
+  /// Takes a refined pose of the current frame as it is (no filtering, covariance unchanged):
+  /// the correction becomes refined * input^-1. For frame-by-frame refinement.
+  Eigen::Isometry3d adopt(const Eigen::Isometry3d& T_W_C_refined);
 
   /// The correction: refined pose = correction() * input pose.
   const Eigen::Isometry3d& correction() const { return correction_; }
