@@ -1,6 +1,9 @@
-// panmap-import: a dataset folder (7-Scenes, ScanNet export, TUM RGB-D) -> an LCM log.
+// panmap-import: a dataset folder (7-Scenes, ScanNet export, TUM RGB-D, a generic rgb/ +
+// depth/ folder) -> an LCM log.
 #include <cstdio>
+#include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <CLI/CLI.hpp>
@@ -13,12 +16,14 @@
 
 namespace {
 
-Eigen::Vector4d parseIntrinsics(const std::string& text) {
+// "fx,fy,cx,cy"; anything else is taken as a file name.
+std::optional<Eigen::Vector4d> parseIntrinsics(const std::string& text) {
   std::istringstream in(text);
   Eigen::Vector4d k;
-  char comma = 0;
-  if (!(in >> k(0) >> comma >> k(1) >> comma >> k(2) >> comma >> k(3))) {
-    throw panmap::Error("--intrinsics must be fx,fy,cx,cy");
+  char c1 = 0, c2 = 0, c3 = 0;
+  if (!(in >> k(0) >> c1 >> k(1) >> c2 >> k(2) >> c3 >> k(3)) || c1 != ',' || c2 != ',' ||
+      c3 != ',' || !(in >> std::ws).eof()) {
+    return std::nullopt;
   }
   return k;
 }
@@ -29,16 +34,21 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Import an RGB-D dataset folder into an LCM log (channels CAMERA_RGBD, CAMERA_POSE and, "
       "with --masks, PANOPTIC).\nLayouts: 7scenes (frame-XXXXXX.{color.jpg,depth.png,pose.txt} "
-      "+ camera-intrinsics.txt), scannet (SensReader export), tum (rgb.txt, depth.txt, "
-      "groundtruth.txt)."};
+      "+ camera-intrinsics.txt), scannet (SensReader export: color/, depth/, pose/, "
+      "intrinsic/), tum (rgb.txt, depth.txt, groundtruth.txt), folder (rgb/ or color/ and "
+      "depth/ images, an intrinsics file such as intrinsic.txt, a pose file such as "
+      "gt_pose.txt or a pose/ folder; README, panmap-import)."};
   std::string dataset_dir, log_path, layout = "auto", intrinsics, registration = "reproject";
   std::string invalid_poses = "auto", pose_source = "gt", drift, reference_path;
+  std::string pairing = "auto";
+  double depth_scale = 0.0;
   uint64_t drift_seed = 1;
   panmap::ImportOptions options;
   bool raw = false, quiet = false;
   app.add_option("dataset", dataset_dir, "dataset folder")->required();
   app.add_option("output", log_path, "LCM log to write (.lcmlog)")->required();
-  app.add_option("--layout", layout, "auto, 7scenes, scannet or tum")->capture_default_str();
+  app.add_option("--layout", layout, "auto, 7scenes, scannet, tum or folder")
+      ->capture_default_str();
   app.add_option("--masks", options.mask_dir,
                  "folder of COCO panoptic PNGs (segment id = R + 256 G + 65536 B)");
   app.add_option("--masks-json", options.mask_json,
@@ -50,7 +60,23 @@ int main(int argc, char** argv) {
                  "quality when colour must be re-encoded")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
-  app.add_option("--intrinsics", intrinsics, "override the depth camera: fx,fy,cx,cy (pixels)");
+  app.add_option("--intrinsics", intrinsics,
+                 "the depth camera: fx,fy,cx,cy (pixels) or a file with a 3x3 or 4x4 matrix or "
+                 "'fx fy cx cy'");
+  app.add_option("--poses", options.dataset.poses_path,
+                 "folder and tum layouts: camera-to-world poses, a TUM file, a matrix per line "
+                 "(12 or 16 numbers), stacked 4x4 matrices, or a folder of per-frame 4x4 files");
+  app.add_option("--depth-scale", depth_scale,
+                 "metres per depth unit (e.g. 0.001 for mm); default: the layout's convention, "
+                 "for the folder layout detected from the values (mm or 1/5000 m)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--pairing", pairing,
+                 "folder layout, colour to depth: auto, name (frame number or file name, else "
+                 "sorted position) or time (file names are timestamps)")
+      ->check(CLI::IsMember({"auto", "name", "time"}))
+      ->capture_default_str();
+  app.add_flag("--skip-bad", options.skip_bad,
+               "skip frames whose files cannot be read (listed, and counted) instead of stopping");
   app.add_option("--rate", options.dataset.frame_rate_hz,
                  "frame rate of datasets without timestamps, Hz")
       ->capture_default_str();
@@ -83,7 +109,14 @@ int main(int argc, char** argv) {
 
   try {
     options.dataset.layout = panmap::parseDatasetLayout(layout);
-    if (!intrinsics.empty()) options.dataset.intrinsics = parseIntrinsics(intrinsics);
+    if (!intrinsics.empty()) {
+      options.dataset.intrinsics = parseIntrinsics(intrinsics);
+      if (!options.dataset.intrinsics) options.dataset.intrinsics_file = intrinsics;
+    }
+    if (depth_scale > 0.0) options.dataset.depth_scale_m = depth_scale;
+    options.dataset.pairing = pairing == "name"   ? panmap::FramePairing::kName
+                              : pairing == "time" ? panmap::FramePairing::kTime
+                                                  : panmap::FramePairing::kAuto;
     options.dataset.registration = registration == "resize" ? panmap::ColorRegistration::kResize
                                                             : panmap::ColorRegistration::kReproject;
     using IP = panmap::ImportOptions::InvalidPose;
@@ -120,6 +153,7 @@ int main(int argc, char** argv) {
         panmap::importDataset(dataset_dir, log_path, options,
                               [&](size_t done, size_t total) { progress.update(done, total); });
     progress.finish();
+    for (const std::string& note : s.notes) std::printf("%s\n", note.c_str());
     std::printf("wrote %s (%s layout): %zu frames, %zu poses, %zu panoptic, %.1f MB\n",
                 log_path.c_str(), s.layout.c_str(), s.frames_written, s.poses_written,
                 s.panoptic_written, s.bytes_written / 1e6);
@@ -133,6 +167,20 @@ int main(int argc, char** argv) {
     if (s.skipped_invalid_pose) {
       std::printf("skipped %zu frames with invalid poses (first: %s)\n", s.skipped_invalid_pose,
                   s.first_skip_reason.c_str());
+    }
+    if (!s.skipped_bad.empty()) {
+      const std::string list_path = log_path + ".skipped.txt";
+      std::ofstream list(list_path);
+      for (const std::string& why : s.skipped_bad) list << why << "\n";
+      std::printf("skipped %zu bad frames (--skip-bad), listed in %s:\n", s.skipped_bad.size(),
+                  list_path.c_str());
+      constexpr size_t kShown = 10;
+      for (size_t i = 0; i < std::min(kShown, s.skipped_bad.size()); ++i) {
+        std::printf("  %s\n", s.skipped_bad[i].c_str());
+      }
+      if (s.skipped_bad.size() > kShown) {
+        std::printf("  ... and %zu more\n", s.skipped_bad.size() - kShown);
+      }
     }
     if (s.unmatched_frames) {
       std::printf("dropped %zu depth images without a colour image in time\n", s.unmatched_frames);

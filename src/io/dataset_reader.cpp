@@ -1,5 +1,6 @@
 #include "panmap/io/dataset_reader.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <regex>
@@ -21,6 +22,9 @@ void DatasetOptions::check() const {
       !((*intrinsics)(0) > 0.0 && (*intrinsics)(1) > 0.0 && intrinsics->allFinite())) {
     throw Error("intrinsics must be fx,fy,cx,cy with positive focal lengths");
   }
+  if (depth_scale_m && !(*depth_scale_m > 0.0 && std::isfinite(*depth_scale_m))) {
+    throw Error("depth scale must be a positive number of metres per unit");
+  }
 }
 
 const char* datasetLayoutName(DatasetLayout layout) {
@@ -31,39 +35,62 @@ const char* datasetLayoutName(DatasetLayout layout) {
       return "scannet";
     case DatasetLayout::kTum:
       return "tum";
+    case DatasetLayout::kFolder:
+      return "folder";
     default:
       return "auto";
   }
 }
 
 DatasetLayout parseDatasetLayout(const std::string& name) {
-  for (DatasetLayout layout : {DatasetLayout::kAuto, DatasetLayout::kSevenScenes,
-                               DatasetLayout::kScanNet, DatasetLayout::kTum}) {
+  for (DatasetLayout layout :
+       {DatasetLayout::kAuto, DatasetLayout::kSevenScenes, DatasetLayout::kScanNet,
+        DatasetLayout::kTum, DatasetLayout::kFolder}) {
     if (name == datasetLayoutName(layout)) return layout;
   }
-  throw Error("unknown dataset layout '" + name + "' (auto, 7scenes, scannet, tum)");
+  throw Error("unknown dataset layout '" + name + "' (auto, 7scenes, scannet, tum, folder)");
 }
 
 std::unique_ptr<DatasetReader> openDataset(const std::string& directory,
-                                           const DatasetOptions& options) {
-  options.check();
+                                           const DatasetOptions& given) {
+  given.check();
   if (!isDirectory(directory)) throw Error("dataset folder " + directory + " does not exist");
+  DatasetOptions options = given;
+  if (!options.intrinsics && !options.intrinsics_file.empty()) {
+    options.intrinsics = readIntrinsicsFile(options.intrinsics_file);
+  }
   DatasetLayout layout = options.layout;
   if (layout == DatasetLayout::kAuto) {
-    namespace fs = std::filesystem;
-    if (isRegularFile(directory + "/depth.txt") && isRegularFile(directory + "/rgb.txt")) {
-      layout = DatasetLayout::kTum;
-    } else if (isDirectory(directory + "/depth") && isDirectory(directory + "/color")) {
-      layout = DatasetLayout::kScanNet;
-    } else {
-      layout = DatasetLayout::kSevenScenes;  // its constructor says so if no frame is found
+    // Most specific first: ScanNet exports also have depth/ and color/ folders.
+    const std::pair<DatasetLayout, std::string> tried[] = {
+        {DatasetLayout::kTum, internal::missingForTum(directory)},
+        {DatasetLayout::kScanNet, internal::missingForScanNet(directory)},
+        {DatasetLayout::kSevenScenes, internal::missingForSevenScenes(directory)},
+        {DatasetLayout::kFolder, internal::missingForFolder(directory)}};
+    std::string why;
+    for (const auto& [candidate, missing] : tried) {
+      if (missing.empty()) {
+        layout = candidate;
+        break;
+      }
+      why += std::string(why.empty() ? "" : "; ") + datasetLayoutName(candidate) + ": " + missing;
     }
+    if (layout == DatasetLayout::kAuto) {
+      throw Error(directory + ": no known dataset layout (" + why + ")");
+    }
+  }
+  if (!options.poses_path.empty() && layout != DatasetLayout::kFolder &&
+      layout != DatasetLayout::kTum) {
+    throw Error(std::string("--poses applies to the folder and tum layouts, not ") +
+                datasetLayoutName(layout));
   }
   switch (layout) {
     case DatasetLayout::kScanNet:
       return internal::makeScanNetReader(directory, options);
     case DatasetLayout::kTum:
       return internal::makeTumReader(directory, options);
+    case DatasetLayout::kFolder:
+      return internal::makeFolderReader(directory, options);
     default:
       return internal::makeSevenScenesReader(directory, options);
   }
@@ -94,6 +121,79 @@ LabelImage registerLabelsToDepth(const LabelImage& labels_color, const DatasetFr
 }
 
 namespace internal {
+
+std::string missingForSevenScenes(const std::string& dir) {
+  return listNumberedFiles(dir, R"(frame-(\d+)\.depth\.png)").empty()
+             ? "no frame-XXXXXX.depth.png files"
+             : "";
+}
+
+std::string missingForScanNet(const std::string& dir) {
+  for (const char* sub : {"depth", "color", "intrinsic"}) {
+    if (!isDirectory(dir + "/" + sub)) return std::string("no ") + sub + "/ folder";
+  }
+  return "";
+}
+
+std::string missingForTum(const std::string& dir) {
+  if (!isRegularFile(dir + "/depth.txt")) return "no depth.txt";
+  if (!isRegularFile(dir + "/rgb.txt")) return "no rgb.txt";
+  return "";
+}
+
+void resizeColorMap(int depth_width, int depth_height, int color_width, int color_height,
+                    Image<float>* map_u, Image<float>* map_v) {
+  *map_u = Image<float>(depth_width, depth_height);
+  *map_v = Image<float>(depth_width, depth_height);
+  const double sx = static_cast<double>(color_width) / depth_width;
+  const double sy = static_cast<double>(color_height) / depth_height;
+  for (int v = 0; v < depth_height; ++v) {
+    for (int u = 0; u < depth_width; ++u) {
+      (*map_u)(u, v) = static_cast<float>((u + 0.5) * sx - 0.5);
+      (*map_v)(u, v) = static_cast<float>((v + 0.5) * sy - 0.5);
+    }
+  }
+}
+
+long nearestIndex(const std::vector<double>& sorted_times, double t, double max_dt) {
+  const auto it = std::lower_bound(sorted_times.begin(), sorted_times.end(), t);
+  long best = -1;
+  double best_dt = max_dt;
+  for (auto c : {it, it == sorted_times.begin() ? it : it - 1}) {
+    if (c == sorted_times.end()) continue;
+    const double dt = std::abs(*c - t);
+    if (dt <= best_dt) {
+      best_dt = dt;
+      best = c - sorted_times.begin();
+    }
+  }
+  return best;
+}
+
+std::optional<Eigen::Isometry3d> poseAtTime(const std::vector<StampedPose>& sorted, double t_s,
+                                            double max_dt_s, const std::string& source,
+                                            std::string* problem) {
+  auto time = [](const StampedPose& p) { return static_cast<double>(p.utime) * 1e-6; };
+  auto it = std::lower_bound(sorted.begin(), sorted.end(), t_s,
+                             [&](const StampedPose& e, double value) { return time(e) < value; });
+  if (it != sorted.end() && it != sorted.begin()) {
+    const double tb = time(*it), ta = time(*(it - 1));
+    if (tb - ta <= 2.0 * max_dt_s + 1e-9) {
+      const double s = (tb > ta) ? (t_s - ta) / (tb - ta) : 0.0;
+      return interpolatePose((it - 1)->T_W_C, it->T_W_C, s);
+    }
+  }
+  std::vector<double> times;
+  times.reserve(sorted.size());
+  for (const StampedPose& p : sorted) times.push_back(time(p));
+  const long best = nearestIndex(times, t_s, max_dt_s);
+  if (best >= 0) return sorted[static_cast<size_t>(best)].T_W_C;
+  std::ostringstream msg;
+  msg.precision(6);
+  msg << std::fixed << source << ": no pose within " << max_dt_s << " s of depth time " << t_s;
+  *problem = msg.str();
+  return std::nullopt;
+}
 
 std::optional<Eigen::Isometry3d> readPoseFile(const std::string& path, double tolerance,
                                               std::string* problem) {

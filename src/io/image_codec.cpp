@@ -3,6 +3,8 @@
 #include <fstream>
 #include <iterator>
 
+#include <zlib.h>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -92,8 +94,53 @@ bool isPng(const uint8_t* data, size_t size) {
   return size >= 8 && std::equal(kMagic, kMagic + 8, data);
 }
 
+uint32_t bigEndian32(const uint8_t* p) {
+  return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | p[3];
+}
+
+// Walks a PNG's chunks (length, type, data, CRC) up to IEND, so that truncated or corrupted
+// files get a message naming the offset instead of reaching libpng (which prints its own
+// warnings), and images too large for an RGB-D frame are refused before any allocation.
+void checkPngStructure(const uint8_t* data, size_t size, const std::string& what) {
+  size_t pos = 8;
+  bool first = true;
+  while (true) {
+    if (size - pos < 12) {
+      throw Error(what + ": truncated PNG (chunk header cut at offset " + std::to_string(pos) +
+                  " of " + std::to_string(size) + " bytes)");
+    }
+    const uint32_t length = bigEndian32(data + pos);
+    const uint8_t* type = data + pos + 4;
+    const std::string type_name(reinterpret_cast<const char*>(type), 4);
+    if (length > size - pos - 12) {
+      throw Error(what + ": truncated PNG (chunk " + type_name + " at offset " +
+                  std::to_string(pos) + " runs past the end)");
+    }
+    const uLong crc = crc32(0L, type, static_cast<uInt>(length + 4));
+    if (crc != bigEndian32(data + pos + 8 + length)) {
+      throw Error(what + ": corrupt PNG (checksum of chunk " + type_name + " at offset " +
+                  std::to_string(pos) + ")");
+    }
+    if (first) {
+      if (type_name != "IHDR" || length != 13) {
+        throw Error(what + ": corrupt PNG (no IHDR chunk first)");
+      }
+      const uint32_t width = bigEndian32(data + pos + 8);
+      const uint32_t height = bigEndian32(data + pos + 12);
+      if (width == 0 || height == 0 || width > kMaxImageSide || height > kMaxImageSide) {
+        throw Error(what + ": PNG of " + std::to_string(width) + "x" + std::to_string(height) +
+                    " pixels (at most " + std::to_string(kMaxImageSide) + " per side)");
+      }
+      first = false;
+    }
+    pos += 12 + length;
+    if (type_name == "IEND") return;
+  }
+}
+
 cv::Mat decodeUnchanged(const uint8_t* data, size_t size, const std::string& what) {
   if (size == 0) throw Error(what + ": empty image data");
+  if (isPng(data, size)) checkPngStructure(data, size, what);
   const cv::Mat buffer(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data));
   cv::Mat mat = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
   if (mat.empty()) throw Error(what + ": not a decodable image (corrupt or truncated)");

@@ -138,7 +138,7 @@ class ScanNetReader : public DatasetReader {
     frame.rgbd.frame_id = number;
     frame.rgbd.camera_name = "scannet";
     frame.rgbd.camera = depth_camera_;
-    frame.rgbd.depth_scale_m = 0.001;
+    frame.rgbd.depth_scale_m = options_.depth_scale_m.value_or(0.001);
     frame.T_W_C = readPoseFile(dir_ + "/pose/" + std::to_string(number) + ".txt",
                                options_.pose_tolerance, &frame.pose_problem);
     return frame;
@@ -157,22 +157,15 @@ class ScanNetReader : public DatasetReader {
   void buildColorMap(const DepthImage& depth, Image<float>* map_u, Image<float>* map_v) const {
     const PinholeCamera& d = depth_camera_;
     const PinholeCamera& c = color_camera_;
-    *map_u = Image<float>(d.width, d.height);
-    *map_v = Image<float>(d.width, d.height);
     if (options_.registration == ColorRegistration::kResize) {
-      const double sx = static_cast<double>(c.width) / d.width;
-      const double sy = static_cast<double>(c.height) / d.height;
-      for (int v = 0; v < d.height; ++v) {
-        for (int u = 0; u < d.width; ++u) {
-          (*map_u)(u, v) = static_cast<float>((u + 0.5) * sx - 0.5);
-          (*map_v)(u, v) = static_cast<float>((v + 0.5) * sy - 0.5);
-        }
-      }
+      resizeColorMap(d.width, d.height, c.width, c.height, map_u, map_v);
       return;
     }
+    *map_u = Image<float>(d.width, d.height);
+    *map_v = Image<float>(d.width, d.height);
     const Eigen::Matrix3d R = T_C_D_.linear();
     const Eigen::Vector3d t = T_C_D_.translation();
-    const double scale = 0.001;
+    const double scale = options_.depth_scale_m.value_or(0.001);
     for (int v = 0; v < d.height; ++v) {
       const uint16_t* z_row = depth.row(v);
       for (int u = 0; u < d.width; ++u) {

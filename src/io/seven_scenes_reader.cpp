@@ -69,7 +69,7 @@ class SevenScenesReader : public DatasetReader {
     frame.rgbd.frame_id = number;
     frame.rgbd.camera_name = "7scenes";
     frame.rgbd.camera = camera_;
-    frame.rgbd.depth_scale_m = 0.001;
+    frame.rgbd.depth_scale_m = options_.depth_scale_m.value_or(0.001);
     frame.T_W_C = readPoseFile(prefix + ".pose.txt", options_.pose_tolerance, &frame.pose_problem);
     return frame;
   }

@@ -11,21 +11,31 @@
 
 namespace panmap {
 
-Eigen::MatrixXd readMatrixFile(const std::string& path, int rows, int cols) {
+std::vector<double> readNumbers(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw Error("cannot read " + path);
   std::vector<double> values;
-  std::string token;
-  while (in >> token) {
-    // strtod, unlike operator>>, accepts "nan" and "-inf" (ScanNet writes -inf poses).
-    char* end = nullptr;
-    errno = 0;
-    const double value = std::strtod(token.c_str(), &end);
-    if (end == token.c_str() || *end != '\0') {
-      throw Error(path + ": '" + token + "' is not a number");
+  std::string line, token;
+  while (std::getline(in, line)) {
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first != std::string::npos && line[first] == '#') continue;
+    std::istringstream tokens(line);
+    while (tokens >> token) {
+      // strtod, unlike operator>>, accepts "nan" and "-inf" (ScanNet writes -inf poses).
+      char* end = nullptr;
+      errno = 0;
+      const double value = std::strtod(token.c_str(), &end);
+      if (end == token.c_str() || *end != '\0') {
+        throw Error(path + ": '" + token + "' is not a number");
+      }
+      values.push_back(value);
     }
-    values.push_back(value);
   }
+  return values;
+}
+
+Eigen::MatrixXd readMatrixFile(const std::string& path, int rows, int cols) {
+  const std::vector<double> values = readNumbers(path);
   if (static_cast<int>(values.size()) != rows * cols) {
     std::ostringstream msg;
     msg << path << ": expected " << rows << "x" << cols << " = " << rows * cols
@@ -37,6 +47,28 @@ Eigen::MatrixXd readMatrixFile(const std::string& path, int rows, int cols) {
     for (int c = 0; c < cols; ++c) m(r, c) = values[static_cast<size_t>(r) * cols + c];
   }
   return m;
+}
+
+Eigen::Vector4d readIntrinsicsFile(const std::string& path) {
+  const std::vector<double> v = readNumbers(path);
+  Eigen::Vector4d k;
+  if (v.size() == 9 || v.size() == 16) {
+    const size_t n = v.size() == 9 ? 3 : 4;  // K sits in the top-left 3x3 of either
+    k << v[0], v[n + 1], v[2], v[n + 2];
+    if (v[1] != 0.0 || v[n] != 0.0 || v[2 * n] != 0.0 || v[2 * n + 1] != 0.0 ||
+        v[2 * n + 2] != 1.0) {
+      throw Error(path + ": not a pinhole matrix (expected [fx 0 cx; 0 fy cy; 0 0 1])");
+    }
+  } else if (v.size() == 4) {
+    k << v[0], v[1], v[2], v[3];
+  } else {
+    throw Error(path + ": expected a 3x3 or 4x4 intrinsics matrix or 'fx fy cx cy', found " +
+                std::to_string(v.size()) + " numbers");
+  }
+  if (!(k(0) > 0.0 && k(1) > 0.0 && k.allFinite())) {
+    throw Error(path + ": focal lengths must be positive and finite");
+  }
+  return k;
 }
 
 bool isDirectory(const std::string& path) {

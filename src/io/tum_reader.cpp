@@ -51,35 +51,16 @@ std::vector<StampedPose> readGroundTruth(const std::string& path) {
   return out;
 }
 
-double timeOf(const Stamped& s) { return s.t; }
-double timeOf(const StampedPose& p) { return static_cast<double>(p.utime) * 1e-6; }
-
-// Index of the entry nearest to t in a time-sorted list, or -1 if farther than max_dt.
-template <typename T>
-long nearest(const std::vector<T>& list, double t, double max_dt) {
-  auto it = std::lower_bound(list.begin(), list.end(), t,
-                             [](const T& e, double value) { return timeOf(e) < value; });
-  long best = -1;
-  double best_dt = max_dt;
-  for (auto c : {it, it == list.begin() ? it : it - 1}) {
-    if (c == list.end()) continue;
-    const double dt = std::abs(timeOf(*c) - t);
-    if (dt <= best_dt) {
-      best_dt = dt;
-      best = c - list.begin();
-    }
-  }
-  return best;
-}
-
 class TumReader : public DatasetReader {
  public:
   TumReader(const std::string& dir, const DatasetOptions& options) : dir_(dir), options_(options) {
     const auto rgb = readFileList(dir + "/rgb.txt");
     const auto depth = readFileList(dir + "/depth.txt");
     if (depth.empty()) throw Error(dir + "/depth.txt: no depth images listed");
+    std::vector<double> rgb_times;
+    for (const Stamped& c : rgb) rgb_times.push_back(c.t);
     for (const Stamped& d : depth) {
-      const long c = nearest(rgb, d.t, options.tum_max_dt_s);
+      const long c = nearestIndex(rgb_times, d.t, options.tum_max_dt_s);
       if (c < 0) {
         ++unmatched_;
         continue;
@@ -90,7 +71,11 @@ class TumReader : public DatasetReader {
       throw Error(dir + ": no depth image has a colour image within " +
                   std::to_string(options.tum_max_dt_s) + " s");
     }
-    ground_truth_ = readGroundTruth(dir + "/groundtruth.txt");
+    poses_path_ = options.poses_path.empty() ? dir + "/groundtruth.txt" : options.poses_path;
+    if (!options.poses_path.empty() && !isRegularFile(poses_path_)) {
+      throw Error(poses_path_ + ": pose file missing");
+    }
+    ground_truth_ = readGroundTruth(poses_path_);
 
     if (options.intrinsics) {
       const Eigen::Vector4d& k = *options.intrinsics;
@@ -142,8 +127,9 @@ class TumReader : public DatasetReader {
     frame.rgbd.frame_id = static_cast<int64_t>(index);
     frame.rgbd.camera_name = "tum";
     frame.rgbd.camera = camera_;
-    frame.rgbd.depth_scale_m = 1.0 / 5000.0;
-    frame.T_W_C = poseAt(p.depth.t, &frame.pose_problem);
+    frame.rgbd.depth_scale_m = options_.depth_scale_m.value_or(1.0 / 5000.0);
+    frame.T_W_C = poseAtTime(ground_truth_, p.depth.t, options_.tum_max_dt_s, poses_path_,
+                             &frame.pose_problem);
     return frame;
   }
 
@@ -153,36 +139,12 @@ class TumReader : public DatasetReader {
     Stamped color;
   };
 
-  std::optional<Eigen::Isometry3d> poseAt(double t, std::string* problem) const {
-    const auto& gt = ground_truth_;
-    auto it = std::lower_bound(gt.begin(), gt.end(), t, [](const StampedPose& e, double value) {
-      return timeOf(e) < value;
-    });
-    // Interpolate between bracketing samples no more than 2 tolerances apart.
-    if (it != gt.end() && it != gt.begin()) {
-      const double tb = timeOf(*it), ta = timeOf(*(it - 1));
-      const StampedPose& b = *it;
-      const StampedPose& a = *(it - 1);
-      if (tb - ta <= 2.0 * options_.tum_max_dt_s + 1e-9) {
-        const double s = (tb > ta) ? (t - ta) / (tb - ta) : 0.0;
-        return interpolatePose(a.T_W_C, b.T_W_C, s);
-      }
-    }
-    const long i = nearest(gt, t, options_.tum_max_dt_s);
-    if (i >= 0) return gt[static_cast<size_t>(i)].T_W_C;
-    std::ostringstream msg;
-    msg.precision(6);
-    msg << std::fixed << dir_ << "/groundtruth.txt: no pose within " << options_.tum_max_dt_s
-        << " s of depth time " << t;
-    *problem = msg.str();
-    return std::nullopt;
-  }
-
   std::string dir_;
   DatasetOptions options_;
   PinholeCamera camera_;
   std::vector<Pair> pairs_;
   std::vector<StampedPose> ground_truth_;
+  std::string poses_path_;
   size_t unmatched_ = 0;
 };
 

@@ -28,6 +28,7 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
   stats.layout = reader->layoutName();
   stats.frames_found = reader->size();
   stats.unmatched_frames = reader->unmatchedFrames();
+  stats.notes = reader->notes();
   const size_t total =
       options.max_frames ? std::min(options.max_frames, reader->size()) : reader->size();
 
@@ -37,7 +38,22 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
     LogWriter writer(partial);
     int64_t last_utime = INT64_MIN;
     for (size_t i = 0; i < total; ++i) {
-      const DatasetFrame frame = reader->read(i);
+      // Everything that reads a file comes first, so a bad frame is skipped whole.
+      DatasetFrame frame;
+      std::optional<PanopticFrame> panoptic;
+      try {
+        frame = reader->read(i);
+        if (frame.T_W_C && masks && masks->has(frame.color_stem)) {
+          panoptic = masks->read(frame.color_stem);
+          panoptic->segment_ids =
+              registerLabelsToDepth(panoptic->segment_ids, frame, "mask of " + frame.color_stem);
+        }
+      } catch (const Error& e) {
+        if (!options.skip_bad) throw;
+        stats.skipped_bad.push_back(e.what());
+        if (progress) progress(i + 1, total);
+        continue;
+      }
       if (!frame.T_W_C) {
         if (!skip_invalid) throw Error(frame.pose_problem);
         if (stats.first_skip_reason.empty()) stats.first_skip_reason = frame.pose_problem;
@@ -67,18 +83,13 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
       writer.write(options.channel_pose, utime, toMessage(pose));
       ++stats.poses_written;
 
-      if (masks) {
-        if (masks->has(frame.color_stem)) {
-          PanopticFrame panoptic = masks->read(frame.color_stem);
-          panoptic.segment_ids =
-              registerLabelsToDepth(panoptic.segment_ids, frame, "mask of " + frame.color_stem);
-          panoptic.utime = utime;
-          panoptic.frame_id = frame.rgbd.frame_id;
-          writer.write(options.channel_panoptic, utime, toMessage(panoptic, options.encoding));
-          ++stats.panoptic_written;
-        } else {
-          ++stats.frames_without_mask;
-        }
+      if (panoptic) {
+        panoptic->utime = utime;
+        panoptic->frame_id = frame.rgbd.frame_id;
+        writer.write(options.channel_panoptic, utime, toMessage(*panoptic, options.encoding));
+        ++stats.panoptic_written;
+      } else if (masks) {
+        ++stats.frames_without_mask;
       }
       if (progress) progress(i + 1, total);
     }

@@ -1,3 +1,5 @@
+#include <zlib.h>
+
 #include <gtest/gtest.h>
 
 #include "panmap/core/error.h"
@@ -66,6 +68,42 @@ TEST(ImageCodec, EightBitPngIsNotDepth) {
   const std::vector<uint8_t> garbage = {1, 2, 3};
   EXPECT_THROW(decodeDepthPng(garbage.data(), garbage.size(), "d.png"), Error);
   EXPECT_THROW(decodeColor(garbage.data(), 0, "c.jpg"), Error);
+}
+
+}  // namespace
+}  // namespace panmap
+
+namespace panmap {
+namespace {
+
+std::string decodeError(const std::vector<uint8_t>& bytes) {
+  try {
+    decodeDepthPng(bytes.data(), bytes.size(), "d.png");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ImageCodec, BrokenPngChunksAreNamedWithTheirOffset) {
+  DepthImage depth(16, 8, 1234);
+  const std::vector<uint8_t> good = encodeDepthPng(depth);
+  ASSERT_EQ(decodeError(good), "");
+
+  std::vector<uint8_t> cut(good.begin(), good.end() - 20);  // IDAT or IEND cut short
+  EXPECT_NE(decodeError(cut).find("d.png: truncated PNG"), std::string::npos) << decodeError(cut);
+
+  std::vector<uint8_t> flipped = good;
+  flipped[8 + 8 + 2] ^= 0x01;  // a byte of IHDR's data: its CRC no longer matches
+  EXPECT_EQ(decodeError(flipped), "d.png: corrupt PNG (checksum of chunk IHDR at offset 8)");
+
+  // IHDR claiming 100000 x 8 pixels, with a correct CRC: refused before any allocation.
+  std::vector<uint8_t> huge = good;
+  const uint32_t width = 100000;
+  for (int i = 0; i < 4; ++i) huge[16 + i] = static_cast<uint8_t>(width >> (24 - 8 * i));
+  const uLong crc = crc32(0L, huge.data() + 12, 17);
+  for (int i = 0; i < 4; ++i) huge[29 + i] = static_cast<uint8_t>(crc >> (24 - 8 * i));
+  EXPECT_EQ(decodeError(huge), "d.png: PNG of 100000x8 pixels (at most 16384 per side)");
 }
 
 }  // namespace

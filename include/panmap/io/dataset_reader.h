@@ -31,8 +31,16 @@ struct DatasetFrame {
   Image<float> color_map_v;
 };
 
-/// Which folder layout a dataset has.
-enum class DatasetLayout { kAuto, kSevenScenes, kScanNet, kTum };
+/// Which folder layout a dataset has. kFolder is the generic export: rgb/ (or color/) and
+/// depth/ image folders, an intrinsics file and a pose file or folder.
+enum class DatasetLayout { kAuto, kSevenScenes, kScanNet, kTum, kFolder };
+
+/// How the folder layout pairs colour with depth images.
+enum class FramePairing {
+  kAuto,  ///< by name when the names agree, by position when the counts do, else by time
+  kName,  ///< same frame number (or stem), else the same position in sorted order
+  kTime,  ///< names are timestamps in seconds; nearest colour within tum_max_dt_s
+};
 
 /// How ScanNet colour is registered to the depth camera.
 enum class ColorRegistration {
@@ -50,6 +58,16 @@ struct DatasetOptions {
   double tum_max_dt_s = 0.02;  ///< TUM: max |t_rgb - t_depth| and |t_pose - t_depth|
   /// Largest |R^T R - I| entry accepted in a pose file (datasets store rounded matrices).
   double pose_tolerance = 1e-3;
+  /// Metres per depth unit, replacing the layout's convention (7-Scenes and ScanNet mm, TUM
+  /// 1/5000 m; the folder layout detects mm or 1/5000 m from the values when unset).
+  std::optional<double> depth_scale_m;
+  /// Intrinsics file (3x3 or 4x4 matrix, or fx fy cx cy) replacing the dataset's; ignored when
+  /// `intrinsics` is set.
+  std::string intrinsics_file;
+  /// Folder and TUM layouts: the poses, a trajectory file (TUM, a matrix per line, stacked
+  /// 4x4) or a folder of per-frame 4x4 files, instead of the one found in the folder.
+  std::string poses_path;
+  FramePairing pairing = FramePairing::kAuto;  ///< folder layout only
   /// Throws Error naming the bad option.
   void check() const;
 };
@@ -58,7 +76,7 @@ struct DatasetOptions {
 class DatasetReader {
  public:
   virtual ~DatasetReader() = default;
-  /// Short layout name: "7scenes", "scannet" or "tum".
+  /// Short layout name: "7scenes", "scannet", "tum" or "folder".
   virtual std::string layoutName() const = 0;
   /// Number of frames (depth images) found.
   virtual size_t size() const = 0;
@@ -71,10 +89,13 @@ class DatasetReader {
   virtual bool invalidPosesExpected() const { return false; }
   /// Frames the reader dropped while indexing (e.g. TUM depth without a matching colour).
   virtual size_t unmatchedFrames() const { return 0; }
+  /// What auto-detection chose, one line each (files found, depth scale, pairing), for users.
+  virtual std::vector<std::string> notes() const { return {}; }
 };
 
 /// Opens a dataset folder. Throws Error naming the folder or file when it is missing or does
-/// not look like the layout.
+/// not look like the layout; with kAuto and no layout recognised, the error lists every
+/// layout tried and what each one missed.
 std::unique_ptr<DatasetReader> openDataset(const std::string& directory,
                                            const DatasetOptions& options);
 
@@ -86,7 +107,7 @@ LabelImage registerLabelsToDepth(const LabelImage& labels_color, const DatasetFr
 /// Name of a layout.
 const char* datasetLayoutName(DatasetLayout layout);
 
-/// Parses "auto", "7scenes", "scannet" or "tum"; throws Error otherwise.
+/// Parses "auto", "7scenes", "scannet", "tum" or "folder"; throws Error otherwise.
 DatasetLayout parseDatasetLayout(const std::string& name);
 
 }  // namespace panmap

@@ -9,6 +9,9 @@
 
 namespace panmap {
 
+/// Largest width or height of a PNG the decoders accept (a bound on what one frame allocates).
+constexpr uint32_t kMaxImageSide = 16384;
+
 /// Bytes of a whole file; throws Error("cannot read <path>") when it cannot be read.
 std::vector<uint8_t> readFileBytes(const std::string& path);
 

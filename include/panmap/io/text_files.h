@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -10,6 +11,15 @@ namespace panmap {
 /// callers decide what a non-finite entry means). Throws Error naming the file when it is
 /// missing or holds a different number of values.
 Eigen::MatrixXd readMatrixFile(const std::string& path, int rows, int cols);
+
+/// Reads every whitespace-separated number of a text file ('#' starts a comment line). Throws
+/// Error naming the file and the first token that is not a number.
+std::vector<double> readNumbers(const std::string& path);
+
+/// Reads pinhole intrinsics fx, fy, cx, cy from a file holding a 3x3 K, a 4x4 matrix with K
+/// in its top-left corner, or the four numbers "fx fy cx cy". Throws Error naming the file
+/// and what it found otherwise.
+Eigen::Vector4d readIntrinsicsFile(const std::string& path);
 
 /// True when the path exists and is a directory.
 bool isDirectory(const std::string& path);

@@ -24,7 +24,10 @@ struct ImportOptions {
   /// kAuto skips where the layout documents invalid poses (ScanNet) and stops elsewhere.
   enum class InvalidPose { kAuto, kSkip, kError } invalid_pose = InvalidPose::kAuto;
   PoseSource pose_source = PoseSource::kGroundTruth;  ///< recorded in every pose message
-  size_t max_frames = 0;                              ///< 0 = all
+  /// Skip a frame whose files cannot be read (corrupt image, mask or pose file) instead of
+  /// stopping; each is listed in ImportStats::skipped_bad.
+  bool skip_bad = false;
+  size_t max_frames = 0;  ///< 0 = all
   /// Applied to each recorded pose, in frame order, before it is written (e.g. injected
   /// drift, panmap-import --drift); empty = written as recorded.
   std::function<Eigen::Isometry3d(const Eigen::Isometry3d&)> pose_filter;
@@ -46,13 +49,15 @@ struct ImportStats {
   size_t unmatched_frames = 0;  ///< e.g. TUM depth without colour in time
   size_t bytes_written = 0;
   std::string first_skip_reason;
+  std::vector<std::string> skipped_bad;     ///< with skip_bad: each skipped frame's error
+  std::vector<std::string> notes;           ///< what the reader detected (DatasetReader::notes)
   std::vector<StampedPose> recorded_poses;  ///< every written frame's pose as recorded
   std::vector<StampedPose> written_poses;   ///< as written (differs with a pose_filter)
 };
 
 /// Reads a dataset folder and writes an LCM log with CAMERA_RGBD, CAMERA_POSE and (with
 /// masks) PANOPTIC events, all stamped with the frame's utime. Throws Error naming the file
-/// at fault; a partial log is removed on failure.
+/// at fault (unless skip_bad); a partial log is removed on failure.
 /// @param progress called after each frame with (frames done, frames total)
 ImportStats importDataset(const std::string& dataset_dir, const std::string& log_path,
                           const ImportOptions& options,

@@ -16,6 +16,30 @@ std::unique_ptr<DatasetReader> makeSevenScenesReader(const std::string& dir,
 std::unique_ptr<DatasetReader> makeScanNetReader(const std::string& dir,
                                                  const DatasetOptions& options);
 std::unique_ptr<DatasetReader> makeTumReader(const std::string& dir, const DatasetOptions& options);
+std::unique_ptr<DatasetReader> makeFolderReader(const std::string& dir,
+                                                const DatasetOptions& options);
+
+/// Why a folder is not of a layout ("" when it looks like one), checked without reading
+/// images: the auto-detection and its error message.
+std::string missingForSevenScenes(const std::string& dir);
+std::string missingForScanNet(const std::string& dir);
+std::string missingForTum(const std::string& dir);
+std::string missingForFolder(const std::string& dir);
+
+/// Colour-image coordinates of every depth pixel when the colour image is the depth image
+/// resized (pixel centres scaled).
+void resizeColorMap(int depth_width, int depth_height, int color_width, int color_height,
+                    Image<float>* map_u, Image<float>* map_v);
+
+/// Index of the time nearest to t in a sorted list, or -1 when none is within max_dt.
+long nearestIndex(const std::vector<double>& sorted_times, double t, double max_dt);
+
+/// Pose at time t_s from time-sorted samples: interpolated between the bracketing samples
+/// when they are at most 2 max_dt_s apart, else the nearest within max_dt_s. Sets `problem`
+/// (naming `source`) and returns nothing when no sample is close enough.
+std::optional<Eigen::Isometry3d> poseAtTime(const std::vector<StampedPose>& sorted, double t_s,
+                                            double max_dt_s, const std::string& source,
+                                            std::string* problem);
 
 /// Reads a 4x4 camera-to-world pose file. Sets `problem` (file and reason) and returns
 /// nothing when the file is missing or the matrix is not a rigid transform.

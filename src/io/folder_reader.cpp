@@ -1,0 +1,488 @@
+// The generic RGB-D export: rgb/ (or color/) and depth/ image folders, an intrinsics file
+// (3x3 or 4x4 matrix, or fx fy cx cy) and a trajectory file (TUM, a matrix per line, stacked
+// 4x4) or a folder of per-frame 4x4 files. Images pair by frame number or name, by position,
+// or by timestamp; depth units are mm unless the values say 1/5000 m (TUM) or the user says
+// otherwise. What was detected is reported by notes(), so a wrong guess is visible.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iterator>
+#include <map>
+#include <regex>
+#include <sstream>
+
+#include <opencv2/imgproc.hpp>
+
+#include "panmap/core/error.h"
+#include "panmap/io/image_codec.h"
+#include "panmap/io/internal/readers.h"
+#include "panmap/io/opencv_image.h"
+#include "panmap/io/pose_list.h"
+#include "panmap/io/text_files.h"
+
+namespace panmap {
+namespace internal {
+namespace {
+
+constexpr const char* kColorFolders[] = {"rgb", "color", "colour", "image", "images"};
+constexpr const char* kIntrinsicsFiles[] = {
+    "intrinsic.txt", "intrinsics.txt", "camera-intrinsics.txt",         "camera_intrinsics.txt",
+    "K.txt",         "cam_K.txt",      "intrinsic/intrinsic_depth.txt", "intrinsic_depth.txt"};
+constexpr const char* kPoseFiles[] = {"gt_pose.txt",     "groundtruth.txt", "poses.txt",
+                                      "pose.txt",        "trajectory.txt",  "traj.txt",
+                                      "camera_poses.txt"};
+constexpr const char* kPoseFolders[] = {"pose", "poses"};
+
+// Depth values above these (median, 99th percentile) are implausible in millimetres for an
+// indoor RGB-D sensor but typical of TUM's 1/5000 m.
+constexpr double kMaxMedianDepthMm = 6500.0;
+constexpr double kMaxP99DepthMm = 15000.0;
+
+struct NamedFile {
+  std::string name;
+  std::string stem;
+  bool numbered = false;
+  double number = 0.0;  ///< the last number in the stem (a frame number or a timestamp)
+};
+
+bool hasExtension(const std::string& name, std::initializer_list<const char*> extensions) {
+  std::string ext = std::filesystem::path(name).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  for (const char* e : extensions) {
+    if (ext == e) return true;
+  }
+  return false;
+}
+
+// Files of a folder with one of the extensions, sorted by number when every name carries a
+// distinct one (so 10.png follows 9.png), else by name.
+std::vector<NamedFile> listFiles(const std::string& dir,
+                                 std::initializer_list<const char*> extensions) {
+  namespace fs = std::filesystem;
+  static const std::regex number_re(R"((\d+(?:\.\d+)?))");
+  std::vector<NamedFile> files;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    if (!entry.is_regular_file(ec)) continue;
+    NamedFile f;
+    f.name = entry.path().filename().string();
+    if (!hasExtension(f.name, extensions)) continue;
+    f.stem = entry.path().stem().string();
+    for (std::sregex_iterator it(f.stem.begin(), f.stem.end(), number_re), end; it != end; ++it) {
+      f.numbered = true;
+      f.number = std::strtod((*it)[1].str().c_str(), nullptr);
+    }
+    files.push_back(std::move(f));
+  }
+  if (ec) throw Error("cannot list " + dir + ": " + ec.message());
+  std::sort(files.begin(), files.end(),
+            [](const NamedFile& a, const NamedFile& b) { return a.name < b.name; });
+  bool by_number =
+      std::all_of(files.begin(), files.end(), [](const NamedFile& f) { return f.numbered; });
+  if (by_number) {
+    std::vector<double> numbers;
+    for (const NamedFile& f : files) numbers.push_back(f.number);
+    std::sort(numbers.begin(), numbers.end());
+    by_number = std::adjacent_find(numbers.begin(), numbers.end()) == numbers.end();
+  }
+  if (by_number) {
+    std::sort(files.begin(), files.end(),
+              [](const NamedFile& a, const NamedFile& b) { return a.number < b.number; });
+  }
+  return files;
+}
+
+bool allNumbered(const std::vector<NamedFile>& files) {
+  return std::all_of(files.begin(), files.end(), [](const NamedFile& f) { return f.numbered; });
+}
+
+// Names that are timestamps (seconds with a fraction, or Unix times) rather than frame numbers.
+bool areTimestamps(const std::vector<NamedFile>& files) {
+  if (files.empty() || !allNumbered(files)) return false;
+  return std::any_of(files.begin(), files.end(), [](const NamedFile& f) {
+    return f.number != std::floor(f.number) || f.number > 1e8;
+  });
+}
+
+// The key two files of one frame share: the number when both folders number their files,
+// else the stem.
+std::string keyOf(const NamedFile& f, bool numbers) {
+  if (!numbers) return f.stem;
+  std::ostringstream key;
+  key.precision(17);
+  key << f.number;
+  return key.str();
+}
+
+std::string firstExisting(const std::string& dir, const char* const* names, size_t count,
+                          bool folders) {
+  for (size_t i = 0; i < count; ++i) {
+    const std::string path = dir + "/" + names[i];
+    if (folders ? isDirectory(path) : isRegularFile(path)) return path;
+  }
+  return "";
+}
+
+template <size_t N>
+std::string joined(const char* const (&names)[N]) {
+  std::string out;
+  for (size_t i = 0; i < N; ++i) out += std::string(i ? ", " : "") + names[i];
+  return out;
+}
+
+std::string formatDepthScale(double scale) {
+  std::ostringstream out;
+  if (std::abs(scale - 0.001) < 1e-12) {
+    out << "0.001 m per unit (mm)";
+  } else if (std::abs(scale - 1.0 / 5000.0) < 1e-12) {
+    out << "1/5000 m per unit (TUM)";
+  } else {
+    out << scale << " m per unit";
+  }
+  return out.str();
+}
+
+class FolderReader : public DatasetReader {
+ public:
+  FolderReader(const std::string& dir, const DatasetOptions& options)
+      : dir_(dir), options_(options) {
+    const std::string missing = missingForFolder(dir);
+    if (!missing.empty()) throw Error(dir + ": not an RGB-D folder (" + missing + ")");
+    color_dir_ = firstExisting(dir, kColorFolders, std::size(kColorFolders), true);
+    depth_dir_ = dir + "/depth";
+    const std::vector<NamedFile> colors = listFiles(color_dir_, {".png", ".jpg", ".jpeg"});
+    const std::vector<NamedFile> depths = listFiles(depth_dir_, {".png"});
+    if (depths.empty()) throw Error(depth_dir_ + ": no PNG depth images");
+    if (colors.empty()) throw Error(color_dir_ + ": no PNG or JPEG colour images");
+    pairImages(colors, depths);
+    timestamps_ = areTimestamps(depths);
+    readCamera();
+    readPoses();
+    detectDepthScale();
+  }
+
+  std::string layoutName() const override { return "folder"; }
+  size_t size() const override { return frames_.size(); }
+  size_t unmatchedFrames() const override { return unmatched_; }
+  std::vector<std::string> notes() const override { return notes_; }
+
+  DatasetFrame read(size_t index) const override {
+    const Frame& f = frames_.at(index);
+    DatasetFrame frame;
+    const std::string depth_path = depth_dir_ + "/" + f.depth.name;
+    frame.depth_png = readFileBytes(depth_path);
+    frame.rgbd.depth = decodeDepthPng(frame.depth_png.data(), frame.depth_png.size(), depth_path);
+    checkImageSize(depth_path, "depth", frame.rgbd.depth.width(), frame.rgbd.depth.height(),
+                   camera_.width, camera_.height);
+    const std::string color_path = color_dir_ + "/" + f.color.name;
+    const std::vector<uint8_t> color_bytes = readFileBytes(color_path);
+    ColorImage color = decodeColor(color_bytes.data(), color_bytes.size(), color_path);
+    checkImageSize(color_path, "colour", color.width(), color.height(), color_width_,
+                   color_height_);
+    frame.color_stem = f.color.stem;
+    frame.color_source_width = color.width();
+    frame.color_source_height = color.height();
+    if (color.width() == camera_.width && color.height() == camera_.height) {
+      if (isCompleteJpeg(color_bytes.data(), color_bytes.size())) frame.color_jpeg = color_bytes;
+      frame.rgbd.color = std::move(color);
+    } else {
+      // A colour camera of another resolution, taken as aligned with depth (common practice for
+      // exports without extrinsics): resampled to the depth size.
+      resizeColorMap(camera_.width, camera_.height, color.width(), color.height(),
+                     &frame.color_map_u, &frame.color_map_v);
+      cv::Mat registered;
+      cv::remap(asMat(color), registered, asMat(frame.color_map_u), asMat(frame.color_map_v),
+                cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0, 0, 0));
+      frame.rgbd.color = colorFromMat(registered);
+    }
+    frame.rgbd.utime = timestamps_ ? static_cast<int64_t>(std::llround(f.depth.number * 1e6))
+                                   : frameUtime(frameNumber(index), options_.frame_rate_hz);
+    frame.rgbd.frame_id = frameNumber(index);
+    frame.rgbd.camera_name = "folder";
+    frame.rgbd.camera = camera_;
+    frame.rgbd.depth_scale_m = depth_scale_m_;
+    frame.T_W_C = poseOf(index, &frame.pose_problem);
+    return frame;
+  }
+
+ private:
+  struct Frame {
+    NamedFile color;
+    NamedFile depth;
+  };
+
+  long long frameNumber(size_t index) const {
+    const NamedFile& d = frames_.at(index).depth;
+    return integer_numbers_ ? static_cast<long long>(d.number) : static_cast<long long>(index);
+  }
+
+  void pairImages(const std::vector<NamedFile>& colors, const std::vector<NamedFile>& depths) {
+    const bool numbers = allNumbered(colors) && allNumbered(depths);
+    integer_numbers_ = numbers && !areTimestamps(depths);
+    const std::string color_name = std::filesystem::path(color_dir_).filename().string() + "/";
+    std::string how;
+    FramePairing pairing = options_.pairing;
+    if (pairing != FramePairing::kTime) {
+      std::map<std::string, size_t> by_key;
+      for (size_t i = 0; i < colors.size(); ++i) by_key.emplace(keyOf(colors[i], numbers), i);
+      std::vector<Frame> named;
+      for (const NamedFile& d : depths) {
+        const auto it = by_key.find(keyOf(d, numbers));
+        if (it != by_key.end()) named.push_back({colors[it->second], d});
+      }
+      const bool positional = colors.size() == depths.size();
+      if (!named.empty() && (pairing == FramePairing::kName || 2 * named.size() >= depths.size())) {
+        frames_ = std::move(named);
+        how = numbers ? "by frame number" : "by file name";
+      } else if (pairing == FramePairing::kAuto && areTimestamps(colors) && areTimestamps(depths)) {
+        pairing = FramePairing::kTime;
+      } else if (positional) {
+        for (size_t i = 0; i < depths.size(); ++i) frames_.push_back({colors[i], depths[i]});
+        how = "by position in sorted order (the names do not pair, the counts agree)";
+      }
+    }
+    if (pairing == FramePairing::kTime) {
+      if (!areTimestamps(colors) || !areTimestamps(depths)) {
+        throw Error(dir_ + ": pairing by time needs timestamps as file names in " + color_name +
+                    " and depth/");
+      }
+      std::vector<double> color_times;
+      for (const NamedFile& c : colors) color_times.push_back(c.number);
+      for (const NamedFile& d : depths) {
+        const long c = nearestIndex(color_times, d.number, options_.tum_max_dt_s);
+        if (c >= 0) frames_.push_back({colors[static_cast<size_t>(c)], d});
+      }
+      std::ostringstream text;
+      text << "by timestamp (within " << options_.tum_max_dt_s << " s)";
+      how = text.str();
+    }
+    if (frames_.empty()) {
+      throw Error(dir_ + ": cannot pair " + std::to_string(colors.size()) + " images in " +
+                  color_name + " with " + std::to_string(depths.size()) +
+                  " in depth/ (names differ, counts differ, names are not timestamps)");
+    }
+    unmatched_ = depths.size() - frames_.size();
+    std::ostringstream note;
+    note << "images: " << frames_.size() << " frames from " << color_name << " and depth/, paired "
+         << how;
+    if (unmatched_) note << "; " << unmatched_ << " depth images without a colour image";
+    notes_.push_back(note.str());
+  }
+
+  void readCamera() {
+    Eigen::Vector4d k;
+    std::string from;
+    if (options_.intrinsics) {
+      k = *options_.intrinsics;
+      from = options_.intrinsics_file.empty() ? "--intrinsics" : options_.intrinsics_file;
+    } else {
+      from = firstExisting(dir_, kIntrinsicsFiles, std::size(kIntrinsicsFiles), false);
+      if (from.empty()) {
+        throw Error(dir_ + ": no intrinsics file (looked for " + joined(kIntrinsicsFiles) +
+                    "; pass --intrinsics FILE or fx,fy,cx,cy)");
+      }
+      k = readIntrinsicsFile(from);
+    }
+    camera_ = PinholeCamera{k(0), k(1), k(2), k(3), 0, 0};
+    const std::string first_depth = depth_dir_ + "/" + frames_.front().depth.name;
+    first_depth_ = readDepthFile(first_depth);
+    camera_.width = first_depth_.width();
+    camera_.height = first_depth_.height();
+    std::string why;
+    if (!camera_.isValid(&why)) throw Error(from + ": " + why);
+    const ColorImage color = readColorFile(color_dir_ + "/" + frames_.front().color.name);
+    color_width_ = color.width();
+    color_height_ = color.height();
+    std::ostringstream note;
+    note << "intrinsics: " << from << " (fx " << k(0) << ", fy " << k(1) << ", cx " << k(2)
+         << ", cy " << k(3) << "), depth " << camera_.width << "x" << camera_.height << ", colour "
+         << color_width_ << "x" << color_height_;
+    if (color_width_ != camera_.width || color_height_ != camera_.height) {
+      note << " (resized to the depth size)";
+    }
+    notes_.push_back(note.str());
+  }
+
+  void readPoses() {
+    poses_from_ = options_.poses_path;
+    if (poses_from_.empty()) {
+      poses_from_ = firstExisting(dir_, kPoseFiles, std::size(kPoseFiles), false);
+    }
+    if (poses_from_.empty()) {
+      poses_from_ = firstExisting(dir_, kPoseFolders, std::size(kPoseFolders), true);
+    }
+    if (poses_from_.empty()) {
+      no_poses_ = dir_ + ": no pose file (looked for " + joined(kPoseFiles) + " and folders " +
+                  joined(kPoseFolders) + "; pass --poses FILE)";
+      notes_.push_back("poses: none found");
+      return;
+    }
+    if (isDirectory(poses_from_)) {
+      const std::vector<NamedFile> files = listFiles(poses_from_, {".txt"});
+      const bool numbers = allNumbered(files) && allNumbered(depthFiles());
+      for (const NamedFile& f : files) pose_files_.emplace(keyOf(f, numbers), f.name);
+      pose_key_by_number_ = numbers;
+      pose_folder_ = true;
+      notes_.push_back("poses: a 4x4 file per frame in " + poses_from_ + " (" +
+                       std::to_string(files.size()) + " files)");
+      return;
+    }
+    if (!isRegularFile(poses_from_)) throw Error(poses_from_ + ": pose file missing");
+    const PoseList list = readPoseList(poses_from_, options_.pose_tolerance);
+    std::string how;
+    if (list.format == PoseList::Format::kTum) {
+      std::map<long long, size_t> by_number;
+      const bool integer_times =
+          std::all_of(list.times_s.begin(), list.times_s.end(),
+                      [](double t) { return t == std::floor(t) && std::abs(t) < 1e15; });
+      if (integer_times && integer_numbers_) {
+        for (size_t i = 0; i < list.times_s.size(); ++i) {
+          by_number.emplace(static_cast<long long>(list.times_s[i]), i);
+        }
+      }
+      size_t found = 0;
+      for (size_t i = 0; i < frames_.size(); ++i) found += by_number.count(frameNumber(i));
+      if (timestamps_) {
+        how = "by timestamp";
+        for (size_t i = 0; i < list.poses.size(); ++i) {
+          if (!list.poses[i]) continue;
+          StampedPose p;
+          p.utime = static_cast<int64_t>(std::llround(list.times_s[i] * 1e6));
+          p.T_W_C = *list.poses[i];
+          timed_.push_back(p);
+        }
+        std::stable_sort(
+            timed_.begin(), timed_.end(),
+            [](const StampedPose& a, const StampedPose& b) { return a.utime < b.utime; });
+      } else if (found == frames_.size()) {
+        how = "by frame number (the timestamp column)";
+        for (size_t i = 0; i < frames_.size(); ++i)
+          by_frame_.push_back(by_number.at(frameNumber(i)));
+      } else if (list.poses.size() == frames_.size()) {
+        how = "by order (one pose per frame)";
+        for (size_t i = 0; i < frames_.size(); ++i) by_frame_.push_back(i);
+      } else {
+        throw Error(poses_from_ + ": " + std::to_string(list.poses.size()) + " TUM poses for " +
+                    std::to_string(frames_.size()) +
+                    " frames whose names are not timestamps, and the timestamp column does not "
+                    "number the frames: cannot pair them");
+      }
+    } else if (list.poses.size() == frames_.size()) {
+      how = "by order (one pose per frame)";
+      for (size_t i = 0; i < frames_.size(); ++i) by_frame_.push_back(i);
+    } else {
+      throw Error(poses_from_ + ": " + std::to_string(list.poses.size()) + " poses (" +
+                  poseListFormatName(list.format) + ") for " + std::to_string(frames_.size()) +
+                  " frames: a pose per frame needed");
+    }
+    list_ = list;
+    notes_.push_back("poses: " + poses_from_ + " (" + poseListFormatName(list.format) +
+                     "), matched " + how);
+  }
+
+  std::vector<NamedFile> depthFiles() const {
+    std::vector<NamedFile> out;
+    for (const Frame& f : frames_) out.push_back(f.depth);
+    return out;
+  }
+
+  std::optional<Eigen::Isometry3d> poseOf(size_t index, std::string* problem) const {
+    if (!no_poses_.empty()) {
+      *problem = no_poses_;
+      return std::nullopt;
+    }
+    const Frame& f = frames_.at(index);
+    if (pose_folder_) {
+      const auto it = pose_files_.find(keyOf(f.depth, pose_key_by_number_));
+      if (it == pose_files_.end()) {
+        *problem = poses_from_ + ": no pose file for depth image " + f.depth.name;
+        return std::nullopt;
+      }
+      return readPoseFile(poses_from_ + "/" + it->second, options_.pose_tolerance, problem);
+    }
+    if (timestamps_ && list_.format == PoseList::Format::kTum) {
+      return poseAtTime(timed_, f.depth.number, options_.tum_max_dt_s, poses_from_, problem);
+    }
+    const size_t i = by_frame_.at(index);
+    if (!list_.poses[i]) *problem = list_.problems[i];
+    return list_.poses[i];
+  }
+
+  void detectDepthScale() {
+    if (options_.depth_scale_m) {
+      depth_scale_m_ = *options_.depth_scale_m;
+      notes_.push_back("depth scale: " + formatDepthScale(depth_scale_m_) + " (given)");
+      return;
+    }
+    std::vector<uint16_t> values;
+    for (int v = 0; v < first_depth_.height(); ++v) {
+      const uint16_t* row = first_depth_.row(v);
+      for (int u = 0; u < first_depth_.width(); ++u) {
+        if (row[u] > 0) values.push_back(row[u]);
+      }
+    }
+    if (values.empty()) {
+      depth_scale_m_ = 0.001;
+      notes_.push_back("depth scale: " + formatDepthScale(depth_scale_m_) +
+                       " (assumed: the first depth image is empty; --depth-scale overrides)");
+      return;
+    }
+    auto quantile = [&values](double q) {
+      const size_t k = std::min(values.size() - 1, static_cast<size_t>(q * values.size()));
+      std::nth_element(values.begin(), values.begin() + static_cast<long>(k), values.end());
+      return static_cast<double>(values[k]);
+    };
+    const double median = quantile(0.5);
+    const double p99 = quantile(0.99);
+    depth_scale_m_ = (median <= kMaxMedianDepthMm && p99 <= kMaxP99DepthMm) ? 0.001 : 1.0 / 5000.0;
+    std::ostringstream note;
+    note.precision(3);
+    note << "depth scale: " << formatDepthScale(depth_scale_m_)
+         << ", detected from the first image (median " << median * depth_scale_m_ << " m, 99th "
+         << "percentile " << p99 * depth_scale_m_ << " m; --depth-scale overrides)";
+    notes_.push_back(note.str());
+  }
+
+  std::string dir_;
+  DatasetOptions options_;
+  std::string color_dir_;
+  std::string depth_dir_;
+  std::vector<Frame> frames_;
+  size_t unmatched_ = 0;
+  bool timestamps_ = false;
+  bool integer_numbers_ = false;
+  PinholeCamera camera_;
+  int color_width_ = 0;
+  int color_height_ = 0;
+  DepthImage first_depth_;
+  double depth_scale_m_ = 0.001;
+  // Poses: a folder of files, a list matched by frame, or a time-stamped list.
+  std::string poses_from_;
+  std::string no_poses_;
+  std::map<std::string, std::string> pose_files_;
+  bool pose_folder_ = false;
+  bool pose_key_by_number_ = false;
+  PoseList list_;
+  std::vector<size_t> by_frame_;
+  std::vector<StampedPose> timed_;
+  std::vector<std::string> notes_;
+};
+
+}  // namespace
+
+std::string missingForFolder(const std::string& dir) {
+  if (firstExisting(dir, kColorFolders, std::size(kColorFolders), true).empty()) {
+    return std::string("no colour folder (") + joined(kColorFolders) + ")";
+  }
+  if (!isDirectory(dir + "/depth")) return "no depth/ folder";
+  return "";
+}
+
+std::unique_ptr<DatasetReader> makeFolderReader(const std::string& dir,
+                                                const DatasetOptions& options) {
+  return std::make_unique<FolderReader>(dir, options);
+}
+
+}  // namespace internal
+}  // namespace panmap

@@ -1,0 +1,131 @@
+#include "panmap/io/pose_list.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "panmap/core/error.h"
+#include "panmap/core/pose.h"
+
+namespace panmap {
+namespace {
+
+struct Line {
+  int number = 0;
+  std::vector<double> values;
+};
+
+std::vector<Line> readLines(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot read pose file " + path);
+  std::vector<Line> out;
+  std::string text, token;
+  int number = 0;
+  while (std::getline(in, text)) {
+    ++number;
+    const size_t first = text.find_first_not_of(" \t\r");
+    if (first == std::string::npos || text[first] == '#') continue;
+    Line line;
+    line.number = number;
+    std::istringstream tokens(text);
+    while (tokens >> token) {
+      char* end = nullptr;
+      errno = 0;
+      const double value = std::strtod(token.c_str(), &end);
+      if (end == token.c_str() || *end != '\0') {
+        throw Error(path + ":" + std::to_string(number) + ": '" + token + "' is not a number");
+      }
+      line.values.push_back(value);
+    }
+    out.push_back(std::move(line));
+  }
+  if (out.empty()) throw Error(path + ": no poses");
+  return out;
+}
+
+void addMatrix(const Eigen::Matrix4d& T, const std::string& where, double tolerance,
+               PoseList* list) {
+  std::string why;
+  if (isRigidTransform(T, tolerance, &why)) {
+    list->poses.emplace_back(nearestIsometry(T));
+    list->problems.emplace_back();
+  } else {
+    list->poses.emplace_back();
+    list->problems.push_back(where + ": invalid pose, " + why);
+  }
+}
+
+}  // namespace
+
+const char* poseListFormatName(PoseList::Format format) {
+  switch (format) {
+    case PoseList::Format::kTum:
+      return "TUM";
+    case PoseList::Format::kMatrixPerLine:
+      return "matrix per line";
+    default:
+      return "stacked 4x4";
+  }
+}
+
+PoseList readPoseList(const std::string& path, double tolerance) {
+  const std::vector<Line> lines = readLines(path);
+  const size_t width = lines.front().values.size();
+  for (const Line& line : lines) {
+    if (line.values.size() != width) {
+      throw Error(path + ":" + std::to_string(line.number) + ": " +
+                  std::to_string(line.values.size()) + " numbers where line " +
+                  std::to_string(lines.front().number) + " has " + std::to_string(width));
+    }
+  }
+  PoseList list;
+  auto where = [&path](const Line& line) { return path + ":" + std::to_string(line.number); };
+  if (width == 8) {
+    list.format = PoseList::Format::kTum;
+    for (const Line& line : lines) {
+      const std::vector<double>& v = line.values;
+      const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+      list.times_s.push_back(v[0]);
+      if (!std::isfinite(v[0]) || !std::isfinite(q.norm()) || std::abs(q.norm() - 1.0) > 1e-3 ||
+          !Eigen::Vector3d(v[1], v[2], v[3]).allFinite()) {
+        list.poses.emplace_back();
+        list.problems.push_back(where(line) + ": invalid pose, not a finite unit quaternion");
+        continue;
+      }
+      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+      T.linear() = q.normalized().toRotationMatrix();
+      T.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+      list.poses.emplace_back(T);
+      list.problems.emplace_back();
+    }
+  } else if (width == 12 || width == 16) {
+    list.format = PoseList::Format::kMatrixPerLine;
+    for (const Line& line : lines) {
+      Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+      for (size_t i = 0; i < width; ++i) T(i / 4, i % 4) = line.values[i];
+      addMatrix(T, where(line), tolerance, &list);
+    }
+  } else if (width == 4) {
+    if (lines.size() % 4 != 0) {
+      throw Error(path + ": " + std::to_string(lines.size()) +
+                  " lines of 4 numbers, not a whole number of 4x4 matrices");
+    }
+    list.format = PoseList::Format::kStacked;
+    for (size_t k = 0; k < lines.size(); k += 4) {
+      Eigen::Matrix4d T;
+      for (int r = 0; r < 4; ++r) {
+        for (int c = 0; c < 4; ++c) T(r, c) = lines[k + r].values[static_cast<size_t>(c)];
+      }
+      addMatrix(T, where(lines[k]), tolerance, &list);
+    }
+  } else {
+    throw Error(path + ":" + std::to_string(lines.front().number) + ": " + std::to_string(width) +
+                " numbers per line; expected TUM (t tx ty tz qx qy qz qw), 12 or 16 (a 3x4 or "
+                "4x4 matrix per line) or 4 (a 4x4 matrix over four lines)");
+  }
+  return list;
+}
+
+}  // namespace panmap
