@@ -75,6 +75,12 @@ occupancy=$(build/panmap-bench-occupancy --benchmark_format=csv --benchmark_filt
 occupancy+=$'\n'$(build/panmap-bench-occupancy --benchmark_format=csv --benchmark_filter=BM_OctomapInsertPointCloud 2>/dev/null | python3 scripts/bench/gb_counters.py median_ms p95_ms)
 hash=$(gb build/panmap-bench-block-hash | awk -F, '{gsub(/"/,"",$1); printf "| %s | %.2f ms |\n", $1, $3}')
 
+# The soak section belongs to scripts/bench/soak.py: kept as it was.
+soak=""
+if [ -f "$out" ]; then
+  soak=$(sed -n '/<!-- soak:begin/,/<!-- soak:end -->/p' "$out")
+fi
+
 cat > "$out" <<MD
 # Performance
 
@@ -178,4 +184,5 @@ lookups in runs of 8 and 11k inserts (\`panmap-bench-block-hash\`):
 |---|---|
 ${hash}
 MD
+[ -n "$soak" ] && printf '\n%s\n' "$soak" >> "$out"
 echo "bench: wrote $out" >&2

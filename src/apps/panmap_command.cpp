@@ -1,14 +1,20 @@
 // panmap-command: sends one PANMAP_COMMAND to a running panmap-mapper (finish, save, export,
-// optimise), e.g. at the end of an lcm-logplayer replay.
+// optimise), e.g. at the end of an lcm-logplayer replay; `status` prints the mapper's next
+// PANMAP_STATUS as one JSON line (for scripts and monitoring).
 #include <chrono>
 #include <cstdio>
 #include <map>
+#include <optional>
+#include <utility>
 
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
 
 #include "panmap/command_t.hpp"
 #include "panmap/lcm/channels.h"
+#include "panmap/lcm/decode.h"
+#include "panmap/status_t.hpp"
 
 namespace {
 
@@ -31,15 +37,74 @@ bool selfTest(const std::string& url) {
   return echo.received > 0;
 }
 
+nlohmann::json statusJson(const panmap::status_t& s) {
+  nlohmann::json rejected = nlohmann::json::object(), stages = nlohmann::json::object();
+  for (int i = 0; i < s.num_reject_reasons; ++i) rejected[s.reject_reasons[i]] = s.reject_counts[i];
+  for (int i = 0; i < s.num_stages; ++i) {
+    stages[s.stage_names[i]] = {{"median_ms", s.stage_median_ms[i]},
+                                {"last_ms", s.stage_last_ms[i]}};
+  }
+  return {{"utime", s.utime},
+          {"state", s.state},
+          {"frames_received", s.frames_received},
+          {"frames_integrated", s.frames_integrated},
+          {"frames_dropped", s.frames_dropped},
+          {"frames_rejected", s.frames_rejected},
+          {"rejected", rejected},
+          {"stages", stages},
+          {"memory_bytes", s.memory_bytes},
+          {"num_blocks", s.num_blocks},
+          {"num_voxels", s.num_voxels},
+          {"num_superpoints", s.num_superpoints},
+          {"num_instances", s.num_instances},
+          {"vote_evictions", s.vote_evictions}};
+}
+
+struct StatusCatcher {
+  std::optional<panmap::status_t> received;
+  int malformed = 0;
+  void onMessage(const lcm::ReceiveBuffer* buffer, const std::string&) {
+    panmap::status_t msg;
+    if (panmap::decodeExactly(buffer->data, buffer->data_size, &msg)) {
+      received = msg;
+    } else {
+      ++malformed;
+    }
+  }
+};
+
+// Waits for one status message; prints it as JSON. 0 when one came, 1 otherwise.
+int printStatus(lcm::LCM* lcm, const std::string& channel, double timeout_s) {
+  StatusCatcher catcher;
+  lcm->subscribe(channel, &StatusCatcher::onMessage, &catcher);
+  std::optional<panmap::status_t>& received = catcher.received;
+  const int& malformed = catcher.malformed;
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::milliseconds(static_cast<int64_t>(timeout_s * 1000));
+  while (!received && std::chrono::steady_clock::now() < deadline) lcm->handleTimeout(100);
+  if (!received) {
+    std::fprintf(stderr, "panmap-command: error: no status on %s within %.1f s%s\n",
+                 channel.c_str(), timeout_s, malformed ? " (only malformed messages)" : "");
+    return 1;
+  }
+  std::printf("%s\n", statusJson(*received).dump().c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
       "Sends a command to panmap-mapper on PANMAP_COMMAND: finish (optimise, write the "
-      "outputs, exit), save [PATH] (map snapshot), export [DIR] (outputs now), optimise."};
+      "outputs, exit), save [PATH] (map snapshot), export [DIR] (outputs now), optimise; or "
+      "status: print the mapper's next PANMAP_STATUS as one JSON line."};
   std::string url, channel = panmap::kChannelCommand, command, argument;
   bool self_test = false;
-  app.add_option("command", command, "finish | save | export | optimise");
+  app.add_option("command", command, "finish | save | export | optimise | status");
+  double timeout_s = 5.0;
+  std::string status_channel = panmap::kChannelStatus;
+  app.add_option("--timeout-s", timeout_s, "status: how long to wait")->capture_default_str();
+  app.add_option("--channel-status", status_channel)->capture_default_str();
   app.add_flag("--self-test", self_test,
                "send nothing; exit 0 when a message published on the URL comes back (UDP "
                "multicast works), 1 otherwise");
@@ -55,6 +120,14 @@ int main(int argc, char** argv) {
       {"optimise", panmap::command_t::COMMAND_OPTIMISE},
       {"optimize", panmap::command_t::COMMAND_OPTIMISE}};
   const auto it = commands.find(command);
+  if (command == "status") {
+    lcm::LCM lcm(url);
+    if (!lcm.good()) {
+      std::fprintf(stderr, "panmap-command: error: cannot open LCM URL '%s'\n", url.c_str());
+      return 1;
+    }
+    return printStatus(&lcm, status_channel, timeout_s);
+  }
   if (command.empty()) {
     std::fprintf(stderr, "panmap-command: error: a command is required (see --help)\n");
     return 2;
@@ -62,7 +135,7 @@ int main(int argc, char** argv) {
   if (it == commands.end()) {
     std::fprintf(stderr,
                  "panmap-command: error: unknown command '%s' (finish, save, export, "
-                 "optimise)\n",
+                 "optimise, status)\n",
                  command.c_str());
     return 2;
   }

@@ -27,6 +27,8 @@
 #include "panmap/mapper/objects.h"
 #include "panmap/mapper/outputs.h"
 #include "panmap/octomap_t.hpp"
+#include "panmap/recovery/autosave.h"
+#include "panmap/recovery/resume.h"
 
 namespace {
 
@@ -85,6 +87,37 @@ nlohmann::json mapJson(const panmap::Mapper& mapper, const panmap::OutputSummary
             {"threads", mapper.config().num_threads}}}};
 }
 
+nlohmann::json autosaveJson(const panmap::Autosaver* autosaver, double period_s) {
+  if (!autosaver) return {{"period_s", 0}};
+  const panmap::Autosaver::Stats s = autosaver->stats();
+  return {{"period_s", period_s},
+          {"written", s.written},
+          {"waited_busy", s.waited_busy},
+          {"waited_ms", s.waited_ms},
+          {"failed", s.failed},
+          {"last_bytes", s.last_bytes},
+          {"last_serialize_ms", s.last_serialize_ms},
+          {"last_write_ms", s.last_write_ms}};
+}
+
+nlohmann::json resumeJson(const std::optional<panmap::ResumePoint>& point) {
+  if (!point) return nullptr;
+  nlohmann::json lost = nlohmann::json::array();
+  for (const auto& [id, utime] : point->lost) lost.push_back(id);
+  return {{"snapshot", point->path},
+          {"frames", point->frames},
+          {"last_frame_id", point->last_frame_id},
+          {"last_utime", point->last_utime},
+          {"lost_frame_ids", lost},
+          {"refused_snapshots", point->refused}};
+}
+
+// The autosave folder of an output folder (or the folder itself when it holds snapshots).
+std::string autosaveDirOf(const std::string& dir) {
+  const std::string sub = dir + "/autosave";
+  return panmap::listAutosaves(dir).empty() ? sub : dir;
+}
+
 void writeJson(const std::string& path, const nlohmann::json& json) {
   std::ofstream out(path);
   out << json.dump(2) << "\n";
@@ -138,6 +171,16 @@ int main(int argc, char** argv) {
                  "(default: the config's tracking.mode, auto)")
       ->check(CLI::IsMember({"off", "auto", "on"}));
   app.add_option("--load", load_path, "resume from a map.panmap snapshot");
+  std::string resume_dir;
+  app.add_option("--resume", resume_dir,
+                 "continue after a crash from the newest good autosave of this output folder "
+                 "(DIR/autosave); frames it already holds are skipped, lost ones reported")
+      ->excludes("--load");
+  double autosave_s = 60.0;
+  app.add_option("--autosave-s", autosave_s,
+                 "snapshot the map every S seconds of stream time into OUT/autosave (atomic, "
+                 "two kept; 0: never). Default 60 live, off offline unless given")
+      ->capture_default_str();
   app.add_flag("--export-only", export_only,
                "with --load: no mapping, only run the final optimisation and write the outputs");
   app.add_option("--channel-rgbd", options.channel_rgbd)->capture_default_str();
@@ -162,6 +205,11 @@ int main(int argc, char** argv) {
                    "wait this long for panmap-optimizer's labels, then write unoptimised outputs")
       ->capture_default_str();
   live_group
+      ->add_option("--optimizer-retry-s", live.optimiser_retry_s,
+                   "publish the final graph again at this period until labels come (an "
+                   "optimiser restarted meanwhile still answers)")
+      ->capture_default_str();
+  live_group
       ->add_option("--queue-frames", live.max_queued_frames,
                    "frames waiting for the mapper at most; the oldest is dropped beyond")
       ->capture_default_str();
@@ -179,6 +227,7 @@ int main(int argc, char** argv) {
       std::printf("%s", panmap::configToYaml(file_config).c_str());
       return 0;
     }
+    if (out_dir.empty()) out_dir = resume_dir;
     if (out_dir.empty()) throw panmap::Error("--out is required");
     if (!config_path.empty()) {
       file_config = panmap::loadConfig(config_path);
@@ -200,9 +249,37 @@ int main(int argc, char** argv) {
     panmap::OptimiserConfig optimiser = file_config.optimiser;
     if (no_regularise) optimiser.regularise = false;
     if (no_refine) optimiser.refine = false;
-    std::unique_ptr<panmap::Mapper> mapper = load_path.empty()
-                                                 ? std::make_unique<panmap::Mapper>(config)
-                                                 : panmap::Mapper::load(load_path);
+    std::unique_ptr<panmap::Mapper> mapper;
+    std::optional<panmap::ResumePoint> resumed;
+    if (!resume_dir.empty()) {
+      resumed = panmap::resumeFrom(autosaveDirOf(resume_dir));
+      mapper = std::move(resumed->mapper);
+      options.resume_after_utime = resumed->last_utime;
+      std::fprintf(stderr, "panmap-mapper: %s\n", panmap::describeResume(*resumed).c_str());
+    } else {
+      mapper = load_path.empty() ? std::make_unique<panmap::Mapper>(config)
+                                 : panmap::Mapper::load(load_path);
+    }
+    // Offline runs can be replayed from their log, so they autosave only when asked to.
+    const bool offline = !log_path.empty() || export_only;
+    if (offline && app.count("--autosave-s") == 0) autosave_s = 0.0;
+    std::unique_ptr<panmap::Autosaver> autosaver;
+    if (autosave_s > 0.0 && !export_only) {
+      panmap::Autosaver::Config autosave_config;
+      autosave_config.dir = out_dir + "/autosave";
+      autosave_config.period_s = autosave_s;
+      autosaver = std::make_unique<panmap::Autosaver>(autosave_config);
+    }
+    // After the outputs are safely written the snapshots have served their purpose.
+    auto finishAutosave = [&]() {
+      if (autosaver) {
+        autosaver->clear();
+      } else if (resumed) {
+        for (const std::string& path : panmap::listAutosaves(autosaveDirOf(resume_dir))) {
+          std::remove(path.c_str());
+        }
+      }
+    };
     panmap::OutputOptions output_options;
     output_options.snapshots = !no_snapshots;
 
@@ -219,7 +296,8 @@ int main(int argc, char** argv) {
         report = panmap::mapLog(
             log_path, options, mapper.get(),
             [&](size_t done, size_t total) { progress.update(done >> 20, total >> 20); },
-            [&](const panmap::SyncedFrame&, const panmap::FrameStats&) {
+            [&](const panmap::SyncedFrame& f, const panmap::FrameStats&) {
+              if (autosaver) autosaver->afterFrame(*mapper, f.frame.frame_id, f.frame.utime);
               ++frames;
               char note[64];
               std::snprintf(note, sizeof(note), "%lld frames, %.1f frames/s",
@@ -239,6 +317,8 @@ int main(int argc, char** argv) {
       nlohmann::json json = sessionJson(report);
       json["mode"] = export_only ? "export-only" : "offline";
       json["log"] = log_path;
+      json["autosave"] = autosaveJson(autosaver.get(), autosave_s);
+      json["resumed"] = resumeJson(resumed);
       json["events"] = report.events;
       json["wall_s"] = report.wall_s;
       json.update(mapJson(*mapper, outputs));
@@ -252,6 +332,7 @@ int main(int argc, char** argv) {
                        {"regularise", optimiser.regularise},
                        {"refine", optimiser.refine}};
       writeJson(out_dir + "/report.json", json);
+      finishAutosave();
       std::printf(
           "mapped %lld frames in %.1f s (median %.1f ms/frame): %zu super-points, %zu "
           "instances after optimisation, %zu mesh vertices; outputs in %s\n",
@@ -266,7 +347,12 @@ int main(int argc, char** argv) {
     // Live: LCM in, LCM out.
     lcm::LCM lcm(lcm_url);
     if (!lcm.good()) throw panmap::Error("cannot open LCM URL '" + lcm_url + "'");
-    panmap::LiveMapper node(&lcm, live, mapper.get());
+    panmap::LiveMapper node(&lcm, live, mapper.get(),
+                            [&](const panmap::SyncedFrame& f, const panmap::FrameStats&) {
+                              if (autosaver) {
+                                autosaver->afterFrame(*mapper, f.frame.frame_id, f.frame.utime);
+                              }
+                            });
     node.setCommandHandler([&](int8_t command, const std::string& argument, panmap::Mapper* m,
                                const panmap::GraphLabels* labels) {
       if (command == panmap::command_t::COMMAND_SAVE) {
@@ -326,6 +412,9 @@ int main(int argc, char** argv) {
     nlohmann::json json = sessionJson(stats);
     json["mode"] = "live";
     json["lcm_url"] = lcm_url;
+    json["autosave"] = autosaveJson(autosaver.get(), autosave_s);
+    json["resumed"] = resumeJson(resumed);
+    json["graph_requests_sent"] = node.graphRequestsSent();
     json["frames_received"] = node.framesReceived();
     json["frames_dropped_behind"] = node.framesDropped();
     json["wall_s"] = wall_s;
@@ -336,6 +425,7 @@ int main(int argc, char** argv) {
                      {"fragments_folded", labels ? labels->fragments_folded : 0},
                      {"fragments_dropped", labels ? labels->fragments_dropped : 0}};
     writeJson(out_dir + "/report.json", json);
+    finishAutosave();
     std::printf(
         "mapped %lld of %lld frames received (%lld dropped behind) in %.1f s: %zu "
         "super-points, %zu instances%s, %zu mesh vertices; outputs in %s\n",

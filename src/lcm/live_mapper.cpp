@@ -28,11 +28,14 @@ void LiveOptions::check() const {
   if (!(publish_period_s >= 0.0)) throw Error("live: publish_period_s must be >= 0");
   if (max_queued_frames < 1) throw Error("live: max_queued_frames must be at least 1");
   if (!(optimiser_timeout_s >= 0.0)) throw Error("live: optimiser_timeout_s must be >= 0");
+  if (!(optimiser_retry_s > 0.0)) throw Error("live: optimiser_retry_s must be positive");
 }
 
-LiveMapper::LiveMapper(lcm::LCM* lcm, const LiveOptions& options, Mapper* mapper)
+LiveMapper::LiveMapper(lcm::LCM* lcm, const LiveOptions& options, Mapper* mapper,
+                       MappingSession::FrameHook hook)
     : lcm_(lcm), options_(options), mapper_(mapper), session_(options.session, mapper) {
   options_.check();
+  if (hook) session_.setFrameHook(std::move(hook));
   if (!lcm_ || !lcm_->good()) throw Error("LCM is not ready");
   for (const std::string& channel : {options_.session.channel_rgbd, options_.session.channel_pose,
                                      options_.session.channel_panoptic}) {
@@ -279,12 +282,21 @@ std::optional<GraphLabels> LiveMapper::requestLabels(const std::atomic<bool>& st
   const int64_t request = ++request_id_;
   labels_.reset();
   const superpoint_graph_t graph = toMessage(mapper_->graph(), wallUtime(), request);
-  lcm_->publish(options_.channel_graph, &graph);
+  using Clock = std::chrono::steady_clock;
+  const auto seconds = [](double s) {
+    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  };
+  const auto deadline = Clock::now() + seconds(options_.optimiser_timeout_s);
+  auto next_send = Clock::now();
   publishStatus("optimising");
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(options_.optimiser_timeout_s));
-  while (!stop && std::chrono::steady_clock::now() < deadline) {
+  while (!stop && Clock::now() < deadline) {
+    if (Clock::now() >= next_send) {
+      // Again and again until answered: an optimiser that was down or restarted meanwhile
+      // never saw the earlier copies (it answers each copy; the first answer is taken).
+      lcm_->publish(options_.channel_graph, &graph);
+      ++graph_requests_sent_;
+      next_send = Clock::now() + seconds(options_.optimiser_retry_s);
+    }
     lcm_->handleTimeout(50);
     if (labels_ && labels_request_id_ == request) return labels_;
   }

@@ -61,6 +61,10 @@ bool MappingSession::handle(const std::string& channel, const void* data, size_t
       }
       RgbdFrame frame = fromMessage(msg);
       ++stats_.frames_received;
+      if (frame.utime <= options_.resume_after_utime) {
+        ++stats_.rejected["frame: mapped before the resume point"];
+        return true;
+      }
       newest_utime_ = std::max(newest_utime_, frame.utime);
       sync_.addFrame(std::move(frame));
     } else if (channel == options_.channel_pose) {
@@ -124,6 +128,15 @@ SessionStats MappingSession::stats() const {
   if (out.sync.rejected_no_pose) out.rejected["frame: no pose"] += out.sync.rejected_no_pose;
   if (out.sync.dropped_queue_full) {
     out.rejected["frame: synchroniser queue full"] += out.sync.dropped_queue_full;
+  }
+  const std::pair<const char*, int64_t> counted[] = {
+      {"frame: repeated timestamp", out.sync.repeated_frames},
+      {"frame: out of order", out.sync.out_of_order_frames},
+      {"pose: repeated timestamp", out.sync.repeated_poses},
+      {"panoptic: repeated timestamp", out.sync.repeated_panoptic},
+      {"panoptic: frame already mapped", out.sync.late_panoptic}};
+  for (const auto& [reason, n] : counted) {
+    if (n) out.rejected[reason] += n;
   }
   for (const auto& [stage, list] : times_ms_) out.timings[stage] = summariseTimes(list);
   return out;

@@ -1,5 +1,7 @@
 #include "panmap/mapper/frame_sync.h"
 
+#include <algorithm>
+
 #include "panmap/core/error.h"
 
 namespace panmap {
@@ -17,18 +19,37 @@ FrameSynchronizer::FrameSynchronizer(const SyncConfig& config) : config_(config)
 
 void FrameSynchronizer::addFrame(RgbdFrame frame) {
   ++stats_.frames_in;
-  if (frames_.size() >= config_.max_queue) {
+  if (frame.utime < newest_handled_) {
+    ++stats_.out_of_order_frames;
+    return;
+  }
+  const auto at =
+      std::upper_bound(frames_.begin(), frames_.end(), frame.utime,
+                       [](int64_t utime, const RgbdFrame& queued) { return utime < queued.utime; });
+  if (frame.utime == newest_handled_ ||
+      (at != frames_.begin() && std::prev(at)->utime == frame.utime)) {
+    ++stats_.repeated_frames;
+    return;
+  }
+  frames_.insert(at, std::move(frame));
+  if (frames_.size() > config_.max_queue) {
+    newest_handled_ = std::max(newest_handled_, frames_.front().utime);
     frames_.pop_front();
     ++stats_.dropped_queue_full;
   }
-  frames_.push_back(std::move(frame));
 }
 
-void FrameSynchronizer::addPose(const StampedPose& pose) { poses_[pose.utime] = pose; }
+void FrameSynchronizer::addPose(const StampedPose& pose) {
+  if (!poses_.emplace(pose.utime, pose).second) ++stats_.repeated_poses;
+}
 
 void FrameSynchronizer::addPanoptic(PanopticFrame panoptic) {
   const int64_t utime = panoptic.utime;
-  panoptics_[utime] = std::move(panoptic);
+  if (utime <= newest_handled_) {
+    ++stats_.late_panoptic;  // its frame is mapped (or refused) already
+    return;
+  }
+  if (!panoptics_.emplace(utime, std::move(panoptic)).second) ++stats_.repeated_panoptic;
 }
 
 std::optional<Eigen::Isometry3d> FrameSynchronizer::poseAt(int64_t utime, bool final,
@@ -81,6 +102,7 @@ std::vector<SyncedFrame> FrameSynchronizer::popReady(int64_t now_utime) {
     if (!pose) {
       if (!timed_out) break;  // keep order: later frames wait behind this one
       ++stats_.rejected_no_pose;
+      newest_handled_ = std::max(newest_handled_, frame.utime);
       frames_.pop_front();
       continue;
     }
@@ -95,6 +117,7 @@ std::vector<SyncedFrame> FrameSynchronizer::popReady(int64_t now_utime) {
     } else {
       ++stats_.geometry_only;
     }
+    newest_handled_ = std::max(newest_handled_, frame.utime);
     out.frame = std::move(frame);
     frames_.pop_front();
     ++stats_.frames_out;

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "panmap/core/binary_io.h"
+#include "panmap/io/atomic_file.h"
 #include "panmap/io/image_codec.h"
 #include "panmap/mapper/mapper.h"
 
@@ -18,6 +19,8 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 // 4: III-B apart counts.
 // 5: the pose correction model, the drift filter's config and state.
 constexpr uint32_t kVersion = 5;
+// Magic, version, payload size.
+constexpr size_t kHeaderBytes = sizeof(kMagic) + sizeof(uint32_t) + sizeof(uint64_t);
 
 void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put(c.map.voxel_size_m);
@@ -282,8 +285,15 @@ GraphAccumulator::Snapshot getGraph(BinaryReader* r) {
 
 }  // namespace
 
-void Mapper::save(const std::string& path) const {
+std::vector<uint8_t> Mapper::serialize() const {
+  // One buffer: header, payload, CRC; the payload size is patched in at the end.
   BinaryWriter payload;
+  // The blocks are most of it; the rest (super-points, graph, occupancy) grows the buffer once
+  // or twice.
+  payload.reserve(map_->numBlocks() * (13 + sizeof(Block::voxels)) * 5 / 4 + (1 << 20));
+  payload.putBytes(kMagic, sizeof(kMagic));
+  payload.put<uint32_t>(kVersion);
+  payload.put<uint64_t>(0);
   putConfig(&payload, config_);
   payload.put<int64_t>(frames_);
   payload.put<uint64_t>(vote_evictions_);
@@ -312,24 +322,25 @@ void Mapper::save(const std::string& path) const {
   }
   if (occupancy_) occupancy_->writeState(&payload);
 
-  BinaryWriter file;
-  file.putBytes(kMagic, sizeof(kMagic));
-  file.put<uint32_t>(kVersion);
-  file.put<uint64_t>(payload.bytes().size());
-  file.putBytes(payload.bytes().data(), payload.bytes().size());
-  file.put<uint32_t>(static_cast<uint32_t>(
-      crc32(0L, payload.bytes().data(), static_cast<uInt>(payload.bytes().size()))));
-  // Write beside and rename, so a crash never leaves a half-written snapshot in place.
-  const std::string partial = path + ".partial";
-  writeFileBytes(partial, file.bytes());
-  if (std::rename(partial.c_str(), path.c_str()) != 0) {
-    std::remove(partial.c_str());
-    throw Error("cannot write map file " + path);
-  }
+  const uint64_t size = payload.bytes().size() - kHeaderBytes;
+  payload.putAt<uint64_t>(sizeof(kMagic) + sizeof(uint32_t), size);
+  payload.put<uint32_t>(static_cast<uint32_t>(
+      crc32(0L, payload.bytes().data() + kHeaderBytes, static_cast<uInt>(size))));
+  return payload.release();
+}
+
+void Mapper::save(const std::string& path) const {
+  const std::vector<uint8_t> bytes = serialize();
+  // A crash never leaves a half-written snapshot in place of a good one.
+  writeFileAtomically(path, bytes.data(), bytes.size());
 }
 
 std::unique_ptr<Mapper> Mapper::load(const std::string& path) {
-  const std::vector<uint8_t> bytes = readFileBytes(path);
+  return deserialize(readFileBytes(path), path);
+}
+
+std::unique_ptr<Mapper> Mapper::deserialize(const std::vector<uint8_t>& bytes,
+                                            const std::string& path) {
   BinaryReader header(bytes.data(), bytes.size(), path);
   char magic[8];
   header.getBytes(magic, sizeof(magic));
@@ -341,14 +352,21 @@ std::unique_ptr<Mapper> Mapper::load(const std::string& path) {
                 std::to_string(kVersion));
   }
   const uint64_t size = header.get<uint64_t>();
-  if (size + sizeof(uint32_t) != header.remaining()) throw Error(path + ": truncated map file");
+  if (size > header.remaining() || header.remaining() - size != sizeof(uint32_t)) {
+    throw Error(path + ": " +
+                (size + sizeof(uint32_t) > header.remaining() ? "truncated" : "overlong") +
+                " map file (" + std::to_string(bytes.size()) +
+                " bytes; the header at offset 12 announces " +
+                std::to_string(kHeaderBytes + size + sizeof(uint32_t)) + ")");
+  }
   const uint8_t* payload = bytes.data() + (bytes.size() - header.remaining());
   uint32_t stored_crc;
   std::memcpy(&stored_crc, payload + size, sizeof(stored_crc));
   if (stored_crc != static_cast<uint32_t>(crc32(0L, payload, static_cast<uInt>(size)))) {
-    throw Error(path + ": checksum mismatch (corrupt map file)");
+    throw Error(path + ": checksum mismatch over bytes " + std::to_string(kHeaderBytes) + "-" +
+                std::to_string(kHeaderBytes + size) + " (corrupt map file)");
   }
-  BinaryReader r(payload, size, path);
+  BinaryReader r(payload, size, path, kHeaderBytes);
   auto mapper = std::make_unique<Mapper>(getConfig(&r));
   mapper->frames_ = r.get<int64_t>();
   mapper->vote_evictions_ = r.get<uint64_t>();

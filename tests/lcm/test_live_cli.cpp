@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "child_process.h"
+#include "lcm_udp.h"
 #include "panmap/command_t.hpp"
 #include "panmap/io/ply.h"
 #include "panmap/io/tum_trajectory.h"
@@ -30,26 +31,6 @@ const char* kUrl = "udpm://239.255.76.67:7683?ttl=0&recv_buf_size=16777216";
 nlohmann::json readJson(const std::string& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);
-}
-
-struct StatusWatch {
-  int received = 0;
-  void onStatus(const lcm::ReceiveBuffer*, const std::string&, const status_t*) { ++received; }
-};
-
-bool multicastWorks() {
-  lcm::LCM lcm(kUrl);
-  if (!lcm.good()) return false;
-  StatusWatch watch;
-  lcm.subscribe("PANMAP_STATUS", &StatusWatch::onStatus, &watch);
-  status_t probe;
-  probe.utime = 0;
-  probe.num_reject_reasons = probe.num_stages = 0;
-  for (int attempt = 0; attempt < 3 && watch.received == 0; ++attempt) {
-    lcm.publish("PANMAP_STATUS", &probe);
-    lcm.handleTimeout(300);
-  }
-  return watch.received > 0;
 }
 
 class LiveCli : public ::testing::Test {
@@ -92,10 +73,7 @@ TEST_F(LiveCli, OfflineRunsAreByteIdentical) {
 }
 
 TEST_F(LiveCli, LogplayerToMapperAndOptimiserOverUdp) {
-  if (!multicastWorks()) {
-    GTEST_SKIP() << "UDP multicast on loopback is unavailable here (run scripts/setup.sh as root: "
-                    "ip link set lo multicast on; ip route add 239.255.76.0/24 dev lo)";
-  }
+  if (!test::multicastWorks(kUrl)) GTEST_SKIP() << test::kNoMulticast;
   const std::string out = dir_->path("live");
   test::ChildProcess optimiser({test::binPath("panmap-optimizer"), "--lcm-url", kUrl},
                                dir_->path("optimizer.log"));
@@ -106,8 +84,8 @@ TEST_F(LiveCli, LogplayerToMapperAndOptimiserOverUdp) {
   ASSERT_TRUE(optimiser.started() && mapper.started());
   // The mapper is up once its status arrives.
   lcm::LCM lcm(kUrl);
-  StatusWatch watch;
-  lcm.subscribe("PANMAP_STATUS", &StatusWatch::onStatus, &watch);
+  test::StatusWatch watch;
+  lcm.subscribe("PANMAP_STATUS", &test::StatusWatch::onStatus, &watch);
   for (int i = 0; i < 100 && watch.received == 0; ++i) lcm.handleTimeout(100);
   ASSERT_GT(watch.received, 0) << test::fileBytes(dir_->path("mapper.log"));
 
@@ -157,8 +135,8 @@ TEST_F(LiveCli, LogplayerToMapperAndOptimiserOverUdp) {
 }
 
 TEST_F(LiveCli, DeadOptimiserCostsTheLabelsNotTheMap) {
-  if (!multicastWorks()) GTEST_SKIP() << "UDP multicast on loopback is unavailable here";
   const std::string url = "udpm://239.255.76.67:7684?ttl=0&recv_buf_size=16777216";
+  if (!test::multicastWorks(url)) GTEST_SKIP() << test::kNoMulticast;
   const std::string out = dir_->path("dead");
   test::ChildProcess optimiser({test::binPath("panmap-optimizer"), "--lcm-url", url});
   test::ChildProcess mapper(
@@ -166,8 +144,8 @@ TEST_F(LiveCli, DeadOptimiserCostsTheLabelsNotTheMap) {
        "--queue-frames", "64", "--optimizer-timeout-s", "1"},
       dir_->path("dead.log"));
   lcm::LCM lcm(url);
-  StatusWatch watch;
-  lcm.subscribe("PANMAP_STATUS", &StatusWatch::onStatus, &watch);
+  test::StatusWatch watch;
+  lcm.subscribe("PANMAP_STATUS", &test::StatusWatch::onStatus, &watch);
   for (int i = 0; i < 100 && watch.received == 0; ++i) lcm.handleTimeout(100);
   ASSERT_GT(watch.received, 0);
   test::ChildProcess player({"lcm-logplayer", "-l", url, log()});

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "lcm_udp.h"
 #include "panmap/lcm/conversions.h"
 #include "panmap/lcm/log_import.h"
 #include "test_helpers.h"
@@ -88,26 +89,11 @@ TEST_F(Replay, FileProviderDeliversEveryFrame) {
   expectIntactFrames(recorder, log_path_);
 }
 
-// True when a message published on this URL comes back to a subscriber of the same process.
-bool multicastWorks(const std::string& url) {
-  lcm::LCM lcm(url);
-  if (!lcm.good()) return false;
-  Recorder recorder;
-  lcm.subscribe("PANMAP_PROBE", &Recorder::onMessage, &recorder);
-  const uint8_t probe[8] = {1, 2, 3, 4, 5, 6, 7, 8};
-  for (int attempt = 0; attempt < 3 && recorder.total() == 0; ++attempt) {
-    lcm.publish("PANMAP_PROBE", probe, sizeof(probe));
-    lcm.handleTimeout(300);
-  }
-  return recorder.total() > 0;
-}
-
 TEST_F(Replay, LcmLogplayerOverLoopbackUdp) {
   // A non-default port keeps this test away from any live LCM traffic on the machine.
   const std::string url = "udpm://239.255.76.67:7671?ttl=0&recv_buf_size=16777216";
-  if (!multicastWorks(url)) {
-    GTEST_SKIP() << "UDP multicast on loopback is unavailable here (run scripts/setup.sh as root: "
-                    "ip link set lo multicast on; ip route add 239.255.76.0/24 dev lo)";
+  if (!test::multicastWorks(url)) {
+    GTEST_SKIP() << test::kNoMulticast;
   }
   lcm::LCM lcm(url);
   Recorder recorder;

@@ -30,8 +30,19 @@ class BinaryWriter {
     put<uint64_t>(s.size());
     putBytes(s.data(), s.size());
   }
+  /// Makes room for `n` bytes in all, so a large buffer is not copied as it grows.
+  void reserve(size_t n) { bytes_.reserve(n); }
+  /// Overwrites a value written earlier at `offset` (e.g. a size known only at the end).
+  template <typename T>
+  void putAt(size_t offset, const T& value) {
+    static_assert(std::is_trivially_copyable<T>::value, "plain values only");
+    if (offset + sizeof(T) > bytes_.size()) throw Error("BinaryWriter::putAt past the end");
+    std::memcpy(bytes_.data() + offset, &value, sizeof(T));
+  }
   /// The bytes so far.
   const std::vector<uint8_t>& bytes() const { return bytes_; }
+  /// Hands the bytes over, leaving the writer empty.
+  std::vector<uint8_t> release() { return std::move(bytes_); }
 
  private:
   std::vector<uint8_t> bytes_;
@@ -41,8 +52,9 @@ class BinaryWriter {
 class BinaryReader {
  public:
   /// @param what names the source in error messages (e.g. the file)
-  BinaryReader(const uint8_t* data, size_t size, std::string what)
-      : data_(data), size_(size), what_(std::move(what)) {}
+  /// @param base_offset where `data` starts in that source, so errors name source offsets
+  BinaryReader(const uint8_t* data, size_t size, std::string what, size_t base_offset = 0)
+      : data_(data), size_(size), what_(std::move(what)), base_(base_offset) {}
   /// Reads a trivially copyable value.
   template <typename T>
   T get() {
@@ -55,7 +67,7 @@ class BinaryReader {
   void getBytes(void* out, size_t size) {
     if (size > size_ - pos_)
       throw Error(what_ + ": truncated (needs " + std::to_string(size) + " more bytes at offset " +
-                  std::to_string(pos_) + ")");
+                  std::to_string(base_ + pos_) + ")");
     std::memcpy(out, data_ + pos_, size);
     pos_ += size;
   }
@@ -65,7 +77,7 @@ class BinaryReader {
     const uint64_t n = get<uint64_t>();
     if (min_item_bytes > 0 && n > (size_ - pos_) / min_item_bytes) {
       throw Error(what_ + ": corrupt count " + std::to_string(n) + " at offset " +
-                  std::to_string(pos_));
+                  std::to_string(base_ + pos_ - sizeof(uint64_t)));
     }
     return n;
   }
@@ -84,6 +96,7 @@ class BinaryReader {
   size_t size_;
   size_t pos_ = 0;
   std::string what_;
+  size_t base_ = 0;
 };
 
 }  // namespace panmap

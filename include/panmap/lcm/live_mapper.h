@@ -36,6 +36,9 @@ struct LiveOptions {
   /// so a slow mapper stays current instead of falling further behind.
   size_t max_queued_frames = 4;
   double optimiser_timeout_s = 30.0;  ///< how long finish() waits for PANMAP_LABELS
+  /// The graph is published again at this period while no labels came: an optimiser started
+  /// (or restarted) after the first request still answers.
+  double optimiser_retry_s = 2.0;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -71,7 +74,9 @@ class LiveMapper {
 
   /// Subscribes on `lcm` (not owned; must outlive this) and starts the worker.
   /// @param mapper the map (not owned); only the worker touches it until stop()
-  LiveMapper(lcm::LCM* lcm, const LiveOptions& options, Mapper* mapper);
+  /// @param hook called on the worker after every integrated frame (e.g. autosave)
+  LiveMapper(lcm::LCM* lcm, const LiveOptions& options, Mapper* mapper,
+             MappingSession::FrameHook hook = {});
   /// Stops the worker (without draining).
   ~LiveMapper();
 
@@ -96,6 +101,9 @@ class LiveMapper {
   int64_t framesDropped() const { return dropped_frames_; }
   /// RGB-D messages received on the input channel so far.
   int64_t framesReceived() const { return received_frames_; }
+  /// Copies of the final graph published by requestLabels() (more than one: the optimiser was
+  /// slow, down or restarted).
+  int64_t graphRequestsSent() const { return graph_requests_sent_; }
   /// A status message of the current state. Call from the worker, or after drain().
   status_t status(const std::string& state) const;
 
@@ -147,6 +155,7 @@ class LiveMapper {
   int64_t request_id_ = 0;
   std::optional<GraphLabels> labels_;
   int64_t labels_request_id_ = -1;
+  int64_t graph_requests_sent_ = 0;
 };
 
 }  // namespace panmap

@@ -24,14 +24,19 @@ class LogWriter {
     const int size = msg.getEncodedSize();
     buffer_.resize(static_cast<size_t>(size));
     if (msg.encode(buffer_.data(), 0, size) != size) throw Error("cannot encode " + channel);
+    writeRaw(channel, utime, buffer_.data(), buffer_.size());
+  }
+
+  /// Appends one event with the bytes as they are (any bytes: e.g. garbage for tests).
+  void writeRaw(const std::string& channel, int64_t utime, const void* data, size_t size) {
     lcm::LogEvent event;
     event.eventnum = next_event_++;
     event.timestamp = utime;
     event.channel = channel;
-    event.datalen = size;
-    event.data = buffer_.data();
+    event.datalen = static_cast<int32_t>(size);
+    event.data = const_cast<void*>(data);
     if (log_.writeEvent(&event) != 0) throw Error("cannot write to log " + path_);
-    bytes_ += static_cast<size_t>(size);
+    bytes_ += size;
   }
 
   /// Payload bytes written so far.

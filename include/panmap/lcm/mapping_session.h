@@ -19,6 +19,8 @@ struct SessionOptions {
   std::string channel_panoptic = "PANOPTIC";
   SyncConfig sync;
   int64_t max_frames = 0;  ///< stop integrating after this many frames (0 = all)
+  /// Frames at or before this utime are refused (counted): a resumed map already holds them.
+  int64_t resume_after_utime = INT64_MIN;
 };
 
 /// Median and 95th percentile of a stage's per-frame time.

@@ -2,11 +2,13 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 
 #include <lcm/lcm-cpp.hpp>
 
 #include "panmap/graph/optimiser.h"
+#include "panmap/graph_labels_t.hpp"
 
 namespace panmap {
 
@@ -25,8 +27,10 @@ class OptimizerNode {
   /// Subscribes on `lcm` (not owned; it must outlive the node).
   OptimizerNode(lcm::LCM* lcm, const Config& config);
 
-  /// Graphs answered so far.
+  /// Graphs solved and answered so far.
   int64_t answered() const { return answered_; }
+  /// Copies of the last graph answered again from the cache, without solving.
+  int64_t repeated() const { return repeated_; }
   /// Messages refused, by reason.
   const std::map<std::string, int64_t>& rejected() const { return rejected_; }
 
@@ -36,6 +40,9 @@ class OptimizerNode {
   lcm::LCM* lcm_;
   Config config_;
   int64_t answered_ = 0;
+  int64_t repeated_ = 0;
+  std::optional<graph_labels_t> last_answer_;
+  size_t last_key_ = 0;
   std::map<std::string, int64_t> rejected_;
 };
 

@@ -42,10 +42,15 @@ struct SyncedFrame {
 struct SyncStats {
   int64_t frames_in = 0;
   int64_t frames_out = 0;
-  int64_t dropped_queue_full = 0;  ///< oldest frames dropped because the queue was full
-  int64_t rejected_no_pose = 0;    ///< no pose arrived in time
-  int64_t geometry_only = 0;       ///< mapped without a panoptic mask
-  int64_t unmatched_panoptic = 0;  ///< masks whose frame never came (or came too late)
+  int64_t dropped_queue_full = 0;   ///< oldest frames dropped because the queue was full
+  int64_t rejected_no_pose = 0;     ///< no pose arrived in time
+  int64_t geometry_only = 0;        ///< mapped without a panoptic mask
+  int64_t unmatched_panoptic = 0;   ///< masks whose frame never came (or came too late)
+  int64_t repeated_frames = 0;      ///< frames with the utime of a queued or mapped frame
+  int64_t out_of_order_frames = 0;  ///< frames older than one already mapped or refused
+  int64_t repeated_poses = 0;       ///< poses with the utime of a held pose (the first kept)
+  int64_t repeated_panoptic = 0;    ///< masks with the utime of a held mask (the first kept)
+  int64_t late_panoptic = 0;        ///< masks arriving after their frame was mapped or refused
 };
 
 /// Matches RGB-D frames with poses (exact, nearest within a tolerance, or interpolated) and
@@ -55,11 +60,15 @@ class FrameSynchronizer {
   /// Throws Error when the config is invalid.
   explicit FrameSynchronizer(const SyncConfig& config);
 
-  /// Queues a frame (drops the oldest when full).
+  /// Queues a frame in utime order (drops the oldest when full). A frame whose utime repeats a
+  /// queued or already handled frame's, or is older than the newest handled frame, is refused
+  /// and counted: the map must not depend on duplicated or late messages.
   void addFrame(RgbdFrame frame);
-  /// Adds a pose; poses must be finite (the caller validates).
+  /// Adds a pose; poses must be finite (the caller validates). A repeated utime keeps the
+  /// first pose (counted).
   void addPose(const StampedPose& pose);
-  /// Adds a panoptic mask for the frame with the same utime.
+  /// Adds a panoptic mask for the frame with the same utime; a repeated utime keeps the first,
+  /// a mask whose frame was already handled is dropped (both counted).
   void addPanoptic(PanopticFrame panoptic);
 
   /// Frames ready at stream time `now_utime` (the newest utime seen, or the wall clock),
@@ -79,6 +88,7 @@ class FrameSynchronizer {
   std::deque<RgbdFrame> frames_;
   std::map<int64_t, StampedPose> poses_;
   std::map<int64_t, PanopticFrame> panoptics_;
+  int64_t newest_handled_ = INT64_MIN;  ///< utime of the newest frame mapped or refused
   SyncStats stats_;
 };
 

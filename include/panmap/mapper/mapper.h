@@ -147,12 +147,19 @@ class Mapper {
   ///        their frame-count labels. Null: frame-count labels only.
   LabelledMesh extractMesh(const GraphLabels* labels = nullptr);
 
-  /// Writes the whole state (config, TSDF, votes, super-points) as a versioned binary file
-  /// with a CRC-32; throws Error naming the file on failure.
+  /// The whole state (config, TSDF, votes, super-points) as the bytes of a map file: a
+  /// versioned header, the payload and its CRC-32.
+  std::vector<uint8_t> serialize() const;
+  /// Writes serialize() atomically (temporary file, fsync, rename); throws Error naming the
+  /// file on failure.
   void save(const std::string& path) const;
   /// Reads a file written by save(); mapping continues exactly as if never interrupted.
   /// Throws Error naming the file when it is missing, of another version, or corrupt.
   static std::unique_ptr<Mapper> load(const std::string& path);
+  /// Rebuilds a mapper from serialize()'s bytes; `what` names the source in errors (with the
+  /// offset where reading failed).
+  static std::unique_ptr<Mapper> deserialize(const std::vector<uint8_t>& bytes,
+                                             const std::string& what);
 
  private:
   void validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,

@@ -1,0 +1,88 @@
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <cstdio>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "panmap/mapper/mapper.h"
+
+namespace panmap {
+
+/// Periodic map snapshots for crash recovery. The mapper is serialised on the thread that owns
+/// it, between frames (where it is consistent); the bytes are written atomically (temporary
+/// file, fsync, rename) on a background thread so the disk never stalls mapping. A journal
+/// lists every integrated frame, so a resume can say which frames the crash cost.
+class Autosaver {
+ public:
+  /// Where and how often.
+  struct Config {
+    std::string dir;         ///< snapshots: dir/autosave-NNNNNN.panmap; journal: dir/frames.journal
+    double period_s = 60.0;  ///< stream time (frame utimes) between snapshots; 0: never
+    int keep = 2;            ///< newest snapshots kept, older ones removed
+    /// Throws Error naming the bad field.
+    void check() const;
+  };
+
+  /// What the autosaver has done.
+  struct Stats {
+    int64_t written = 0;      ///< snapshots on disk
+    int64_t waited_busy = 0;  ///< due while the previous one was still being written
+    double waited_ms = 0.0;   ///< mapping time spent waiting for those writes
+    int64_t failed = 0;       ///< writes that failed (disk full, ...), with last_error
+    std::string last_path;
+    std::string last_error;
+    size_t last_bytes = 0;
+    double last_serialize_ms = 0.0;  ///< on the mapping thread
+    double last_write_ms = 0.0;      ///< on the background thread
+  };
+
+  /// Creates the folder; continues the numbering of snapshots already there (a resumed run).
+  /// Throws Error naming the folder when it cannot be created.
+  explicit Autosaver(const Config& config);
+  /// Waits for the snapshot being written.
+  ~Autosaver();
+  Autosaver(const Autosaver&) = delete;
+  Autosaver& operator=(const Autosaver&) = delete;
+
+  /// Call after every integrated frame, on the thread that owns the mapper: journals the frame
+  /// and snapshots the map once period_s of stream time has passed since the last snapshot
+  /// (or since the first frame).
+  void afterFrame(const Mapper& mapper, int64_t frame_id, int64_t utime);
+  /// Snapshots now, whatever the period (e.g. before a planned stop).
+  void snapshotNow(const Mapper& mapper);
+  /// Blocks until the snapshot in flight is on disk.
+  void wait();
+  /// Removes the snapshots and the journal (after the final outputs are safely written).
+  void clear();
+  /// Counters so far (thread-safe).
+  Stats stats() const;
+
+ private:
+  void writerLoop();
+
+  Config config_;
+  std::FILE* journal_ = nullptr;
+  int64_t next_number_ = 1;
+  int64_t last_snapshot_utime_ = INT64_MIN;
+
+  mutable std::mutex mutex_;
+  std::condition_variable cv_;
+  std::vector<uint8_t> pending_;  ///< bytes waiting for the writer
+  int64_t pending_number_ = 0;
+  bool writing_ = false;
+  bool stop_ = false;
+  Stats stats_;
+  std::thread writer_;
+};
+
+/// The snapshot file of a given number in an autosave folder.
+std::string autosavePath(const std::string& dir, int64_t number);
+
+/// Snapshot files of an autosave folder, newest (highest number) first.
+std::vector<std::string> listAutosaves(const std::string& dir);
+
+}  // namespace panmap

@@ -1,0 +1,182 @@
+#include "panmap/recovery/autosave.h"
+
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <filesystem>
+#include <regex>
+
+#include "panmap/core/error.h"
+#include "panmap/io/atomic_file.h"
+
+namespace panmap {
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+std::vector<std::pair<int64_t, std::string>> numberedAutosaves(const std::string& dir) {
+  namespace fs = std::filesystem;
+  static const std::regex name_re(R"(autosave-(\d+)\.panmap)");
+  std::vector<std::pair<int64_t, std::string>> out;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    std::smatch m;
+    if (std::regex_match(name, m, name_re)) {
+      out.emplace_back(std::stoll(m[1].str()), entry.path().string());
+    }
+  }
+  std::sort(out.rbegin(), out.rend());
+  return out;
+}
+
+}  // namespace
+
+void Autosaver::Config::check() const {
+  if (dir.empty()) throw Error("autosave: no folder");
+  if (!(period_s >= 0.0 && std::isfinite(period_s))) throw Error("autosave: period_s must be >= 0");
+  if (keep < 1) throw Error("autosave: keep must be at least 1");
+}
+
+std::string autosavePath(const std::string& dir, int64_t number) {
+  char name[64];
+  std::snprintf(name, sizeof(name), "autosave-%06" PRId64 ".panmap", number);
+  return dir + "/" + name;
+}
+
+std::vector<std::string> listAutosaves(const std::string& dir) {
+  std::vector<std::string> out;
+  for (const auto& [number, path] : numberedAutosaves(dir)) out.push_back(path);
+  return out;
+}
+
+Autosaver::Autosaver(const Config& config) : config_(config) {
+  config_.check();
+  std::error_code ec;
+  std::filesystem::create_directories(config_.dir, ec);
+  if (ec) throw Error("cannot create autosave folder " + config_.dir + ": " + ec.message());
+  const auto existing = numberedAutosaves(config_.dir);
+  if (!existing.empty()) next_number_ = existing.front().first + 1;
+  const std::string journal = config_.dir + "/frames.journal";
+  journal_ = std::fopen(journal.c_str(), "a");
+  if (!journal_) throw Error("cannot open " + journal);
+  // A marker per run: a resume reads only the frames journaled since the last one.
+  std::fprintf(journal_, "# run, next snapshot %" PRId64 "\n", next_number_);
+  std::fflush(journal_);
+  writer_ = std::thread(&Autosaver::writerLoop, this);
+}
+
+Autosaver::~Autosaver() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  if (writer_.joinable()) writer_.join();
+  if (journal_) std::fclose(journal_);
+}
+
+void Autosaver::afterFrame(const Mapper& mapper, int64_t frame_id, int64_t utime) {
+  // One write per frame: survives kill -9 (the kernel holds it), not a power cut, which is all
+  // the journal is for (saying which frames were lost).
+  std::fprintf(journal_, "%" PRId64 " %" PRId64 "\n", frame_id, utime);
+  std::fflush(journal_);
+  if (config_.period_s <= 0.0) return;
+  if (last_snapshot_utime_ == INT64_MIN) {
+    last_snapshot_utime_ = utime;
+    return;
+  }
+  if (static_cast<double>(utime - last_snapshot_utime_) < config_.period_s * 1e6) return;
+  last_snapshot_utime_ = utime;
+  snapshotNow(mapper);
+}
+
+void Autosaver::snapshotNow(const Mapper& mapper) {
+  {
+    // A disk slower than the period makes mapping wait rather than skip a snapshot: the bound
+    // on what a crash costs (one period) holds, and at most one map copy is in memory.
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (writing_ || !pending_.empty()) {
+      const auto start = std::chrono::steady_clock::now();
+      cv_.wait(lock, [&] { return pending_.empty() && !writing_; });
+      ++stats_.waited_busy;
+      stats_.waited_ms += msSince(start);
+    }
+  }
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<uint8_t> bytes = mapper.serialize();
+  const double serialize_ms = msSince(start);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_ = std::move(bytes);
+    pending_number_ = next_number_++;
+    stats_.last_serialize_ms = serialize_ms;
+  }
+  cv_.notify_all();
+}
+
+void Autosaver::wait() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  cv_.wait(lock, [&] { return pending_.empty() && !writing_; });
+}
+
+void Autosaver::clear() {
+  wait();
+  for (const std::string& path : listAutosaves(config_.dir)) std::remove(path.c_str());
+  std::fclose(journal_);
+  journal_ = std::fopen((config_.dir + "/frames.journal").c_str(), "w");  // emptied
+  if (!journal_) throw Error("cannot reopen " + config_.dir + "/frames.journal");
+}
+
+Autosaver::Stats Autosaver::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stats_;
+}
+
+void Autosaver::writerLoop() {
+  for (;;) {
+    std::vector<uint8_t> bytes;
+    int64_t number = 0;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      cv_.wait(lock, [&] { return stop_ || !pending_.empty(); });
+      if (pending_.empty()) return;  // stopping with nothing left to write
+      bytes.swap(pending_);
+      number = pending_number_;
+      writing_ = true;
+    }
+    const std::string path = autosavePath(config_.dir, number);
+    const auto start = std::chrono::steady_clock::now();
+    std::string error;
+    try {
+      writeFileAtomically(path, bytes.data(), bytes.size());
+      // Only once the new one is safe: drop those beyond `keep`.
+      const auto all = numberedAutosaves(config_.dir);
+      for (size_t i = static_cast<size_t>(config_.keep); i < all.size(); ++i) {
+        std::remove(all[i].second.c_str());
+      }
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      writing_ = false;
+      if (error.empty()) {
+        ++stats_.written;
+        stats_.last_path = path;
+        stats_.last_bytes = bytes.size();
+        stats_.last_write_ms = msSince(start);
+      } else {
+        ++stats_.failed;
+        stats_.last_error = error;
+      }
+    }
+    if (!error.empty()) std::fprintf(stderr, "panmap: autosave failed: %s\n", error.c_str());
+    cv_.notify_all();
+  }
+}
+
+}  // namespace panmap

@@ -1,0 +1,79 @@
+#include "panmap/recovery/resume.h"
+
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "panmap/core/error.h"
+#include "panmap/recovery/autosave.h"
+
+namespace panmap {
+namespace {
+
+// (frame id, utime) of the frames journaled after `utime`, by utime: frames mapped again by a
+// resumed run (a replayed log) appear once.
+std::vector<std::pair<int64_t, int64_t>> journalAfter(const std::string& path, int64_t utime) {
+  std::map<int64_t, int64_t> by_utime;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;  // '#': a run marker
+    std::istringstream fields(line);
+    int64_t id = 0, t = 0;
+    if (!(fields >> id >> t)) continue;  // a line cut by the crash
+    if (t > utime) by_utime.emplace(t, id);
+  }
+  std::vector<std::pair<int64_t, int64_t>> out;
+  for (const auto& [t, id] : by_utime) out.emplace_back(id, t);
+  return out;
+}
+
+}  // namespace
+
+ResumePoint resumeFrom(const std::string& dir) {
+  const std::vector<std::string> snapshots = listAutosaves(dir);
+  if (snapshots.empty()) throw Error(dir + ": no autosave-NNNNNN.panmap snapshot to resume from");
+  ResumePoint point;
+  for (const std::string& path : snapshots) {
+    try {
+      point.mapper = Mapper::load(path);
+      point.path = path;
+      break;
+    } catch (const std::exception& e) {
+      point.refused.push_back(e.what());
+    }
+  }
+  if (!point.mapper) {
+    std::string why;
+    for (const std::string& r : point.refused) why += (why.empty() ? "" : "; ") + r;
+    throw Error(dir + ": no snapshot loads (" + why + ")");
+  }
+  point.frames = point.mapper->framesIntegrated();
+  const std::vector<StampedPose>& trajectory = point.mapper->trajectory();
+  if (!trajectory.empty()) {
+    point.last_utime = trajectory.back().utime;
+    point.last_frame_id = trajectory.back().frame_id;
+  }
+  point.lost = journalAfter(dir + "/frames.journal", point.last_utime);
+  return point;
+}
+
+std::string describeResume(const ResumePoint& point) {
+  std::ostringstream out;
+  out << "resumed from " << point.path << ": " << point.frames << " frames";
+  if (point.last_frame_id >= 0) {
+    out << " (last frame " << point.last_frame_id << ", utime " << point.last_utime << ")";
+  }
+  if (point.lost.empty()) {
+    out << "; no frame integrated after it was lost";
+  } else {
+    out << "; lost " << point.lost.size() << " frames integrated after it (frames "
+        << point.lost.front().first << "-" << point.lost.back().first << ")";
+  }
+  if (!point.refused.empty()) {
+    out << "; " << point.refused.size() << " newer snapshot(s) refused: " << point.refused.front();
+  }
+  return out.str();
+}
+
+}  // namespace panmap

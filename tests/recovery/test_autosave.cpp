@@ -1,0 +1,157 @@
+// Crash recovery: periodic snapshots in stream time, atomic files, the frame journal, and
+// resuming from the newest snapshot that loads (past a corrupt one) exactly as if never
+// interrupted.
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "lcm/synthetic_stream.h"
+#include "panmap/core/error.h"
+#include "panmap/io/atomic_file.h"
+#include "panmap/recovery/autosave.h"
+#include "panmap/recovery/resume.h"
+#include "test_helpers.h"
+
+namespace panmap {
+namespace {
+
+namespace fs = std::filesystem;
+
+void integrate(Mapper* mapper, const test::SyntheticStream& s, size_t k) {
+  mapper->integrate(s.frames[k], s.poses[k].T_W_C, &s.masks[k], s.poses[k].source);
+}
+
+// Maps the 12-frame stream (frames 333 ms apart) with a 1 s autosave period.
+void mapWithAutosave(const std::string& dir) {
+  const test::SyntheticStream& s = test::syntheticStream();
+  Mapper mapper(test::streamMapperConfig());
+  Autosaver::Config config;
+  config.dir = dir;
+  config.period_s = 1.0;
+  Autosaver autosaver(config);
+  for (size_t k = 0; k < s.frames.size(); ++k) {
+    integrate(&mapper, s, k);
+    autosaver.afterFrame(mapper, s.frames[k].frame_id, s.frames[k].utime);
+  }
+  autosaver.wait();
+  // Frame 0 starts the clock; frames 3, 6 and 9 are each 1 s of stream time after the last.
+  EXPECT_EQ(autosaver.stats().written, 3);
+  EXPECT_EQ(autosaver.stats().failed, 0);
+}
+
+TEST(Autosaver, SnapshotsEveryPeriodOfStreamTimeAndKeepsTheNewestTwo) {
+  test::TempDir dir;
+  mapWithAutosave(dir.path());
+  const std::vector<std::string> kept = listAutosaves(dir.path());
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_EQ(kept[0], autosavePath(dir.path(), 3));
+  EXPECT_EQ(kept[1], autosavePath(dir.path(), 2));
+  EXPECT_EQ(Mapper::load(kept[0])->framesIntegrated(), 10);  // frames 0-9
+  EXPECT_EQ(Mapper::load(kept[1])->framesIntegrated(), 7);   // frames 0-6
+  EXPECT_FALSE(fs::exists(kept[0] + ".partial"));
+  // The journal: a run marker, then one line per frame.
+  std::ifstream journal(dir.path("frames.journal"));
+  std::string line;
+  int frames = 0, markers = 0;
+  while (std::getline(journal, line)) (line[0] == '#' ? markers : frames)++;
+  EXPECT_EQ(markers, 1);
+  EXPECT_EQ(frames, 12);
+
+  // A second run in the same folder continues the numbering.
+  Autosaver::Config config;
+  config.dir = dir.path();
+  Autosaver again(config);
+  again.snapshotNow(*Mapper::load(kept[1]));
+  again.wait();
+  EXPECT_EQ(listAutosaves(dir.path())[0], autosavePath(dir.path(), 4));
+  again.clear();
+  EXPECT_TRUE(listAutosaves(dir.path()).empty());
+}
+
+TEST(Resume, SkipsACorruptSnapshotListsLostFramesAndContinuesExactly) {
+  test::TempDir dir;
+  mapWithAutosave(dir.path());
+  // The newest snapshot cut short, as a disk could leave it.
+  const std::string newest = autosavePath(dir.path(), 3);
+  fs::resize_file(newest, fs::file_size(newest) / 2);
+
+  ResumePoint point = resumeFrom(dir.path());
+  EXPECT_EQ(point.path, autosavePath(dir.path(), 2));
+  ASSERT_EQ(point.refused.size(), 1u);
+  EXPECT_NE(point.refused[0].find("autosave-000003.panmap: truncated map file"), std::string::npos)
+      << point.refused[0];
+  const test::SyntheticStream& s = test::syntheticStream();
+  EXPECT_EQ(point.frames, 7);
+  EXPECT_EQ(point.last_utime, s.frames[6].utime);
+  EXPECT_EQ(point.last_frame_id, s.frames[6].frame_id);
+  ASSERT_EQ(point.lost.size(), 5u);  // frames 7-11 were journaled after it
+  EXPECT_EQ(point.lost.front().first, s.frames[7].frame_id);
+  EXPECT_EQ(point.lost.back().second, s.frames[11].utime);
+  EXPECT_NE(describeResume(point).find("lost 5 frames"), std::string::npos)
+      << describeResume(point);
+
+  // Mapping on from the snapshot equals never stopping.
+  for (size_t k = 7; k < s.frames.size(); ++k) integrate(point.mapper.get(), s, k);
+  Mapper uninterrupted(test::streamMapperConfig());
+  for (size_t k = 0; k < s.frames.size(); ++k) integrate(&uninterrupted, s, k);
+  EXPECT_EQ(test::mapBytes(*point.mapper), test::mapBytes(uninterrupted));
+}
+
+TEST(Resume, NoLoadableSnapshotIsOneClearError) {
+  test::TempDir dir;
+  EXPECT_THROW(resumeFrom(dir.path()), Error);
+  std::ofstream(autosavePath(dir.path(), 1)) << "not a map";
+  try {
+    resumeFrom(dir.path());
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no snapshot loads"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("autosave-000001.panmap"), std::string::npos);
+  }
+}
+
+TEST(MapFile, CorruptionIsNamedWithFileAndOffset) {
+  test::TempDir dir;
+  Mapper mapper(test::streamMapperConfig());
+  integrate(&mapper, test::syntheticStream(), 0);
+  std::vector<uint8_t> bytes = mapper.serialize();
+  const size_t size = bytes.size();
+  auto error = [&](const std::vector<uint8_t>& b) -> std::string {
+    try {
+      Mapper::deserialize(b, "m.panmap");
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(error(bytes), "");
+  std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + static_cast<long>(size / 3));
+  EXPECT_EQ(error(cut), "m.panmap: truncated map file (" + std::to_string(size / 3) +
+                            " bytes; the header at offset 12 announces " + std::to_string(size) +
+                            ")");
+  bytes[size / 2] ^= 0x40;
+  EXPECT_EQ(error(bytes), "m.panmap: checksum mismatch over bytes 20-" + std::to_string(size - 4) +
+                              " (corrupt map file)");
+  EXPECT_NE(error({'P', 'A', 'N'}).find("m.panmap: truncated"), std::string::npos);
+}
+
+TEST(AtomicFile, ReplacesWholeFilesAndNamesFailures) {
+  test::TempDir dir;
+  const std::string path = dir.path("f.bin");
+  writeFileAtomically(path, "first", 5);
+  writeFileAtomically(path, "second!", 7);
+  EXPECT_EQ(test::fileBytes(path), "second!");
+  EXPECT_FALSE(fs::exists(path + ".partial"));
+  try {
+    writeFileAtomically(dir.path("missing/f.bin"), "x", 1);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot create " + dir.path("missing/f.bin.partial")),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace panmap
