@@ -221,9 +221,11 @@ def write_section(args, r):
     # with `frame:` reasons of their own.
     garbage_frames = sum(expected.get(k, 0) for k in (
         "malformed CAMERA_RGBD", "frame: repeated timestamp", "frame: out of order"))
-    real_refused = frame_rejects - counted("frame: repeated timestamp") - counted(
-        "frame: out of order")
-    unaccounted = received - garbage_frames - integrated - dropped - real_refused
+    # Whatever arrives on the frame channel, garbage or not, is integrated, pushed out of the
+    # full queue (the oldest message, whatever it holds) or refused with a reason.
+    refused_on_channel = (frame_rejects + counted("malformed CAMERA_RGBD") +
+                          counted("bad CAMERA_RGBD"))
+    unaccounted = received - integrated - dropped - refused_on_channel
 
     autosave = report.get("autosave", {})
     md = [BEGIN, "## Soak", "",
@@ -255,12 +257,15 @@ def write_section(args, r):
            "| lost on UDP (log + garbage - received) | %d |" % (sent + garbage_frames - received),
            "| integrated | %d |" % integrated,
            "| dropped by the live queue (counted) | %d |" % dropped,
-           "| refused by the session (`frame:` reasons) | %d |" % frame_rejects,
-           "| garbage on the frame channel (injected) | %d |" % garbage_frames,
-           "| unaccounted (real frames received - integrated - dropped - refused) | %d |" %
-           unaccounted,
-           "", "Garbage injected and counted, by reason (%d garbage events):" %
-           summary["garbage_events"], "",
+           "| refused by the session (`frame:` reasons, malformed or bad frames) | %d |" %
+           refused_on_channel,
+           "| of which garbage injected on the frame channel | %d |" % garbage_frames,
+           "| unaccounted (received - integrated - dropped - refused) | %d |" % unaccounted,
+           "", "Garbage injected and counted, by reason (%d garbage events). The live queue "
+           "pushes out the oldest message of the frame channel when it is full, garbage "
+           "included, and a late copy of a frame whose original was pushed out is no longer "
+           "late: where frames were dropped, the counts on the frame channel may fall short of "
+           "the injected ones by those." % summary["garbage_events"], "",
            "| reason | injected | counted by the mapper |", "|---|---|---|"]
     for reason in sorted(expected):
         md.append("| %s | %d | %d |" % (reason, expected[reason], counted(reason)))

@@ -16,6 +16,7 @@
 
 #include "panmap/command_t.hpp"
 #include "panmap/core/error.h"
+#include "panmap/core/memory_policy.h"
 #include "panmap/core/process_memory.h"
 #include "panmap/core/progress.h"
 #include "panmap/graph/optimiser.h"
@@ -220,6 +221,7 @@ int main(int argc, char** argv) {
   live_group->add_option("--channel-labels", live.channel_labels)->capture_default_str();
   live_group->add_option("--channel-command", live.channel_command)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  panmap::returnLargeBuffersToTheSystem();
 
   try {
     panmap::PanmapConfig file_config;
