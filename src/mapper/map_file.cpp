@@ -3,6 +3,7 @@
 // super-point state, so that load-then-continue equals an uninterrupted run.
 #include <zlib.h>
 
+#include <algorithm>
 #include <cstdio>
 
 #include "panmap/core/binary_io.h"
@@ -21,6 +22,29 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 constexpr uint32_t kVersion = 5;
 // Magic, version, payload size.
 constexpr size_t kHeaderBytes = sizeof(kMagic) + sizeof(uint32_t) + sizeof(uint64_t);
+
+// Forwards a stream and keeps the CRC-32 of what follows the header (the payload).
+class ChecksummingSink : public ByteSink {
+ public:
+  explicit ChecksummingSink(ByteSink* out) : out_(out) {}
+  void append(const uint8_t* data, size_t size) override {
+    const size_t skip = seen_ < kHeaderBytes ? std::min(size, kHeaderBytes - seen_) : 0;
+    crc_ = crc32(crc_, data + skip, static_cast<uInt>(size - skip));
+    seen_ += size;
+    out_->append(data, size);
+  }
+  // Only the header's size field is overwritten, outside the checksummed payload.
+  void overwrite(uint64_t offset, const uint8_t* data, size_t size) override {
+    if (offset + size > kHeaderBytes) throw Error("map file: payload overwritten");
+    out_->overwrite(offset, data, size);
+  }
+  uint32_t crc() const { return static_cast<uint32_t>(crc_); }
+
+ private:
+  ByteSink* out_;
+  uLong crc_ = crc32(0L, Z_NULL, 0);
+  size_t seen_ = 0;
+};
 
 void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put(c.map.voxel_size_m);
@@ -285,12 +309,10 @@ GraphAccumulator::Snapshot getGraph(BinaryReader* r) {
 
 }  // namespace
 
-std::vector<uint8_t> Mapper::serialize() const {
-  // One buffer: header, payload, CRC; the payload size is patched in at the end.
-  BinaryWriter payload;
-  // The blocks are most of it; the rest (super-points, graph, occupancy) grows the buffer once
-  // or twice.
-  payload.reserve(map_->numBlocks() * (13 + sizeof(Block::voxels)) * 5 / 4 + (1 << 20));
+void Mapper::serialize(ByteSink* sink) const {
+  // Streamed: header, payload, CRC; the payload size is patched in at the end.
+  ChecksummingSink checked(sink);
+  BinaryWriter payload(&checked);
   payload.putBytes(kMagic, sizeof(kMagic));
   payload.put<uint32_t>(kVersion);
   payload.put<uint64_t>(0);
@@ -322,17 +344,25 @@ std::vector<uint8_t> Mapper::serialize() const {
   }
   if (occupancy_) occupancy_->writeState(&payload);
 
-  const uint64_t size = payload.bytes().size() - kHeaderBytes;
+  payload.flush();
+  const uint64_t size = payload.size() - kHeaderBytes;
   payload.putAt<uint64_t>(sizeof(kMagic) + sizeof(uint32_t), size);
-  payload.put<uint32_t>(static_cast<uint32_t>(
-      crc32(0L, payload.bytes().data() + kHeaderBytes, static_cast<uInt>(size))));
-  return payload.release();
+  const uint32_t crc = checked.crc();
+  sink->append(reinterpret_cast<const uint8_t*>(&crc), sizeof(crc));
+}
+
+std::vector<uint8_t> Mapper::serialize() const {
+  std::vector<uint8_t> bytes;
+  VectorSink sink(&bytes);
+  serialize(&sink);
+  return bytes;
 }
 
 void Mapper::save(const std::string& path) const {
-  const std::vector<uint8_t> bytes = serialize();
   // A crash never leaves a half-written snapshot in place of a good one.
-  writeFileAtomically(path, bytes.data(), bytes.size());
+  AtomicFileWriter file(path);
+  serialize(&file);
+  file.commit();
 }
 
 std::unique_ptr<Mapper> Mapper::load(const std::string& path) {

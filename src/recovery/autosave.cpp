@@ -99,20 +99,28 @@ void Autosaver::snapshotNow(const Mapper& mapper) {
     // A disk slower than the period makes mapping wait rather than skip a snapshot: the bound
     // on what a crash costs (one period) holds, and at most one map copy is in memory.
     std::unique_lock<std::mutex> lock(mutex_);
-    if (writing_ || !pending_.empty()) {
+    if (writing_ || pending_) {
       const auto start = std::chrono::steady_clock::now();
-      cv_.wait(lock, [&] { return pending_.empty() && !writing_; });
+      cv_.wait(lock, [&] { return !pending_ && !writing_; });
       ++stats_.waited_busy;
       stats_.waited_ms += msSince(start);
     }
   }
   const auto start = std::chrono::steady_clock::now();
-  std::vector<uint8_t> bytes = mapper.serialize();
+  auto file = std::make_unique<AtomicFileWriter>(autosavePath(config_.dir, next_number_++));
+  try {
+    mapper.serialize(file.get());
+  } catch (const std::exception& e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++stats_.failed;
+    stats_.last_error = e.what();
+    std::fprintf(stderr, "panmap: autosave failed: %s\n", e.what());
+    return;  // the partial file goes with `file`
+  }
   const double serialize_ms = msSince(start);
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    pending_ = std::move(bytes);
-    pending_number_ = next_number_++;
+    pending_ = std::move(file);
     stats_.last_serialize_ms = serialize_ms;
   }
   cv_.notify_all();
@@ -120,7 +128,7 @@ void Autosaver::snapshotNow(const Mapper& mapper) {
 
 void Autosaver::wait() {
   std::unique_lock<std::mutex> lock(mutex_);
-  cv_.wait(lock, [&] { return pending_.empty() && !writing_; });
+  cv_.wait(lock, [&] { return !pending_ && !writing_; });
 }
 
 void Autosaver::clear() {
@@ -138,21 +146,22 @@ Autosaver::Stats Autosaver::stats() const {
 
 void Autosaver::writerLoop() {
   for (;;) {
-    std::vector<uint8_t> bytes;
-    int64_t number = 0;
+    std::unique_ptr<AtomicFileWriter> file;
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      cv_.wait(lock, [&] { return stop_ || !pending_.empty(); });
-      if (pending_.empty()) return;  // stopping with nothing left to write
-      bytes.swap(pending_);
-      number = pending_number_;
+      cv_.wait(lock, [&] { return stop_ || pending_; });
+      if (!pending_) return;  // stopping with nothing left to write
+      file = std::move(pending_);
       writing_ = true;
     }
-    const std::string path = autosavePath(config_.dir, number);
+    const std::string path = file->path();
     const auto start = std::chrono::steady_clock::now();
     std::string error;
+    size_t bytes = 0;
     try {
-      writeFileAtomically(path, bytes.data(), bytes.size());
+      file->commit();
+      std::error_code ec;
+      bytes = static_cast<size_t>(std::filesystem::file_size(path, ec));
       // Only once the new one is safe: drop those beyond `keep`.
       const auto all = numberedAutosaves(config_.dir);
       for (size_t i = static_cast<size_t>(config_.keep); i < all.size(); ++i) {
@@ -161,13 +170,14 @@ void Autosaver::writerLoop() {
     } catch (const std::exception& e) {
       error = e.what();
     }
+    file.reset();
     {
       std::lock_guard<std::mutex> lock(mutex_);
       writing_ = false;
       if (error.empty()) {
         ++stats_.written;
         stats_.last_path = path;
-        stats_.last_bytes = bytes.size();
+        stats_.last_bytes = bytes;
         stats_.last_write_ms = msSince(start);
       } else {
         ++stats_.failed;

@@ -6,24 +6,34 @@
 #include <type_traits>
 #include <vector>
 
+#include "panmap/core/byte_sink.h"
 #include "panmap/core/error.h"
 
 namespace panmap {
 
-/// Appends plain values to a byte buffer (little-endian host layout, as written).
+/// Appends plain values to a byte buffer (little-endian host layout, as written). With a sink,
+/// the buffer is handed over in chunks as it fills, so large outputs (map files) stream to
+/// disk instead of being held whole in memory.
 class BinaryWriter {
  public:
+  /// Keeps everything in memory (bytes()).
+  BinaryWriter() = default;
+  /// Streams to `sink` (not owned) in chunks of about `chunk_bytes`; call flush() at the end.
+  explicit BinaryWriter(ByteSink* sink, size_t chunk_bytes = size_t{1} << 20)
+      : sink_(sink), chunk_bytes_(chunk_bytes) {
+    bytes_.reserve(chunk_bytes_);
+  }
   /// Appends a trivially copyable value.
   template <typename T>
   void put(const T& value) {
     static_assert(std::is_trivially_copyable<T>::value, "plain values only");
-    const auto* p = reinterpret_cast<const uint8_t*>(&value);
-    bytes_.insert(bytes_.end(), p, p + sizeof(T));
+    putBytes(&value, sizeof(T));
   }
   /// Appends raw bytes.
   void putBytes(const void* data, size_t size) {
     const auto* p = static_cast<const uint8_t*>(data);
     bytes_.insert(bytes_.end(), p, p + size);
+    if (sink_ && bytes_.size() >= chunk_bytes_) flush();
   }
   /// Appends a length-prefixed string.
   void putString(const std::string& s) {
@@ -36,16 +46,34 @@ class BinaryWriter {
   template <typename T>
   void putAt(size_t offset, const T& value) {
     static_assert(std::is_trivially_copyable<T>::value, "plain values only");
-    if (offset + sizeof(T) > bytes_.size()) throw Error("BinaryWriter::putAt past the end");
-    std::memcpy(bytes_.data() + offset, &value, sizeof(T));
+    if (offset + sizeof(T) > size()) throw Error("BinaryWriter::putAt past the end");
+    const auto* p = reinterpret_cast<const uint8_t*>(&value);
+    if (offset >= flushed_) {
+      std::memcpy(bytes_.data() + (offset - flushed_), p, sizeof(T));
+    } else {
+      flush();
+      sink_->overwrite(offset, p, sizeof(T));
+    }
   }
-  /// The bytes so far.
+  /// Hands what is buffered to the sink (no-op without one).
+  void flush() {
+    if (!sink_ || bytes_.empty()) return;
+    sink_->append(bytes_.data(), bytes_.size());
+    flushed_ += bytes_.size();
+    bytes_.clear();
+  }
+  /// Bytes written so far, flushed or not.
+  size_t size() const { return flushed_ + bytes_.size(); }
+  /// The bytes so far (without a sink: all of them).
   const std::vector<uint8_t>& bytes() const { return bytes_; }
   /// Hands the bytes over, leaving the writer empty.
   std::vector<uint8_t> release() { return std::move(bytes_); }
 
  private:
   std::vector<uint8_t> bytes_;
+  ByteSink* sink_ = nullptr;
+  size_t chunk_bytes_ = 0;
+  size_t flushed_ = 0;
 };
 
 /// Reads plain values back, refusing to read past the end (Error naming `what`).

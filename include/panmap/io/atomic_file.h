@@ -1,14 +1,42 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
+
+#include "panmap/core/byte_sink.h"
 
 namespace panmap {
 
-/// Writes `size` bytes to `path` so that a crash or power cut at any moment leaves either the
-/// previous file or the complete new one: the bytes go to a temporary file beside it, which is
-/// fsync'ed and renamed over `path`, and the folder is fsync'ed so the rename itself is
-/// durable. Throws Error naming the path and the failing step.
+/// Writes a file so that a crash or power cut at any moment leaves either the previous file or
+/// the complete new one: the bytes go to PATH.partial, and commit() fsyncs it, renames it over
+/// PATH and fsyncs the folder so the rename itself is durable. Destroyed without commit(), it
+/// removes the partial file. Errors throw Error naming the file and the failing step.
+class AtomicFileWriter : public ByteSink {
+ public:
+  /// Creates PATH.partial.
+  explicit AtomicFileWriter(std::string path);
+  /// Removes the partial file unless committed.
+  ~AtomicFileWriter() override;
+  AtomicFileWriter(const AtomicFileWriter&) = delete;
+  AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
+
+  /// Appends bytes.
+  void append(const uint8_t* data, size_t size) override;
+  /// Replaces bytes written earlier.
+  void overwrite(uint64_t offset, const uint8_t* data, size_t size) override;
+  /// Makes the file durable and puts it in place of PATH.
+  void commit();
+  /// The final path.
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::string partial_;
+  int fd_ = -1;
+};
+
+/// Writes `size` bytes to `path` through an AtomicFileWriter.
 void writeFileAtomically(const std::string& path, const void* data, size_t size);
 
 }  // namespace panmap

@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 
+#include "panmap/core/byte_sink.h"
 #include "panmap/core/frame.h"
 #include "panmap/core/pose.h"
 #include "panmap/core/thread_pool.h"
@@ -147,8 +148,10 @@ class Mapper {
   ///        their frame-count labels. Null: frame-count labels only.
   LabelledMesh extractMesh(const GraphLabels* labels = nullptr);
 
-  /// The whole state (config, TSDF, votes, super-points) as the bytes of a map file: a
-  /// versioned header, the payload and its CRC-32.
+  /// Streams the whole state (config, TSDF, votes, super-points) as a map file into `sink`: a
+  /// versioned header, the payload and its CRC-32, in chunks of 1 MiB (never whole in memory).
+  void serialize(ByteSink* sink) const;
+  /// serialize() into a byte vector.
   std::vector<uint8_t> serialize() const;
   /// Writes serialize() atomically (temporary file, fsync, rename); throws Error naming the
   /// file on failure.

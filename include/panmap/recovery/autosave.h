@@ -3,6 +3,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -12,10 +13,13 @@
 
 namespace panmap {
 
-/// Periodic map snapshots for crash recovery. The mapper is serialised on the thread that owns
-/// it, between frames (where it is consistent); the bytes are written atomically (temporary
-/// file, fsync, rename) on a background thread so the disk never stalls mapping. A journal
-/// lists every integrated frame, so a resume can say which frames the crash cost.
+class AtomicFileWriter;
+
+/// Periodic map snapshots for crash recovery. The mapper is streamed into a temporary file on
+/// the thread that owns it, between frames (where it is consistent; the data goes to the page
+/// cache, never whole into memory); a background thread makes it durable (fsync) and renames
+/// it into place, so the disk never stalls mapping. A journal lists every integrated frame, so
+/// a resume can say which frames the crash cost.
 class Autosaver {
  public:
   /// Where and how often.
@@ -36,8 +40,8 @@ class Autosaver {
     std::string last_path;
     std::string last_error;
     size_t last_bytes = 0;
-    double last_serialize_ms = 0.0;  ///< on the mapping thread
-    double last_write_ms = 0.0;      ///< on the background thread
+    double last_serialize_ms = 0.0;  ///< streaming the map to the file, on the mapping thread
+    double last_write_ms = 0.0;      ///< fsync and rename, on the background thread
   };
 
   /// Creates the folder; continues the numbering of snapshots already there (a resumed run).
@@ -71,8 +75,7 @@ class Autosaver {
 
   mutable std::mutex mutex_;
   std::condition_variable cv_;
-  std::vector<uint8_t> pending_;  ///< bytes waiting for the writer
-  int64_t pending_number_ = 0;
+  std::unique_ptr<AtomicFileWriter> pending_;  ///< a snapshot waiting to be made durable
   bool writing_ = false;
   bool stop_ = false;
   Stats stats_;
