@@ -59,6 +59,23 @@ TEST(OptimizerNode, AnswersGraphsAndSurvivesGarbage) {
   EXPECT_EQ(labels.instance.at(1), labels.instance.at(2));
   EXPECT_GT(labels.instance.at(1), 0);
   EXPECT_EQ(node.answered(), 1);
+
+  // The mapper's repeat of the same request (it heard nothing yet) is answered from the cache,
+  // with the same labels; another request is solved.
+  lcm.publish("PANMAP_GRAPH", &msg);
+  while (lcm.handleTimeout(0) > 0) {
+  }
+  ASSERT_EQ(inbox.received.size(), 2u);
+  EXPECT_EQ(node.answered(), 1);
+  EXPECT_EQ(node.repeated(), 1);
+  EXPECT_EQ(fromMessage(inbox.received[1]).instance, labels.instance);
+  const superpoint_graph_t next = toMessage(g, 200, 78);
+  lcm.publish("PANMAP_GRAPH", &next);
+  while (lcm.handleTimeout(0) > 0) {
+  }
+  ASSERT_EQ(inbox.received.size(), 3u);
+  EXPECT_EQ(inbox.received[2].request_id, 78);
+  EXPECT_EQ(node.answered(), 2);
 }
 
 }  // namespace
