@@ -78,6 +78,14 @@ void Mapper::validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
   // fuzz/fuzz_lcm_session) is refused here instead.
   {
     const PinholeCamera& c = frame.camera;
+    // The per-pixel geometry runs in float: intrinsics must be far inside its range (an fx of
+    // 2e233 overflowed an int conversion in the integrator).
+    constexpr double kMaxIntrinsicPx = 1e6;
+    for (double v : {c.fx, c.fy, c.cx, c.cy}) {
+      if (!(std::abs(v) <= kMaxIntrinsicPx)) {
+        throw Error("intrinsics: fx, fy, cx, cy must be within 1e6 pixels");
+      }
+    }
     const double tan_x = std::max(std::abs(c.cx), std::abs(w - 1 - c.cx)) / c.fx;
     const double tan_y = std::max(std::abs(c.cy), std::abs(h - 1 - c.cy)) / c.fy;
     const double reach =

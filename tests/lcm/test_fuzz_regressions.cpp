@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "panmap/lcm/conversions.h"
 #include "panmap/lcm/decode.h"
 #include "panmap/lcm/mapping_session.h"
 #include "panmap/lcm/message_types.h"
@@ -111,13 +112,12 @@ TEST(LcmFuzzRegressions, EmptyStringLengthIsRefused) {
   expectRefused<rgbd_frame_t>(bytes, "rgbd_frame_t");
 }
 
-TEST(LcmFuzzRegressions, FrameReachingBeyondTheMapIsRefusedByTheSession) {
-  // fuzz_lcm_session: two frames with poses and masks, the second with depth_scale_m 3.6e52;
-  // its points reached the voxel lookup as NaN (UBSan: float to int). Replayed the way the
-  // target does: entries [channel][length 2 bytes LE][body], the fingerprint put in front.
-  const std::string input =
-      test::fileBytes(test::fixtureDir("fuzz_regressions/lcm_session/depth_scale_3e52"));
-  ASSERT_FALSE(input.empty());
+// Replays a fuzz_lcm_session input the way the target does: entries [channel][length, 2 bytes
+// little-endian][body], the channel type's fingerprint put in front unless bit 7 is set, fed
+// to a MappingSession over the target's mapper; nothing may escape.
+SessionStats replaySession(const std::string& fixture) {
+  const std::string input = test::fileBytes(test::fixtureDir("fuzz_regressions/" + fixture));
+  EXPECT_FALSE(input.empty()) << fixture;
   MapperConfig config;
   config.num_threads = 1;
   config.map.voxel_size_m = 0.05f;
@@ -143,12 +143,37 @@ TEST(LcmFuzzRegressions, FrameReachingBeyondTheMapIsRefusedByTheSession) {
     EXPECT_NO_THROW(session.handle(channels[channel], bytes.data(), bytes.size()));
   }
   EXPECT_NO_THROW(session.flush());
-  const SessionStats stats = session.stats();
-  // The first frame's depth PNG is corrupt (refused as a bad message), the second decodes
-  // and reaches the mapper, which refuses it.
+  return session.stats();
+}
+
+TEST(LcmFuzzRegressions, FrameReachingBeyondTheMapIsRefusedByTheSession) {
+  // Two frames with poses and masks, the second with depth_scale_m 3.6e52: its points reached
+  // the voxel lookup as NaN (UBSan: float to int). The first frame's depth PNG is corrupt
+  // (refused as a bad message); the second decodes and the mapper refuses it.
+  const SessionStats stats = replaySession("lcm_session/depth_scale_3e52");
   EXPECT_EQ(stats.frames_received, 1);
   EXPECT_EQ(stats.frames_integrated, 0);
   EXPECT_EQ(stats.rejected.count("frame: extent"), 1u) << ::testing::PrintToString(stats.rejected);
+}
+
+TEST(LcmFuzzRegressions, HugeFocalLengthIsRefusedByTheSession) {
+  // The first frame says fx = 2.2e233: the integrator's ray stride overflowed an int.
+  const SessionStats stats = replaySession("lcm_session/focal_length_2e233");
+  EXPECT_EQ(stats.rejected.count("frame: intrinsics"), 1u)
+      << ::testing::PrintToString(stats.rejected);
+}
+
+TEST(LcmFuzzRegressions, PoseAtInt64MinIsRefusedByTheSession) {
+  // A pose with utime INT64_MIN: the synchroniser's time differences overflowed int64.
+  const SessionStats stats = replaySession("lcm_session/pose_utime_int64_min");
+  EXPECT_GE(stats.rejected.count("bad CAMERA_POSE: pose"), 1u)
+      << ::testing::PrintToString(stats.rejected);
+  pose_t msg{};
+  msg.utime = INT64_MIN;
+  msg.orientation[0] = 1.0;
+  test::expectError([&] { fromMessage(msg); }, {"utime", "out of range"});
+  msg.utime = 1700000000000000;  // 2023 in microseconds
+  EXPECT_NO_THROW(fromMessage(msg));
 }
 
 TEST(LcmFuzzRegressions, MapperRefusesFramesBeyondItsExtent) {
@@ -166,6 +191,9 @@ TEST(LcmFuzzRegressions, MapperRefusesFramesBeyondItsExtent) {
   frame.camera.fx = 1e-300;
   test::expectError([&] { mapper.integrate(frame, Eigen::Isometry3d::Identity(), nullptr); },
                     {"extent"});
+  frame.camera.fx = 2.2e233;
+  test::expectError([&] { mapper.integrate(frame, Eigen::Isometry3d::Identity(), nullptr); },
+                    {"intrinsics"});
   frame.camera.fx = 10.0;
   EXPECT_NO_THROW(mapper.integrate(frame, Eigen::Isometry3d::Identity(), nullptr));
   EXPECT_EQ(mapper.framesIntegrated(), 1);

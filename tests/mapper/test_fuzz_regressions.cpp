@@ -49,6 +49,15 @@ TEST(MapFileFuzzRegressions, EmptyParentArrayIsACleanError) {
   test::expectError([&] { Mapper::load(path); }, {"bad parent array"});
 }
 
+TEST(MapFileFuzzRegressions, BlockIndexOutOfRangeIsACleanError) {
+  // A one-frame map whose block index was mutated to 536870911: voxel coordinates (index * 8)
+  // overflowed int, and indices past 21 bits alias other blocks.
+  test::TempDir dir;
+  const std::string path = writeMapFileOfFuzzInput(fuzzInput("map_file/block_index_out_of_range"),
+                                                   dir.path("map.panmap"));
+  test::expectError([&] { Mapper::load(path); }, {path, "block index", "out of range"});
+}
+
 TEST(MapFileFuzzRegressions, SavedMapsStillLoad) {
   test::TempDir dir;
   MapperConfig config;
