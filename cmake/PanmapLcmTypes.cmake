@@ -7,6 +7,7 @@
 find_program(LCM_GEN_EXECUTABLE lcm-gen REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(LCM REQUIRED IMPORTED_TARGET lcm)
+set(PANMAP_LCM_CMAKE_DIR ${CMAKE_CURRENT_LIST_DIR})
 
 function(panmap_lcm_types)
   cmake_parse_arguments(ARG "" "TARGET;PACKAGE;JAVA_JAR" "FILES" ${ARGN})
@@ -26,7 +27,10 @@ function(panmap_lcm_types)
     OUTPUT ${headers}
     COMMAND ${CMAKE_COMMAND} -E make_directory ${cpp_dir}
     COMMAND ${LCM_GEN_EXECUTABLE} --cpp --cpp-hpath ${cpp_dir} ${ARG_FILES}
-    DEPENDS ${ARG_FILES}
+    # Bound array lengths by the message size before the decoders allocate them.
+    COMMAND ${CMAKE_COMMAND} -DDIR=${cpp_dir}/${ARG_PACKAGE}
+            -P ${PANMAP_LCM_CMAKE_DIR}/PanmapLcmBoundArrays.cmake
+    DEPENDS ${ARG_FILES} ${PANMAP_LCM_CMAKE_DIR}/PanmapLcmBoundArrays.cmake
     COMMENT "lcm-gen: C++ headers for ${ARG_PACKAGE}"
     VERBATIM)
   add_custom_target(${ARG_TARGET}_gen DEPENDS ${headers})

@@ -37,6 +37,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev          # tests and benchmarks
   nlohmann-json3-dev libcli11-dev                     # JSON files, command-line parsing
   libnanoflann-dev libboost-graph-dev                 # k-d tree (evaluation), graph algorithms
+  clang libclang-rt-14-dev                            # libFuzzer and sanitisers (scripts/fuzz.sh)
   iproute2 procps                                     # ip / sysctl for the LCM network setup
 )
 

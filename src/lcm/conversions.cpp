@@ -11,6 +11,15 @@
 namespace panmap {
 namespace {
 
+// Synchronisation subtracts time stamps from one another: beyond 2^61 us (73,000 years) from
+// the epoch the differences overflow int64 (a pose at INT64_MIN did, in fuzz/fuzz_lcm_session).
+void checkUtime(int64_t utime, const std::string& what) {
+  constexpr int64_t kMaxUtime = int64_t{1} << 61;
+  if (utime < -kMaxUtime || utime > kMaxUtime) {
+    throw Error(what + ": utime " + std::to_string(utime) + " is out of range");
+  }
+}
+
 template <typename T>
 image_t rawImage(const Image<T>& image, int8_t format) {
   image_t msg;
@@ -168,6 +177,7 @@ rgbd_frame_t toMessage(const RgbdFrame& frame, const ImageEncoding& encoding,
 }
 
 RgbdFrame fromMessage(const rgbd_frame_t& msg) {
+  checkUtime(msg.utime, "frame");
   RgbdFrame frame;
   frame.utime = msg.utime;
   frame.frame_id = msg.frame_id;
@@ -222,6 +232,7 @@ pose_t toMessage(const StampedPose& pose) {
 }
 
 StampedPose fromMessage(const pose_t& msg) {
+  checkUtime(msg.utime, "pose");
   bool finite = true;
   for (double x : msg.position) finite = finite && std::isfinite(x);
   for (double x : msg.orientation) finite = finite && std::isfinite(x);
@@ -260,6 +271,7 @@ panoptic_t toMessage(const PanopticFrame& frame, const ImageEncoding& encoding) 
 }
 
 PanopticFrame fromMessage(const panoptic_t& msg) {
+  checkUtime(msg.utime, "panoptic");
   PanopticFrame frame;
   frame.utime = msg.utime;
   frame.frame_id = msg.frame_id;

@@ -155,8 +155,9 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
   // Blocks near the surface: sample the truncation band of every few pixels' rays (the
   // stride keeps neighbouring samples well under a block apart at the far range).
   const Eigen::Isometry3f T_W_Cf = T_W_C.cast<float>();
+  // Clamped before the conversion: a huge focal length would overflow int.
   const int stride =
-      std::clamp(static_cast<int>(map->blockSize() * cam.fx / config_.max_depth_m / 2.0), 1, 8);
+      static_cast<int>(std::clamp(map->blockSize() * cam.fx / config_.max_depth_m / 2.0, 1.0, 8.0));
   // Tens of thousands of samples hit a few hundred blocks: per-thread hash sets drop the
   // repeats, so only the distinct keys are sorted.
   const float inv_block = 1.0f / map->blockSize();

@@ -1,5 +1,6 @@
 #include "panmap/mapper/config_file.h"
 
+#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -60,9 +61,48 @@ class Section {
   std::set<std::string> seen_;
 };
 
+// OpenCV's YAML reader (4.6) loops forever when a document's root collection ends before the
+// end of the file and what follows does not start a new document ("%YAML:1.0\n m: 1\nma-- 3"
+// hung fuzz/fuzz_config: the root mapping at column 1 ends at "ma--", the reader skips three
+// characters and then spins on the "-"). A root block mapping at column 0 only ends at the end
+// of the file or at a "..." line, so a config must be exactly that: one document whose first
+// entry is a section name at column 0, with no "..." line. Checked before OpenCV parses it.
+void checkConfigShape(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot read config " + path);
+  std::string line;
+  int line_no = 0;
+  bool root_seen = false;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::string where = path + ":" + std::to_string(line_no) + ": ";
+    if (line.compare(0, 3, "...") == 0) {
+      throw Error(where + "'...' ends the document; a config is one document without it");
+    }
+    if (root_seen) continue;
+    const size_t first = line.find_first_not_of(' ');
+    if (first == std::string::npos || line[first] == '#' || line[0] == '%') continue;
+    if (line.compare(0, 3, "---") == 0) {
+      const size_t rest = line.find_first_not_of(' ', 3);
+      if (rest != std::string::npos && line[rest] != '#') {
+        throw Error(where + "nothing may follow '---' on its line");
+      }
+      continue;
+    }
+    const char c = line[0];
+    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_')) {
+      throw Error(where +
+                  "expected a section name at column 0 (a config is a mapping of sections)");
+    }
+    root_seen = true;
+  }
+}
+
 }  // namespace
 
 PanmapConfig loadConfig(const std::string& path) {
+  checkConfigShape(path);
   cv::FileStorage fs;
   try {
     if (!fs.open(path, cv::FileStorage::READ)) throw Error("cannot read config " + path);

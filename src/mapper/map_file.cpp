@@ -401,11 +401,19 @@ std::unique_ptr<Mapper> Mapper::deserialize(const std::vector<uint8_t>& bytes,
   mapper->frames_ = r.get<int64_t>();
   mapper->vote_evictions_ = r.get<uint64_t>();
   const uint64_t blocks = r.getCount(13 + sizeof(Block::voxels));
+  // Block keys hold 21 bits per axis: an index beyond them would alias another block, and its
+  // voxel coordinates (index * 8) overflow int (fuzz/fuzz_map_file).
+  constexpr int32_t kMaxBlockIndex = 1 << 20;
   for (uint64_t i = 0; i < blocks; ++i) {
     BlockIndex index;
     index.x() = r.get<int32_t>();
     index.y() = r.get<int32_t>();
     index.z() = r.get<int32_t>();
+    for (int axis = 0; axis < 3; ++axis) {
+      if (index[axis] < -kMaxBlockIndex || index[axis] >= kMaxBlockIndex) {
+        throw Error(path + ": block index " + std::to_string(index[axis]) + " out of range");
+      }
+    }
     Block* block = mapper->map_->allocateBlock(index);
     block->updated = r.get<uint8_t>() != 0;
     r.getBytes(block->voxels, sizeof(block->voxels));

@@ -1,5 +1,6 @@
 #include "panmap/mapper/mapper.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -70,6 +71,35 @@ void Mapper::validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
     throw Error("depth scale must be > 0");
   }
   const int w = frame.camera.width, h = frame.camera.height;
+  // Every point the frame can produce must lie where the map can address it: block indices
+  // wrap at 2^20 blocks from the origin and voxel coordinates are converted to int from
+  // float. A depth scale, focal length, principal point or translation far out of range
+  // (an LCM frame with depth_scale_m 3.6e52 reached the float-to-int conversion as NaN in
+  // fuzz/fuzz_lcm_session) is refused here instead.
+  {
+    const PinholeCamera& c = frame.camera;
+    // The per-pixel geometry runs in float: intrinsics must be far inside its range (an fx of
+    // 2e233 overflowed an int conversion in the integrator).
+    constexpr double kMaxIntrinsicPx = 1e6;
+    for (double v : {c.fx, c.fy, c.cx, c.cy}) {
+      if (!(std::abs(v) <= kMaxIntrinsicPx)) {
+        throw Error("intrinsics: fx, fy, cx, cy must be within 1e6 pixels");
+      }
+    }
+    const double tan_x = std::max(std::abs(c.cx), std::abs(w - 1 - c.cx)) / c.fx;
+    const double tan_y = std::max(std::abs(c.cy), std::abs(h - 1 - c.cy)) / c.fy;
+    const double reach =
+        T_W_C.translation().norm() +
+        65535.0 * frame.depth_scale_m * std::sqrt(1.0 + tan_x * tan_x + tan_y * tan_y);
+    const double extent =
+        0.5 * kBlockSide * config_.map.voxel_size_m * static_cast<double>(1 << 20);
+    if (!(reach < extent)) {
+      std::ostringstream s;
+      s << "extent: with its pose, depth scale and intrinsics the frame reaches " << reach
+        << " m from the origin, beyond the map's " << extent << " m";
+      throw Error(s.str());
+    }
+  }
   if (frame.depth.empty()) throw Error("empty depth image");
   if (frame.depth.width() != w || frame.depth.height() != h) {
     std::ostringstream s;

@@ -97,13 +97,16 @@ TEST(ImageCodec, BrokenPngChunksAreNamedWithTheirOffset) {
   flipped[8 + 8 + 2] ^= 0x01;  // a byte of IHDR's data: its CRC no longer matches
   EXPECT_EQ(decodeError(flipped), "d.png: corrupt PNG (checksum of chunk IHDR at offset 8)");
 
-  // IHDR claiming 100000 x 8 pixels, with a correct CRC: refused before any allocation.
+  // IHDR claiming 30000 x 30000 pixels, with a correct CRC: refused before any allocation.
   std::vector<uint8_t> huge = good;
-  const uint32_t width = 100000;
-  for (int i = 0; i < 4; ++i) huge[16 + i] = static_cast<uint8_t>(width >> (24 - 8 * i));
+  const uint32_t side = 30000;
+  for (int i = 0; i < 4; ++i) {
+    huge[16 + i] = huge[20 + i] = static_cast<uint8_t>(side >> (24 - 8 * i));
+  }
   const uLong crc = crc32(0L, huge.data() + 12, 17);
   for (int i = 0; i < 4; ++i) huge[29 + i] = static_cast<uint8_t>(crc >> (24 - 8 * i));
-  EXPECT_EQ(decodeError(huge), "d.png: PNG of 100000x8 pixels (at most 16384 per side)");
+  EXPECT_EQ(decodeError(huge),
+            "d.png: image of 30000x30000 pixels is larger than the 33554432 pixels panmap reads");
 }
 
 }  // namespace

@@ -96,6 +96,8 @@ class BinaryReader {
     if (size > size_ - pos_)
       throw Error(what_ + ": truncated (needs " + std::to_string(size) + " more bytes at offset " +
                   std::to_string(base_ + pos_) + ")");
+    // memcpy with a null pointer is undefined even for 0 bytes (an empty vector's data()).
+    if (size == 0) return;
     std::memcpy(out, data_ + pos_, size);
     pos_ += size;
   }

@@ -9,8 +9,9 @@
 
 namespace panmap {
 
-/// Largest width or height of a PNG the decoders accept (a bound on what one frame allocates).
-constexpr uint32_t kMaxImageSide = 16384;
+/// Largest image the decoders accept, in pixels (2^25, about 33.5 M): the header's size is
+/// checked before anything is allocated.
+constexpr uint64_t kMaxImagePixels = uint64_t{1} << 25;
 
 /// Bytes of a whole file; throws Error("cannot read <path>") when it cannot be read.
 std::vector<uint8_t> readFileBytes(const std::string& path);
