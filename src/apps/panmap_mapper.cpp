@@ -277,7 +277,7 @@ int main(int argc, char** argv) {
       if (autosaver) {
         autosaver->clear();
       } else if (resumed) {
-        for (const std::string& path : panmap::listAutosaves(autosaveDirOf(resume_dir))) {
+        for (const std::string& path : panmap::listResumeCandidates(autosaveDirOf(resume_dir))) {
           std::remove(path.c_str());
         }
       }

@@ -17,15 +17,19 @@ double msSince(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
-std::vector<std::pair<int64_t, std::string>> numberedAutosaves(const std::string& dir) {
+// Snapshot files of a folder, newest first; with `partial`, also the .partial files a crash
+// left (after the complete file of the same number).
+std::vector<std::pair<int64_t, std::string>> numberedAutosaves(const std::string& dir,
+                                                               bool partial = false) {
   namespace fs = std::filesystem;
   static const std::regex name_re(R"(autosave-(\d+)\.panmap)");
+  static const std::regex any_re(R"(autosave-(\d+)\.panmap(\.partial)?)");
   std::vector<std::pair<int64_t, std::string>> out;
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     const std::string name = entry.path().filename().string();
     std::smatch m;
-    if (std::regex_match(name, m, name_re)) {
+    if (std::regex_match(name, m, partial ? any_re : name_re)) {
       out.emplace_back(std::stoll(m[1].str()), entry.path().string());
     }
   }
@@ -53,12 +57,18 @@ std::vector<std::string> listAutosaves(const std::string& dir) {
   return out;
 }
 
+std::vector<std::string> listResumeCandidates(const std::string& dir) {
+  std::vector<std::string> out;
+  for (const auto& [number, path] : numberedAutosaves(dir, true)) out.push_back(path);
+  return out;
+}
+
 Autosaver::Autosaver(const Config& config) : config_(config) {
   config_.check();
   std::error_code ec;
   std::filesystem::create_directories(config_.dir, ec);
   if (ec) throw Error("cannot create autosave folder " + config_.dir + ": " + ec.message());
-  const auto existing = numberedAutosaves(config_.dir);
+  const auto existing = numberedAutosaves(config_.dir, true);
   if (!existing.empty()) next_number_ = existing.front().first + 1;
   const std::string journal = config_.dir + "/frames.journal";
   journal_ = std::fopen(journal.c_str(), "a");
@@ -133,7 +143,7 @@ void Autosaver::wait() {
 
 void Autosaver::clear() {
   wait();
-  for (const std::string& path : listAutosaves(config_.dir)) std::remove(path.c_str());
+  for (const std::string& path : listResumeCandidates(config_.dir)) std::remove(path.c_str());
   std::fclose(journal_);
   journal_ = std::fopen((config_.dir + "/frames.journal").c_str(), "w");  // emptied
   if (!journal_) throw Error("cannot reopen " + config_.dir + "/frames.journal");

@@ -31,7 +31,7 @@ std::vector<std::pair<int64_t, int64_t>> journalAfter(const std::string& path, i
 }  // namespace
 
 ResumePoint resumeFrom(const std::string& dir) {
-  const std::vector<std::string> snapshots = listAutosaves(dir);
+  const std::vector<std::string> snapshots = listResumeCandidates(dir);
   if (snapshots.empty()) throw Error(dir + ": no autosave-NNNNNN.panmap snapshot to resume from");
   ResumePoint point;
   for (const std::string& path : snapshots) {

@@ -98,6 +98,34 @@ TEST(Resume, SkipsACorruptSnapshotListsLostFramesAndContinuesExactly) {
   EXPECT_EQ(test::mapBytes(*point.mapper), test::mapBytes(uninterrupted));
 }
 
+TEST(Resume, TakesACompletePartialSnapshotAndRefusesACutOne) {
+  // A kill after the snapshot was streamed but before its fsync and rename leaves it complete
+  // under .partial: resuming from it loses nothing beyond it.
+  test::TempDir dir;
+  mapWithAutosave(dir.path());
+  const std::string newest = autosavePath(dir.path(), 3);
+  fs::rename(newest, newest + ".partial");
+  ResumePoint point = resumeFrom(dir.path());
+  EXPECT_EQ(point.path, newest + ".partial");
+  EXPECT_EQ(point.frames, 10);
+  EXPECT_TRUE(point.refused.empty());
+  // Cut short, as a kill while streaming leaves it: refused, the complete one before it taken.
+  fs::resize_file(newest + ".partial", fs::file_size(newest + ".partial") - 100);
+  point = resumeFrom(dir.path());
+  EXPECT_EQ(point.path, autosavePath(dir.path(), 2));
+  ASSERT_EQ(point.refused.size(), 1u);
+  EXPECT_NE(point.refused[0].find(".partial: truncated map file"), std::string::npos);
+  // A new run numbers its snapshots after the leftover, and clears it at the end.
+  Autosaver::Config config;
+  config.dir = dir.path();
+  Autosaver again(config);
+  again.snapshotNow(*point.mapper);
+  again.wait();
+  EXPECT_EQ(listAutosaves(dir.path())[0], autosavePath(dir.path(), 4));
+  again.clear();
+  EXPECT_TRUE(listResumeCandidates(dir.path()).empty());
+}
+
 TEST(Resume, NoLoadableSnapshotIsOneClearError) {
   test::TempDir dir;
   EXPECT_THROW(resumeFrom(dir.path()), Error);

@@ -60,7 +60,8 @@ class Autosaver {
   void snapshotNow(const Mapper& mapper);
   /// Blocks until the snapshot in flight is on disk.
   void wait();
-  /// Removes the snapshots and the journal (after the final outputs are safely written).
+  /// Removes the snapshots, partial ones and the journal (after the final outputs are safely
+  /// written).
   void clear();
   /// Counters so far (thread-safe).
   Stats stats() const;
@@ -87,5 +88,10 @@ std::string autosavePath(const std::string& dir, int64_t number);
 
 /// Snapshot files of an autosave folder, newest (highest number) first.
 std::vector<std::string> listAutosaves(const std::string& dir);
+
+/// What a resume may load, newest first: the snapshots and the .partial files a crash left
+/// behind. A process killed after streaming a snapshot but before its fsync and rename leaves
+/// a complete .partial (its checksum tells), which costs less than the previous snapshot.
+std::vector<std::string> listResumeCandidates(const std::string& dir);
 
 }  // namespace panmap

@@ -22,8 +22,9 @@ struct ResumePoint {
   std::vector<std::pair<int64_t, int64_t>> lost;
 };
 
-/// Loads the newest snapshot of an autosave folder that reads cleanly (a corrupt or truncated
-/// newer one is refused with its error and the next older one tried), and reads the frame
+/// Loads the newest snapshot of an autosave folder that reads cleanly, a complete .partial one
+/// included (a corrupt or truncated newer one is refused with its error and the next older
+/// one tried; the checksum tells a complete partial file from a cut one), and reads the frame
 /// journal to list the frames lost since it. Throws Error naming the folder when no snapshot
 /// loads, listing each one's error.
 ResumePoint resumeFrom(const std::string& dir);
