@@ -22,6 +22,7 @@ void checkValues(const std::map<int32_t, double>& values, const std::string& fie
 }  // namespace
 
 constexpr int32_t kTableSize = 1 << 16;
+constexpr int32_t kMaxInitialInstance = 1 << 30;
 
 void checkGraph(const SuperpointGraph& graph) {
   if (graph.classes.empty() && !graph.vertices.empty()) {
@@ -39,6 +40,11 @@ void checkGraph(const SuperpointGraph& graph) {
     if (i > 0 && v.id <= graph.vertices[i - 1].id) {
       throw Error(field + ".id: " + std::to_string(v.id) + " not above the previous id " +
                   std::to_string(graph.vertices[i - 1].id));
+    }
+    // Refinement numbers new instances above the largest initial one: leave it room (an
+    // initial instance of INT32_MAX overflowed, found by fuzz/fuzz_lcm_messages).
+    if (v.instance < 0 || v.instance >= kMaxInitialInstance) {
+      throw Error(field + ".instance: " + std::to_string(v.instance) + " (must be in [0, 2^30))");
     }
     checkValues(v.scores, field + ".scores");
   }

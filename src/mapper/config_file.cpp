@@ -66,7 +66,9 @@ class Section {
 // hung fuzz/fuzz_config: the root mapping at column 1 ends at "ma--", the reader skips three
 // characters and then spins on the "-"). A root block mapping at column 0 only ends at the end
 // of the file or at a "..." line, so a config must be exactly that: one document whose first
-// entry is a section name at column 0, with no "..." line. Checked before OpenCV parses it.
+// entry is a section name at column 0, with no "..." line. Control characters are refused as
+// well: OpenCV measures lines with strlen, and a NUL byte on the header line led to the same
+// loop. Checked before OpenCV parses the file.
 void checkConfigShape(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw Error("cannot read config " + path);
@@ -77,6 +79,13 @@ void checkConfigShape(const std::string& path) {
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const std::string where = path + ":" + std::to_string(line_no) + ": ";
+    for (size_t i = 0; i < line.size(); ++i) {
+      const auto c = static_cast<unsigned char>(line[i]);
+      if (c < 0x20 && c != '\t') {
+        throw Error(where + "control character " + std::to_string(c) + " at column " +
+                    std::to_string(i + 1));
+      }
+    }
     if (line.compare(0, 3, "...") == 0) {
       throw Error(where + "'...' ends the document; a config is one document without it");
     }

@@ -10,8 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "panmap/graph/optimiser.h"
 #include "panmap/lcm/conversions.h"
 #include "panmap/lcm/decode.h"
+#include "panmap/lcm/graph_conversions.h"
 #include "panmap/lcm/mapping_session.h"
 #include "panmap/lcm/message_types.h"
 #include "panmap/panoptic_t.hpp"
@@ -80,6 +82,16 @@ TEST(LcmFuzzRegressions, StringLengthOfInt32MinIsRefused) {
   expectRefused<status_t>(
       messageOfFuzzInput("lcm_messages/status_string_length_int_min", status_t::getHash()),
       "status_t");
+}
+
+TEST(LcmFuzzRegressions, GraphWithInstanceInt32MaxIsRefusedByTheOptimiser) {
+  // A superpoint_graph_t whose vertex carried instance INT32_MAX: refinement numbered new
+  // instances from max + 1 (signed overflow). panmap-optimizer converts and optimises it.
+  const std::vector<uint8_t> bytes =
+      messageOfFuzzInput("lcm_messages/graph_instance_int32_max", superpoint_graph_t::getHash());
+  superpoint_graph_t msg;
+  ASSERT_TRUE(decodeExactly(bytes.data(), bytes.size(), &msg));
+  test::expectError([&] { optimise(fromMessage(msg), OptimiserConfig{}); }, {"instance", "2^30"});
 }
 
 TEST(LcmFuzzRegressions, ImageSizeFieldBeyondTheMessageIsRefused) {

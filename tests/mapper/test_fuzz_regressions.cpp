@@ -97,6 +97,17 @@ TEST(ConfigFuzzRegressions, RootMappingNotAtColumnZeroIsRefused) {
   test::expectError([&] { loadConfig(minimal); }, {minimal + ":2", "column 0"});
 }
 
+TEST(ConfigFuzzRegressions, ControlCharactersAreRefused) {
+  // NUL bytes on the header line made OpenCV's reader (which measures lines with strlen) end
+  // the root mapping early and loop the same way.
+  const std::string path = test::fixtureDir("fuzz_regressions/config/nul_byte_endless_loop");
+  test::expectError([&] { loadConfig(path); }, {path + ":3", "control character"});
+  test::TempDir dir;
+  const std::string nul = dir.path("nul.yaml");
+  std::ofstream(nul, std::ios::binary) << std::string("%YAML:1.0\0\nmap:\n", 16);
+  test::expectError([&] { loadConfig(nul); }, {nul + ":1", "control character 0 at column 10"});
+}
+
 TEST(ConfigFuzzRegressions, DocumentEndAndTextAfterSeparatorAreRefused) {
   // Both end OpenCV's root collection early, which is what made it loop.
   test::TempDir dir;
