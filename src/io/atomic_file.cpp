@@ -78,10 +78,4 @@ void AtomicFileWriter::commit() {
   }
 }
 
-void writeFileAtomically(const std::string& path, const void* data, size_t size) {
-  AtomicFileWriter file(path);
-  file.append(static_cast<const uint8_t*>(data), size);
-  file.commit();
-}
-
 }  // namespace panmap

@@ -1,46 +1,19 @@
 #include "panmap/io/pose_list.h"
 
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
-#include <fstream>
-#include <sstream>
 
 #include "panmap/core/error.h"
 #include "panmap/core/pose.h"
+#include "panmap/io/text_files.h"
 
 namespace panmap {
 namespace {
 
-struct Line {
-  int number = 0;
-  std::vector<double> values;
-};
+using Line = NumberLine;
 
 std::vector<Line> readLines(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error("cannot read pose file " + path);
-  std::vector<Line> out;
-  std::string text, token;
-  int number = 0;
-  while (std::getline(in, text)) {
-    ++number;
-    const size_t first = text.find_first_not_of(" \t\r");
-    if (first == std::string::npos || text[first] == '#') continue;
-    Line line;
-    line.number = number;
-    std::istringstream tokens(text);
-    while (tokens >> token) {
-      char* end = nullptr;
-      errno = 0;
-      const double value = std::strtod(token.c_str(), &end);
-      if (end == token.c_str() || *end != '\0') {
-        throw Error(path + ":" + std::to_string(number) + ": '" + token + "' is not a number");
-      }
-      line.values.push_back(value);
-    }
-    out.push_back(std::move(line));
-  }
+  if (!isRegularFile(path)) throw Error("cannot read pose file " + path);
+  std::vector<Line> out = readNumberLines(path);
   if (out.empty()) throw Error(path + ": no poses");
   return out;
 }
@@ -75,13 +48,13 @@ PoseList readPoseList(const std::string& path, double tolerance) {
   const size_t width = lines.front().values.size();
   for (const Line& line : lines) {
     if (line.values.size() != width) {
-      throw Error(path + ":" + std::to_string(line.number) + ": " +
+      throw Error(path + ":" + std::to_string(line.line) + ": " +
                   std::to_string(line.values.size()) + " numbers where line " +
-                  std::to_string(lines.front().number) + " has " + std::to_string(width));
+                  std::to_string(lines.front().line) + " has " + std::to_string(width));
     }
   }
   PoseList list;
-  auto where = [&path](const Line& line) { return path + ":" + std::to_string(line.number); };
+  auto where = [&path](const Line& line) { return path + ":" + std::to_string(line.line); };
   if (width == 8) {
     list.format = PoseList::Format::kTum;
     for (const Line& line : lines) {
@@ -121,7 +94,7 @@ PoseList readPoseList(const std::string& path, double tolerance) {
       addMatrix(T, where(lines[k]), tolerance, &list);
     }
   } else {
-    throw Error(path + ":" + std::to_string(lines.front().number) + ": " + std::to_string(width) +
+    throw Error(path + ":" + std::to_string(lines.front().line) + ": " + std::to_string(width) +
                 " numbers per line; expected TUM (t tx ty tz qx qy qz qw), 12 or 16 (a 3x4 or "
                 "4x4 matrix per line) or 4 (a 4x4 matrix over four lines)");
   }

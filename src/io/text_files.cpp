@@ -11,25 +11,38 @@
 
 namespace panmap {
 
-std::vector<double> readNumbers(const std::string& path) {
+std::vector<NumberLine> readNumberLines(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw Error("cannot read " + path);
-  std::vector<double> values;
-  std::string line, token;
-  while (std::getline(in, line)) {
-    const size_t first = line.find_first_not_of(" \t\r");
-    if (first != std::string::npos && line[first] == '#') continue;
-    std::istringstream tokens(line);
+  std::vector<NumberLine> out;
+  std::string text, token;
+  int number = 0;
+  while (std::getline(in, text)) {
+    ++number;
+    const size_t first = text.find_first_not_of(" \t\r");
+    if (first == std::string::npos || text[first] == '#') continue;
+    NumberLine line;
+    line.line = number;
+    std::istringstream tokens(text);
     while (tokens >> token) {
       // strtod, unlike operator>>, accepts "nan" and "-inf" (ScanNet writes -inf poses).
       char* end = nullptr;
       errno = 0;
       const double value = std::strtod(token.c_str(), &end);
       if (end == token.c_str() || *end != '\0') {
-        throw Error(path + ": '" + token + "' is not a number");
+        throw Error(path + ":" + std::to_string(number) + ": '" + token + "' is not a number");
       }
-      values.push_back(value);
+      line.values.push_back(value);
     }
+    out.push_back(std::move(line));
+  }
+  return out;
+}
+
+std::vector<double> readNumbers(const std::string& path) {
+  std::vector<double> values;
+  for (const NumberLine& line : readNumberLines(path)) {
+    values.insert(values.end(), line.values.begin(), line.values.end());
   }
   return values;
 }

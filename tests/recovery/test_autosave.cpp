@@ -167,12 +167,17 @@ TEST(MapFile, CorruptionIsNamedWithFileAndOffset) {
 TEST(AtomicFile, ReplacesWholeFilesAndNamesFailures) {
   test::TempDir dir;
   const std::string path = dir.path("f.bin");
-  writeFileAtomically(path, "first", 5);
-  writeFileAtomically(path, "second!", 7);
+  auto write = [](const std::string& to, const std::string& text) {
+    AtomicFileWriter file(to);
+    file.append(reinterpret_cast<const uint8_t*>(text.data()), text.size());
+    file.commit();
+  };
+  write(path, "first");
+  write(path, "second!");
   EXPECT_EQ(test::fileBytes(path), "second!");
   EXPECT_FALSE(fs::exists(path + ".partial"));
   try {
-    writeFileAtomically(dir.path("missing/f.bin"), "x", 1);
+    write(dir.path("missing/f.bin"), "x");
     FAIL() << "expected an error";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("cannot create " + dir.path("missing/f.bin.partial")),

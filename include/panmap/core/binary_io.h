@@ -40,8 +40,6 @@ class BinaryWriter {
     put<uint64_t>(s.size());
     putBytes(s.data(), s.size());
   }
-  /// Makes room for `n` bytes in all, so a large buffer is not copied as it grows.
-  void reserve(size_t n) { bytes_.reserve(n); }
   /// Overwrites a value written earlier at `offset` (e.g. a size known only at the end).
   template <typename T>
   void putAt(size_t offset, const T& value) {
@@ -66,8 +64,6 @@ class BinaryWriter {
   size_t size() const { return flushed_ + bytes_.size(); }
   /// The bytes so far (without a sink: all of them).
   const std::vector<uint8_t>& bytes() const { return bytes_; }
-  /// Hands the bytes over, leaving the writer empty.
-  std::vector<uint8_t> release() { return std::move(bytes_); }
 
  private:
   std::vector<uint8_t> bytes_;

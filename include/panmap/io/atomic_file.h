@@ -36,7 +36,4 @@ class AtomicFileWriter : public ByteSink {
   int fd_ = -1;
 };
 
-/// Writes `size` bytes to `path` through an AtomicFileWriter.
-void writeFileAtomically(const std::string& path, const void* data, size_t size);
-
 }  // namespace panmap

@@ -12,8 +12,18 @@ namespace panmap {
 /// missing or holds a different number of values.
 Eigen::MatrixXd readMatrixFile(const std::string& path, int rows, int cols);
 
-/// Reads every whitespace-separated number of a text file ('#' starts a comment line). Throws
-/// Error naming the file and the first token that is not a number.
+/// One line of numbers and its 1-based line number in the file.
+struct NumberLine {
+  int line = 0;
+  std::vector<double> values;
+};
+
+/// Reads the whitespace-separated numbers of a text file line by line, skipping empty lines and
+/// '#' comment lines ("nan", "inf", "-inf" accepted). Throws Error naming the file, the line and
+/// the first token that is not a number.
+std::vector<NumberLine> readNumberLines(const std::string& path);
+
+/// Every number of a text file (readNumberLines, flattened).
 std::vector<double> readNumbers(const std::string& path);
 
 /// Reads pinhole intrinsics fx, fy, cx, cy from a file holding a 3x3 K, a 4x4 matrix with K
