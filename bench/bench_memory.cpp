@@ -17,6 +17,7 @@
 
 #include "panmap/core/error.h"
 #include "panmap/core/process_memory.h"
+#include "panmap/mapper/config_file.h"
 #include "panmap/mapper/mapper.h"
 #include "panmap/sim/procedural_room.h"
 #include "panmap/sim/sequence.h"
@@ -57,7 +58,10 @@ int main(int argc, char** argv) {
       "map's own size every few hundred frames."};
   int room = 1, frames = 3000, every = 250, threads = 2;
   double voxel = 0.02;
-  std::string json_path;
+  std::string json_path, config_path;
+  app.add_option(
+      "--config", config_path,
+      "YAML config (panmap-mapper --print-config); --voxel-size and --threads override it");
   app.add_option("--room", room, "procedural room seed")->capture_default_str();
   app.add_option("--frames", frames, "frames to map (30 Hz survey)")->capture_default_str();
   app.add_option("--voxel-size", voxel, "metres")->capture_default_str();
@@ -76,6 +80,7 @@ int main(int argc, char** argv) {
     panmap::SequenceSynthesizer synth(layout.mesh, panmap::planSurvey(layout.mesh, survey, 1),
                                       synth_config);
     panmap::MapperConfig config;
+    if (!config_path.empty()) config = panmap::loadConfig(config_path).mapper;
     config.map.voxel_size_m = static_cast<float>(voxel);
     config.num_threads = threads;
     panmap::Mapper mapper(config);

@@ -16,7 +16,7 @@ namespace {
 // The header Mapper::save writes: magic, version, payload size, payload, CRC-32.
 std::vector<uint8_t> wrapPayload(const uint8_t* payload, size_t size) {
   std::vector<uint8_t> file = {'P', 'A', 'N', 'M', 'A', 'P', 0, 0};
-  const uint32_t version = 5;
+  const uint32_t version = 6;  // the current one (src/mapper/map_file.cpp kVersion)
   const uint64_t n = size;
   const uint32_t crc = static_cast<uint32_t>(crc32(0L, payload, static_cast<uInt>(size)));
   const auto append = [&file](const void* p, size_t k) {

@@ -3,17 +3,60 @@
 # ScalableTSDFVolume on the same frames, and the pipeline's parts; writes docs/PERFORMANCE.md.
 # About 15 minutes on 2 cores. Installs libopen3d-dev (setup.sh --with-open3d) when it can;
 # without it the Open3D columns say so.
-#   scripts/bench/speed.sh [--no-memory]     (--no-memory: skip the 3000-frame memory run)
+#   scripts/bench/speed.sh [--no-memory | --memory-only]
+#     --no-memory    skip the 3000-frame memory run
+#     --memory-only  only the memory run (4 min): rewrites its section of docs/PERFORMANCE.md
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 memory=1
+memory_only=0
 for arg in "$@"; do
   case "$arg" in
     --no-memory) memory=0 ;;
-    -h|--help) sed -n '2,6p' "$0"; exit 0 ;;
+    --memory-only) memory_only=1 ;;
+    -h|--help) sed -n '2,8p' "$0"; exit 0 ;;
     *) echo "speed.sh: unknown option $arg" >&2; exit 2 ;;
   esac
 done
+out=docs/PERFORMANCE.md
+# The long-run memory section, between markers so that --memory-only can replace it alone.
+memory_section() {  # $1: the table rows
+  cat <<MD
+<!-- memory:begin (scripts/bench/speed.sh; --memory-only rewrites this section alone) -->
+## Memory on a long run
+
+\`panmap-bench-memory --room 1 --frames 3000 --voxel-size 0.02\`: a 100 s walk (30 Hz)
+through one room, rendered in-process and mapped frame by frame with its masks; measured on
+$(date -u +%Y-%m-%d) at commit \`$(git rev-parse --short HEAD)\`. Resident memory against what the map
+holds: TSDF blocks, occupancy cells and the super-point graph with its bookkeeping (estimated
+from its table slots and std::map nodes); \`other\` is the rest of the process (the renderer
+and its room, libraries, scratch buffers), which must stay flat. Graph edges are kept only
+between super-points that own observed surface and touch there, or whose co-observation is
+strong (\`graph.prune_edges\`, checked every 100 frames; docs/MAPPING.md). \`graph ms\` and
+\`total ms\` are the medians of the graph update and the whole frame over the 250 frames
+before each sample (2 threads, with rendering in between).
+
+$1
+<!-- memory:end -->
+MD
+}
+if [ "$memory_only" -eq 1 ]; then
+  scripts/setup.sh --skip-network --skip-apt --targets panmap-bench-memory >&2
+  [ -f "$out" ] && grep -q '<!-- memory:begin' "$out" ||
+    { echo "speed.sh: $out has no memory section markers: run the whole script" >&2; exit 1; }
+  echo "bench: 3000 frames through one room, memory sampled every 250 frames" >&2
+  section=$(mktemp)
+  memory_section "$(build/panmap-bench-memory --room 1 --frames 3000 --voxel-size 0.02 --every 250)" >"$section"
+  awk -v section="$section" '
+    /<!-- memory:begin/ { while ((getline line < section) > 0) print line; skip = 1; next }
+    /<!-- memory:end -->/ { skip = 0; next }
+    !skip { print }' "$out" >"$section.md"
+  mv "$section.md" "$out"
+  rm -f "$section"
+  echo "bench: rewrote the memory section of $out" >&2
+  exit 0
+fi
+
 targets="panmap-bench-mapping panmap-bench-memory panmap-bench-renderer panmap-bench-segmentation
   panmap-bench-block-hash panmap-bench-optimiser panmap-bench-tracking panmap-bench-occupancy
   panmap-synth"
@@ -25,7 +68,6 @@ scripts/setup.sh --skip-network --with-open3d --targets "$targets panmap-bench-o
   scripts/setup.sh --skip-network --skip-apt --targets "$targets" >&2
 }
 data=../shared/data/7scenes-200
-out=docs/PERFORMANCE.md
 mkdir -p docs
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')
 tmp=$(mktemp -d)
@@ -75,6 +117,7 @@ occupancy=$(build/panmap-bench-occupancy --benchmark_format=csv --benchmark_filt
 occupancy+=$'\n'$(build/panmap-bench-occupancy --benchmark_format=csv --benchmark_filter=BM_OctomapInsertPointCloud 2>/dev/null | python3 scripts/bench/gb_counters.py median_ms p95_ms)
 hash=$(gb build/panmap-bench-block-hash | awk -F, '{gsub(/"/,"",$1); printf "| %s | %.2f ms |\n", $1, $3}')
 
+memory_text=$(memory_section "$memory_rows")
 # The soak section belongs to scripts/bench/soak.py: kept as it was.
 soak=""
 if [ -f "$out" ]; then
@@ -125,18 +168,7 @@ ${room_rows}
 
 Targets of roadmap issue 9 (2 threads, median total): <= 33 ms at 1 cm, <= 15 ms at 2 cm.
 
-## Memory on a long run
-
-\`panmap-bench-memory --room 1 --frames 3000 --voxel-size 0.02\`: a 100 s walk (30 Hz)
-through one room, rendered in-process and mapped frame by frame with its masks. Resident
-memory against what the map holds: TSDF blocks, occupancy cells and the super-point graph
-with its bookkeeping (estimated from its table slots and std::map nodes); \`other\` is the
-rest of the process (the renderer and its room, libraries, scratch buffers), which must stay
-flat. The graph grows with the pairs of super-points seen under one mask (Eq. 6 keeps an edge
-for every such pair). \`graph ms\` and \`total ms\` are the medians of the graph update and
-the whole frame over the 250 frames before each sample (2 threads, with rendering in between).
-
-${memory_rows}
+${memory_text}
 
 ## Parts
 

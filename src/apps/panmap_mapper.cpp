@@ -326,6 +326,7 @@ int main(int argc, char** argv) {
       json.update(mapJson(*mapper, outputs));
       json["graph"] = {{"vertices", graph.vertices.size()},
                        {"edges", graph.edges.size()},
+                       {"edges_pruned", mapper->edgesPruned()},
                        {"optimised", true},
                        {"optimise_ms", optimise_ms},
                        {"solve_ms", labels.solve_ms},
@@ -422,6 +423,7 @@ int main(int argc, char** argv) {
     json["wall_s"] = wall_s;
     json.update(mapJson(*mapper, outputs));
     json["graph"] = {{"optimised", labels.has_value()},
+                     {"edges_pruned", mapper->edgesPruned()},
                      {"optimise_ms", optimise_ms},
                      {"solve_ms", labels ? labels->solve_ms : 0.0},
                      {"fragments_folded", labels ? labels->fragments_folded : 0},

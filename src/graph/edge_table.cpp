@@ -76,6 +76,19 @@ void EdgeTable::keepIf(const std::function<bool(int32_t)>& keep) {
   }
 }
 
+size_t EdgeTable::keepPairsIf(const std::function<bool(int32_t, int32_t, const Classes&)>& keep) {
+  size_t dropped = 0;
+  for (auto it = table_.begin(); it != table_.end();) {
+    if (keep(first(it->first), second(it->first), it->second)) {
+      ++it;
+    } else {
+      table_.erase(it++);
+      ++dropped;
+    }
+  }
+  return dropped;
+}
+
 void EdgeTable::forEachSorted(
     const std::function<void(int32_t, int32_t, const Classes&)>& f) const {
   std::vector<const std::pair<const uint64_t, Classes>*> entries;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <tuple>
 #include <vector>
 
@@ -25,6 +26,10 @@ void GraphConfig::check() const {
   if (!(spatial_scale_m > 0.0)) throw Error("graph spatial_scale_m must be > 0");
   if (sample_stride_px < 1) throw Error("graph sample_stride_px must be >= 1");
   if (!(separation_radius_m >= 0.0)) throw Error("graph separation_radius_m must be >= 0");
+  if (!(edge_min_share >= 0.0 && edge_min_share <= 1.0)) {
+    throw Error("graph edge_min_share must be in [0, 1]");
+  }
+  if (!(surface_band_voxels > 0.0f)) throw Error("graph surface_band_voxels must be > 0");
 }
 
 GraphAccumulator::GraphAccumulator(const GraphConfig& config, ThreadPool* pool)
@@ -108,7 +113,8 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   }
   std::map<int32_t, bool> is_thing_mask;  // thing masks of a class with two or more things
   for (const PanopticSegment& s : panoptic.segments) {
-    if (s.category > 0 && s.is_thing && things_per_class[s.category] > 1) is_thing_mask[s.id] = true;
+    if (s.category > 0 && s.is_thing && things_per_class[s.category] > 1)
+      is_thing_mask[s.id] = true;
   }
   mask_groups_.clear();
   if (masks.empty()) return;
@@ -306,6 +312,35 @@ void GraphAccumulator::forgetUnvoted(const std::vector<uint8_t>& has_votes,
   edges_.keepIf(voted);
 }
 
+bool GraphAccumulator::keepEdge(int32_t a, int32_t b, double strongest,
+                                const SurfaceAdjacency& surface) const {
+  if (!config_.prune_edges) return true;
+  if (a == b || surface.surfaceVoxels(a) == 0 || surface.surfaceVoxels(b) == 0) return false;
+  if (surface.touching(a, b)) return true;
+  auto total = [this](int32_t label) {
+    double sum = 0.0;
+    const auto it = scores_.find(label);
+    if (it != scores_.end()) {
+      for (const auto& [cls, value] : it->second) sum += value;
+    }
+    return sum;
+  };
+  return strongest > 0.0 && strongest >= config_.edge_min_share * std::min(total(a), total(b));
+}
+
+size_t GraphAccumulator::pruneEdges(const SurfaceAdjacency& surface,
+                                    const LabelRegistry& registry) {
+  if (!config_.prune_edges) return 0;
+  return edges_.keepPairsIf([&](int32_t a, int32_t b, const EdgeTable::Classes& classes) {
+    // P_eps^C (C > 0) or P_sep^C (C < 0); P_apart (0) only weighs them.
+    double strongest = 0.0;
+    for (const auto& [cls, value] : classes) {
+      if (cls != 0) strongest = std::max(strongest, value);
+    }
+    return keepEdge(registry.resolve(a), registry.resolve(b), strongest, surface);
+  });
+}
+
 SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
                                         const SuperpointTracker& tracker) const {
   SuperpointGraph g;
@@ -330,7 +365,13 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
       }
     }
   }
+  std::unique_ptr<SurfaceAdjacency> surface;
+  if (config_.prune_edges) {
+    surface = std::make_unique<SurfaceAdjacency>(SurfaceAdjacency::compute(
+        map, [&resolve](int32_t l) { return resolve(l); }, config_.surface_band_voxels));
+  }
   for (const auto& [label, state] : tracker.states()) {
+    if (surface && surface->surfaceVoxels(label) == 0) continue;
     GraphVertex vertex;
     vertex.id = label;
     const auto it = voxels.find(label);
@@ -376,6 +417,21 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
     } else {
       merged.push_back(std::move(e));
     }
+  }
+  if (surface) {
+    // After the sums above: a pair's evidence is judged whole.
+    merged.erase(std::remove_if(merged.begin(), merged.end(),
+                                [&](const GraphEdge& e) {
+                                  double strongest = 0.0;
+                                  for (const auto& [cls, c] : e.confidences) {
+                                    strongest = std::max(strongest, c);
+                                  }
+                                  for (const auto& [cls, c] : e.separations) {
+                                    strongest = std::max(strongest, c);
+                                  }
+                                  return !keepEdge(e.a, e.b, strongest, *surface);
+                                }),
+                 merged.end());
   }
   g.edges = std::move(merged);
   return g;

@@ -174,6 +174,9 @@ PanmapConfig loadConfig(const std::string& path) {
     Section s(root["graph"], "graph", path);
     s.read("spatial_scale_m", &m.graph.spatial_scale_m);
     s.read("sample_stride_px", &m.graph.sample_stride_px);
+    s.read("prune_edges", &m.graph.prune_edges);
+    s.read("edge_min_share", &m.graph.edge_min_share);
+    s.read("surface_band_voxels", &m.graph.surface_band_voxels);
     s.finish();
   }
   {
@@ -353,7 +356,13 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   instance_min_overlap: " << m.superpoints.instance_min_overlap << "\n";
   y << "graph:\n"
     << "   spatial_scale_m: " << m.graph.spatial_scale_m << "   # P_s = 1 / (1 + d / scale)\n"
-    << "   sample_stride_px: " << m.graph.sample_stride_px << "\n";
+    << "   sample_stride_px: " << m.graph.sample_stride_px << "\n"
+    << "   prune_edges: " << m.graph.prune_edges
+    << "   # keep edges only between touching or strongly co-observed surface owners\n"
+    << "   edge_min_share: " << m.graph.edge_min_share
+    << "   # strong: P_eps or P_sep >= share x the smaller sum of P_nu\n"
+    << "   surface_band_voxels: " << m.graph.surface_band_voxels
+    << "   # |sdf| band of the surface\n";
   const OccupancyMap::Config& oc = m.occupancy;
   y << "occupancy:\n"
     << "   enabled: " << m.occupancy_enabled << "   # OctoMap tree for planners (0/1)\n"

@@ -19,7 +19,10 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 // 3: the pose refinement's weak_direction_damping.
 // 4: III-B apart counts.
 // 5: the pose correction model, the drift filter's config and state.
-constexpr uint32_t kVersion = 5;
+// 6: graph edge pruning (prune_edges, edge_min_share, surface_band_voxels); version 5 files
+//    still load, with pruning off as they were built.
+constexpr uint32_t kVersion = 6;
+constexpr uint32_t kOldestVersion = 5;
 // Magic, version, payload size.
 constexpr size_t kHeaderBytes = sizeof(kMagic) + sizeof(uint32_t) + sizeof(uint64_t);
 
@@ -72,6 +75,9 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put(c.superpoints.instance_min_overlap);
   w->put(c.graph.spatial_scale_m);
   w->put<int32_t>(c.graph.sample_stride_px);
+  w->put<uint8_t>(c.graph.prune_edges);
+  w->put(c.graph.edge_min_share);
+  w->put(c.graph.surface_band_voxels);
   w->put<uint8_t>(c.occupancy_enabled);
   const OccupancyMap::Config& o = c.occupancy;
   for (double v : {o.resolution_m, o.min_depth_m, o.max_depth_m, o.prob_hit, o.prob_miss,
@@ -104,7 +110,7 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put<int32_t>(c.num_threads);
 }
 
-MapperConfig getConfig(BinaryReader* r) {
+MapperConfig getConfig(BinaryReader* r, uint32_t version) {
   MapperConfig c;
   c.map.voxel_size_m = r->get<float>();
   c.integrator.truncation_voxels = r->get<float>();
@@ -131,6 +137,13 @@ MapperConfig getConfig(BinaryReader* r) {
   c.superpoints.instance_min_overlap = r->get<float>();
   c.graph.spatial_scale_m = r->get<double>();
   c.graph.sample_stride_px = r->get<int32_t>();
+  if (version >= 6) {
+    c.graph.prune_edges = r->get<uint8_t>() != 0;
+    c.graph.edge_min_share = r->get<double>();
+    c.graph.surface_band_voxels = r->get<float>();
+  } else {
+    c.graph.prune_edges = false;
+  }
   c.occupancy_enabled = r->get<uint8_t>() != 0;
   OccupancyMap::Config& o = c.occupancy;
   for (double* v : {&o.resolution_m, &o.min_depth_m, &o.max_depth_m, &o.prob_hit, &o.prob_miss,
@@ -377,9 +390,9 @@ std::unique_ptr<Mapper> Mapper::deserialize(const std::vector<uint8_t>& bytes,
   if (std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)
     throw Error(path + ": not a panmap map file");
   const uint32_t version = header.get<uint32_t>();
-  if (version != kVersion) {
+  if (version < kOldestVersion || version > kVersion) {
     throw Error(path + ": map file version " + std::to_string(version) + ", this panmap reads " +
-                std::to_string(kVersion));
+                std::to_string(kOldestVersion) + " to " + std::to_string(kVersion));
   }
   const uint64_t size = header.get<uint64_t>();
   if (size > header.remaining() || header.remaining() - size != sizeof(uint32_t)) {
@@ -397,7 +410,7 @@ std::unique_ptr<Mapper> Mapper::deserialize(const std::vector<uint8_t>& bytes,
                 std::to_string(kHeaderBytes + size) + " (corrupt map file)");
   }
   BinaryReader r(payload, size, path, kHeaderBytes);
-  auto mapper = std::make_unique<Mapper>(getConfig(&r));
+  auto mapper = std::make_unique<Mapper>(getConfig(&r, version));
   mapper->frames_ = r.get<int64_t>();
   mapper->vote_evictions_ = r.get<uint64_t>();
   const uint64_t blocks = r.getCount(13 + sizeof(Block::voxels));

@@ -150,6 +150,12 @@ void Mapper::forgetUnvotedSuperpoints() {
   }
   superpoints_forgotten_ += tracker_->forgetUnvoted(has_votes);
   graph_->forgetUnvoted(has_votes, registry);
+  if (config_.graph.prune_edges) {
+    const SurfaceAdjacency surface = SurfaceAdjacency::compute(
+        *map_, [&registry](int32_t label) { return registry.resolve(label); },
+        config_.graph.surface_band_voxels);
+    edges_pruned_ += graph_->pruneEdges(surface, registry);
+  }
 }
 
 FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C_given,

@@ -85,6 +85,21 @@ TEST(ConfigFile, DriftFilterCorrectionSwitchesTheAlignerDefaults) {
       {"drift_per_m"});
 }
 
+TEST(ConfigFile, GraphPruningKeys) {
+  test::TempDir dir;
+  const PanmapConfig c =
+      loadConfig(write(dir,
+                       "%YAML:1.0\n---\ngraph:\n   prune_edges: 0\n"
+                       "   edge_min_share: 0.25\n   surface_band_voxels: 1.5\n"));
+  EXPECT_FALSE(c.mapper.graph.prune_edges);
+  EXPECT_DOUBLE_EQ(c.mapper.graph.edge_min_share, 0.25);
+  EXPECT_FLOAT_EQ(c.mapper.graph.surface_band_voxels, 1.5f);
+  EXPECT_TRUE(PanmapConfig{}.mapper.graph.prune_edges);  // on by default
+  test::expectError(
+      [&] { loadConfig(write(dir, "%YAML:1.0\n---\ngraph:\n   edge_min_share: 2\n")); },
+      {"edge_min_share"});
+}
+
 TEST(ConfigFile, BadKeysAndValuesNameTheKey) {
   test::TempDir dir;
   auto error = [&](const std::string& text) {

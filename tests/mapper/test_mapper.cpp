@@ -3,6 +3,7 @@
 #include <limits>
 
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include "panmap/core/error.h"
 #include "panmap/graph/optimiser.h"
@@ -229,6 +230,62 @@ TEST_F(BoxScene, BadInputIsRefusedAndTheMapIsUnharmed) {
   PanopticFrame unknown = panoptic;
   for (auto& s : unknown.segments) s.category = 0;
   EXPECT_NO_THROW(mapper->integrate(frame, pose(3), &unknown));
+}
+
+}  // namespace
+}  // namespace panmap
+
+namespace panmap {
+namespace {
+
+// The bytes of a map file rewritten as version 5 wrote them: without the three graph pruning
+// fields, which start one byte before the double at `share_offset`.
+std::vector<uint8_t> asVersionFive(std::vector<uint8_t> file, size_t share_offset) {
+  constexpr size_t kHeader = 20;  // magic, version, payload size
+  file.erase(file.begin() + static_cast<std::ptrdiff_t>(share_offset - 1),
+             file.begin() + static_cast<std::ptrdiff_t>(share_offset + 8 + 4));
+  const uint32_t version = 5;
+  std::memcpy(&file[8], &version, sizeof(version));
+  const uint64_t size = file.size() - kHeader - sizeof(uint32_t);
+  std::memcpy(&file[12], &size, sizeof(size));
+  const auto crc = static_cast<uint32_t>(crc32(0L, &file[kHeader], static_cast<uInt>(size)));
+  std::memcpy(&file[kHeader + size], &crc, sizeof(crc));
+  return file;
+}
+
+TEST(MapFile, KeepsThePruningSettingsAndReadsVersionFive) {
+  MapperConfig a;
+  a.map.voxel_size_m = 0.05f;
+  a.graph.prune_edges = false;
+  a.graph.edge_min_share = 0.3;
+  a.graph.surface_band_voxels = 1.5f;
+  const auto back = Mapper::deserialize(Mapper(a).serialize(), "a.panmap");
+  EXPECT_FALSE(back->config().graph.prune_edges);
+  EXPECT_EQ(back->config().graph.edge_min_share, 0.3);
+  EXPECT_EQ(back->config().graph.surface_band_voxels, 1.5f);
+
+  // A version 5 file was built without pruning: it loads with pruning off, whatever the
+  // defaults say now. The share field is found where two files differ only in it.
+  MapperConfig b = a;
+  b.graph.prune_edges = true;
+  MapperConfig c = b;
+  c.graph.edge_min_share = 0.1;
+  const std::vector<uint8_t> bytes_b = Mapper(b).serialize();
+  const std::vector<uint8_t> bytes_c = Mapper(c).serialize();
+  ASSERT_EQ(bytes_b.size(), bytes_c.size());
+  size_t offset = 0;
+  while (offset < bytes_b.size() && bytes_b[offset] == bytes_c[offset]) ++offset;
+  ASSERT_LT(offset, bytes_b.size());
+  const auto old = Mapper::deserialize(asVersionFive(bytes_b, offset), "old.panmap");
+  EXPECT_FALSE(old->config().graph.prune_edges);
+  EXPECT_EQ(old->config().map.voxel_size_m, 0.05f);
+  EXPECT_EQ(Mapper(old->config()).serialize().size(), bytes_b.size());
+
+  // Versions outside 5-6 are refused by name.
+  std::vector<uint8_t> future = bytes_b;
+  future[8] = 7;
+  test::expectError([&] { Mapper::deserialize(future, "future.panmap"); },
+                    {"future.panmap", "version 7", "reads 5 to 6"});
 }
 
 }  // namespace

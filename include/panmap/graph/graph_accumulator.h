@@ -12,6 +12,7 @@
 #include "panmap/core/thread_pool.h"
 #include "panmap/graph/internal/edge_table.h"
 #include "panmap/graph/superpoint_graph.h"
+#include "panmap/graph/surface_adjacency.h"
 #include "panmap/map/tsdf_map.h"
 #include "panmap/map/voxel_label_sampler.h"
 #include "panmap/superpoint/superpoint_tracker.h"
@@ -29,6 +30,20 @@ struct GraphConfig {
   /// two masks of one thing class in a frame whose voxels' centroids are at most this far
   /// apart: farther pairs are never candidates for one instance anyway.
   double separation_radius_m = 1.5;
+  /// Keep the graph bounded by the surface instead of by the history of masks (issue 23): an
+  /// edge survives only between super-points that own observed surface (SurfaceAdjacency) and
+  /// that touch there, or whose evidence is strong (below). Eq. 6 otherwise keeps a pair for
+  /// every two super-points ever seen under one wall or floor mask, and most of them are
+  /// super-points that lost every voxel to a newer one. Applied to the table every
+  /// Mapper::kForgetEveryFrames frames and to every graph() handed to the optimiser.
+  bool prune_edges = true;
+  /// A pair that does not touch keeps its edge when its strongest P_eps^C or P_sep^C reaches
+  /// this share of the smaller super-point's sum_C P_nu^C: the smaller one was seen with the
+  /// other under one mask (or as two objects) in at least about this share of its sightings.
+  double edge_min_share = 0.1;
+  /// Half-width of the surface band, voxels: observed voxels with |sdf| at most this count as
+  /// surface (as objects and meshes do: mapper/objects.h kObjectSurfaceBandVoxels).
+  float surface_band_voxels = 2.0f;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -36,8 +51,9 @@ struct GraphConfig {
 /// Accumulates the super-point graph frame by frame: vertex scores P_nu^C (Eq. 5), edge
 /// confidences P_eps^C (Eq. 6), and their counterpart P_sep^C: the evidence that two
 /// super-points seen in one frame under two different masks of one thing class belong to
-/// different objects (Eq. 6 with the two masks' smaller confidence). Keyed by live super-points; merges fold scores and edges
-/// together, so the cost of an update does not grow with the number of frames seen.
+/// different objects (Eq. 6 with the two masks' smaller confidence). Keyed by live super-points;
+/// merges fold scores and edges together, so the cost of an update does not grow with the number of
+/// frames seen.
 class GraphAccumulator {
  public:
   /// Throws Error when the config is invalid.
@@ -55,8 +71,20 @@ class GraphAccumulator {
   /// SuperpointTracker::forgetUnvoted; has_votes is indexed by root label).
   void forgetUnvoted(const std::vector<uint8_t>& has_votes, const LabelRegistry& registry);
 
+  /// Drops the edges GraphConfig::prune_edges says the graph does without: an end owns no
+  /// surface, or the two neither touch nor have strong evidence (keepEdge). No-op when pruning
+  /// is off. Labels are resolved through `registry`.
+  /// @return the number of edges dropped
+  size_t pruneEdges(const SurfaceAdjacency& surface, const LabelRegistry& registry);
+
+  /// Whether the edge (a, b) of live super-points stays under GraphConfig::prune_edges (true
+  /// for every edge when pruning is off); `strongest` is its largest P_eps^C or P_sep^C.
+  bool keepEdge(int32_t a, int32_t b, double strongest, const SurfaceAdjacency& surface) const;
+
   /// The graph of the live super-points: scores and confidences, centroids and voxel counts
-  /// from the map, initial labels from the tracker's frame counts.
+  /// from the map, initial labels from the tracker's frame counts. With prune_edges, only the
+  /// super-points owning surface and the edges keepEdge() keeps: the rest cannot change an
+  /// output (meshes and objects are made of surface voxels) and would only slow the solver.
   SuperpointGraph graph(const TsdfMap& map, const SuperpointTracker& tracker) const;
 
   /// P_nu^C of a super-point (merges resolved by the caller), empty if never seen.
@@ -119,10 +147,10 @@ class GraphAccumulator {
 
   GraphConfig config_;
   ThreadPool* pool_ = nullptr;
-  std::vector<ThreadScratch> thread_scratch_;            // one per thread
-  std::vector<Hit> hits_;                                // scratch
-  std::vector<Hit> merged_;                              // scratch
-  std::vector<Group> groups_;                            // one mask's, scratch
+  std::vector<ThreadScratch> thread_scratch_;  // one per thread
+  std::vector<Hit> hits_;                      // scratch
+  std::vector<Hit> merged_;                    // scratch
+  std::vector<Group> groups_;                  // one mask's, scratch
   /// Groups of every mask of the frame, for the evidence of two segments.
   struct MaskGroups {
     int32_t cls;
@@ -130,7 +158,7 @@ class GraphAccumulator {
     bool thing;  ///< a thing mask of a class with two or more things in the frame
     std::vector<Group> groups;
   };
-  std::vector<MaskGroups> mask_groups_;  // scratch
+  std::vector<MaskGroups> mask_groups_;                  // scratch
   absl::flat_hash_map<int32_t, size_t> group_index_;     // label -> groups_ index, scratch
   std::map<int32_t, std::map<int32_t, double>> scores_;  // label -> class -> P_nu
   EdgeTable edges_;  // (a<b) -> class C -> P_eps^C, -C -> P_sep^C, 0 -> P_apart

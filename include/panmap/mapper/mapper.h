@@ -130,6 +130,8 @@ class Mapper {
   /// Super-points forgotten so far because no voxel voted for them any more (checked every
   /// kForgetEveryFrames frames; they would otherwise pile up in the graph on long runs).
   uint64_t superpointsForgotten() const { return superpoints_forgotten_; }
+  /// Graph edges dropped so far by GraphConfig::prune_edges (in this process).
+  uint64_t edgesPruned() const { return edges_pruned_; }
   /// Frames between checks for super-points without votes.
   static constexpr int64_t kForgetEveryFrames = 100;
   /// The occupancy map, or null when disabled.
@@ -189,6 +191,7 @@ class Mapper {
   FrameSegmentation segmentation_;  // scratch, reused every frame
   FrameAssociation association_;    // scratch, reused every frame
   uint64_t superpoints_forgotten_ = 0;
+  uint64_t edges_pruned_ = 0;
 };
 
 }  // namespace panmap

@@ -44,6 +44,8 @@ class EdgeTable {
   void applyMerges(const std::vector<SuperpointMerge>& merges, size_t begin, size_t end);
   /// Drops every edge with an end for which keep() is false.
   void keepIf(const std::function<bool(int32_t)>& keep);
+  /// Drops every edge for which keep(a, b, classes) is false; returns how many.
+  size_t keepPairsIf(const std::function<bool(int32_t, int32_t, const Classes&)>& keep);
 
   /// Calls f(a, b, classes) for every edge in (a, b) order.
   void forEachSorted(const std::function<void(int32_t, int32_t, const Classes&)>& f) const;

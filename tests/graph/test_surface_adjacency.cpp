@@ -1,0 +1,159 @@
+#include <gtest/gtest.h>
+
+#include "panmap/core/error.h"
+#include "panmap/graph/graph_accumulator.h"
+#include "panmap/graph/surface_adjacency.h"
+#include "panmap/superpoint/label_registry.h"
+
+namespace panmap {
+namespace {
+
+// A map of hand-set voxels at 0.1 m: each voxel observed with the given sdf (voxels) and one
+// vote for a label.
+class HandMap {
+ public:
+  HandMap() : map_(config()) {}
+  static TsdfMap::Config config() {
+    TsdfMap::Config c;
+    c.voxel_size_m = 0.1f;
+    return c;
+  }
+  // Global voxel coordinates (any sign); sdf in voxels.
+  void set(int gx, int gy, int gz, int32_t label, float sdf_voxels = 0.0f, float weight = 1.0f) {
+    auto split = [](int g, int* local) {
+      const int b = g >= 0 ? g / kBlockSide : -((-g + kBlockSide - 1) / kBlockSide);
+      *local = g - b * kBlockSide;
+      return b;
+    };
+    int x, y, z;
+    const BlockIndex index(split(gx, &x), split(gy, &y), split(gz, &z));
+    Voxel& v = map_.allocateBlock(index)->at(x, y, z);
+    v.sdf_m = sdf_voxels * 0.1f;
+    v.weight = weight;
+    v.votes[0] = LabelVote{label, 1};
+  }
+  const TsdfMap& map() const { return map_; }
+
+ private:
+  TsdfMap map_;
+};
+
+int32_t identity(int32_t l) { return l; }
+
+TEST(SurfaceAdjacency, OwnersAndTouchingPairsOnHandSetVoxels) {
+  HandMap m;
+  m.set(0, 0, 0, 1);
+  m.set(1, 0, 0, 1);
+  m.set(2, 0, 0, 2);              // face neighbour of a voxel of 1
+  m.set(3, 1, 1, 3);              // corner (26-) neighbour of 2's voxel
+  m.set(6, 0, 0, 4);              // alone
+  m.set(7, 0, 0, 5, 2.5f);        // next to 4 but off the 2-voxel band: not surface
+  m.set(5, 0, 0, 6, 0.0f, 0.0f);  // next to 4 but never observed
+  const SurfaceAdjacency s = SurfaceAdjacency::compute(m.map(), identity, 2.0f);
+  EXPECT_EQ(s.surfaceVoxels(1), 2);
+  EXPECT_EQ(s.surfaceVoxels(2), 1);
+  EXPECT_EQ(s.surfaceVoxels(3), 1);
+  EXPECT_EQ(s.surfaceVoxels(4), 1);
+  EXPECT_EQ(s.surfaceVoxels(5), 0);
+  EXPECT_EQ(s.surfaceVoxels(6), 0);
+  EXPECT_EQ(s.numOwners(), 4u);
+  EXPECT_TRUE(s.touching(1, 2));
+  EXPECT_TRUE(s.touching(2, 1));
+  EXPECT_TRUE(s.touching(2, 3));
+  EXPECT_FALSE(s.touching(1, 3));  // two voxels apart
+  EXPECT_FALSE(s.touching(4, 5));
+  EXPECT_FALSE(s.touching(4, 6));
+  EXPECT_FALSE(s.touching(1, 1));
+  EXPECT_EQ(s.numPairs(), 2u);
+}
+
+TEST(SurfaceAdjacency, TouchingAcrossBlockBordersInEveryDirection) {
+  // Voxel 7 and voxel 8 lie in different blocks along each axis, and diagonally.
+  const int offsets[][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, -1, 0}, {1, 1, -1}, {-1, 1, 1}};
+  for (const auto& d : offsets) {
+    HandMap m;
+    m.set(7, 7, 7, 1);
+    m.set(7 + d[0] * 1, 7 + d[1] * 1, 7 + d[2] * 1, 2);
+    m.set(-1, -1, -1, 3);
+    m.set(0, 0, 0, 4);  // across the origin: negative block indices
+    const SurfaceAdjacency s = SurfaceAdjacency::compute(m.map(), identity, 2.0f);
+    EXPECT_TRUE(s.touching(1, 2)) << d[0] << " " << d[1] << " " << d[2];
+    EXPECT_TRUE(s.touching(3, 4));
+    EXPECT_FALSE(s.touching(1, 4));
+  }
+}
+
+TEST(SurfaceAdjacency, LabelsResolveToTheirRoots) {
+  HandMap m;
+  m.set(0, 0, 0, 1);
+  m.set(1, 0, 0, 2);
+  m.set(2, 0, 0, 3);
+  // 2 was merged into 1: one owner of two voxels, touching 3 only.
+  const SurfaceAdjacency s = SurfaceAdjacency::compute(
+      m.map(), [](int32_t l) { return l == 2 ? 1 : l; }, 2.0f);
+  EXPECT_EQ(s.surfaceVoxels(1), 2);
+  EXPECT_EQ(s.surfaceVoxels(2), 0);
+  EXPECT_TRUE(s.touching(1, 3));
+  EXPECT_EQ(s.numPairs(), 1u);
+  EXPECT_THROW(SurfaceAdjacency::compute(m.map(), identity, 0.0f), Error);
+}
+
+// Pruning keeps touching pairs and strong pairs between surface owners, drops the rest.
+TEST(GraphPruning, KeepsTouchingAndStrongPairsOfSurfaceOwners) {
+  HandMap m;
+  m.set(0, 0, 0, 1);
+  m.set(1, 0, 0, 2);  // touches 1
+  m.set(5, 0, 0, 3);  // apart from both
+  m.set(9, 0, 0, 4);  // apart
+  // 5 owns no surface (only a voxel far behind it).
+  m.set(12, 0, 0, 5, 3.0f);
+  const SurfaceAdjacency surface = SurfaceAdjacency::compute(m.map(), identity, 2.0f);
+
+  GraphConfig config;  // edge_min_share 0.1
+  GraphAccumulator graph{config};
+  GraphAccumulator::Snapshot s;
+  s.scores[1][5] = 10.0;
+  s.scores[2][5] = 10.0;
+  s.scores[3][5] = 4.0;
+  s.scores[4][5] = 20.0;
+  s.scores[5][5] = 50.0;
+  s.edges[{1, 2}][5] = 0.01;  // weak, but touching: kept
+  s.edges[{1, 3}][5] = 0.4;   // 0.4 >= 0.1 x min(10, 4): kept
+  s.edges[{1, 4}][5] = 0.9;   // 0.9 < 0.1 x min(10, 20): dropped
+  s.edges[{1, 4}][0] = 5.0;   // P_apart alone never makes a pair strong
+  s.edges[{3, 4}][-5] = 0.5;  // P_sep 0.5 >= 0.1 x 4: kept
+  s.edges[{1, 5}][5] = 40.0;  // 5 owns no surface: dropped
+  graph.restore(s);
+  LabelRegistry registry;
+  for (int i = 0; i < 5; ++i) registry.create();
+  EXPECT_EQ(graph.pruneEdges(surface, registry), 2u);
+  const GraphAccumulator::Snapshot after = graph.snapshot();
+  ASSERT_EQ(after.edges.size(), 3u);
+  EXPECT_EQ(after.edges.count({1, 2}), 1u);
+  EXPECT_EQ(after.edges.count({1, 3}), 1u);
+  EXPECT_EQ(after.edges.count({3, 4}), 1u);
+  EXPECT_EQ(after.scores.size(), 5u);  // scores stay: only edges go
+
+  // The threshold is inclusive, and pruning off keeps everything.
+  GraphConfig off;
+  off.prune_edges = false;
+  GraphAccumulator kept{off};
+  kept.restore(s);
+  EXPECT_EQ(kept.pruneEdges(surface, registry), 0u);
+  EXPECT_EQ(kept.snapshot().edges.size(), 5u);
+  EXPECT_TRUE(graph.keepEdge(1, 3, 0.4, surface));
+  EXPECT_FALSE(graph.keepEdge(1, 3, 0.39, surface));
+  EXPECT_FALSE(graph.keepEdge(1, 1, 100.0, surface));
+}
+
+TEST(GraphPruning, RejectsBadConfig) {
+  GraphConfig bad;
+  bad.edge_min_share = 1.5;
+  EXPECT_THROW(GraphAccumulator{bad}, Error);
+  bad.edge_min_share = 0.1;
+  bad.surface_band_voxels = 0.0f;
+  EXPECT_THROW(GraphAccumulator{bad}, Error);
+}
+
+}  // namespace
+}  // namespace panmap
