@@ -60,6 +60,13 @@ nlohmann::json trackingJson(const panmap::Mapper& mapper) {
   return out;
 }
 
+// Seconds each export step took, by step name.
+nlohmann::json exportSeconds(const panmap::OutputSummary& outputs) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [step, seconds] : outputs.step_seconds) out[step] = seconds;
+  return out;
+}
+
 nlohmann::json mapJson(const panmap::Mapper& mapper, const panmap::OutputSummary& outputs) {
   return {{"frames_total", mapper.framesIntegrated()},
           {"memory",
@@ -79,6 +86,7 @@ nlohmann::json mapJson(const panmap::Mapper& mapper, const panmap::OutputSummary
             {"faces", outputs.mesh_faces},
             {"area_m2", outputs.mesh_area_m2}}},
           {"files", outputs.files},
+          {"export_seconds", exportSeconds(outputs)},
           {"config",
            {{"voxel_size_m", mapper.config().map.voxel_size_m},
             {"truncation_voxels", mapper.config().integrator.truncation_voxels},

@@ -1,4 +1,5 @@
-// panmap-synth: renders a labelled mesh (a procedural room or a ScanNet scene's ground truth)
+// panmap-synth: renders a labelled mesh (a procedural room, a building of them or a ScanNet
+// scene's ground truth)
 // along a camera trajectory into an LCM log with RGB-D frames, drifting poses and simulated
 // panoptic masks, plus the ground truth to evaluate against.
 #include <chrono>
@@ -9,6 +10,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "panmap/building/building.h"
 #include "panmap/core/error.h"
 #include "panmap/core/progress.h"
 #include "panmap/io/image_codec.h"
@@ -133,6 +135,12 @@ int main(int argc, char** argv) {
   std::string unannotated_masks = "painted";
   auto* source = app.add_option_group("source", "ground-truth mesh (one of)");
   source->add_option("--room", room_seed, "procedural room with this seed");
+  int64_t building_seed = -1;
+  panmap::BuildingConfig building_config;
+  source->add_option("--building", building_seed,
+                     "procedural building with this seed: rooms of --room-style along a "
+                     "corridor, walked once through every room at 5 Hz unless --frames or "
+                     "--rate-hz say otherwise");
   source->add_option("--scannet", scannet_dir,
                      "ScanNet scene folder (<scene>_vh_clean_2.ply, .aggregation.json, "
                      "_vh_clean_2.0.010000.segs.json)");
@@ -143,6 +151,14 @@ int main(int argc, char** argv) {
                  "objects, clutter against furniture and walls, unannotated piles)")
       ->capture_default_str()
       ->check(CLI::IsMember({"boxes", "scannet"}));
+  app.add_option("--building-rooms", building_config.min_rooms,
+                 "a building has at least this many rooms")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 200));
+  app.add_option("--building-area", building_config.min_floor_area_m2,
+                 "a building has at least this much floor, square metres")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 20000.0));
   app.add_option("--scannet-labels", scannet_labels, "ScanNet label table (tsv)")
       ->capture_default_str();
   app.add_option("--trajectory", trajectory_file, "TUM trajectory to follow instead of a survey");
@@ -190,7 +206,24 @@ int main(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     panmap::LabelledMesh mesh;
     json source_json;
-    if (room_seed >= 0) {
+    std::vector<Eigen::Vector2d> building_stops;
+    if (building_seed >= 0) {
+      if (room_style == "scannet") building_config.room.style = panmap::RoomStyle::kScanNetLike;
+      const panmap::Building building =
+          panmap::generateBuilding(static_cast<uint64_t>(building_seed), building_config);
+      mesh = building.mesh;
+      building_stops = panmap::buildingSurveyStops(building);
+      source_json = {{"type", "procedural_building"},
+                     {"building_seed", building_seed},
+                     {"room_style", room_style},
+                     {"rooms", building.rooms.size()},
+                     {"floor_area_m2", building.floor_area_m2}};
+      if (!quiet) {
+        std::printf("building %lld: %zu rooms, %.0f m2 of floor, %zu triangles\n",
+                    static_cast<long long>(building_seed), building.rooms.size(),
+                    building.floor_area_m2, building.mesh.numFaces());
+      }
+    } else if (room_seed >= 0) {
       const panmap::ProceduralRoom room = panmap::generateRoom(
           static_cast<uint64_t>(room_seed),
           room_style == "scannet" ? panmap::RoomConfig::scanNetLike() : panmap::RoomConfig());
@@ -219,10 +252,19 @@ int main(int argc, char** argv) {
     config.depth.enabled = !no_depth_noise;
     std::vector<panmap::StampedPose> trajectory;
     panmap::SurveyConfig survey;
-    survey.num_frames = frames;
-    survey.rate_hz = rate_hz;
+    if (!building_stops.empty()) {
+      survey = panmap::buildingSurveyConfig();
+      if (app.count("--frames")) survey.num_frames = frames;
+      if (app.count("--rate-hz")) survey.rate_hz = rate_hz;
+      rate_hz = survey.rate_hz;
+    } else {
+      survey.num_frames = frames;
+      survey.rate_hz = rate_hz;
+    }
     survey.laps = laps;
-    if (!trajectory_file.empty()) {
+    if (!building_stops.empty() && trajectory_file.empty()) {
+      trajectory = panmap::planSurveyThrough(mesh, survey, building_stops, seed);
+    } else if (!trajectory_file.empty()) {
       trajectory = panmap::readTumTrajectory(trajectory_file);
       if (static_cast<int>(trajectory.size()) > frames)
         trajectory.resize(static_cast<size_t>(frames));
@@ -289,7 +331,10 @@ int main(int argc, char** argv) {
          {{"source", trajectory_file.empty() ? "survey" : trajectory_file},
           {"laps", trajectory_file.empty() ? laps : 0},
           {"walk_length_m",
-           trajectory_file.empty() ? panmap::planSurveyPath(mesh, survey, seed).length_m : 0.0},
+           !trajectory_file.empty() ? 0.0
+           : building_stops.empty()
+               ? panmap::planSurveyPath(mesh, survey, seed).length_m
+               : panmap::planSurveyPathThrough(mesh, survey, building_stops).length_m},
           {"min_clearance_m", panmap::minClearance(synth.groundTruthTrajectory(), mesh)}}},
         {"masks", masksJson(config.masks)},
         {"unannotation",

@@ -10,6 +10,7 @@
 #include "panmap/core/error.h"
 #include "panmap/core/random.h"
 #include "panmap/sim/internal/room_clutter.h"
+#include "panmap/sim/internal/room_edit.h"
 #include "panmap/sim/internal/room_layout.h"
 #include "panmap/sim/internal/room_mesh.h"
 #include "panmap/sim/internal/room_parts.h"
@@ -84,6 +85,13 @@ RoomConfig RoomConfig::scanNetLike() {
 }
 
 ProceduralRoom generateRoom(uint64_t seed, const RoomConfig& config) {
+  return internal::room::generateEditedRoom(seed, config, nullptr);
+}
+
+namespace internal {
+namespace room {
+
+ProceduralRoom generateEditedRoom(uint64_t seed, const RoomConfig& config, const RoomEdit& edit) {
   config.check();
   const bool scannet = config.style == RoomStyle::kScanNetLike;
   // The floor plan depends on the seed alone; furnishing retries draw from their own streams.
@@ -119,7 +127,10 @@ ProceduralRoom generateRoom(uint64_t seed, const RoomConfig& config) {
   colours.wall = tint(&colour_rng, 225, 220, 210, 25);
   colours.floor = tint(&colour_rng, 150, 115, 80, 40);
   colours.ceiling = tint(&colour_rng, 240, 240, 238, 8);
-  writeRoomMesh(shape, ceiling_m, config.max_edge_m, layout->items(), colours, &room.mesh);
+  std::vector<Item> items = layout->items();
+  const std::vector<Doorway> doorways =
+      edit ? edit(shape, ceiling_m, &items) : std::vector<Doorway>();
+  writeRoomMesh(shape, ceiling_m, config.max_edge_m, items, colours, &room.mesh, doorways);
 
   const float w = shape.width_m, d = shape.depth_m, h = ceiling_m;
   room.objects.push_back(
@@ -129,7 +140,7 @@ ProceduralRoom generateRoom(uint64_t seed, const RoomConfig& config) {
   room.objects.push_back(
       RoomObject{3, kCeiling, "ceiling", Box3(Vector3f(0.0f, 0.0f, h), Vector3f(w, d, h)), {}});
   int32_t instance = 4;
-  for (const Item& item : layout->items()) {
+  for (const Item& item : items) {
     RoomObject object{instance, item.semantic, item.name, item.bounds(), {}};
     for (const Part& p : item.parts) object.parts.push_back(p.box);
     room.objects.push_back(std::move(object));
@@ -138,4 +149,6 @@ ProceduralRoom generateRoom(uint64_t seed, const RoomConfig& config) {
   return room;
 }
 
+}  // namespace room
+}  // namespace internal
 }  // namespace panmap

@@ -8,6 +8,15 @@
 
 namespace panmap {
 
+namespace {
+
+// Faces per culling run: meshes are written object by object, so a run of consecutive faces
+// is spatially compact; small enough to cull a room's far half, large enough that testing the
+// runs costs nothing next to drawing.
+constexpr int32_t kRunFaces = 512;
+
+}  // namespace
+
 void RenderConfig::check() const {
   if (!(near_m > 0.0f)) throw Error("render near_m must be > 0");
   if (!(far_m > near_m)) throw Error("render far_m must exceed near_m");
@@ -43,6 +52,22 @@ MeshRenderer::MeshRenderer(const LabelledMesh& mesh, const RenderConfig& config)
     if (!mesh.instance.empty()) face_instance_[f] = mesh.instance[t[0]];
     if (!mesh.semantic.empty()) face_semantic_[f] = mesh.semantic[t[0]];
     if (!mesh.colors.empty()) face_color_[f] = mesh.colors[t[0]];
+  }
+  for (size_t first = 0; first < n; first += kRunFaces) {
+    FaceRun run;
+    run.first_face = static_cast<int32_t>(first);
+    run.end_face = static_cast<int32_t>(std::min(n, first + kRunFaces));
+    run.first_vertex = std::numeric_limits<int32_t>::max();
+    run.end_vertex = 0;
+    for (int32_t f = run.first_face; f < run.end_face; ++f) {
+      for (int k = 0; k < 3; ++k) {
+        const int32_t v = mesh.faces[f][k];
+        run.box_W.extend(mesh.vertices[v]);
+        run.first_vertex = std::min(run.first_vertex, v);
+        run.end_vertex = std::max(run.end_vertex, v + 1);
+      }
+    }
+    runs_.push_back(run);
   }
 }
 
@@ -104,42 +129,90 @@ inline void drawTriangle(const PinholeCamera& cam, const Eigen::Vector3f& af,
 
 }  // namespace
 
+std::vector<const MeshRenderer::FaceRun*> MeshRenderer::visibleRuns(
+    const PinholeCamera& camera, const Eigen::Isometry3f& T_C_W) const {
+  // Half-spaces of the frustum in the camera frame, a . p + b z > 0 inside: a point of a face
+  // drawn at z >= near outside one of them projects beside the image, so a run whose eight
+  // corners are all outside one draws nothing (the clipped corners are convex combinations).
+  // One pixel of margin absorbs float rounding against drawTriangle's double setup.
+  const float fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
+  const float cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
+  const float right = static_cast<float>(camera.width - 1) + 1.0f - cx;
+  const float bottom = static_cast<float>(camera.height - 1) + 1.0f - cy;
+  std::vector<const FaceRun*> visible;
+  for (const FaceRun& run : runs_) {
+    if (!config_.cull) {
+      visible.push_back(&run);
+      continue;
+    }
+    bool behind = true, beyond = true, left = true, over_right = true, above = true, below = true;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3f p =
+          T_C_W * run.box_W.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c));
+      behind = behind && p.z() < config_.near_m;
+      beyond = beyond && p.z() > config_.far_m;
+      left = left && fx * p.x() + (cx + 1.0f) * p.z() < 0.0f;
+      over_right = over_right && fx * p.x() - right * p.z() > 0.0f;
+      above = above && fy * p.y() + (cy + 1.0f) * p.z() < 0.0f;
+      below = below && fy * p.y() - bottom * p.z() > 0.0f;
+    }
+    if (!(behind || beyond || left || over_right || above || below)) visible.push_back(&run);
+  }
+  return visible;
+}
+
 void MeshRenderer::rasterise(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
                              Scratch* s) const {
   const Eigen::Isometry3f T_C_W = T_W_C.inverse().cast<float>();
-  const size_t nv = mesh_.vertices.size();
-  s->points_C.resize(nv);
-  for (size_t i = 0; i < nv; ++i) s->points_C[i] = T_C_W * mesh_.vertices[i];
+  const std::vector<const FaceRun*> runs = visibleRuns(camera, T_C_W);
+  // Transform the vertices the visible runs use: the union of their index ranges.
+  s->points_C.resize(mesh_.vertices.size());
+  std::vector<std::pair<int32_t, int32_t>> ranges;
+  for (const FaceRun* run : runs) ranges.push_back({run->first_vertex, run->end_vertex});
+  std::sort(ranges.begin(), ranges.end());
+  int32_t done = 0;
+  for (const auto& [first, end] : ranges) {
+    for (int32_t i = std::max(first, done); i < end; ++i)
+      s->points_C[i] = T_C_W * mesh_.vertices[i];
+    done = std::max(done, end);
+  }
   const float near = config_.near_m;
   const float far = config_.far_m;
-  for (size_t f = 0; f < mesh_.faces.size(); ++f) {
-    const Eigen::Vector3i& t = mesh_.faces[f];
-    const Eigen::Vector3f* p[3] = {&s->points_C[t[0]], &s->points_C[t[1]], &s->points_C[t[2]]};
-    const int in_front = (p[0]->z() >= near) + (p[1]->z() >= near) + (p[2]->z() >= near);
-    if (in_front == 0) continue;
-    if (p[0]->z() > far && p[1]->z() > far && p[2]->z() > far) continue;
-    const auto id = static_cast<int32_t>(f);
-    if (in_front == 3) {
-      drawTriangle(camera, *p[0], *p[1], *p[2], id, &s->zbuffer, &s->face);
-      continue;
+  for (const FaceRun* run : runs) {
+    for (int32_t f = run->first_face; f < run->end_face; ++f) {
+      drawFace(camera, f, near, far, s);
     }
-    // Clip the polygon against z = near (Sutherland-Hodgman, one plane): 3 or 4 corners.
-    Eigen::Vector3f poly[4];
-    int n = 0;
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3f& cur = *p[k];
-      const Eigen::Vector3f& nxt = *p[(k + 1) % 3];
-      const bool cur_in = cur.z() >= near, nxt_in = nxt.z() >= near;
-      if (cur_in) poly[n++] = cur;
-      if (cur_in != nxt_in) {
-        const float s_t = (near - cur.z()) / (nxt.z() - cur.z());
-        poly[n++] = cur + s_t * (nxt - cur);
-        poly[n - 1].z() = near;
-      }
+  }
+}
+
+void MeshRenderer::drawFace(const PinholeCamera& camera, int32_t f, float near, float far,
+                            Scratch* s) const {
+  const Eigen::Vector3i& t = mesh_.faces[f];
+  const Eigen::Vector3f* p[3] = {&s->points_C[t[0]], &s->points_C[t[1]], &s->points_C[t[2]]};
+  const int in_front = (p[0]->z() >= near) + (p[1]->z() >= near) + (p[2]->z() >= near);
+  if (in_front == 0) return;
+  if (p[0]->z() > far && p[1]->z() > far && p[2]->z() > far) return;
+  const auto id = static_cast<int32_t>(f);
+  if (in_front == 3) {
+    drawTriangle(camera, *p[0], *p[1], *p[2], id, &s->zbuffer, &s->face);
+    return;
+  }
+  // Clip the polygon against z = near (Sutherland-Hodgman, one plane): 3 or 4 corners.
+  Eigen::Vector3f poly[4];
+  int n = 0;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3f& cur = *p[k];
+    const Eigen::Vector3f& nxt = *p[(k + 1) % 3];
+    const bool cur_in = cur.z() >= near, nxt_in = nxt.z() >= near;
+    if (cur_in) poly[n++] = cur;
+    if (cur_in != nxt_in) {
+      const float s_t = (near - cur.z()) / (nxt.z() - cur.z());
+      poly[n++] = cur + s_t * (nxt - cur);
+      poly[n - 1].z() = near;
     }
-    for (int k = 1; k + 1 < n; ++k) {
-      drawTriangle(camera, poly[0], poly[k], poly[k + 1], id, &s->zbuffer, &s->face);
-    }
+  }
+  for (int k = 1; k + 1 < n; ++k) {
+    drawTriangle(camera, poly[0], poly[k], poly[k + 1], id, &s->zbuffer, &s->face);
   }
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <queue>
 #include <sstream>
@@ -39,7 +40,15 @@ struct FreeSpace {
   double cell = 0.05;
   cv::Mat safe;         // CV_8U, 1 where the camera may stand
   cv::Mat clearance_m;  // CV_32F, distance to the nearest obstacle cell, metres
+  cv::Mat walls;        // CV_8U, 1 where a wall crosses the camera's height band (or empty)
   double floor_z = 0.0;
+
+  // Cell of a world point, or false when it is off the grid.
+  bool cellOf(const Eigen::Vector2d& p, int* i, int* j) const {
+    *i = static_cast<int>(std::floor((p.x() - origin.x()) / cell));
+    *j = static_cast<int>(std::floor((p.y() - origin.y()) / cell));
+    return *i >= 0 && *j >= 0 && *i < safe.cols && *j < safe.rows;
+  }
 
   Eigen::Vector2d centre(int i, int j) const {
     return origin + Eigen::Vector2d((i + 0.5) * cell, (j + 0.5) * cell);
@@ -65,17 +74,23 @@ FreeSpace buildFreeSpace(const LabelledMesh& mesh, const SurveyConfig& config) {
   const int ny = static_cast<int>(std::ceil((hi.y() - lo.y()) / fs.cell)) + 3;
   cv::Mat occupied = cv::Mat::zeros(ny, nx, CV_8U);
   cv::Mat floor = cv::Mat::zeros(ny, nx, CV_8U);
+  if (config.walls_block_view) fs.walls = cv::Mat::zeros(ny, nx, CV_8U);
+  bool wall_face = false;
   const double band_lo = fs.floor_z + config.min_height_m - config.clearance_m;
   const double band_hi = fs.floor_z + config.max_height_m + config.clearance_m;
   auto mark = [&](const Eigen::Vector3f& p) {
     const int i = static_cast<int>((p.x() - fs.origin.x()) / fs.cell);
     const int j = static_cast<int>((p.y() - fs.origin.y()) / fs.cell);
     if (i < 0 || j < 0 || i >= nx || j >= ny) return;
-    if (p.z() >= band_lo && p.z() <= band_hi) occupied.at<uint8_t>(j, i) = 1;
+    if (p.z() >= band_lo && p.z() <= band_hi) {
+      occupied.at<uint8_t>(j, i) = 1;
+      if (wall_face) fs.walls.at<uint8_t>(j, i) = 1;
+    }
     if (p.z() < fs.floor_z + 0.1) floor.at<uint8_t>(j, i) = 1;
   };
   // Sample every triangle densely enough that no cell it crosses is missed.
   for (const auto& f : mesh.faces) {
+    wall_face = !fs.walls.empty() && !mesh.semantic.empty() && mesh.semantic[f[0]] == 1;
     const Eigen::Vector3f& a = mesh.vertices[f[0]];
     const Eigen::Vector3f& b = mesh.vertices[f[1]];
     const Eigen::Vector3f& c = mesh.vertices[f[2]];
@@ -214,6 +229,10 @@ SurveyPath planWalk(const FreeSpace& fs, const std::vector<Cell>& stops, int lap
   std::vector<Cell> lap;
   for (size_t k = 0; k < stops.size(); ++k) {
     const auto leg = shortestPath(fs, stops[k], stops[(k + 1) % stops.size()]);
+    if (leg.empty()) {
+      throw Error("survey: stop " + std::to_string((k + 1) % stops.size()) +
+                  " cannot be reached from stop " + std::to_string(k) + " on free floor");
+    }
     lap.insert(lap.end(), leg.begin(), leg.empty() ? leg.end() : leg.end() - 1);
   }
   // A backward lap starts where the forward one ended (its first cell) and retraces it, so the
@@ -316,15 +335,26 @@ std::vector<Target> objectTargets(const LabelledMesh& mesh) {
   return targets;
 }
 
-}  // namespace
+// True when a wall of the free-space grid lies between the eye and the target (seen from
+// above). The last 15 cm before the target are not tested: a picture shares its wall's cells.
+bool wallBetween(const FreeSpace& fs, const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
+  if (fs.walls.empty()) return false;
+  const Eigen::Vector2d a = eye.head<2>(), b = target.head<2>();
+  const double length = (b - a).norm();
+  // Half-cell steps cannot step over an axis-aligned line of wall cells.
+  for (double s = 0.0; s < length - 0.15; s += 0.5 * fs.cell) {
+    int i = 0, j = 0;
+    if (fs.cellOf(a + (b - a) * (s / length), &i, &j) && fs.walls.at<uint8_t>(j, i)) return true;
+  }
+  return false;
+}
 
-std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& config,
-                                    uint64_t seed) {
-  config.check();
-  Rng rng(hashSeed(seed, 0x5u));
-  const FreeSpace fs = buildFreeSpace(mesh, config);
-  const std::vector<Eigen::Vector2d> loop =
-      planWalk(fs, chooseWaypoints(fs, config.num_waypoints, &rng), config.laps).points;
+// The camera walking the closed loop at speed_mps, head turning to the objects (the stops'
+// draws have been taken from `rng` already: the rest of the stream picks the looks).
+std::vector<StampedPose> posesAlong(const LabelledMesh& mesh, const FreeSpace& fs,
+                                    const std::vector<Eigen::Vector2d>& loop,
+                                    const SurveyConfig& config, Rng* rng_ptr) {
+  Rng& rng = *rng_ptr;
   std::vector<double> arc = {0.0};
   for (size_t k = 1; k <= loop.size(); ++k)
     arc.push_back(arc.back() + (loop[k % loop.size()] - loop[k - 1]).norm());
@@ -364,6 +394,7 @@ std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig
           std::abs(wrapAngle(std::atan2(d.y(), d.x()) - std::atan2(heading.y(), heading.x())));
       if (range < config.view_min_m * 0.5 || range > config.view_max_m * 1.5 || off > 0.6 * M_PI)
         return false;
+      if (wallBetween(fs, eye, tg.centre)) return false;
       // Revisiting surveys prefer what was not looked at from here: the laps exist for new
       // viewpoints (a single lap keeps the head schedule its rooms were measured with).
       const int seen = config.laps > 1 ? looksFrom(tg, std::atan2(d.y(), d.x())) : tg.looks;
@@ -426,6 +457,75 @@ std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig
     out.push_back(pose);
   }
   return out;
+}
+
+// Free-space cells of the stops: the nearest safe cell within 0.5 m of each.
+std::vector<Cell> stopCells(const FreeSpace& fs, const std::vector<Eigen::Vector2d>& stops) {
+  const int reach = static_cast<int>(std::ceil(0.5 / fs.cell));
+  std::vector<Cell> cells;
+  for (size_t k = 0; k < stops.size(); ++k) {
+    int i0 = 0, j0 = 0;
+    fs.cellOf(stops[k], &i0, &j0);
+    Cell best{-1, -1};
+    int best_d = std::numeric_limits<int>::max();
+    for (int dj = -reach; dj <= reach; ++dj) {
+      for (int di = -reach; di <= reach; ++di) {
+        const int i = i0 + di, j = j0 + dj;
+        if (i < 0 || j < 0 || i >= fs.safe.cols || j >= fs.safe.rows) continue;
+        if (!fs.safe.at<uint8_t>(j, i) || di * di + dj * dj > reach * reach) continue;
+        if (di * di + dj * dj < best_d) {
+          best_d = di * di + dj * dj;
+          best = {i, j};
+        }
+      }
+    }
+    if (best.first < 0) {
+      std::ostringstream msg;
+      msg << "survey: stop " << k << " at (" << stops[k].x() << ", " << stops[k].y()
+          << ") is not within 0.5 m of floor the camera can walk on";
+      throw Error(msg.str());
+    }
+    cells.push_back(best);
+  }
+  if (cells.size() < 2) throw Error("survey: a walk needs at least 2 stops");
+  return cells;
+}
+
+}  // namespace
+
+std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& config,
+                                    uint64_t seed) {
+  config.check();
+  Rng rng(hashSeed(seed, 0x5u));
+  const FreeSpace fs = buildFreeSpace(mesh, config);
+  const std::vector<Eigen::Vector2d> loop =
+      planWalk(fs, chooseWaypoints(fs, config.num_waypoints, &rng), config.laps).points;
+  return posesAlong(mesh, fs, loop, config, &rng);
+}
+
+std::vector<StampedPose> planSurveyThrough(const LabelledMesh& mesh, SurveyConfig config,
+                                           const std::vector<Eigen::Vector2d>& stops,
+                                           uint64_t seed) {
+  const bool once = config.num_frames == 0;
+  if (once) config.num_frames = 1;
+  config.check();
+  Rng rng(hashSeed(seed, 0x5u));
+  const FreeSpace fs = buildFreeSpace(mesh, config);
+  const SurveyPath path = planWalk(fs, stopCells(fs, stops), config.laps);
+  if (once) {
+    config.num_frames =
+        std::max(2, static_cast<int>(std::ceil(path.length_m / config.speed_mps * config.rate_hz)));
+  }
+  return posesAlong(mesh, fs, path.points, config, &rng);
+}
+
+SurveyPath planSurveyPathThrough(const LabelledMesh& mesh, const SurveyConfig& config,
+                                 const std::vector<Eigen::Vector2d>& stops) {
+  SurveyConfig checked = config;
+  if (checked.num_frames == 0) checked.num_frames = 1;
+  checked.check();
+  const FreeSpace fs = buildFreeSpace(mesh, checked);
+  return planWalk(fs, stopCells(fs, stops), checked.laps);
 }
 
 SurveyPath planSurveyPath(const LabelledMesh& mesh, const SurveyConfig& config, uint64_t seed) {

@@ -162,6 +162,42 @@ TEST(Renderer, NearPlaneClipsSurfacesAroundTheCamera) {
   EXPECT_EQ(view.instance(320, 10), 0);  // sky above the horizon
 }
 
+TEST(Renderer, CullingLeavesTheImageBitIdentical) {
+  // A floor of 1 m tiles and a 20 x 20 grid of boxes: many face runs, some behind the camera,
+  // some beside the image, some crossing the near plane around the camera.
+  LabelledMesh mesh;
+  for (int i = -10; i < 10; ++i) {
+    for (int j = -10; j < 10; ++j) {
+      addQuad(&mesh, Eigen::Vector3f(i, j, 0), Eigen::Vector3f(i + 1, j, 0),
+              Eigen::Vector3f(i + 1, j + 1, 0), Eigen::Vector3f(i, j + 1, 0), 1, 2);
+      addBox(&mesh, Eigen::Vector3f(i + 0.3f, j + 0.3f, 0.0f),
+             Eigen::Vector3f(i + 0.6f, j + 0.7f, 0.4f + 0.05f * ((i * 7 + j * 3) & 15)),
+             100 + (i + 10) * 20 + (j + 10), 5);
+    }
+  }
+  RenderConfig off;
+  off.cull = false;
+  const MeshRenderer culled(mesh), full(mesh, off);
+  const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> views = {
+      {{0.05, 0.1, 1.5}, {1.0, 0.2, -0.3}},  {{-9.0, -9.0, 1.2}, {1.0, 1.0, -0.2}},
+      {{3.5, -2.0, 0.3}, {-0.3, 1.0, 0.0}},  {{0.45, 0.5, 0.2}, {0.0, 1.0, 0.1}},
+      {{5.0, 5.0, 6.0}, {-0.2, -0.1, -1.0}}, {{12.0, 0.0, 1.0}, {-1.0, 0.0, 0.0}},
+      {{0.0, 0.0, 1.0}, {1.0, 0.0, 0.0}}};
+  for (const auto& [eye, forward] : views) {
+    const Eigen::Isometry3d T_W_C = lookAlong(eye, forward);
+    const RenderedView a = culled.render(kCamera, T_W_C), b = full.render(kCamera, T_W_C);
+    int drawn = 0;
+    for (int v = 0; v < kCamera.height; ++v) {
+      for (int u = 0; u < kCamera.width; ++u) {
+        ASSERT_EQ(a.depth_m(u, v), b.depth_m(u, v)) << "pixel " << u << "," << v;
+        ASSERT_EQ(a.instance(u, v), b.instance(u, v)) << "pixel " << u << "," << v;
+        drawn += b.instance(u, v) > 0 ? 1 : 0;
+      }
+    }
+    EXPECT_GT(drawn, 10000) << "the view must see part of the scene";
+  }
+}
+
 TEST(Renderer, RejectsBadInput) {
   LabelledMesh bad;
   bad.vertices = {{0, 0, 0}};

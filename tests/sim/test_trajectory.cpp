@@ -118,6 +118,70 @@ TEST(Survey, NoRoomToWalkIsAClearError) {
   }
 }
 
+// Two-triangle rectangle p00, p10 = p00 + u, p01 = p00 + v, with labels.
+void addRect(LabelledMesh* mesh, const Eigen::Vector3f& p00, const Eigen::Vector3f& u,
+             const Eigen::Vector3f& v, int32_t instance, int32_t semantic) {
+  const auto base = static_cast<int32_t>(mesh->vertices.size());
+  for (const Eigen::Vector3f& p :
+       {p00, Eigen::Vector3f(p00 + u), Eigen::Vector3f(p00 + u + v), Eigen::Vector3f(p00 + v)}) {
+    mesh->vertices.push_back(p);
+    mesh->instance.push_back(instance);
+    mesh->semantic.push_back(semantic);
+  }
+  mesh->faces.emplace_back(base, base + 1, base + 2);
+  mesh->faces.emplace_back(base, base + 2, base + 3);
+}
+
+// Frames whose view turns toward `target` (within 10 degrees) and away from the walking
+// direction (more than 30 degrees): the head has picked it.
+int looksAt(const std::vector<StampedPose>& poses, const Eigen::Vector2d& target) {
+  int n = 0;
+  for (size_t k = 1; k < poses.size(); ++k) {
+    const Eigen::Vector2d eye = poses[k].T_W_C.translation().head<2>();
+    const Eigen::Vector2d walk = eye - poses[k - 1].T_W_C.translation().head<2>();
+    const Eigen::Vector2d forward = poses[k].T_W_C.linear().col(2).head<2>().normalized();
+    const Eigen::Vector2d to_target = (target - eye).normalized();
+    if (walk.norm() < 1e-6) continue;
+    if (forward.dot(to_target) > std::cos(10.0 * M_PI / 180.0) &&
+        forward.dot(walk.normalized()) < std::cos(30.0 * M_PI / 180.0)) {
+      ++n;
+    }
+  }
+  return n;
+}
+
+TEST(Survey, WallsHideObjectsBehindThemWhenAsked) {
+  // Two rooms side by side, a solid wall at x = 3.5 between them (class wall, full height); a
+  // 0.5 m box (a chair's class) stands in the smaller east room, the walk keeps to the west one
+  // (the planner walks the largest free region).
+  LabelledMesh mesh;
+  const Eigen::Vector3f x = Eigen::Vector3f::UnitX(), y = Eigen::Vector3f::UnitY(),
+                        z = Eigen::Vector3f::UnitZ();
+  addRect(&mesh, Eigen::Vector3f::Zero(), 6.0f * x, 3.0f * y, 2, 2);  // floor
+  addRect(&mesh, Eigen::Vector3f::Zero(), 6.0f * x, 2.5f * z, 1, 1);  // south wall
+  addRect(&mesh, 3.0f * y, 6.0f * x, 2.5f * z, 1, 1);                 // north wall
+  addRect(&mesh, Eigen::Vector3f::Zero(), 3.0f * y, 2.5f * z, 1, 1);  // west wall
+  addRect(&mesh, 6.0f * x, 3.0f * y, 2.5f * z, 1, 1);                 // east wall
+  addRect(&mesh, 3.5f * x, 3.0f * y, 2.5f * z, 1, 1);                 // the wall between
+  const Eigen::Vector3f lo(4.5f, 1.25f, 0.0f);
+  for (int i = 0; i < 2; ++i) {  // six faces, 24 vertices: enough to be a target
+    addRect(&mesh, lo + i * 0.5f * x, 0.5f * y, 0.5f * z, 10, 5);
+    addRect(&mesh, lo + i * 0.5f * y, 0.5f * x, 0.5f * z, 10, 5);
+    addRect(&mesh, lo + i * 0.5f * z, 0.5f * x, 0.5f * y, 10, 5);
+  }
+  SurveyConfig config;
+  config.num_frames = 600;
+  config.rate_hz = 10.0;
+  const std::vector<Eigen::Vector2d> stops = {{0.8, 0.8}, {2.7, 0.8}, {2.7, 2.2}, {0.8, 2.2}};
+  const Eigen::Vector2d chair(4.75, 1.5);
+  const std::vector<StampedPose> seen_through = planSurveyThrough(mesh, config, stops, 1);
+  config.walls_block_view = true;
+  const std::vector<StampedPose> blocked = planSurveyThrough(mesh, config, stops, 1);
+  for (const StampedPose& p : blocked) ASSERT_LT(p.T_W_C.translation().x(), 3.5);
+  EXPECT_GT(looksAt(seen_through, chair), 30);
+  EXPECT_EQ(looksAt(blocked, chair), 0);
+}
+
 TEST(Survey, TumRoundTrip) {
   test::TempDir dir;
   std::vector<StampedPose> traj(3);

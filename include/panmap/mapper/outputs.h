@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "panmap/graph/optimiser.h"
@@ -23,6 +24,9 @@ struct OutputSummary {
   size_t instances_in_mesh = 0;    ///< distinct instance ids > 0 on mesh vertices
   size_t objects = 0;              ///< entries of objects.json
   std::vector<std::string> files;  ///< file names written, in order
+  /// Wall time of each step ("mesh extraction", "meshes", "objects.json", "occupancy.bt",
+  /// "trajectory.txt", "map.panmap", "config.yaml", "snapshots"), seconds, in order.
+  std::vector<std::pair<std::string, double>> step_seconds;
 };
 
 /// Writes a map's outputs (DESIGN 4) into `dir` (created when missing): mesh_semantic.ply,

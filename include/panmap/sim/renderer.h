@@ -28,6 +28,9 @@ struct RenderConfig {
                                    ///< headlight (Lambert term |n . ray|)
   float texture_cell_m = 0.08f;    ///< size of the per-object procedural texture's cells, metres
   float texture_contrast = 0.25f;  ///< brightness swing of that texture, 0..1
+  /// Skip runs of consecutive faces whose bounds lie wholly outside the view frustum. The
+  /// image is bit-identical either way (faces keep their order); off only to test that.
+  bool cull = true;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -51,6 +54,19 @@ class MeshRenderer {
 
  private:
   struct Scratch;
+  /// Consecutive faces [first_face, end_face) and the vertex indices they use.
+  struct FaceRun {
+    Eigen::AlignedBox3f box_W;
+    int32_t first_face = 0, end_face = 0;
+    int32_t first_vertex = 0, end_vertex = 0;
+  };
+  /// Runs that can draw a pixel: bounds not wholly behind the near plane, beyond the far plane
+  /// or beside the image.
+  std::vector<const FaceRun*> visibleRuns(const PinholeCamera& camera,
+                                          const Eigen::Isometry3f& T_C_W) const;
+  /// Draws face f (vertices in scratch->points_C), clipped at the near plane.
+  void drawFace(const PinholeCamera& camera, int32_t f, float near, float far,
+                Scratch* scratch) const;
   void rasterise(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
                  Scratch* scratch) const;
 
@@ -60,6 +76,7 @@ class MeshRenderer {
   std::vector<int32_t> face_instance_;
   std::vector<int32_t> face_semantic_;
   std::vector<Rgb8> face_color_;
+  std::vector<FaceRun> runs_;
 };
 
 }  // namespace panmap

@@ -32,6 +32,10 @@ struct SurveyConfig {
   /// looked at from about where it stands (20 degrees) to those looked at least, so later laps
   /// see the other sides. 1 walks the one loop over and over with the head schedule of before.
   int laps = 1;
+  /// Walls (NYU40 class 1) hide the objects behind them: the head only turns to objects it can
+  /// see. Off for single rooms, whose trajectories were measured without the test; on for
+  /// buildings, where most objects are behind a wall.
+  bool walls_block_view = false;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -52,6 +56,18 @@ struct SurveyPath {
 /// walk in.
 std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& config,
                                     uint64_t seed);
+
+/// planSurvey through given stops (world x, y, visited in order; the walk closes back to the
+/// first) instead of stops it spreads itself. num_frames = 0 walks the loop once. Throws Error
+/// naming the stop when one is not within 0.5 m of free space or cannot be reached from the
+/// one before.
+std::vector<StampedPose> planSurveyThrough(const LabelledMesh& mesh, SurveyConfig config,
+                                           const std::vector<Eigen::Vector2d>& stops,
+                                           uint64_t seed);
+
+/// The walk planSurveyThrough follows for the same arguments.
+SurveyPath planSurveyPathThrough(const LabelledMesh& mesh, const SurveyConfig& config,
+                                 const std::vector<Eigen::Vector2d>& stops);
 
 /// The walk planSurvey follows for the same mesh, config and seed (to tell its laps apart).
 SurveyPath planSurveyPath(const LabelledMesh& mesh, const SurveyConfig& config, uint64_t seed);
