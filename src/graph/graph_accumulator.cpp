@@ -349,35 +349,25 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
   for (int32_t c = 1; c <= kMaxNyu40Class; ++c) {
     if (isStuffClass(c)) g.background.push_back(c);
   }
-  // Voxel counts and centroids of the live super-points.
-  std::map<int32_t, std::pair<int, Eigen::Vector3d>> voxels;
+  // Voxel counts and centroids of the live super-points, indexed by label (labels are dense),
+  // from the scan that finds who owns the surface: the map is read once.
+  const size_t num_labels = static_cast<size_t>(std::max(0, tracker.labels().size())) + 1;
+  SurfaceAdjacency::OwnerTotals totals;
+  totals.voxels.assign(num_labels, 0);
+  totals.centre_sum.assign(num_labels, Eigen::Vector3d::Zero());
   auto resolve = [&tracker](int32_t l) { return tracker.labels().resolve(l); };
-  for (const auto& block : map.blocks()) {
-    for (int z = 0; z < kBlockSide; ++z) {
-      for (int y = 0; y < kBlockSide; ++y) {
-        for (int x = 0; x < kBlockSide; ++x) {
-          const int32_t label = argmaxLabel(block->at(x, y, z), resolve);
-          if (label <= 0) continue;
-          auto& v = voxels.try_emplace(label, 0, Eigen::Vector3d::Zero()).first->second;
-          ++v.first;
-          v.second += map.voxelCentre(block->index, x, y, z).cast<double>();
-        }
-      }
-    }
-  }
-  std::unique_ptr<SurfaceAdjacency> surface;
-  if (config_.prune_edges) {
-    surface = std::make_unique<SurfaceAdjacency>(SurfaceAdjacency::compute(
-        map, [&resolve](int32_t l) { return resolve(l); }, config_.surface_band_voxels));
-  }
+  tracker.labels().flatten();  // every label points at its root: resolving is a table lookup
+  const SurfaceAdjacency adjacency = SurfaceAdjacency::compute(
+      map, tracker.labels().parents(), config_.surface_band_voxels, &totals);
+  // Without pruning the adjacency is not used (its scan still counts the voxels).
+  const SurfaceAdjacency* surface = config_.prune_edges ? &adjacency : nullptr;
   for (const auto& [label, state] : tracker.states()) {
     if (surface && surface->surfaceVoxels(label) == 0) continue;
     GraphVertex vertex;
     vertex.id = label;
-    const auto it = voxels.find(label);
-    if (it != voxels.end()) {
-      vertex.num_voxels = it->second.first;
-      vertex.centroid = it->second.second / it->second.first;
+    if (label > 0 && static_cast<size_t>(label) < num_labels && totals.voxels[label] > 0) {
+      vertex.num_voxels = totals.voxels[label];
+      vertex.centroid = totals.centre_sum[label] / totals.voxels[label];
     }
     vertex.instance = state.instance();
     vertex.semantic = state.semanticClass();
@@ -385,15 +375,29 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
     if (s != scores_.end()) vertex.scores = s->second;
     g.vertices.push_back(vertex);
   }
-  // In pair order, so that equal pairs below are summed in the same order on every run.
-  edges_.forEachSorted([&](int32_t first, int32_t second, const EdgeTable::Classes& conf) {
-    // Edges only between live super-points (merges are folded in at the next update).
-    const int32_t a = tracker.labels().resolve(first), b = tracker.labels().resolve(second);
+  // Stored pairs between live super-points (merges are folded in at the next update), in pair
+  // order, so that equal pairs below are summed in the same order on every run.
+  struct Stored {
+    int32_t a, b;
+    const EdgeTable::Classes* classes;
+  };
+  std::vector<Stored> stored;
+  stored.reserve(edges_.size());
+  edges_.forEachSorted([&](int32_t first, int32_t second, const EdgeTable::Classes& classes) {
+    const int32_t a = resolve(first), b = resolve(second);
     if (a == b || a == 0 || b == 0) return;
+    stored.push_back({std::min(a, b), std::max(a, b), &classes});
+  });
+  // Sorting these small records gives the permutation sorting the edges themselves gave (it
+  // depends on the comparisons alone), so equal pairs are summed in the same order as before.
+  std::sort(stored.begin(), stored.end(), [](const Stored& x, const Stored& y) {
+    return std::tie(x.a, x.b) < std::tie(y.a, y.b);
+  });
+  auto toEdge = [](const Stored& s) {
     GraphEdge e;
-    e.a = std::min(a, b);
-    e.b = std::max(a, b);
-    for (const auto& [cls, value] : conf) {
+    e.a = s.a;
+    e.b = s.b;
+    for (const auto& [cls, value] : *s.classes) {
       if (cls > 0) {
         e.confidences[cls] = value;
       } else if (cls < 0) {
@@ -402,38 +406,38 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
         e.apart = value;
       }
     }
-    g.edges.push_back(std::move(e));
-  });
-  std::sort(g.edges.begin(), g.edges.end(), [](const GraphEdge& x, const GraphEdge& y) {
-    return std::tie(x.a, x.b) < std::tie(y.a, y.b);
-  });
-  // Pending merges can map two stored edges onto one pair: add them up.
-  std::vector<GraphEdge> merged;
-  for (GraphEdge& e : g.edges) {
-    if (!merged.empty() && merged.back().a == e.a && merged.back().b == e.b) {
-      for (const auto& [cls, c] : e.confidences) merged.back().confidences[cls] += c;
-      for (const auto& [cls, c] : e.separations) merged.back().separations[cls] += c;
-      merged.back().apart += e.apart;
-    } else {
-      merged.push_back(std::move(e));
+    return e;
+  };
+  g.edges.reserve(stored.size());
+  for (size_t i = 0; i < stored.size();) {
+    size_t j = i + 1;
+    while (j < stored.size() && stored[j].a == stored[i].a && stored[j].b == stored[i].b) ++j;
+    // P_eps^C (C > 0) and P_sep^C (C < 0); P_apart (0) only weighs them.
+    double strongest = 0.0;
+    if (j == i + 1) {
+      for (const auto& [cls, value] : *stored[i].classes) {
+        if (cls != 0) strongest = std::max(strongest, value);
+      }
+      // After the sums: a pair's evidence is judged whole.
+      if (!surface || keepEdge(stored[i].a, stored[i].b, strongest, *surface)) {
+        g.edges.push_back(toEdge(stored[i]));
+      }
+      i = j;
+      continue;
     }
+    // Pending merges can map two stored edges onto one pair: add them up.
+    GraphEdge sum = toEdge(stored[i]);
+    for (size_t k = i + 1; k < j; ++k) {
+      const GraphEdge e = toEdge(stored[k]);
+      for (const auto& [cls, c] : e.confidences) sum.confidences[cls] += c;
+      for (const auto& [cls, c] : e.separations) sum.separations[cls] += c;
+      sum.apart += e.apart;
+    }
+    for (const auto& [cls, c] : sum.confidences) strongest = std::max(strongest, c);
+    for (const auto& [cls, c] : sum.separations) strongest = std::max(strongest, c);
+    if (!surface || keepEdge(sum.a, sum.b, strongest, *surface)) g.edges.push_back(std::move(sum));
+    i = j;
   }
-  if (surface) {
-    // After the sums above: a pair's evidence is judged whole.
-    merged.erase(std::remove_if(merged.begin(), merged.end(),
-                                [&](const GraphEdge& e) {
-                                  double strongest = 0.0;
-                                  for (const auto& [cls, c] : e.confidences) {
-                                    strongest = std::max(strongest, c);
-                                  }
-                                  for (const auto& [cls, c] : e.separations) {
-                                    strongest = std::max(strongest, c);
-                                  }
-                                  return !keepEdge(e.a, e.b, strongest, *surface);
-                                }),
-                 merged.end());
-  }
-  g.edges = std::move(merged);
   return g;
 }
 

@@ -25,7 +25,31 @@ uint64_t SurfaceAdjacency::key(int32_t a, int32_t b) {
 SurfaceAdjacency SurfaceAdjacency::compute(const TsdfMap& map,
                                            const std::function<int32_t(int32_t)>& resolve,
                                            float band_voxels) {
+  return computeWith(map, resolve, band_voxels, nullptr);
+}
+
+SurfaceAdjacency SurfaceAdjacency::compute(const TsdfMap& map,
+                                           const std::function<int32_t(int32_t)>& resolve,
+                                           float band_voxels, OwnerTotals* totals) {
+  return computeWith(map, resolve, band_voxels, totals);
+}
+
+SurfaceAdjacency SurfaceAdjacency::compute(const TsdfMap& map, const std::vector<int32_t>& roots,
+                                           float band_voxels, OwnerTotals* totals) {
+  const auto size = static_cast<int32_t>(roots.size());
+  return computeWith(
+      map, [&roots, size](int32_t l) { return l > 0 && l < size ? roots[l] : 0; }, band_voxels,
+      totals);
+}
+
+template <typename Resolve>
+SurfaceAdjacency SurfaceAdjacency::computeWith(const TsdfMap& map, const Resolve& resolve,
+                                               float band_voxels, OwnerTotals* totals) {
   if (!(band_voxels > 0.0f)) throw Error("surface adjacency band_voxels must be > 0");
+  if (totals && totals->centre_sum.size() != totals->voxels.size()) {
+    throw Error("surface adjacency totals: voxels and centre_sum differ in size");
+  }
+  const size_t num_totals = totals ? totals->voxels.size() : 0;
   const float band_m = band_voxels * map.voxelSize();
   SurfaceAdjacency out;
   // Owner of every surface voxel, for the blocks that have one (others stay out: at building
@@ -35,9 +59,18 @@ SurfaceAdjacency SurfaceAdjacency::compute(const TsdfMap& map,
     std::vector<int32_t> labels;
     for (int i = 0; i < kBlockVoxels; ++i) {
       const Voxel& voxel = block->voxels[i];
-      if (!(voxel.weight > 0.0f) || !(std::fabs(voxel.sdf_m) <= band_m)) continue;
+      const bool on_surface = voxel.weight > 0.0f && std::fabs(voxel.sdf_m) <= band_m;
+      if (!on_surface && !totals) continue;
       const int32_t label = argmaxLabel(voxel, resolve);
       if (label <= 0) continue;
+      if (static_cast<size_t>(label) < num_totals) {
+        ++totals->voxels[label];
+        totals->centre_sum[label] +=
+            map.voxelCentre(block->index, i % kBlockSide, (i / kBlockSide) % kBlockSide,
+                            i / (kBlockSide * kBlockSide))
+                .cast<double>();
+      }
+      if (!on_surface) continue;
       if (labels.empty()) labels.assign(kBlockVoxels, 0);
       labels[static_cast<size_t>(i)] = label;
       ++out.surface_voxels_[label];
@@ -47,6 +80,18 @@ SurfaceAdjacency SurfaceAdjacency::compute(const TsdfMap& map,
   for (const auto& block : map.blocks()) {
     const auto own = owners.find(TsdfMap::key(block->index));
     if (own == owners.end()) continue;
+    // The owner arrays of the block and its 26 neighbours, looked up once per block rather than
+    // per voxel on its border: near[dx + 1][dy + 1][dz + 1], null where nothing owns surface.
+    const std::vector<int32_t>* near[3][3][3];
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const BlockIndex nb = block->index + BlockIndex(dx, dy, dz);
+          const auto it = owners.find(TsdfMap::key(nb));
+          near[dx + 1][dy + 1][dz + 1] = it == owners.end() ? nullptr : &it->second;
+        }
+      }
+    }
     const std::vector<int32_t>& labels = own->second;
     for (int z = 0; z < kBlockSide; ++z) {
       for (int y = 0; y < kBlockSide; ++y) {
@@ -55,21 +100,15 @@ SurfaceAdjacency SurfaceAdjacency::compute(const TsdfMap& map,
           if (label <= 0) continue;
           for (const auto& d : kForward) {
             int nx = x + d[0], ny = y + d[1], nz = z + d[2];
-            BlockIndex nb = block->index;
-            const std::vector<int32_t>* other = &labels;
-            if (nx < 0 || nx >= kBlockSide || ny < 0 || ny >= kBlockSide || nz < 0 ||
-                nz >= kBlockSide) {
-              auto wrap = [](int* v, int* b) {
-                if (*v < 0) *v += kBlockSide, --*b;
-                if (*v >= kBlockSide) *v -= kBlockSide, ++*b;
-              };
-              wrap(&nx, &nb.x());
-              wrap(&ny, &nb.y());
-              wrap(&nz, &nb.z());
-              const auto it = owners.find(TsdfMap::key(nb));
-              if (it == owners.end()) continue;
-              other = &it->second;
-            }
+            // Which neighbour block (-1, 0, 1 per axis) and the voxel inside it.
+            const int bx = nx < 0 ? -1 : (nx >= kBlockSide ? 1 : 0);
+            const int by = ny < 0 ? -1 : (ny >= kBlockSide ? 1 : 0);
+            const int bz = nz < 0 ? -1 : (nz >= kBlockSide ? 1 : 0);
+            const std::vector<int32_t>* other = near[bx + 1][by + 1][bz + 1];
+            if (!other) continue;
+            nx -= bx * kBlockSide;
+            ny -= by * kBlockSide;
+            nz -= bz * kBlockSide;
             const int32_t neighbour =
                 (*other)[static_cast<size_t>(nx + kBlockSide * (ny + kBlockSide * nz))];
             if (neighbour > 0 && neighbour != label) out.pairs_.insert(key(label, neighbour));

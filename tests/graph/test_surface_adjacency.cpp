@@ -40,6 +40,36 @@ class HandMap {
 
 int32_t identity(int32_t l) { return l; }
 
+TEST(SurfaceAdjacency, TotalsCountEveryVoxelAndATableResolvesAsTheFunctionDoes) {
+  HandMap m;
+  m.set(0, 0, 0, 1);
+  m.set(1, 0, 0, 3);              // label 3 was merged into 1
+  m.set(-1, 2, 0, 2);             // another block (negative x)
+  m.set(7, 0, 0, 2, 2.5f);        // off the band: counted in the totals, not on the surface
+  m.set(5, 0, 0, 2, 0.0f, 0.0f);  // never observed but voted: counted too
+  const std::vector<int32_t> roots = {0, 1, 2, 1};
+  SurfaceAdjacency::OwnerTotals totals;
+  totals.voxels.assign(4, 0);
+  totals.centre_sum.assign(4, Eigen::Vector3d::Zero());
+  const SurfaceAdjacency s = SurfaceAdjacency::compute(m.map(), roots, 2.0f, &totals);
+  EXPECT_EQ(totals.voxels, (std::vector<int>{0, 2, 3, 0}));
+  // Voxel centres at 0.1 m: (i + 0.5) * 0.1.
+  EXPECT_NEAR(totals.centre_sum[1].x(), 0.05 + 0.15, 1e-6);
+  EXPECT_NEAR(totals.centre_sum[2].x(), -0.05 + 0.75 + 0.55, 1e-6);
+  EXPECT_NEAR(totals.centre_sum[2].y(), 0.25 + 0.05 + 0.05, 1e-6);
+  EXPECT_EQ(s.surfaceVoxels(1), 2);
+  EXPECT_EQ(s.surfaceVoxels(2), 1);
+  EXPECT_EQ(s.surfaceVoxels(3), 0);
+  EXPECT_TRUE(s.touching(1, 2) == false);
+  const SurfaceAdjacency f = SurfaceAdjacency::compute(
+      m.map(), [&roots](int32_t l) { return l > 0 && l < 4 ? roots[l] : 0; }, 2.0f);
+  EXPECT_EQ(f.numOwners(), s.numOwners());
+  EXPECT_EQ(f.numPairs(), s.numPairs());
+  // Sizes that disagree are refused.
+  totals.centre_sum.pop_back();
+  EXPECT_THROW(SurfaceAdjacency::compute(m.map(), roots, 2.0f, &totals), Error);
+}
+
 TEST(SurfaceAdjacency, OwnersAndTouchingPairsOnHandSetVoxels) {
   HandMap m;
   m.set(0, 0, 0, 1);

@@ -27,6 +27,26 @@ class SurfaceAdjacency {
                                   const std::function<int32_t(int32_t)>& resolve,
                                   float band_voxels);
 
+  /// Voxel counts of the live super-points over the whole map (not only the surface band),
+  /// indexed by label, and the sums of their voxels' centres (summed in block order, voxel
+  /// index order within a block). Sized by the caller: labels beyond the size are not counted.
+  struct OwnerTotals {
+    std::vector<int> voxels;
+    std::vector<Eigen::Vector3d> centre_sum;
+  };
+
+  /// compute() that also fills `totals` in the same scan: the super-point graph needs both,
+  /// and reading the map once instead of twice saves a pass over every voxel.
+  static SurfaceAdjacency compute(const TsdfMap& map,
+                                  const std::function<int32_t(int32_t)>& resolve, float band_voxels,
+                                  OwnerTotals* totals);
+
+  /// The same with labels resolved through a table: roots[label] is the live super-point of a
+  /// stored label (LabelRegistry::parents() after flatten()); labels outside it resolve to 0.
+  /// Every voxel's votes are resolved, so a table lookup instead of a call matters.
+  static SurfaceAdjacency compute(const TsdfMap& map, const std::vector<int32_t>& roots,
+                                  float band_voxels, OwnerTotals* totals);
+
   /// Surface voxels owned by a live super-point (0 when it owns none).
   int surfaceVoxels(int32_t label) const;
   /// True when the two super-points own touching surface voxels (either order; false for a == b).
@@ -38,6 +58,9 @@ class SurfaceAdjacency {
 
  private:
   static uint64_t key(int32_t a, int32_t b);
+  template <typename Resolve>
+  static SurfaceAdjacency computeWith(const TsdfMap& map, const Resolve& resolve, float band_voxels,
+                                      OwnerTotals* totals);
 
   absl::flat_hash_map<int32_t, int> surface_voxels_;
   absl::flat_hash_set<uint64_t> pairs_;  // (min << 32) | max

@@ -1,0 +1,66 @@
+// The final optimisation of a saved map, as panmap-mapper runs it at the end of a session:
+// the super-point graph of the live super-points (Mapper::graph), then the solve (optimise).
+// Prints the median of each over --repeats runs.
+//   panmap-bench-final MAP.panmap [--repeats 5]
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "panmap/graph/optimiser.h"
+#include "panmap/mapper/mapper.h"
+
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Time the final optimisation (graph, then solve) of a saved map."};
+  std::string path;
+  int repeats = 5;
+  app.add_option("map", path, "map.panmap written by panmap-mapper")->required();
+  app.add_option("--repeats", repeats, "runs to take the median of")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
+  CLI11_PARSE(app, argc, argv);
+  try {
+    const auto mapper = panmap::Mapper::load(path);
+    std::vector<double> graph_ms, solve_ms;
+    size_t vertices = 0, edges = 0;
+    for (int r = 0; r < repeats; ++r) {
+      auto start = std::chrono::steady_clock::now();
+      const panmap::SuperpointGraph graph = mapper->graph();
+      graph_ms.push_back(msSince(start));
+      start = std::chrono::steady_clock::now();
+      const panmap::GraphLabels labels = panmap::optimise(graph, panmap::OptimiserConfig());
+      solve_ms.push_back(msSince(start));
+      vertices = graph.vertices.size();
+      edges = graph.edges.size();
+      std::fprintf(stderr, "\r  run %d/%d", r + 1, repeats);
+    }
+    std::fprintf(stderr, "\n");
+    std::printf(
+        "%s: %zu blocks, %zu vertices, %zu edges; median of %d: graph %.1f ms, solve %.1f ms, "
+        "total %.1f ms\n",
+        path.c_str(), mapper->map().numBlocks(), vertices, edges, repeats, median(graph_ms),
+        median(solve_ms), median(graph_ms) + median(solve_ms));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "panmap-bench-final: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
