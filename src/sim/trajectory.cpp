@@ -464,6 +464,16 @@ std::vector<Cell> stopCells(const FreeSpace& fs, const std::vector<Eigen::Vector
   const int reach = static_cast<int>(std::ceil(0.5 / fs.cell));
   std::vector<Cell> cells;
   for (size_t k = 0; k < stops.size(); ++k) {
+    if (!stops[k].allFinite()) throw Error("survey: stop " + std::to_string(k) + " is not finite");
+    // Far off the grid: no cell can be near (and the cell index must not overflow).
+    const Eigen::Vector2d grid = (stops[k] - fs.origin) / fs.cell;
+    if (grid.minCoeff() < -reach || grid.x() > fs.safe.cols + reach ||
+        grid.y() > fs.safe.rows + reach) {
+      std::ostringstream msg;
+      msg << "survey: stop " << k << " at (" << stops[k].x() << ", " << stops[k].y()
+          << ") is outside the mesh";
+      throw Error(msg.str());
+    }
     int i0 = 0, j0 = 0;
     fs.cellOf(stops[k], &i0, &j0);
     Cell best{-1, -1};

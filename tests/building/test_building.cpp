@@ -168,6 +168,8 @@ TEST(Building, BadConfigAndUnreachableStopsAreNamed) {
   // A stop in the middle of a wall slab between two rooms.
   const Building& b = fourRooms();
   std::vector<Eigen::Vector2d> stops = buildingSurveyStops(b);
+  const std::vector<Eigen::Vector2d> nan_stop = {stops[0], {std::nan(""), 1.0}};
+  EXPECT_THROW(planSurveyThrough(b.mesh, buildingSurveyConfig(), nan_stop, 1), Error);
   stops.push_back({b.corridor.center().x(), b.corridor.max().y() + 50.0});
   try {
     planSurveyThrough(b.mesh, buildingSurveyConfig(), stops, 1);
