@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -46,20 +47,58 @@ Mapper::Mapper(const MapperConfig& config) : config_(config), drift_(config.drif
   aligner_ = std::make_unique<FrameToModelAligner>(config_.tracking);
 }
 
-LabelledMesh Mapper::extractMesh(const GraphLabels* labels) {
-  mesher_->update(map_.get());
+MeshLabeller Mapper::meshLabeller(const GraphLabels* labels,
+                                  absl::flat_hash_map<int32_t, SuperpointLabels>* cache) const {
   const SuperpointTracker& tracker = *tracker_;
+  auto lookup = [&tracker, labels, cache](int32_t label) -> const SuperpointLabels& {
+    auto [it, inserted] = cache->try_emplace(label);
+    if (inserted) it->second = finalLabels(label, tracker, labels);
+    return it->second;
+  };
   MeshLabeller labeller;
   labeller.superpoint = [&tracker](const Voxel& voxel) {
     return argmaxLabel(voxel, [&tracker](int32_t l) { return tracker.labels().resolve(l); });
   };
-  labeller.semantic = [&tracker, labels](int32_t label) {
-    return finalLabels(label, tracker, labels).semantic;
-  };
-  labeller.instance = [&tracker, labels](int32_t label) {
-    return finalLabels(label, tracker, labels).instance;
-  };
-  return mesher_->assemble(*map_, labeller);
+  labeller.semantic = [lookup](int32_t label) { return lookup(label).semantic; };
+  labeller.instance = [lookup](int32_t label) { return lookup(label).instance; };
+  return labeller;
+}
+
+LabelledMesh Mapper::extractMesh(const GraphLabels* labels) {
+  mesher_->update(map_.get());
+  absl::flat_hash_map<int32_t, SuperpointLabels> cache;
+  return mesher_->assemble(*map_, meshLabeller(labels, &cache));
+}
+
+MeshUpdate Mapper::updateMesh(const GraphLabels* labels) {
+  // Every thread labels the blocks it has just meshed, while their voxels are in cache, with
+  // its own cache of super-point labels; resolve() only reads once the registry is flattened.
+  tracker_->labels().flatten();
+  const int threads = pool_->size();
+  std::vector<absl::flat_hash_map<int32_t, SuperpointLabels>> caches(threads);
+  std::vector<MeshLabeller> labellers;
+  for (auto& cache : caches) labellers.push_back(meshLabeller(labels, &cache));
+  std::vector<std::vector<std::pair<BlockIndex, LabelledMesh>>> labelled(threads);
+  mesher_->update(map_.get(), [&](const BlockMesh& mesh, int thread) {
+    labelled[thread].emplace_back(mesh.index, labelBlockMesh(*map_, mesh, labellers[thread]));
+  });
+  std::vector<std::pair<BlockIndex, LabelledMesh>> all;
+  for (auto& list : labelled) std::move(list.begin(), list.end(), std::back_inserter(all));
+  std::sort(all.begin(), all.end(),
+            [](const auto& a, const auto& b) { return blockIndexLess(a.first, b.first); });
+  MeshUpdate update;
+  update.blocks = mesher_->takeChangedBlocks();
+  update.meshes.resize(update.blocks.size());
+  // Both lists are sorted; blocks re-meshed earlier by extractMesh() are labelled now.
+  auto next = all.begin();
+  for (size_t i = 0; i < update.blocks.size(); ++i) {
+    if (next != all.end() && next->first == update.blocks[i]) {
+      update.meshes[i] = std::move((next++)->second);
+    } else {
+      update.meshes[i] = labelBlockMesh(*map_, *mesher_->find(update.blocks[i]), labellers[0]);
+    }
+  }
+  return update;
 }
 
 void Mapper::validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,

@@ -10,7 +10,7 @@ IncrementalMesher::IncrementalMesher(const MarchingCubesConfig& config, ThreadPo
   config_.check();
 }
 
-size_t IncrementalMesher::update(TsdfMap* map) {
+size_t IncrementalMesher::update(TsdfMap* map, const BlockMeshedFn& on_meshed) {
   std::vector<const Block*> dirty;
   for (const auto& block : map->blocks()) {
     if (!block->updated && meshes_.contains(TsdfMap::key(block->index))) continue;
@@ -21,7 +21,7 @@ size_t IncrementalMesher::update(TsdfMap* map) {
     }
     block->updated = false;
   }
-  remesh(*map, &dirty);
+  remesh(*map, &dirty, on_meshed);
   return last_remeshed_;
 }
 
@@ -32,13 +32,29 @@ void IncrementalMesher::rebuild(const TsdfMap& map) {
   remesh(map, &all);
 }
 
+std::vector<BlockIndex> IncrementalMesher::takeChangedBlocks() {
+  std::vector<BlockIndex> out;
+  out.reserve(changed_.size());
+  for (uint64_t key : changed_) out.push_back(meshes_.at(key).index);
+  changed_.clear();
+  std::sort(out.begin(), out.end(), blockIndexLess);
+  return out;
+}
+
+const BlockMesh* IncrementalMesher::find(const BlockIndex& index) const {
+  const auto it = meshes_.find(TsdfMap::key(index));
+  return it == meshes_.end() ? nullptr : &it->second;
+}
+
 void IncrementalMesher::clear() {
   meshes_.clear();
+  changed_.clear();
   last_remeshed_ = 0;
   total_remeshed_ = 0;
 }
 
-void IncrementalMesher::remesh(const TsdfMap& map, std::vector<const Block*>* blocks) {
+void IncrementalMesher::remesh(const TsdfMap& map, std::vector<const Block*>* blocks,
+                               const BlockMeshedFn& on_meshed) {
   // Blocks never move, so their addresses identify them.
   std::sort(blocks->begin(), blocks->end());
   blocks->erase(std::unique(blocks->begin(), blocks->end()), blocks->end());
@@ -48,8 +64,12 @@ void IncrementalMesher::remesh(const TsdfMap& map, std::vector<const Block*>* bl
   std::vector<BlockMesh*> targets;
   targets.reserve(blocks->size());
   for (const Block* block : *blocks) targets.push_back(&meshes_.at(TsdfMap::key(block->index)));
-  auto work = [&](size_t begin, size_t end, int) {
-    for (size_t i = begin; i < end; ++i) meshBlock(map, *(*blocks)[i], config_, targets[i]);
+  for (const Block* block : *blocks) changed_.insert(TsdfMap::key(block->index));
+  auto work = [&](size_t begin, size_t end, int thread) {
+    for (size_t i = begin; i < end; ++i) {
+      meshBlock(map, *(*blocks)[i], config_, targets[i]);
+      if (on_meshed) on_meshed(*targets[i], thread);
+    }
   };
   if (pool_ && blocks->size() > 1) {
     pool_->parallelFor(blocks->size(), work);

@@ -214,21 +214,38 @@ namespace {
 // A grid edge anywhere in the map: its lower voxel's block and its id within that block.
 using EdgeKey = std::pair<uint64_t, uint16_t>;
 
-// Labels one vertex from its source voxel.
 struct VertexLabels {
   int32_t superpoint = 0, semantic = 0, instance = 0;
 };
 
-VertexLabels labelVertex(const MeshLabeller& labeller, const Block* const* neighbours,
-                         uint16_t source) {
-  VertexLabels labels;
-  const Block* block = neighbours[source >> 9];
-  if (!block) return labels;
-  labels.superpoint = labeller.superpoint(block->voxels[source & 511]);
-  if (labeller.semantic) labels.semantic = labeller.semantic(labels.superpoint);
-  if (labeller.instance) labels.instance = labeller.instance(labels.superpoint);
-  return labels;
-}
+// Labels vertices from their source voxels through a MeshLabeller. Neighbouring vertices
+// mostly share their voxel, and neighbouring voxels their super-point, so the last of each is
+// remembered (the map must not change while it is in use).
+class VertexLabeller {
+ public:
+  explicit VertexLabeller(const MeshLabeller& labeller) : labeller_(labeller) {}
+
+  VertexLabels operator()(const Block* const* neighbours, uint16_t source) {
+    const Block* block = neighbours[source >> 9];
+    if (!block) return VertexLabels{};
+    const Voxel* voxel = &block->voxels[source & 511];
+    if (voxel == last_voxel_) return last_;
+    last_voxel_ = voxel;
+    const int32_t superpoint = labeller_.superpoint(*voxel);
+    if (superpoint == last_.superpoint && have_last_) return last_;
+    have_last_ = true;
+    last_.superpoint = superpoint;
+    last_.semantic = labeller_.semantic ? labeller_.semantic(superpoint) : 0;
+    last_.instance = labeller_.instance ? labeller_.instance(superpoint) : 0;
+    return last_;
+  }
+
+ private:
+  const MeshLabeller& labeller_;
+  const Voxel* last_voxel_ = nullptr;
+  bool have_last_ = false;
+  VertexLabels last_;
+};
 
 }  // namespace
 
@@ -247,6 +264,7 @@ LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const Blo
   out.colors.reserve(offsets.back());
   out.faces.reserve(num_faces);
 
+  VertexLabeller label_vertex(labeller);
   const Block* neighbours[8];
   auto findNeighbours = [&](const BlockIndex& index) {
     if (!labelled) return;
@@ -257,7 +275,7 @@ LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const Blo
     out.vertices.push_back(mesh.vertices[i]);
     out.colors.push_back(mesh.colors[i]);
     if (labelled) {
-      const VertexLabels labels = labelVertex(labeller, neighbours, mesh.sources[i]);
+      const VertexLabels labels = label_vertex(neighbours, mesh.sources[i]);
       out.superpoint.push_back(labels.superpoint);
       out.semantic.push_back(labels.semantic);
       out.instance.push_back(labels.instance);
@@ -323,6 +341,30 @@ LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const Blo
     for (const Eigen::Vector3i& f : blocks[b]->faces) {
       out.faces.emplace_back(map_to[f[0]], map_to[f[1]], map_to[f[2]]);
     }
+  }
+  return out;
+}
+
+LabelledMesh labelBlockMesh(const TsdfMap& map, const BlockMesh& mesh,
+                            const MeshLabeller& labeller) {
+  LabelledMesh out;
+  out.vertices = mesh.vertices;
+  out.colors = mesh.colors;
+  out.faces = mesh.faces;
+  if (!labeller.superpoint) return out;
+  const Block* neighbours[8];
+  for (int slot = 0; slot < 8; ++slot)
+    neighbours[slot] = map.findBlock(mesh.index + slotOffset(slot));
+  const size_t n = mesh.vertices.size();
+  out.superpoint.resize(n);
+  out.semantic.resize(n);
+  out.instance.resize(n);
+  VertexLabeller label_vertex(labeller);
+  for (size_t i = 0; i < n; ++i) {
+    const VertexLabels labels = label_vertex(neighbours, mesh.sources[i]);
+    out.superpoint[i] = labels.superpoint;
+    out.semantic[i] = labels.semantic;
+    out.instance[i] = labels.instance;
   }
   return out;
 }

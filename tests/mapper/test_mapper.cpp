@@ -1,6 +1,10 @@
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
+#include <set>
 
 #include <gtest/gtest.h>
 #include <zlib.h>
@@ -160,6 +164,58 @@ TEST_F(BoxScene, SameInputGivesBitIdenticalOutput) {
   size_t differing = 0;
   for (size_t i = 0; i < bytes_a.size(); ++i) differing += bytes_a[i] != bytes_c[i];
   EXPECT_LE(differing, 8u);
+}
+
+TEST_F(BoxScene, LiveMeshUpdatesAddUpToTheExportedMesh) {
+  Mapper mapper(config());
+  // A viewer: one mesh per block, replaced when an update names the block.
+  std::map<std::array<int, 3>, LabelledMesh> view;
+  auto apply = [&view](const MeshUpdate& update) {
+    EXPECT_EQ(update.blocks.size(), update.meshes.size());
+    EXPECT_TRUE(std::is_sorted(update.blocks.begin(), update.blocks.end(), blockIndexLess));
+    for (size_t i = 0; i < update.blocks.size(); ++i) {
+      const BlockIndex& b = update.blocks[i];
+      view[{b.x(), b.y(), b.z()}] = update.meshes[i];
+    }
+  };
+  MeshUpdate last;
+  for (int k = 0; k < 8; ++k) {
+    RgbdFrame frame;
+    PanopticFrame panoptic;
+    frameAt(k, &frame, &panoptic);
+    mapper.integrate(frame, pose(k), &panoptic);
+    if (k == 5) mapper.extractMesh();  // an export between updates loses no block
+    if (k % 2 == 1) {
+      last = mapper.updateMesh();
+      EXPECT_FALSE(last.blocks.empty());
+      apply(last);
+    }
+  }
+  EXPECT_TRUE(mapper.updateMesh().blocks.empty());  // nothing integrated since
+
+  // The blocks the viewer holds give exactly the exported mesh's vertices; those of the last
+  // update carry the exported labels (older blocks keep the labels of their update).
+  const LabelledMesh whole = mapper.extractMesh();
+  std::map<std::array<float, 3>, std::array<int32_t, 3>> exported;
+  for (size_t i = 0; i < whole.numVertices(); ++i) {
+    const Eigen::Vector3f& p = whole.vertices[i];
+    exported[{p.x(), p.y(), p.z()}] = {whole.superpoint[i], whole.semantic[i], whole.instance[i]};
+  }
+  std::set<std::array<float, 3>> held;
+  for (const auto& [key, mesh] : view) {
+    for (const Eigen::Vector3f& p : mesh.vertices) held.insert({p.x(), p.y(), p.z()});
+  }
+  EXPECT_EQ(held.size(), exported.size());
+  for (const auto& p : held) ASSERT_TRUE(exported.count(p)) << "a vertex the export lacks";
+  size_t checked = 0;
+  for (const LabelledMesh& mesh : last.meshes) {
+    for (size_t i = 0; i < mesh.numVertices(); ++i, ++checked) {
+      const Eigen::Vector3f& p = mesh.vertices[i];
+      ASSERT_EQ(exported.at({p.x(), p.y(), p.z()}),
+                (std::array<int32_t, 3>{mesh.superpoint[i], mesh.semantic[i], mesh.instance[i]}));
+    }
+  }
+  EXPECT_GT(checked, 100u);
 }
 
 TEST_F(BoxScene, SaveLoadRoundTripAndContinue) {

@@ -1,10 +1,12 @@
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
+#include <mutex>
 #include <set>
 #include <string>
 #include <tuple>
@@ -470,6 +472,72 @@ TEST(IncrementalMesher, ThreadsGiveTheSameMesh) {
   serial.update(&a);
   parallel.update(&b);
   expectSameMesh(serial.assemble(a, identityLabeller()), parallel.assemble(b, identityLabeller()));
+}
+
+TEST(IncrementalMesher, ReportsChangedBlocksOnceAndTheirMeshesMatchTheWholeMesh) {
+  TsdfMap map(TsdfMap::Config{0.01f});
+  fillSphere(&map, 0.15f);
+  ThreadPool pool(2);
+  IncrementalMesher mesher(MarchingCubesConfig(), &pool);
+  EXPECT_TRUE(mesher.takeChangedBlocks().empty());
+  std::vector<BlockIndex> meshed_on_thread;
+  std::mutex mutex;
+  mesher.update(&map, [&](const BlockMesh& mesh, int thread) {
+    ASSERT_GE(thread, 0);
+    ASSERT_LT(thread, 2);
+    std::lock_guard<std::mutex> lock(mutex);
+    meshed_on_thread.push_back(mesh.index);
+  });
+  std::vector<BlockIndex> all;
+  for (const auto& block : map.blocks()) all.push_back(block->index);
+  std::sort(all.begin(), all.end(), blockIndexLess);
+  std::sort(meshed_on_thread.begin(), meshed_on_thread.end(), blockIndexLess);
+  EXPECT_EQ(meshed_on_thread, all);
+  EXPECT_EQ(mesher.takeChangedBlocks(), all);
+  EXPECT_TRUE(mesher.takeChangedBlocks().empty());
+
+  // Every block's own labelled mesh, vertex by vertex, is the whole mesh's: same positions,
+  // colours and labels (border vertices appear in two blocks, welded once in the whole mesh).
+  const MeshLabeller labeller = identityLabeller();
+  const LabelledMesh whole = mesher.assemble(map, labeller);
+  std::map<std::array<float, 3>, std::array<int32_t, 3>> expected;
+  for (size_t i = 0; i < whole.numVertices(); ++i) {
+    const Eigen::Vector3f& p = whole.vertices[i];
+    expected[{p.x(), p.y(), p.z()}] = {whole.superpoint[i], whole.semantic[i], whole.instance[i]};
+  }
+  std::set<std::array<float, 3>> seen;
+  size_t faces = 0;
+  for (const BlockIndex& index : all) {
+    const BlockMesh* stored = mesher.find(index);
+    ASSERT_NE(stored, nullptr);
+    const LabelledMesh mesh = labelBlockMesh(map, *stored, labeller);
+    ASSERT_EQ(mesh.check(), "");
+    faces += mesh.numFaces();
+    for (size_t i = 0; i < mesh.numVertices(); ++i) {
+      const Eigen::Vector3f& p = mesh.vertices[i];
+      const auto it = expected.find({p.x(), p.y(), p.z()});
+      ASSERT_NE(it, expected.end()) << "block vertex not in the whole mesh";
+      EXPECT_EQ(it->second,
+                (std::array<int32_t, 3>{mesh.superpoint[i], mesh.semantic[i], mesh.instance[i]}));
+      seen.insert(it->first);
+    }
+  }
+  EXPECT_EQ(seen.size(), expected.size());
+  EXPECT_EQ(faces, whole.numFaces());
+  EXPECT_EQ(mesher.find(BlockIndex(99, 99, 99)), nullptr);
+
+  // One changed block: it and its existing lower neighbours are reported, whoever updated.
+  const BlockIndex changed = map.blockIndexOf(kCentre + Eigen::Vector3f(0.15f, 0.0f, 0.0f));
+  map.findBlock(changed)->updated = true;
+  std::vector<BlockIndex> expected_changed;
+  for (int slot = 0; slot < 8; ++slot) {
+    const BlockIndex lower = changed - BlockIndex(slot & 1, (slot >> 1) & 1, slot >> 2);
+    if (map.findBlock(lower)) expected_changed.push_back(lower);
+  }
+  std::sort(expected_changed.begin(), expected_changed.end(), blockIndexLess);
+  mesher.update(&map);
+  mesher.update(&map);  // nothing new: the list is kept until taken
+  EXPECT_EQ(mesher.takeChangedBlocks(), expected_changed);
 }
 
 // ---- MeshExport ------------------------------------------------------------------------

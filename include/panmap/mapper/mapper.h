@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include <absl/container/flat_hash_map.h>
 #include <Eigen/Geometry>
 
 #include "panmap/core/byte_sink.h"
@@ -16,6 +17,7 @@
 #include "panmap/graph/graph_accumulator.h"
 #include "panmap/map/projective_integrator.h"
 #include "panmap/map/tsdf_map.h"
+#include "panmap/mapper/final_labels.h"
 #include "panmap/mesh/incremental_mesher.h"
 #include "panmap/occupancy/occupancy_map.h"
 #include "panmap/segmentation/panoptic_geometric.h"
@@ -24,6 +26,14 @@
 #include "panmap/tracking/frame_to_model_aligner.h"
 
 namespace panmap {
+
+/// The blocks whose surface changed since the previous Mapper::updateMesh(), each with its own
+/// labelled mesh (labels as of this call). A viewer keeps one mesh per block and replaces
+/// these; an empty mesh means the block has no surface any more.
+struct MeshUpdate {
+  std::vector<BlockIndex> blocks;    ///< in blockIndexLess order
+  std::vector<LabelledMesh> meshes;  ///< meshes[i] is the mesh of blocks[i]
+};
 
 /// Every parameter of the per-frame pipeline, grouped by component.
 struct MapperConfig {
@@ -150,6 +160,12 @@ class Mapper {
   ///        their frame-count labels. Null: frame-count labels only.
   LabelledMesh extractMesh(const GraphLabels* labels = nullptr);
 
+  /// The mesh of the blocks that changed since the previous call (marching cubes on those
+  /// only), labelled as extractMesh() labels them: the periodic update of a live view, whose
+  /// cost follows what the camera saw since, not the size of the map.
+  /// @param labels as for extractMesh()
+  MeshUpdate updateMesh(const GraphLabels* labels = nullptr);
+
   /// Streams the whole state (config, TSDF, votes, super-points) as a map file into `sink`: a
   /// versioned header, the payload and its CRC-32, in chunks of 1 MiB (never whole in memory).
   void serialize(ByteSink* sink) const;
@@ -170,6 +186,10 @@ class Mapper {
   void validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
                 const PanopticFrame* panoptic) const;
   void forgetUnvotedSuperpoints();
+  /// Labels mesh vertices; `cache` holds each super-point's labels once looked up (a mesh
+  /// has millions of vertices but thousands of super-points).
+  MeshLabeller meshLabeller(const GraphLabels* labels,
+                            absl::flat_hash_map<int32_t, SuperpointLabels>* cache) const;
 
   MapperConfig config_;
   std::unique_ptr<ThreadPool> pool_;

@@ -2,9 +2,11 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <absl/container/flat_hash_map.h>
+#include <absl/container/flat_hash_set.h>
 
 #include "panmap/core/labelled_mesh.h"
 #include "panmap/core/thread_pool.h"
@@ -23,10 +25,14 @@ class IncrementalMesher {
   /// @param pool threads to mesh blocks with (not owned), or null for the calling thread
   explicit IncrementalMesher(const MarchingCubesConfig& config = {}, ThreadPool* pool = nullptr);
 
+  /// Called on the meshing thread (0 .. pool size - 1) right after a block is re-meshed, while
+  /// its voxels are still in cache (e.g. to label its vertices).
+  using BlockMeshedFn = std::function<void(const BlockMesh& mesh, int thread)>;
+
   /// Re-meshes every block whose `updated` flag is set, their lower neighbours, and blocks
   /// (with their lower neighbours) this mesher has not seen yet; then clears the flags.
   /// Deterministic whatever the thread count. Returns the number of blocks re-meshed.
-  size_t update(TsdfMap* map);
+  size_t update(TsdfMap* map, const BlockMeshedFn& on_meshed = {});
 
   /// Re-meshes every allocated block, whatever its flag (flags are left as they are).
   void rebuild(const TsdfMap& map);
@@ -34,6 +40,14 @@ class IncrementalMesher {
   /// The whole mesh: block meshes in blockIndexLess order, border vertices welded, labels
   /// read from `map`'s current voxels through `labeller`.
   LabelledMesh assemble(const TsdfMap& map, const MeshLabeller& labeller = {}) const;
+
+  /// Blocks re-meshed since the last call, in blockIndexLess order (each once), and forgets
+  /// them: what a live viewer has to replace. update() and rebuild() add to the list whoever
+  /// triggered them (an export between two calls loses nothing).
+  std::vector<BlockIndex> takeChangedBlocks();
+
+  /// The stored mesh of a block, or null when the block was never meshed.
+  const BlockMesh* find(const BlockIndex& index) const;
 
   /// Blocks re-meshed by the last update() or rebuild().
   size_t lastRemeshedBlocks() const { return last_remeshed_; }
@@ -47,11 +61,13 @@ class IncrementalMesher {
   const MarchingCubesConfig& config() const { return config_; }
 
  private:
-  void remesh(const TsdfMap& map, std::vector<const Block*>* blocks);
+  void remesh(const TsdfMap& map, std::vector<const Block*>* blocks,
+              const BlockMeshedFn& on_meshed = {});
 
   MarchingCubesConfig config_;
   ThreadPool* pool_;
   absl::flat_hash_map<uint64_t, BlockMesh> meshes_;  // by TsdfMap::key of the block
+  absl::flat_hash_set<uint64_t> changed_;            // re-meshed since takeChangedBlocks()
   size_t last_remeshed_ = 0;
   uint64_t total_remeshed_ = 0;
 };

@@ -81,6 +81,12 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
 LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const BlockMesh*>& blocks,
                                  const MeshLabeller& labeller = {});
 
+/// One block's mesh on its own, labelled through `labeller` from the map's current voxels:
+/// its vertices on the upper borders are not welded with the neighbours' (a viewer draws
+/// blocks side by side and replaces a block when it changes).
+LabelledMesh labelBlockMesh(const TsdfMap& map, const BlockMesh& mesh,
+                            const MeshLabeller& labeller = {});
+
 /// Orders block indices by x, then y, then z: the order of every assembled mesh.
 inline bool blockIndexLess(const BlockIndex& a, const BlockIndex& b) {
   if (a.x() != b.x()) return a.x() < b.x();
