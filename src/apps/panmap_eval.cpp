@@ -122,7 +122,8 @@ json toJson(const panmap::SceneDiagnostics& d) {
     for (const auto& [cls, share] : b.class_mix) {
       classes.push_back({{"class_id", cls}, {"name", panmap::nyu40Name(cls)}, {"share", share}});
     }
-    bridges.push_back({{"superpoint", b.superpoint}, {"vertices", b.vertices}, {"classes", classes}});
+    bridges.push_back(
+        {{"superpoint", b.superpoint}, {"vertices", b.vertices}, {"classes", classes}});
   }
   json things = json::array();
   for (const auto& t : d.gt_things) {
@@ -131,7 +132,13 @@ json toJson(const panmap::SceneDiagnostics& d) {
                       {"vertices", t.vertices},
                       {"best_object", t.best_object},
                       {"best_object_class", t.best_object_class},
-                      {"best_iou", t.best_iou}});
+                      {"best_iou", t.best_iou},
+                      {"observed_share", t.observed_share},
+                      {"class_share", t.class_share},
+                      {"other_class_share", t.other_class_share},
+                      {"best_same_class_iou", t.best_same_class_iou},
+                      {"best_same_class_cover", t.best_same_class_cover},
+                      {"cause", panmap::missCauseName(t.cause)}});
   }
   json bins = json::array();
   for (const auto& b : d.reliability) {
@@ -315,8 +322,7 @@ int main(int argc, char** argv) {
           panmap::evaluateTransferred(gt, transferred, confidences, config);
       std::printf("%s", panmap::formatEvalTable(result).c_str());
       out = toJson(result);
-      const panmap::SceneDiagnostics diagnostics =
-          panmap::diagnose(gt, transferred, confidences);
+      const panmap::SceneDiagnostics diagnostics = panmap::diagnose(gt, transferred, confidences);
       std::printf("%s", panmap::formatDiagnostics(diagnostics).c_str());
       out["diagnostics"] = toJson(diagnostics);
     }

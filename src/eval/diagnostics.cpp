@@ -41,7 +41,8 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
   if (gt.semantic.size() != n || gt.instance.size() != n) {
     throw Error("diagnose: ground-truth mesh lacks semantic or instance labels");
   }
-  if (pred.semantic.size() != n || pred.instance.size() != n || pred.superpoint.size() != n) {
+  if (pred.semantic.size() != n || pred.instance.size() != n || pred.superpoint.size() != n ||
+      (!pred.reached.empty() && pred.reached.size() != n)) {
     throw Error("diagnose: transferred labels do not match the ground-truth vertex count");
   }
   if (num_bins < 1) throw Error("diagnose: num_bins must be >= 1");
@@ -125,7 +126,20 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
   for (const auto& [key, count] : thing_size) {
     if (count < kScanNetMinRegionSize) continue;
     thing_index[key] = static_cast<int>(d.gt_things.size());
-    d.gt_things.push_back({key.first, key.second, count});
+    SceneDiagnostics::GtThing thing;
+    thing.class_id = key.first;
+    thing.instance_id = key.second;
+    thing.vertices = count;
+    d.gt_things.push_back(thing);
+  }
+  std::vector<int64_t> thing_reached(d.gt_things.size(), 0), thing_class(d.gt_things.size(), 0),
+      thing_other(d.gt_things.size(), 0);
+  for (size_t v = 0; v < n; ++v) {
+    const auto it = thing_index.find({gt.semantic[v], gt.instance[v]});
+    if (it == thing_index.end()) continue;
+    thing_reached[it->second] += pred.reached.empty() || pred.reached[v];
+    thing_class[it->second] += pred.semantic[v] == gt.semantic[v];
+    thing_other[it->second] += pred.semantic[v] > 0 && pred.semantic[v] != gt.semantic[v];
   }
 
   // Predicted objects: their vertices, classes, void share and overlaps with GT things.
@@ -153,9 +167,32 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
     }
     for (const auto& [g, inter] : by_gt) {
       SceneDiagnostics::GtThing& t = d.gt_things[g];
-      const double iou = static_cast<double>(inter) /
-                         static_cast<double>(t.vertices + pred_size[p].first - inter);
+      const double iou =
+          static_cast<double>(inter) / static_cast<double>(t.vertices + pred_size[p].first - inter);
       if (iou > t.best_iou) t.best_iou = iou, t.best_object = p, t.best_object_class = cls;
+      if (cls == t.class_id) {
+        t.best_same_class_iou = std::max(t.best_same_class_iou, iou);
+        t.best_same_class_cover = std::max(
+            t.best_same_class_cover, static_cast<double>(inter) / static_cast<double>(t.vertices));
+      }
+    }
+  }
+  for (size_t g = 0; g < d.gt_things.size(); ++g) {
+    SceneDiagnostics::GtThing& t = d.gt_things[g];
+    t.observed_share = static_cast<double>(thing_reached[g]) / static_cast<double>(t.vertices);
+    t.class_share = static_cast<double>(thing_class[g]) / static_cast<double>(t.vertices);
+    t.other_class_share = static_cast<double>(thing_other[g]) / static_cast<double>(t.vertices);
+    // Reached vertices without a class: what neither its class nor another holds.
+    const double unlabelled = t.observed_share - t.class_share - t.other_class_share;
+    using Cause = SceneDiagnostics::MissCause;
+    if (t.best_same_class_iou > 0.5) {
+      t.cause = Cause::kMatched;
+    } else if (t.observed_share <= 0.5) {
+      t.cause = Cause::kUnobserved;
+    } else if (t.class_share <= 0.5) {
+      t.cause = t.other_class_share >= unlabelled ? Cause::kWrongClass : Cause::kUnlabelled;
+    } else {
+      t.cause = t.best_same_class_cover > 0.5 ? Cause::kMerged : Cause::kSplit;
     }
   }
   std::map<int32_t, double> listed = objects;
@@ -214,15 +251,31 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
   for (SceneDiagnostics::ReliabilityBin& bin : d.reliability) {
     if (bin.count > 0) bin.mean_confidence /= bin.count;
   }
-  d.confident_precision = d.confident_objects > 0
-                              ? static_cast<double>(confident_matched) / d.confident_objects
-                              : kNaN;
-  d.confident_recall =
-      d.gt_things.empty()
-          ? kNaN
-          : static_cast<double>(std::count(covered.begin(), covered.end(), true)) /
-                static_cast<double>(d.gt_things.size());
+  d.confident_precision =
+      d.confident_objects > 0 ? static_cast<double>(confident_matched) / d.confident_objects : kNaN;
+  d.confident_recall = d.gt_things.empty()
+                           ? kNaN
+                           : static_cast<double>(std::count(covered.begin(), covered.end(), true)) /
+                                 static_cast<double>(d.gt_things.size());
   return d;
+}
+
+const char* missCauseName(SceneDiagnostics::MissCause cause) {
+  switch (cause) {
+    case SceneDiagnostics::MissCause::kMatched:
+      return "matched";
+    case SceneDiagnostics::MissCause::kUnobserved:
+      return "unobserved";
+    case SceneDiagnostics::MissCause::kWrongClass:
+      return "wrong class";
+    case SceneDiagnostics::MissCause::kUnlabelled:
+      return "unlabelled";
+    case SceneDiagnostics::MissCause::kMerged:
+      return "merged";
+    case SceneDiagnostics::MissCause::kSplit:
+      return "split";
+  }
+  return "?";
 }
 
 std::string formatDiagnostics(const SceneDiagnostics& d) {
@@ -256,8 +309,15 @@ std::string formatDiagnostics(const SceneDiagnostics& d) {
                 d.num_objects, d.gt_things.size(), d.objects_per_gt_instance, d.confident_objects,
                 d.confident_precision, d.confident_recall);
   out += line;
-  std::snprintf(line, sizeof(line), "stuff IoU: wall %.3f, floor %.3f, ceiling %.3f\n",
-                d.wall_iou, d.floor_iou, d.ceiling_iou);
+  int causes[6] = {0, 0, 0, 0, 0, 0};
+  for (const SceneDiagnostics::GtThing& t : d.gt_things) ++causes[static_cast<int>(t.cause)];
+  std::snprintf(line, sizeof(line),
+                "GT things at IoU 0.5: %d matched; missed: %d unobserved, %d wrong class, %d "
+                "unlabelled, %d merged, %d split\n",
+                causes[0], causes[1], causes[2], causes[3], causes[4], causes[5]);
+  out += line;
+  std::snprintf(line, sizeof(line), "stuff IoU: wall %.3f, floor %.3f, ceiling %.3f\n", d.wall_iou,
+                d.floor_iou, d.ceiling_iou);
   out += line;
   out += "reliability:";
   for (const SceneDiagnostics::ReliabilityBin& b : d.reliability) {

@@ -28,6 +28,7 @@ TransferredLabels transferLabels(const LabelledMesh& predicted,
   out.semantic.assign(gt_vertices.size(), 0);
   out.instance.assign(gt_vertices.size(), 0);
   out.superpoint.assign(gt_vertices.size(), 0);
+  out.reached.assign(gt_vertices.size(), 0);
   if (predicted.vertices.empty() || gt_vertices.empty()) return out;
 
   const NearestPointIndex tree(&predicted.vertices);
@@ -42,6 +43,7 @@ TransferredLabels transferLabels(const LabelledMesh& predicted,
     out.semantic[g] = labelOr0(predicted.semantic, index);
     out.instance[g] = labelOr0(predicted.instance, index);
     out.superpoint[g] = labelOr0(predicted.superpoint, index);
+    out.reached[g] = 1;
     ++out.num_transferred;
   }
   return out;

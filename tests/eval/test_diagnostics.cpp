@@ -1,4 +1,6 @@
 #include <cmath>
+#include <map>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -13,8 +15,10 @@ namespace {
 struct Case {
   LabelledMesh gt;
   TransferredLabels pred;
-  void add(int count, int32_t cls, int32_t inst, int32_t p_cls, int32_t p_inst, int32_t sp) {
+  void add(int count, int32_t cls, int32_t inst, int32_t p_cls, int32_t p_inst, int32_t sp,
+           bool reached = true) {
     for (int k = 0; k < count; ++k) {
+      pred.reached.push_back(reached ? 1 : 0);
       gt.vertices.emplace_back(0.0f, 0.0f, 0.0f);
       gt.semantic.push_back(cls);
       gt.instance.push_back(inst);
@@ -43,6 +47,64 @@ Case makeCase() {
   c.add(40, 0, 0, 39, 10, 6);
   c.add(10, 0, 0, 5, 7, 3);
   return c;
+}
+
+TEST(Diagnostics, MissedThingsGetTheCauseThatBoundsThem) {
+  Case c;
+  // Chair (200): object 1 holds 180 of it and nothing else: IoU 0.9, matched.
+  c.add(180, 5, 1, 5, 1, 1);
+  c.add(20, 5, 1, 0, 0, 2);
+  // Cabinet (200): only 80 vertices reached, all in object 2: IoU 0.4, unobserved.
+  c.add(80, 3, 2, 3, 2, 3);
+  c.add(120, 3, 2, 0, 0, 0, false);
+  // Table (200): 150 labelled desk (object 3), 50 table (object 4): wrong class.
+  c.add(150, 7, 3, 14, 3, 4);
+  c.add(50, 7, 3, 7, 4, 5);
+  // Two cabinets (100 each) in one cabinet object 5: IoU 100 / 200 = 0.5 each, merged.
+  c.add(100, 3, 4, 3, 5, 6);
+  c.add(100, 3, 5, 3, 5, 6);
+  // Fridge (200): objects 6 and 7 hold 80 each, 40 unlabelled: class share 0.8, split.
+  c.add(80, 24, 6, 24, 6, 7);
+  c.add(80, 24, 6, 24, 7, 8);
+  c.add(40, 24, 6, 0, 0, 9);
+  // Other furniture (200): 60 in object 8, 140 reached but unlabelled: unlabelled.
+  c.add(60, 39, 7, 39, 8, 10);
+  c.add(140, 39, 7, 0, 0, 0);
+  const SceneDiagnostics d = diagnose(c.gt, c.pred, {});
+  ASSERT_EQ(d.gt_things.size(), 7u);
+  std::map<int32_t, SceneDiagnostics::GtThing> by_instance;
+  for (const auto& t : d.gt_things) by_instance[t.instance_id] = t;
+  using Cause = SceneDiagnostics::MissCause;
+  EXPECT_EQ(by_instance[1].cause, Cause::kMatched);
+  EXPECT_NEAR(by_instance[1].best_same_class_iou, 0.9, 1e-12);
+  EXPECT_NEAR(by_instance[1].observed_share, 1.0, 1e-12);
+  EXPECT_EQ(by_instance[2].cause, Cause::kUnobserved);
+  EXPECT_NEAR(by_instance[2].observed_share, 0.4, 1e-12);
+  EXPECT_NEAR(by_instance[2].best_same_class_iou, 0.4, 1e-12);
+  EXPECT_EQ(by_instance[3].cause, Cause::kWrongClass);
+  EXPECT_NEAR(by_instance[3].class_share, 0.25, 1e-12);
+  EXPECT_NEAR(by_instance[3].other_class_share, 0.75, 1e-12);
+  EXPECT_EQ(by_instance[7].cause, Cause::kUnlabelled);
+  EXPECT_NEAR(by_instance[7].class_share, 0.3, 1e-12);
+  EXPECT_NEAR(by_instance[7].other_class_share, 0.0, 1e-12);
+  EXPECT_EQ(by_instance[3].best_object, 3);  // the desk holds most of it
+  EXPECT_EQ(by_instance[4].cause, Cause::kMerged);
+  EXPECT_EQ(by_instance[5].cause, Cause::kMerged);
+  EXPECT_NEAR(by_instance[4].best_same_class_iou, 0.5, 1e-12);
+  EXPECT_NEAR(by_instance[4].best_same_class_cover, 1.0, 1e-12);
+  EXPECT_EQ(by_instance[6].cause, Cause::kSplit);
+  EXPECT_NEAR(by_instance[6].class_share, 0.8, 1e-12);
+  EXPECT_NEAR(by_instance[6].best_same_class_cover, 0.4, 1e-12);
+  EXPECT_STREQ(missCauseName(Cause::kWrongClass), "wrong class");
+  EXPECT_NE(formatDiagnostics(d).find("1 matched; missed: 1 unobserved, 1 wrong class, 1 "
+                                      "unlabelled, 2 merged, 1 split"),
+            std::string::npos);
+  // Labels built without `reached` count every vertex as observed.
+  Case bare = c;
+  bare.pred.reached.clear();
+  for (const auto& t : diagnose(bare.gt, bare.pred, {}).gt_things) {
+    EXPECT_NEAR(t.observed_share, 1.0, 1e-12) << "instance " << t.instance_id;
+  }
 }
 
 TEST(Diagnostics, HandComputedCase) {
@@ -104,7 +166,7 @@ TEST(Diagnostics, HandComputedCase) {
 TEST(Diagnostics, WithoutAnObjectListEveryMeshInstanceIsAnObject) {
   const Case c = makeCase();
   const SceneDiagnostics d = diagnose(c.gt, c.pred, {});
-  EXPECT_EQ(d.num_objects, 4);  // 7, 8, 9, 10
+  EXPECT_EQ(d.num_objects, 4);        // 7, 8, 9, 10
   EXPECT_EQ(d.confident_objects, 3);  // 10 is unverifiable
 }
 

@@ -18,6 +18,7 @@ TEST(LabelTransfer, RespectsFiveCentimetreRadius) {
   EXPECT_EQ(t.semantic, (std::vector<int32_t>{5, 0, 5, 7}));
   EXPECT_EQ(t.instance, (std::vector<int32_t>{3, 0, 3, 4}));
   EXPECT_EQ(t.superpoint, (std::vector<int32_t>{9, 0, 9, 10}));
+  EXPECT_EQ(t.reached, (std::vector<uint8_t>{1, 0, 1, 1}));
   EXPECT_EQ(t.num_transferred, 3u);
 }
 
@@ -34,6 +35,7 @@ TEST(LabelTransfer, MissingArraysReadAsZero) {
 TEST(LabelTransfer, EmptyPredictionLeavesEverythingUnlabelled) {
   const TransferredLabels t = transferLabels(LabelledMesh(), {{0.0f, 0.0f, 0.0f}});
   EXPECT_EQ(t.semantic, (std::vector<int32_t>{0}));
+  EXPECT_EQ(t.reached, (std::vector<uint8_t>{0}));
   EXPECT_EQ(t.num_transferred, 0u);
   EXPECT_THROW(transferLabels(LabelledMesh(), {}, -1.0), Error);
 }

@@ -42,7 +42,7 @@ struct SceneDiagnostics {
 
   /// The super-point on the most GT vertices (annotated or not).
   int32_t largest_superpoint = 0;
-  int64_t largest_vertices = 0;             ///< all GT vertices it carries
+  int64_t largest_vertices = 0;              ///< all GT vertices it carries
   int64_t largest_unannotated_vertices = 0;  ///< of those, on unannotated GT
   /// Its annotated vertices by GT class, largest first: (NYU40 id, share).
   std::vector<std::pair<int32_t, double>> largest_class_mix;
@@ -66,14 +66,37 @@ struct SceneDiagnostics {
     bool unverifiable = false;
   };
   std::vector<ObjectMatch> objects;
-  /// GT thing instances (class > 0, not stuff, any size): (class, instance id, vertices).
+  /// Why a GT thing is not matched at IoU 0.5, in the order tested; each cause bounds what
+  /// can fix it. kUnobserved: at most half of it found a predicted vertex in range, so no
+  /// labelling can reach IoU 0.5 (the trajectory did not see it). At most half of it carries
+  /// its class, and more of the rest carries another class (kWrongClass: semantics, III-C's
+  /// domain) or no class at all (kUnlabelled). kMerged: one object of its class covers more
+  /// than half of it but is too large (it spans neighbours or background). kSplit: its class
+  /// covers most of it, but no single object more than half (fragments).
+  enum class MissCause : int8_t {
+    kMatched = 0,
+    kUnobserved,
+    kWrongClass,
+    kUnlabelled,
+    kMerged,
+    kSplit
+  };
+
+  /// GT thing instances of at least ScanNet's minimum region size: (class, instance id,
+  /// vertices) and what became of them.
   struct GtThing {
     int32_t class_id = 0;
     int32_t instance_id = 0;
     int64_t vertices = 0;
-    int32_t best_object = 0;       ///< the object overlapping it with the best IoU, any class
-    int32_t best_object_class = 0;  ///< that object's class
-    double best_iou = 0.0;          ///< its IoU (0 when no object overlaps)
+    int32_t best_object = 0;             ///< the object overlapping it with the best IoU, any class
+    int32_t best_object_class = 0;       ///< that object's class
+    double best_iou = 0.0;               ///< its IoU (0 when no object overlaps)
+    double observed_share = 0.0;         ///< share of its vertices that found a predicted vertex
+    double class_share = 0.0;            ///< share of its vertices predicted with its class
+    double other_class_share = 0.0;      ///< share predicted with another class (not 0)
+    double best_same_class_iou = 0.0;    ///< best IoU with an object of its class
+    double best_same_class_cover = 0.0;  ///< largest share of it one object of its class holds
+    MissCause cause = MissCause::kMatched;
   };
   std::vector<GtThing> gt_things;
   int num_objects = 0;  ///< predicted objects (object list entries, else mesh instances)
@@ -104,6 +127,9 @@ struct SceneDiagnostics {
 /// @param num_bins reliability bins over [0, 1]
 SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
                           const std::map<int32_t, double>& objects, int num_bins = 5);
+
+/// "matched", "unobserved", "wrong class", "unlabelled", "merged" or "split".
+const char* missCauseName(SceneDiagnostics::MissCause cause);
 
 /// A few lines of text: purity, the largest super-point, objects, stuff IoU, reliability.
 std::string formatDiagnostics(const SceneDiagnostics& d);

@@ -18,7 +18,10 @@ struct TransferredLabels {
   std::vector<int32_t> semantic;    ///< predicted NYU40 id, 0 = unlabelled
   std::vector<int32_t> instance;    ///< predicted instance id, 0 = none
   std::vector<int32_t> superpoint;  ///< predicted super-point id, 0 = none
-  size_t num_transferred = 0;       ///< GT vertices that found a predicted vertex in range
+  /// 1 where the GT vertex found a predicted vertex in range (the map observed it). Empty:
+  /// every vertex did (labels built by hand).
+  std::vector<uint8_t> reached;
+  size_t num_transferred = 0;  ///< GT vertices that found a predicted vertex in range
 };
 
 /// For each ground-truth vertex, the labels of the nearest predicted vertex (nanoflann k-d
