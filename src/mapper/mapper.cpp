@@ -61,6 +61,7 @@ MeshLabeller Mapper::meshLabeller(const GraphLabels* labels,
   };
   labeller.semantic = [lookup](int32_t label) { return lookup(label).semantic; };
   labeller.instance = [lookup](int32_t label) { return lookup(label).instance; };
+  labeller.fill_from_neighbours = true;
   return labeller;
 }
 

@@ -223,15 +223,25 @@ struct VertexLabels {
 // remembered (the map must not change while it is in use).
 class VertexLabeller {
  public:
-  explicit VertexLabeller(const MeshLabeller& labeller) : labeller_(labeller) {}
+  VertexLabeller(const TsdfMap& map, const MeshLabeller& labeller)
+      : map_(map), labeller_(labeller) {}
 
+  /// @param neighbours the 8 block slots of the block whose cubes made the vertex
   VertexLabels operator()(const Block* const* neighbours, uint16_t source) {
-    const Block* block = neighbours[source >> 9];
-    if (!block) return VertexLabels{};
-    const Voxel* voxel = &block->voxels[source & 511];
+    const Block* owner = neighbours[source >> 9];
+    if (!owner) return VertexLabels{};
+    const Voxel* voxel = &owner->voxels[source & 511];
     if (voxel == last_voxel_) return last_;
     last_voxel_ = voxel;
-    const int32_t superpoint = labeller_.superpoint(*voxel);
+    int32_t superpoint = labeller_.superpoint(*voxel);
+    if (superpoint == 0 && labeller_.fill_from_neighbours) {
+      const int local = source & 511;
+      const Eigen::Vector3i global =
+          (owner->index * kBlockSide) + Eigen::Vector3i(local % kBlockSide,
+                                                        (local / kBlockSide) % kBlockSide,
+                                                        local / (kBlockSide * kBlockSide));
+      superpoint = neighbourhoodLabel(global);
+    }
     if (superpoint == last_.superpoint && have_last_) return last_;
     have_last_ = true;
     last_.superpoint = superpoint;
@@ -241,10 +251,67 @@ class VertexLabeller {
   }
 
  private:
+  // The label most of the 26 neighbours of voxel `global` carry (ties: more votes, then the
+  // smaller label); 0 when none carries one.
+  int32_t neighbourhoodLabel(const Eigen::Vector3i& global) {
+    struct Tally {
+      int32_t label;
+      int voxels;
+      uint64_t votes;
+    };
+    Tally tally[26];
+    int n = 0;
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          if (dx == 0 && dy == 0 && dz == 0) continue;
+          const Eigen::Vector3i g = global + Eigen::Vector3i(dx, dy, dz);
+          const BlockIndex b(floorDiv(g.x()), floorDiv(g.y()), floorDiv(g.z()));
+          if (!have_cached_ || cached_index_ != b) {
+            cached_block_ = map_.findBlock(b);
+            cached_index_ = b;
+            have_cached_ = true;
+          }
+          if (!cached_block_) continue;
+          const Eigen::Vector3i l = g - b * kBlockSide;
+          const Voxel& v = cached_block_->at(l.x(), l.y(), l.z());
+          const int32_t label = labeller_.superpoint(v);
+          if (label == 0) continue;
+          uint64_t votes = 0;
+          for (const LabelVote& vote : v.votes) votes += vote.count;
+          int k = 0;
+          while (k < n && tally[k].label != label) ++k;
+          if (k == n) tally[n++] = Tally{label, 0, 0};
+          ++tally[k].voxels;
+          tally[k].votes += votes;
+        }
+      }
+    }
+    int32_t best = 0;
+    int best_voxels = 0;
+    uint64_t best_votes = 0;
+    for (int k = 0; k < n; ++k) {
+      const Tally& t = tally[k];
+      if (t.voxels > best_voxels || (t.voxels == best_voxels && t.votes > best_votes) ||
+          (t.voxels == best_voxels && t.votes == best_votes && t.label < best)) {
+        best = t.label, best_voxels = t.voxels, best_votes = t.votes;
+      }
+    }
+    return best;
+  }
+
+  static int floorDiv(int v) {
+    return v >= 0 ? v / kBlockSide : -((-v + kBlockSide - 1) / kBlockSide);
+  }
+
+  const TsdfMap& map_;
   const MeshLabeller& labeller_;
   const Voxel* last_voxel_ = nullptr;
   bool have_last_ = false;
   VertexLabels last_;
+  bool have_cached_ = false;  // the last block looked up for a neighbour, found or not
+  const Block* cached_block_ = nullptr;
+  BlockIndex cached_index_ = BlockIndex::Zero();
 };
 
 }  // namespace
@@ -264,7 +331,7 @@ LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const Blo
   out.colors.reserve(offsets.back());
   out.faces.reserve(num_faces);
 
-  VertexLabeller label_vertex(labeller);
+  VertexLabeller label_vertex(map, labeller);
   const Block* neighbours[8];
   auto findNeighbours = [&](const BlockIndex& index) {
     if (!labelled) return;
@@ -359,7 +426,7 @@ LabelledMesh labelBlockMesh(const TsdfMap& map, const BlockMesh& mesh,
   out.superpoint.resize(n);
   out.semantic.resize(n);
   out.instance.resize(n);
-  VertexLabeller label_vertex(labeller);
+  VertexLabeller label_vertex(map, labeller);
   for (size_t i = 0; i < n; ++i) {
     const VertexLabels labels = label_vertex(neighbours, mesh.sources[i]);
     out.superpoint[i] = labels.superpoint;

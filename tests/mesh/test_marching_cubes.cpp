@@ -371,6 +371,92 @@ TEST(MarchingCubes, ColoursInterpolateAndLabelsComeFromTheNearerVoxel) {
   EXPECT_GT(checked, mesh.numVertices() * 9 / 10);
 }
 
+TEST(MarchingCubes, VerticesOfUnvotedVoxelsTakeTheirNeighboursLabelWhenAsked) {
+  const float voxel = 0.01f;
+  TsdfMap map(TsdfMap::Config{voxel});
+  fillSphere(&map, 0.15f);
+  // Every 4th voxel along a diagonal pattern loses its votes (as voxels no pixel voted for).
+  auto erased = [](const Eigen::Vector3i& g) { return ((g.x() + 2 * g.y() + 3 * g.z()) & 3) == 0; };
+  auto voxelAt = [&map](const Eigen::Vector3i& g) -> const Voxel* {
+    const BlockIndex b(static_cast<int>(std::floor(g.x() / 8.0)),
+                       static_cast<int>(std::floor(g.y() / 8.0)),
+                       static_cast<int>(std::floor(g.z() / 8.0)));
+    const Block* block = map.findBlock(b);
+    if (!block) return nullptr;
+    const Eigen::Vector3i l = g - b * kBlockSide;
+    return &block->at(l.x(), l.y(), l.z());
+  };
+  for (const auto& block : map.blocks()) {
+    for (int z = 0; z < kBlockSide; ++z) {
+      for (int y = 0; y < kBlockSide; ++y) {
+        for (int x = 0; x < kBlockSide; ++x) {
+          if (erased(globalVoxel(block->index, x, y, z))) block->at(x, y, z).votes[0] = {};
+        }
+      }
+    }
+  }
+  // The label most of the 26 neighbours carry; every vote count is 3, so ties go to the
+  // smaller label.
+  auto expectedFill = [&](const Eigen::Vector3i& g) {
+    std::map<int32_t, int> counts;
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          if (dx == 0 && dy == 0 && dz == 0) continue;
+          const Voxel* v = voxelAt(g + Eigen::Vector3i(dx, dy, dz));
+          if (v && v->votes[0].count > 0) ++counts[v->votes[0].label];
+        }
+      }
+    }
+    int32_t best = 0;
+    int most = 0;
+    for (const auto& [label, count] : counts) {
+      if (count > most) best = label, most = count;
+    }
+    return best;
+  };
+  MeshLabeller plain = identityLabeller();
+  MeshLabeller filling = identityLabeller();
+  filling.fill_from_neighbours = true;
+  const LabelledMesh without = marchingCubes(map, {}, plain);
+  const LabelledMesh with = marchingCubes(map, {}, filling);
+  ASSERT_EQ(with.vertices, without.vertices);
+  size_t filled = 0, kept = 0;
+  for (size_t i = 0; i < with.numVertices(); ++i) {
+    const Eigen::Vector3f q = with.vertices[i] / voxel - Eigen::Vector3f::Constant(0.5f);
+    int axis = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (std::abs(q[k] - std::round(q[k])) > 1e-3f) axis = k;
+    }
+    if (axis < 0) continue;
+    Eigen::Vector3i a = q.array().round().cast<int>();
+    a[axis] = static_cast<int>(std::floor(q[axis]));
+    const float t = q[axis] - static_cast<float>(a[axis]);
+    if (std::abs(t - 0.5f) < 1e-3f) continue;
+    const Eigen::Vector3i source = t < 0.5f ? a : Eigen::Vector3i(a + Eigen::Vector3i::Unit(axis));
+    if (erased(source)) {
+      ASSERT_EQ(without.superpoint[i], 0);
+      ASSERT_EQ(without.semantic[i], 0);
+      ASSERT_EQ(with.superpoint[i], expectedFill(source)) << "vertex " << i;
+      ASSERT_EQ(with.semantic[i], with.superpoint[i] + 2);
+      ASSERT_EQ(with.instance[i], 1000 + with.superpoint[i]);
+      ++filled;
+    } else {
+      ASSERT_EQ(with.superpoint[i], voxelLabel(source));
+      ASSERT_EQ(without.superpoint[i], voxelLabel(source));
+      ++kept;
+    }
+  }
+  EXPECT_GT(filled, with.numVertices() / 8);
+  EXPECT_GT(kept, with.numVertices() / 2);
+
+  // Nothing to copy from: no label is invented.
+  for (const auto& block : map.blocks()) {
+    for (Voxel& v : block->voxels) v.votes[0] = {};
+  }
+  for (int32_t label : marchingCubes(map, {}, filling).superpoint) ASSERT_EQ(label, 0);
+}
+
 TEST(MarchingCubes, RejectsBadConfig) {
   MarchingCubesConfig config;
   config.max_sdf_jump_voxels = 0.0f;

@@ -41,6 +41,10 @@ struct MeshLabeller {
   std::function<int32_t(int32_t)> semantic;
   /// Instance of a super-point label; empty: 0 (none).
   std::function<int32_t(int32_t)> instance;
+  /// A vertex whose voxel has no label (no pixel's point ever fell in it: pixels on edges
+  /// and in tiny segments do not vote, so thin parts keep many such voxels) takes the label
+  /// most of the voxel's 26 neighbours carry (ties: more votes, then the smaller label).
+  bool fill_from_neighbours = false;
 };
 
 /// The mesh of the cubes whose lower corner lies in one block. Its vertices sit on the block's
