@@ -49,15 +49,16 @@ Mapper::Mapper(const MapperConfig& config) : config_(config), drift_(config.drif
 
 MeshLabeller Mapper::meshLabeller(const GraphLabels* labels,
                                   absl::flat_hash_map<int32_t, SuperpointLabels>* cache) const {
-  const SuperpointTracker& tracker = *tracker_;
-  auto lookup = [&tracker, labels, cache](int32_t label) -> const SuperpointLabels& {
+  // Captured by pointer: the labeller outlives this call.
+  const SuperpointTracker* tracker = tracker_.get();
+  auto lookup = [tracker, labels, cache](int32_t label) -> const SuperpointLabels& {
     auto [it, inserted] = cache->try_emplace(label);
-    if (inserted) it->second = finalLabels(label, tracker, labels);
+    if (inserted) it->second = finalLabels(label, *tracker, labels);
     return it->second;
   };
   MeshLabeller labeller;
-  labeller.superpoint = [&tracker](const Voxel& voxel) {
-    return argmaxLabel(voxel, [&tracker](int32_t l) { return tracker.labels().resolve(l); });
+  labeller.superpoint = [tracker](const Voxel& voxel) {
+    return argmaxLabel(voxel, [tracker](int32_t l) { return tracker->labels().resolve(l); });
   };
   labeller.semantic = [lookup](int32_t label) { return lookup(label).semantic; };
   labeller.instance = [lookup](int32_t label) { return lookup(label).instance; };

@@ -233,20 +233,26 @@ class VertexLabeller {
     const Voxel* voxel = &owner->voxels[source & 511];
     if (voxel == last_voxel_) return last_;
     last_voxel_ = voxel;
-    int32_t superpoint = labeller_.superpoint(*voxel);
+    const int32_t superpoint = labeller_.superpoint(*voxel);
+    // A filled vertex takes its class and instance from the neighbours' super-point but keeps
+    // super-point 0: it belongs to none (super-point diagnostics measure them as voted).
+    int32_t source_label = superpoint;
     if (superpoint == 0 && labeller_.fill_from_neighbours) {
       const int local = source & 511;
       const Eigen::Vector3i global =
           (owner->index * kBlockSide) + Eigen::Vector3i(local % kBlockSide,
                                                         (local / kBlockSide) % kBlockSide,
                                                         local / (kBlockSide * kBlockSide));
-      superpoint = neighbourhoodLabel(global);
+      source_label = neighbourhoodLabel(global);
     }
-    if (superpoint == last_.superpoint && have_last_) return last_;
+    if (have_last_ && superpoint == last_.superpoint && source_label == last_source_) {
+      return last_;
+    }
     have_last_ = true;
+    last_source_ = source_label;
     last_.superpoint = superpoint;
-    last_.semantic = labeller_.semantic ? labeller_.semantic(superpoint) : 0;
-    last_.instance = labeller_.instance ? labeller_.instance(superpoint) : 0;
+    last_.semantic = labeller_.semantic ? labeller_.semantic(source_label) : 0;
+    last_.instance = labeller_.instance ? labeller_.instance(source_label) : 0;
     return last_;
   }
 
@@ -308,6 +314,7 @@ class VertexLabeller {
   const MeshLabeller& labeller_;
   const Voxel* last_voxel_ = nullptr;
   bool have_last_ = false;
+  int32_t last_source_ = 0;  // the label last_'s class and instance come from
   VertexLabels last_;
   bool have_cached_ = false;  // the last block looked up for a neighbour, found or not
   const Block* cached_block_ = nullptr;

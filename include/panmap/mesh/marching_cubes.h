@@ -42,8 +42,9 @@ struct MeshLabeller {
   /// Instance of a super-point label; empty: 0 (none).
   std::function<int32_t(int32_t)> instance;
   /// A vertex whose voxel has no label (no pixel's point ever fell in it: pixels on edges
-  /// and in tiny segments do not vote, so thin parts keep many such voxels) takes the label
-  /// most of the voxel's 26 neighbours carry (ties: more votes, then the smaller label).
+  /// and in tiny segments do not vote, so thin parts keep many such voxels) takes the class
+  /// and instance of the label most of the voxel's 26 neighbours carry (ties: more votes,
+  /// then the smaller label); its super-point stays 0 (it belongs to none).
   bool fill_from_neighbours = false;
 };
 
