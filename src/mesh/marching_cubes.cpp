@@ -8,6 +8,7 @@
 #include <absl/container/flat_hash_map.h>
 
 #include "panmap/core/error.h"
+#include "panmap/map/voxel_lookup.h"
 #include "panmap/mesh/internal/marching_cubes_tables.h"
 
 namespace panmap {
@@ -224,7 +225,7 @@ struct VertexLabels {
 class VertexLabeller {
  public:
   VertexLabeller(const TsdfMap& map, const MeshLabeller& labeller)
-      : map_(map), labeller_(labeller) {}
+      : lookup_(map), labeller_(labeller) {}
 
   /// @param neighbours the 8 block slots of the block whose cubes made the vertex
   VertexLabels operator()(const Block* const* neighbours, uint16_t source) {
@@ -271,20 +272,12 @@ class VertexLabeller {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           if (dx == 0 && dy == 0 && dz == 0) continue;
-          const Eigen::Vector3i g = global + Eigen::Vector3i(dx, dy, dz);
-          const BlockIndex b(floorDiv(g.x()), floorDiv(g.y()), floorDiv(g.z()));
-          if (!have_cached_ || cached_index_ != b) {
-            cached_block_ = map_.findBlock(b);
-            cached_index_ = b;
-            have_cached_ = true;
-          }
-          if (!cached_block_) continue;
-          const Eigen::Vector3i l = g - b * kBlockSide;
-          const Voxel& v = cached_block_->at(l.x(), l.y(), l.z());
-          const int32_t label = labeller_.superpoint(v);
+          const Voxel* v = lookup_.findGrid(global.x() + dx, global.y() + dy, global.z() + dz);
+          if (!v) continue;
+          const int32_t label = labeller_.superpoint(*v);
           if (label == 0) continue;
           uint64_t votes = 0;
-          for (const LabelVote& vote : v.votes) votes += vote.count;
+          for (const LabelVote& vote : v->votes) votes += vote.count;
           int k = 0;
           while (k < n && tally[k].label != label) ++k;
           if (k == n) tally[n++] = Tally{label, 0, 0};
@@ -306,19 +299,12 @@ class VertexLabeller {
     return best;
   }
 
-  static int floorDiv(int v) {
-    return v >= 0 ? v / kBlockSide : -((-v + kBlockSide - 1) / kBlockSide);
-  }
-
-  const TsdfMap& map_;
+  VoxelLookup lookup_;  // remembers the last block: neighbours mostly share it
   const MeshLabeller& labeller_;
   const Voxel* last_voxel_ = nullptr;
   bool have_last_ = false;
   int32_t last_source_ = 0;  // the label last_'s class and instance come from
   VertexLabels last_;
-  bool have_cached_ = false;  // the last block looked up for a neighbour, found or not
-  const Block* cached_block_ = nullptr;
-  BlockIndex cached_index_ = BlockIndex::Zero();
 };
 
 }  // namespace
