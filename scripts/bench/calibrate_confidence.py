@@ -98,7 +98,7 @@ def main():
             specs.append(Spec(spec.kind, spec.source, spec.seed, spec.poses, spec.masks,
                               spec.annotation, "full", spec.frames, spec.rate_hz))
     results = suite.run_all(args.work, specs, args.voxel_size, args.jobs, args.keep_logs,
-                            label="calibrate")
+                            label="calibrate", reuse_maps=args.reuse_maps)
     rows, old, kinds, skipped = [], [], [], 0
     for spec in specs:
         for o in results[spec.name()]["results"]["full"]["diagnostics"]["objects"]:

@@ -219,9 +219,31 @@ def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
             "total_ms": report["timings"]["total"]["median_ms"]}
 
 
-def run_all(work, specs, voxel_m, jobs, keep_logs, config="", variants=None, label="suite"):
-    """Renders and maps every spec (jobs at a time). Returns {spec.name(): result}."""
+def reexport(work, spec, config=""):
+    """The full method's result of a spec mapped before (runs/NAME/A/map.panmap): only the
+    final optimisation and the outputs are redone, then scored. None when there is no map."""
+    seq_dir = os.path.join(work, "seq", spec.name())
+    out = os.path.join(work, "runs", spec.name())
+    if spec.runs != "full" or not os.path.exists(os.path.join(out, "A", "map.panmap")):
+        return None
+    folder = os.path.join(out, "A")
+    run([tool("panmap-mapper"), "-q", "--no-snapshots", "--export-only", "--load",
+         os.path.join(folder, "map.panmap"), "--out", folder] +
+        (["--config", config] if config else []), os.path.join(out, "commands.log"))
+    return {"results": {"full": evaluate(folder, seq_dir)}}
+
+
+def run_all(work, specs, voxel_m, jobs, keep_logs, config="", variants=None, label="suite",
+            reuse_maps=False):
+    """Renders and maps every spec (jobs at a time). Returns {spec.name(): result}. With
+    reuse_maps, a spec of the full method mapped before is only re-exported (reexport)."""
     def job(spec):
+        out = reexport(work, spec, config) if reuse_maps else None
+        if out is not None:
+            print("%s: %s: re-exported, full mAP50 %.1f" % (
+                label, spec.name(), 100 * (out["results"]["full"]["map50"] or 0)),
+                file=sys.stderr, flush=True)
+            return out
         seq = render(work, spec)
         out = map_sequence(work, seq, spec, voxel_m, config, variants)
         if not keep_logs:
@@ -247,6 +269,9 @@ def tuning_args(description, out_name):
     parser.add_argument("--voxel-size", type=float, default=0.02)
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 2)
     parser.add_argument("--keep-logs", action="store_true")
+    parser.add_argument("--reuse-maps", action="store_true",
+                        help="keep the maps of an earlier run in --work when all are there "
+                             "(re-run only what follows the mapping)")
     args = parser.parse_args()
     return args, scene_dirs(args.scannet)
 

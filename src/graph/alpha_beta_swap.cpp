@@ -53,25 +53,25 @@ class SwapSolver {
     members_.resize(L_);
     changed_at_.assign(L_, 0);
     evaluated_at_.assign(static_cast<size_t>(L_) * L_, -1);
-    neighbours_with_.assign(static_cast<size_t>(n) * L_, 0);
+    kc_with_.assign(static_cast<size_t>(n) * L_, 0.0);
+    std::vector<double> kc_total(n, 0.0);
     scored_offset_.assign(n + 1, 0);
     for (int p = 0; p < n; ++p) {
       members_[labels[p]].push_back(p);
       for (int e = problem.adj_offset[p]; e < problem.adj_offset[p + 1]; ++e) {
-        ++neighbours_with_[at(p, labels[problem.adj_vertex[e]])];
+        kc_with_[at(p, labels[problem.adj_vertex[e]])] += problem.adj_kc[e];
+        kc_total[p] += problem.adj_kc[e];
       }
       for (int l = 0; l < L_; ++l) {
         if (problem.score[at(p, l)] > 0.0) scored_label_.push_back(l);
       }
       scored_offset_[p + 1] = static_cast<int>(scored_label_.size());
     }
-    // pair_sum_: K_C per neighbour with another label, unless p has a score for l (exp terms).
+    // pair_sum_: the edge's K per neighbour with another label, unless p has a score for l
+    // (exp terms).
     pair_sum_.assign(static_cast<size_t>(n) * L_, 0.0);
     for (int p = 0; p < n; ++p) {
-      const int degree = problem.adj_offset[p + 1] - problem.adj_offset[p];
-      for (int l = 0; l < L_; ++l) {
-        pair_sum_[at(p, l)] = problem.K_C * (degree - neighbours_with_[at(p, l)]);
-      }
+      for (int l = 0; l < L_; ++l) pair_sum_[at(p, l)] = kc_total[p] - kc_with_[at(p, l)];
       for (int s = scored_offset_[p]; s < scored_offset_[p + 1]; ++s) {
         const int l = scored_label_[s];
         double sum = 0.0;
@@ -129,7 +129,7 @@ class SwapSolver {
   /// psi_p(l, lq) of the edge at adjacency entry e from p to q (Eq. 9).
   double pairTo(int p, int l, int q, int lq, int e) const {
     return pairwisePotential(l, lq, problem_.score[at(p, l)], problem_.score[at(q, lq)],
-                             problem_.adj_factor[e], problem_.K_C);
+                             problem_.adj_factor[e], problem_.adj_kc[e]);
   }
 
   /// verts_: the vertices of the move that may change, ascending; the other vertices of P keep
@@ -156,8 +156,8 @@ class SwapSolver {
             const int q = problem_.adj_vertex[e];
             if (labels_[q] == own) swap -= pairTo(v, other, q, own, e);
           }
-        } else {  // psi_p(other, own) = K_C without a score for `other`
-          swap -= problem_.K_C * neighbours_with_[at(v, own)];
+        } else {  // psi_p(other, own) = the edge's K without a score for `other`
+          swap -= kc_with_[at(v, own)];
         }
         switch_cost_[v] = swap - stay;
         gain_[v] = 0.0;
@@ -176,7 +176,7 @@ class SwapSolver {
         if (local_[q] >= 0 || labels_[q] != lv) continue;
         gain_[q] +=
             pairwisePotential(lv, other, problem_.score[at(q, lv)], problem_.score[at(v, other)],
-                              problem_.adj_factor[e], problem_.K_C);
+                              problem_.adj_factor[e], problem_.adj_kc[e]);
         if (gain_[q] > switch_cost_[q]) {
           local_[q] = 0;
           verts_.push_back(q);
@@ -240,17 +240,17 @@ class SwapSolver {
       labels_[v] = label;
       for (int e = problem_.adj_offset[v]; e < problem_.adj_offset[v + 1]; ++e) {
         const int q = problem_.adj_vertex[e];
-        --neighbours_with_[at(q, old)];
-        ++neighbours_with_[at(q, label)];
+        kc_with_[at(q, old)] -= problem_.adj_kc[e];
+        kc_with_[at(q, label)] += problem_.adj_kc[e];
         changed_at_[labels_[q]] = clock_;
         // pair_sum_[q][l] += psi(l, label) - psi(l, old): exp terms where q has a score for l,
-        // else K_C [l != label] - K_C [l != old].
+        // else K [l != label] - K [l != old] with the edge's K.
         for (int s = scored_offset_[q]; s < scored_offset_[q + 1]; ++s) {
           const int l = scored_label_[s];
           pair_sum_[at(q, l)] += pairTo(q, l, v, label, e) - pairTo(q, l, v, old, e);
         }
-        if (problem_.score[at(q, old)] <= 0.0) pair_sum_[at(q, old)] += problem_.K_C;
-        if (problem_.score[at(q, label)] <= 0.0) pair_sum_[at(q, label)] -= problem_.K_C;
+        if (problem_.score[at(q, old)] <= 0.0) pair_sum_[at(q, old)] += problem_.adj_kc[e];
+        if (problem_.score[at(q, label)] <= 0.0) pair_sum_[at(q, label)] -= problem_.adj_kc[e];
       }
     }
     merged_.clear();
@@ -265,9 +265,9 @@ class SwapSolver {
   std::vector<int>& labels_;
   const int L_;
   std::vector<std::vector<int>> members_;  ///< vertices per label, ascending
-  std::vector<int> neighbours_with_;       ///< [vertex * L + label]: neighbours with the label
-  std::vector<double> pair_sum_;           ///< [vertex * L + label]: sum_q psi_p(label, l_q)
-  std::vector<int> scored_offset_;         ///< CSR of the labels each vertex has a score for
+  std::vector<double> kc_with_;     ///< [vertex * L + label]: sum of the K of edges to that label
+  std::vector<double> pair_sum_;    ///< [vertex * L + label]: sum_q psi_p(label, l_q)
+  std::vector<int> scored_offset_;  ///< CSR of the labels each vertex has a score for
   std::vector<int> scored_label_;
   int64_t clock_ = 0;                  ///< counts solved and accepted moves
   std::vector<int64_t> changed_at_;    ///< per label: clock of the last change it depends on

@@ -41,13 +41,19 @@ double valueOf(const std::map<int32_t, double>& values, const ClassSet& classes,
 
 }  // namespace
 
+double vertexWeight(const GraphVertex& vertex, OptimiserConfig::Weighting weighting) {
+  if (weighting == OptimiserConfig::Weighting::kNone) return 1.0;
+  return std::max<double>(1.0, vertex.num_voxels);
+}
+
 LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConfig& config) {
   const ClassSet classes(graph.classes);
   const VertexIndex index(graph);
   const int n = static_cast<int>(graph.vertices.size());
   LabelProblem problem;
   problem.num_vertices = n;
-  problem.K_C = config.K_C;
+  std::vector<double> weight(n);
+  for (int i = 0; i < n; ++i) weight[i] = vertexWeight(graph.vertices[i], config.weighting);
 
   // Initial classes (argmax) and the label space.
   std::vector<double> score_sum(n, 0.0);
@@ -89,12 +95,12 @@ LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConf
     problem.initial[i] = labelIndex(initial_class[i]);
     for (int l = 0; l < L; ++l) {
       problem.unary[static_cast<size_t>(i) * L + l] =
-          unaryPotential(0.0, score_sum[i], config.score_floor);
+          weight[i] * unaryPotential(0.0, score_sum[i], config.score_floor);
     }
     for (const auto& [c, s] : graph.vertices[i].scores) {
       if (s <= 0.0 || !label_set.contains(c)) continue;
       const size_t at = static_cast<size_t>(i) * L + labelIndex(c);
-      problem.unary[at] = unaryPotential(s, score_sum[i], config.score_floor);
+      problem.unary[at] = weight[i] * unaryPotential(s, score_sum[i], config.score_floor);
       problem.score[at] = s / score_sum[i];
     }
   }
@@ -111,6 +117,7 @@ LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConf
     problem.edge_a.push_back(a);
     problem.edge_b.push_back(b);
     problem.edge_factor.push_back(factor);
+    problem.edge_kc.push_back(config.K_C * std::min(weight[a], weight[b]));
     ++degree[a + 1];
     ++degree[b + 1];
   }
@@ -118,14 +125,15 @@ LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConf
   problem.adj_offset = degree;
   problem.adj_vertex.resize(degree[n]);
   problem.adj_factor.resize(degree[n]);
+  problem.adj_kc.resize(degree[n]);
   std::vector<int> fill(degree.begin(), degree.end() - 1);
   for (size_t k = 0; k < problem.edge_a.size(); ++k) {
-    const int a = problem.edge_a[k];
-    const int b = problem.edge_b[k];
-    problem.adj_vertex[fill[a]] = b;
-    problem.adj_factor[fill[a]++] = problem.edge_factor[k];
-    problem.adj_vertex[fill[b]] = a;
-    problem.adj_factor[fill[b]++] = problem.edge_factor[k];
+    for (const auto& [from, to] : {std::make_pair(problem.edge_a[k], problem.edge_b[k]),
+                                   std::make_pair(problem.edge_b[k], problem.edge_a[k])}) {
+      problem.adj_vertex[fill[from]] = to;
+      problem.adj_factor[fill[from]] = problem.edge_factor[k];
+      problem.adj_kc[fill[from]++] = problem.edge_kc[k];
+    }
   }
   return problem;
 }
@@ -139,9 +147,10 @@ double labellingEnergy(const LabelProblem& problem, const std::vector<int>& labe
   for (size_t k = 0; k < problem.edge_a.size(); ++k) {
     const int a = problem.edge_a[k];
     const int b = problem.edge_b[k];
-    energy += pairwisePotential(
-        labels[a], labels[b], problem.score[static_cast<size_t>(a) * L + labels[a]],
-        problem.score[static_cast<size_t>(b) * L + labels[b]], problem.edge_factor[k], problem.K_C);
+    energy += pairwisePotential(labels[a], labels[b],
+                                problem.score[static_cast<size_t>(a) * L + labels[a]],
+                                problem.score[static_cast<size_t>(b) * L + labels[b]],
+                                problem.edge_factor[k], problem.edge_kc[k]);
   }
   return energy;
 }
@@ -156,7 +165,7 @@ double semanticEnergy(const SuperpointGraph& graph, const std::map<int32_t, int3
   const internal::VertexIndex index(graph);
   const size_t n = graph.vertices.size();
   std::vector<int32_t> label(n);
-  std::vector<double> normalised(n, 0.0), sums(n, 0.0);
+  std::vector<double> normalised(n, 0.0), sums(n, 0.0), weight(n, 1.0);
   double energy = 0.0;
   for (size_t i = 0; i < n; ++i) {
     const GraphVertex& v = graph.vertices[i];
@@ -169,17 +178,18 @@ double semanticEnergy(const SuperpointGraph& graph, const std::map<int32_t, int3
     sums[i] = sum;
     const double score = internal::valueOf(v.scores, classes, label[i]);
     normalised[i] = sum > 0.0 ? score / sum : 0.0;
-    energy += internal::unaryPotential(score, sum, config.score_floor);
+    weight[i] = internal::vertexWeight(v, config.weighting);
+    energy += weight[i] * internal::unaryPotential(score, sum, config.score_floor);
   }
   for (const GraphEdge& e : graph.edges) {
     const int a = index(e.a);
     const int b = index(e.b);
-    const double factor = internal::edgeFactor(
-        internal::normalisedConfidence(internal::edgeEvidence(e, classes, config), sums[a],
-                                       sums[b]),
-        config.theta);
+    const double factor =
+        internal::edgeFactor(internal::normalisedConfidence(
+                                 internal::edgeEvidence(e, classes, config), sums[a], sums[b]),
+                             config.theta);
     energy += internal::pairwisePotential(label[a], label[b], normalised[a], normalised[b], factor,
-                                          config.K_C);
+                                          config.K_C * std::min(weight[a], weight[b]));
   }
   return energy;
 }

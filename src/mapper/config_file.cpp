@@ -262,6 +262,13 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("theta", &o.theta);
     s.read("max_sweeps", &o.max_sweeps);
     s.read("discount_apart", &o.discount_apart);
+    std::string weighting = o.weighting == OptimiserConfig::Weighting::kNone ? "none" : "surface";
+    s.readString("weighting", &weighting);
+    if (weighting != "surface" && weighting != "none") {
+      s.fail("optimiser.weighting must be surface or none");
+    }
+    o.weighting = weighting == "none" ? OptimiserConfig::Weighting::kNone
+                                      : OptimiserConfig::Weighting::kSurface;
     std::string refinement =
         o.refinement == OptimiserConfig::Refinement::kPaperRules ? "paper" : "clustering";
     s.readString("refinement", &refinement);
@@ -427,6 +434,8 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   max_sweeps: " << o.max_sweeps << "\n"
     << "   discount_apart: " << o.discount_apart
     << "   # Eq. 9 co-observation times P_eps / (P_eps + P_apart) (0/1)\n"
+    << "   weighting: \"" << (o.weighting == OptimiserConfig::Weighting::kNone ? "none" : "surface")
+    << "\"   # Eq. 7 terms per voxel (surface) or per super-point and edge (none, the paper)\n"
     << "   refinement: \""
     << (o.refinement == OptimiserConfig::Refinement::kPaperRules ? "paper" : "clustering")
     << "\"   # III-D: clustering by one-mask / two-mask evidence, or the paper's rules\n"

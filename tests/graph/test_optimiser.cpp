@@ -21,6 +21,7 @@ namespace {
 OptimiserConfig handConfig() {
   OptimiserConfig config;  // the paper's weights, which the hand computations below use
   config.K_C = 15.0;
+  config.weighting = OptimiserConfig::Weighting::kNone;
   config.refinement = OptimiserConfig::Refinement::kPaperRules;
   config.default_thresholds = {0.1, 0.1, 0.5};
   return config;
@@ -65,6 +66,7 @@ SuperpointGraph randomGraph(uint64_t seed, int max_vertices, const std::vector<i
     }
     const int32_t semantic = classes[rng.below(classes.size())];
     graph.vertices.push_back(vertex(i + 1, scores, 0, semantic));
+    graph.vertices.back().num_voxels = static_cast<int32_t>(rng.below(40));  // 0 weighs as 1
   }
   for (int a = 1; a <= n; ++a) {
     for (int b = a + 1; b <= n; ++b) {
@@ -172,11 +174,65 @@ TEST(SemanticEnergy, PairwiseIsAsymmetricInTheLabels) {
               1e-12);
 }
 
+TEST(SemanticEnergy, SurfaceWeightingCountsEachTermPerVoxel) {
+  // The graph of HandComputedThreeVertices without vertex 3; vertex 1 holds 4 voxels,
+  // vertex 2 one: unaries count 4 and 1 times, the edge min(4, 1) = 1 time.
+  SuperpointGraph graph;
+  graph.classes = {1, 2};
+  graph.vertices = {vertex(1, {{1, 3.0}, {2, 1.0}}), vertex(2, {{2, 2.0}})};
+  graph.vertices[0].num_voxels = 4;
+  graph.vertices[1].num_voxels = 1;
+  graph.edges = {edge(1, 2, {{1, 0.5}, {2, 1.0}})};
+  OptimiserConfig config = handConfig();
+  config.weighting = OptimiserConfig::Weighting::kSurface;
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 1}, {2, 2}}, config),
+              4.0 * 0.2876820724517809 + 15.0 * std::exp(-2.0), 1e-12);
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 1}, {2, 1}}, config),
+              4.0 * 0.2876820724517809 + 13.815510557964274, 1e-12);
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 2}, {2, 2}}, config), 4.0 * 1.3862943611198906, 1e-12);
+  // A vertex without voxels weighs as one.
+  graph.vertices[0].num_voxels = 0;
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 2}, {2, 2}}, config), 1.3862943611198906, 1e-12);
+  // Unweighted, the same graph gives the paper's energy whatever the voxel counts.
+  config.weighting = OptimiserConfig::Weighting::kNone;
+  graph.vertices[0].num_voxels = 4;
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 1}, {2, 2}}, config),
+              0.2876820724517809 + 15.0 * std::exp(-2.0), 1e-12);
+}
+
+/// The mechanism behind kSurface (seen on scene0470: a chair relabelled floor): a chair
+/// super-point of 60 voxels, confidently a chair (0.9), co-observed with 30 one-voxel
+/// fragments that lean floor (0.6). Unweighted, the 30 disagreeing edges (15 e^-2.16 = 1.73
+/// each) outweigh the chair's whole unary (-log 0.1 + log 0.9 = 2.2): the chair becomes
+/// floor. Per voxel, the chair's unary weighs 60 times that, and the cheapest way out is for
+/// the fragments (0.41 each) to join the chair.
+TEST(AlphaBetaSwap, SurfaceWeightingKeepsAnObjectAmongOneVoxelFragments) {
+  SuperpointGraph graph;
+  graph.classes = {2, 5};
+  graph.background = {2};
+  graph.vertices.push_back(vertex(1, {{5, 9.0}, {2, 1.0}}));
+  graph.vertices.back().num_voxels = 60;
+  for (int32_t id = 2; id <= 31; ++id) {
+    graph.vertices.push_back(vertex(id, {{2, 6.0}, {5, 4.0}}));
+    graph.vertices.back().num_voxels = 1;
+    // Normalised confidence 5 / min(10, 10) = 0.5: edge factor 1 / (2 theta^2 0.5) = 4.
+    graph.edges.push_back(edge(1, id, {{2, 5.0}}));
+  }
+  OptimiserConfig config = semanticOnly();
+  config.discount_apart = false;
+  const GraphLabels paper = optimise(graph, config);
+  EXPECT_EQ(paper.semantic.at(1), 2);
+  config.weighting = OptimiserConfig::Weighting::kSurface;
+  const GraphLabels surface = optimise(graph, config);
+  for (const auto& [id, c] : surface.semantic) EXPECT_EQ(c, 5) << "super-point " << id;
+}
+
 /// (a) With two labels one swap move covers every labelling: the result is the global minimum
-/// (brute force over all labellings, <= 12 vertices).
+/// (brute force over all labellings, <= 12 vertices), with either weighting.
 TEST(AlphaBetaSwap, TwoLabelsReachTheGlobalMinimum) {
-  const OptimiserConfig config = semanticOnly();
-  for (uint64_t seed = 0; seed < 50; ++seed) {
+  for (uint64_t seed = 0; seed < 100; ++seed) {
+    OptimiserConfig config = semanticOnly();
+    if (seed >= 50) config.weighting = OptimiserConfig::Weighting::kSurface;
     const SuperpointGraph graph =
         randomGraph(seed, seed % 5 ? 8 : 12, {3, 7}, seed % 2 ? 0.6 : 0.3);
     double best = INFINITY;
@@ -210,10 +266,12 @@ std::vector<int32_t> argmaxLabels(const SuperpointGraph& graph) {
 }
 
 /// (b) With 3-4 labels: E(result) <= E(argmax start), and no single alpha-beta swap move lowers
-/// E (brute force over every pair and every reassignment of its vertices, <= 10 vertices).
+/// E (brute force over every pair and every reassignment of its vertices, <= 10 vertices),
+/// with either weighting.
 TEST(AlphaBetaSwap, ManyLabelsEndInASwapLocalMinimumBelowTheStart) {
-  const OptimiserConfig config = semanticOnly();
-  for (uint64_t seed = 100; seed < 150; ++seed) {
+  for (uint64_t seed = 100; seed < 200; ++seed) {
+    OptimiserConfig config = semanticOnly();
+    if (seed >= 150) config.weighting = OptimiserConfig::Weighting::kSurface;
     const std::vector<int32_t> classes =
         seed % 2 ? std::vector<int32_t>{1, 2, 3} : std::vector<int32_t>{1, 2, 3, 4};
     const SuperpointGraph graph =

@@ -122,7 +122,20 @@ TEST(ConfigFile, BadKeysAndValuesNameTheKey) {
             std::string::npos);
   EXPECT_NE(error("%YAML:1.0\n---\nmap:\n   voxel_size_m: [1]\n").find("must be a number"),
             std::string::npos);
+  EXPECT_NE(error("%YAML:1.0\n---\noptimiser:\n   weighting: \"voxels\"\n")
+                .find("optimiser.weighting must be surface or none"),
+            std::string::npos);
   EXPECT_THROW(loadConfig(dir.path("missing.yaml")), Error);
+}
+
+TEST(ConfigFile, EnergyWeightingReadsBothValues) {
+  test::TempDir dir;
+  EXPECT_EQ(PanmapConfig().optimiser.weighting, OptimiserConfig::Weighting::kSurface);
+  const PanmapConfig none =
+      loadConfig(write(dir, "%YAML:1.0\n---\noptimiser:\n   weighting: \"none\"\n"));
+  EXPECT_EQ(none.optimiser.weighting, OptimiserConfig::Weighting::kNone);
+  EXPECT_EQ(loadConfig(write(dir, configToYaml(none))).optimiser.weighting,
+            OptimiserConfig::Weighting::kNone);
 }
 
 }  // namespace

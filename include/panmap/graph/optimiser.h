@@ -11,12 +11,19 @@ namespace panmap {
 struct OptimiserConfig {
   bool regularise = true;  ///< III-C semantic regularisation (off: argmax of the scores)
   bool refine = true;      ///< III-D instance refinement (off: initial instances)
-  double K_C = 30.0;       ///< pairwise weight (Eq. 9; docs/TUNING.md)
+  double K_C = 120.0;      ///< pairwise weight per voxel (Eq. 9, weighting; docs/TUNING.md)
   double theta = 0.5;      ///< pairwise bandwidth (Eq. 9)
   /// Discount Eq. 9's co-observation sum_C P_eps^C by P_eps / (P_eps + P_apart): how often the
   /// two super-points were under one mask rather than two (not in the paper).
   bool discount_apart = true;
-  int max_sweeps = 10;     ///< alpha-beta swap sweeps over all class pairs at most
+  int max_sweeps = 10;  ///< alpha-beta swap sweeps over all class pairs at most
+  /// How much each term of Eq. 7 counts. kSurface (not in the paper): a vertex's unary counts
+  /// once per voxel it holds, an edge's pairwise once per voxel of the smaller of its two
+  /// vertices, so E sums over surface as a voxel CRF would. kNone: once per vertex and edge
+  /// (the paper); then a super-point of one voxel outweighs a whole chair part, and a chair
+  /// bordered by dozens of one-voxel floor fragments is relabelled floor (docs/MAPPING.md).
+  enum class Weighting : int8_t { kNone = 0, kSurface = 1 };
+  Weighting weighting = Weighting::kSurface;
   /// Floor of the normalised score P_nu^C / sum_C' P_nu^C' in the unary (Eq. 8): a class
   /// without score costs -log(score_floor) (13.8 for 1e-6) instead of infinity.
   double score_floor = 1e-6;

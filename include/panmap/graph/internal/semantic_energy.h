@@ -60,19 +60,24 @@ struct LabelProblem {
   /// lower E and is left out.
   std::vector<int32_t> labels;
   int num_vertices = 0;
-  std::vector<double> unary;       ///< [vertex * L + label] Eq. 8
+  std::vector<double> unary;       ///< [vertex * L + label] Eq. 8, times the vertex weight
   std::vector<double> score;       ///< [vertex * L + label] normalised P_nu (0 if no scores)
   std::vector<int> adj_offset;     ///< CSR over edges with a positive confidence sum, n + 1
   std::vector<int> adj_vertex;     ///< neighbour vertex index
   std::vector<double> adj_factor;  ///< edgeFactor of that edge
+  std::vector<double> adj_kc;      ///< K_C times the weight of that edge
   std::vector<int> edge_a;         ///< the same edges once, vertex indices
   std::vector<int> edge_b;
   std::vector<double> edge_factor;
-  double K_C = 0.0;
+  std::vector<double> edge_kc;
   std::vector<int> initial;  ///< argmax labelling (label indices), see buildLabelProblem
   /// Number of labels L.
   int numLabels() const { return static_cast<int>(labels.size()); }
 };
+
+/// The weight of a vertex's unary under `weighting`: 1 (kNone) or its voxels, at least 1
+/// (kSurface). An edge weighs the smaller of its two vertices' weights.
+double vertexWeight(const GraphVertex& vertex, OptimiserConfig::Weighting weighting);
 
 /// Builds the problem from a checked graph. The initial label of a vertex is the argmax of its
 /// scores over graph.classes (ties: the smaller class id); a vertex without scores keeps its
