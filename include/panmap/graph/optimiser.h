@@ -63,9 +63,9 @@ struct OptimiserConfig {
     /// (docs/CALIBRATION.md) so that about a share c of the objects reported with confidence
     /// c match a real object. The class share did not help on scene kinds left out of the
     /// fit: held at 0.
-    double bias = -1.320;
-    double area = 2.596;
-    double support = 1.175;
+    double bias = 0.4745;
+    double area = 2.5046;
+    double support = 0.8669;
     double share = 0.0;
   };
   Objects objects;
