@@ -39,6 +39,42 @@ double valueOf(const std::map<int32_t, double>& values, const ClassSet& classes,
   return it == values.end() ? 0.0 : it->second;
 }
 
+/// Per graph edge: the normalised confidence sum_C P_eps^C of Eq. 9 (0: the edge costs
+/// nothing and is left out) and the weight its pairwise term counts with.
+struct EdgeTerms {
+  std::vector<double> confidence;
+  std::vector<double> weight;
+};
+
+EdgeTerms edgeTerms(const SuperpointGraph& graph, const ClassSet& classes, const VertexIndex& index,
+                    const OptimiserConfig& config, const std::vector<double>& score_sum,
+                    const std::vector<double>& weight) {
+  const size_t m = graph.edges.size();
+  EdgeTerms terms{std::vector<double>(m, 0.0), std::vector<double>(m, 0.0)};
+  std::vector<double> total(weight.size(), 0.0);  // per vertex: confidence of its edges
+  for (size_t k = 0; k < m; ++k) {
+    const GraphEdge& e = graph.edges[k];
+    const int a = index(e.a);
+    const int b = index(e.b);
+    const double c =
+        normalisedConfidence(edgeEvidence(e, classes, config), score_sum[a], score_sum[b]);
+    if (!(c > 0.0)) continue;
+    terms.confidence[k] = c;
+    total[a] += c;
+    total[b] += c;
+  }
+  for (size_t k = 0; k < m; ++k) {
+    const double c = terms.confidence[k];
+    if (c <= 0.0) continue;
+    const int a = index(graph.edges[k].a);
+    const int b = index(graph.edges[k].b);
+    terms.weight[k] = config.weighting == OptimiserConfig::Weighting::kShared
+                          ? std::min(weight[a] * c / total[a], weight[b] * c / total[b])
+                          : std::min(weight[a], weight[b]);
+  }
+  return terms;
+}
+
 }  // namespace
 
 double vertexWeight(const GraphVertex& vertex, OptimiserConfig::Weighting weighting) {
@@ -106,18 +142,17 @@ LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConf
   }
 
   // Edges with a positive confidence sum, once and as CSR adjacency.
+  const EdgeTerms terms = edgeTerms(graph, classes, index, config, score_sum, weight);
   std::vector<int> degree(n + 1, 0);
-  for (const GraphEdge& e : graph.edges) {
-    const int a = index(e.a);
-    const int b = index(e.b);
-    const double factor = edgeFactor(
-        normalisedConfidence(edgeEvidence(e, classes, config), score_sum[a], score_sum[b]),
-        config.theta);
+  for (size_t k = 0; k < graph.edges.size(); ++k) {
+    const double factor = edgeFactor(terms.confidence[k], config.theta);
     if (factor <= 0.0) continue;
+    const int a = index(graph.edges[k].a);
+    const int b = index(graph.edges[k].b);
     problem.edge_a.push_back(a);
     problem.edge_b.push_back(b);
     problem.edge_factor.push_back(factor);
-    problem.edge_kc.push_back(config.K_C * std::min(weight[a], weight[b]));
+    problem.edge_kc.push_back(config.K_C * terms.weight[k]);
     ++degree[a + 1];
     ++degree[b + 1];
   }
@@ -181,15 +216,14 @@ double semanticEnergy(const SuperpointGraph& graph, const std::map<int32_t, int3
     weight[i] = internal::vertexWeight(v, config.weighting);
     energy += weight[i] * internal::unaryPotential(score, sum, config.score_floor);
   }
-  for (const GraphEdge& e : graph.edges) {
-    const int a = index(e.a);
-    const int b = index(e.b);
-    const double factor =
-        internal::edgeFactor(internal::normalisedConfidence(
-                                 internal::edgeEvidence(e, classes, config), sums[a], sums[b]),
-                             config.theta);
+  const internal::EdgeTerms terms =
+      internal::edgeTerms(graph, classes, index, config, sums, weight);
+  for (size_t k = 0; k < graph.edges.size(); ++k) {
+    const int a = index(graph.edges[k].a);
+    const int b = index(graph.edges[k].b);
+    const double factor = internal::edgeFactor(terms.confidence[k], config.theta);
     energy += internal::pairwisePotential(label[a], label[b], normalised[a], normalised[b], factor,
-                                          config.K_C * std::min(weight[a], weight[b]));
+                                          config.K_C * terms.weight[k]);
   }
   return energy;
 }

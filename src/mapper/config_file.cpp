@@ -108,6 +108,19 @@ void checkConfigShape(const std::string& path) {
   }
 }
 
+/// The YAML name of an energy weighting.
+const char* weightingName(OptimiserConfig::Weighting weighting) {
+  switch (weighting) {
+    case OptimiserConfig::Weighting::kNone:
+      return "none";
+    case OptimiserConfig::Weighting::kShared:
+      return "shared";
+    case OptimiserConfig::Weighting::kSurface:
+      break;
+  }
+  return "surface";
+}
+
 }  // namespace
 
 PanmapConfig loadConfig(const std::string& path) {
@@ -262,13 +275,17 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("theta", &o.theta);
     s.read("max_sweeps", &o.max_sweeps);
     s.read("discount_apart", &o.discount_apart);
-    std::string weighting = o.weighting == OptimiserConfig::Weighting::kNone ? "none" : "surface";
+    std::string weighting = weightingName(o.weighting);
     s.readString("weighting", &weighting);
-    if (weighting != "surface" && weighting != "none") {
-      s.fail("optimiser.weighting must be surface or none");
+    if (weighting == "none") {
+      o.weighting = OptimiserConfig::Weighting::kNone;
+    } else if (weighting == "surface") {
+      o.weighting = OptimiserConfig::Weighting::kSurface;
+    } else if (weighting == "shared") {
+      o.weighting = OptimiserConfig::Weighting::kShared;
+    } else {
+      s.fail("optimiser.weighting must be surface, shared or none");
     }
-    o.weighting = weighting == "none" ? OptimiserConfig::Weighting::kNone
-                                      : OptimiserConfig::Weighting::kSurface;
     std::string refinement =
         o.refinement == OptimiserConfig::Refinement::kPaperRules ? "paper" : "clustering";
     s.readString("refinement", &refinement);
@@ -434,8 +451,9 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   max_sweeps: " << o.max_sweeps << "\n"
     << "   discount_apart: " << o.discount_apart
     << "   # Eq. 9 co-observation times P_eps / (P_eps + P_apart) (0/1)\n"
-    << "   weighting: \"" << (o.weighting == OptimiserConfig::Weighting::kNone ? "none" : "surface")
-    << "\"   # Eq. 7 terms per voxel (surface) or per super-point and edge (none, the paper)\n"
+    << "   weighting: \"" << weightingName(o.weighting)
+    << "\"   # Eq. 7 terms per voxel (surface; shared: edges split each super-point's voxels)"
+       " or per super-point and edge (none, the paper)\n"
     << "   refinement: \""
     << (o.refinement == OptimiserConfig::Refinement::kPaperRules ? "paper" : "clustering")
     << "\"   # III-D: clustering by one-mask / two-mask evidence, or the paper's rules\n"

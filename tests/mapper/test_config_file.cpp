@@ -123,12 +123,12 @@ TEST(ConfigFile, BadKeysAndValuesNameTheKey) {
   EXPECT_NE(error("%YAML:1.0\n---\nmap:\n   voxel_size_m: [1]\n").find("must be a number"),
             std::string::npos);
   EXPECT_NE(error("%YAML:1.0\n---\noptimiser:\n   weighting: \"voxels\"\n")
-                .find("optimiser.weighting must be surface or none"),
+                .find("optimiser.weighting must be surface, shared or none"),
             std::string::npos);
   EXPECT_THROW(loadConfig(dir.path("missing.yaml")), Error);
 }
 
-TEST(ConfigFile, EnergyWeightingReadsBothValues) {
+TEST(ConfigFile, EnergyWeightingReadsEveryValue) {
   test::TempDir dir;
   EXPECT_EQ(PanmapConfig().optimiser.weighting, OptimiserConfig::Weighting::kSurface);
   const PanmapConfig none =
@@ -136,6 +136,10 @@ TEST(ConfigFile, EnergyWeightingReadsBothValues) {
   EXPECT_EQ(none.optimiser.weighting, OptimiserConfig::Weighting::kNone);
   EXPECT_EQ(loadConfig(write(dir, configToYaml(none))).optimiser.weighting,
             OptimiserConfig::Weighting::kNone);
+  const PanmapConfig shared =
+      loadConfig(write(dir, "%YAML:1.0\n---\noptimiser:\n   weighting: \"shared\"\n"));
+  EXPECT_EQ(loadConfig(write(dir, configToYaml(shared))).optimiser.weighting,
+            OptimiserConfig::Weighting::kShared);
 }
 
 }  // namespace

@@ -22,7 +22,11 @@ struct OptimiserConfig {
   /// vertices, so E sums over surface as a voxel CRF would. kNone: once per vertex and edge
   /// (the paper); then a super-point of one voxel outweighs a whole chair part, and a chair
   /// bordered by dozens of one-voxel floor fragments is relabelled floor (docs/MAPPING.md).
-  enum class Weighting : int8_t { kNone = 0, kSurface = 1 };
+  /// kShared: unaries as kSurface; each vertex shares its voxels over its edges in proportion
+  /// to their normalised confidence, and an edge weighs the smaller of its two shares, so the
+  /// pairwise terms around a vertex never outweigh its own surface however many small
+  /// neighbours it has (opt-in: not yet through the tuning suite).
+  enum class Weighting : int8_t { kNone = 0, kSurface = 1, kShared = 2 };
   Weighting weighting = Weighting::kSurface;
   /// Floor of the normalised score P_nu^C / sum_C' P_nu^C' in the unary (Eq. 8): a class
   /// without score costs -log(score_floor) (13.8 for 1e-6) instead of infinity.

@@ -76,7 +76,8 @@ struct LabelProblem {
 };
 
 /// The weight of a vertex's unary under `weighting`: 1 (kNone) or its voxels, at least 1
-/// (kSurface). An edge weighs the smaller of its two vertices' weights.
+/// (kSurface, kShared). An edge weighs the smaller of its two vertices' weights (kNone,
+/// kSurface) or of their confidence-proportional shares of them (kShared).
 double vertexWeight(const GraphVertex& vertex, OptimiserConfig::Weighting weighting);
 
 /// Builds the problem from a checked graph. The initial label of a vertex is the argmax of its
