@@ -284,7 +284,7 @@ PanmapConfig loadConfig(const std::string& path) {
     } else if (weighting == "shared") {
       o.weighting = OptimiserConfig::Weighting::kShared;
     } else {
-      s.fail("optimiser.weighting must be surface, shared or none");
+      s.fail("optimiser.weighting must be surface, shared or none, not \"" + weighting + "\"");
     }
     std::string refinement =
         o.refinement == OptimiserConfig::Refinement::kPaperRules ? "paper" : "clustering";

@@ -125,6 +125,8 @@ TEST(ConfigFile, BadKeysAndValuesNameTheKey) {
   EXPECT_NE(error("%YAML:1.0\n---\noptimiser:\n   weighting: \"voxels\"\n")
                 .find("optimiser.weighting must be surface, shared or none"),
             std::string::npos);
+  EXPECT_NE(error("%YAML:1.0\n---\noptimiser:\n   weighting: \"voxels\"\n").find("not \"voxels\""),
+            std::string::npos);
   EXPECT_THROW(loadConfig(dir.path("missing.yaml")), Error);
 }
 
