@@ -95,7 +95,10 @@ std::vector<uint8_t> encodeLabelPng(const LabelImage& image) {
 }
 
 bool isCompleteJpeg(const uint8_t* data, size_t size) {
-  if (size < 4 || data[0] != 0xFF || data[1] != 0xD8) return false;
+  // SOI and the next marker's 0xFF: exactly what OpenCV's JPEG decoder matches. Bytes starting
+  // FF D8 without it went to whichever other decoder claimed them (GDAL, through a temporary
+  // file left in /tmp), found by fuzz/fuzz_image_codec.
+  if (size < 4 || data[0] != 0xFF || data[1] != 0xD8 || data[2] != 0xFF) return false;
   // EOI ends the stream; some writers pad a few bytes after it.
   const size_t tail = size > 64 ? size - 64 : 2;
   for (size_t i = size - 2; i + 1 > tail; --i) {
@@ -170,7 +173,10 @@ bool headerSize(const uint8_t* data, size_t size, uint64_t* width, uint64_t* hei
       ++pos;
       continue;
     }
-    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {  // no length field
+    // FF 00 is a stuffed zero, which libjpeg skips like stray bytes (reading a length there
+    // let a frame header hide from this check, found by fuzz/fuzz_image_codec); TEM and RSTn
+    // have no length field.
+    if (marker == 0x00 || marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {
       pos += 2;
       continue;
     }
@@ -190,7 +196,12 @@ bool headerSize(const uint8_t* data, size_t size, uint64_t* width, uint64_t* hei
 
 cv::Mat decodeUnchanged(const uint8_t* data, size_t size, const std::string& what) {
   if (size == 0) throw Error(what + ": empty image data");
-  if (isPng(data, size)) checkPngStructure(data, size, what);
+  // Only PNG and JPEG signatures reach cv::imdecode, so it never picks another of its decoders.
+  if (isPng(data, size)) {
+    checkPngStructure(data, size, what);
+  } else if (!isCompleteJpeg(data, size)) {
+    throw Error(what + ": not a PNG or a complete JPEG image");
+  }
   // The decoders allocate the whole image from the header's size before reading any pixel:
   // a 100-byte file claiming 30000 x 30000 pixels took 1.8 GB and 10 s in fuzz/
   // fuzz_image_codec. No RGB-D camera comes near the limit (8K UHD is 33.2 M pixels).

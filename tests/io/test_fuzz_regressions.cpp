@@ -29,6 +29,15 @@ TEST(ImageFuzzRegressions, JpegClaimingHugeSizeIsRefusedBeforeDecoding) {
                     {"f.jpg", "12040x14895", "larger than"});
 }
 
+TEST(ImageFuzzRegressions, StuffedZeroBeforeTheFrameHeaderDoesNotHideItsSize) {
+  // 178 bytes opening FF D8 FF 00: libjpeg skips FF 00 as a stuffed zero and found the same
+  // 12040 x 14895 frame header, which the size check had read past as a segment length.
+  const std::vector<uint8_t> jpeg = fuzzInput("image_codec/jpeg_stuffed_zero_hides_179m_pixels");
+  ASSERT_TRUE(isCompleteJpeg(jpeg.data(), jpeg.size()));
+  test::expectError([&] { decodeColor(jpeg.data(), jpeg.size(), "f.jpg"); },
+                    {"f.jpg", "12040x14895", "larger than"});
+}
+
 TEST(ImageFuzzRegressions, PngClaimingHugeSizeIsRefusedBeforeDecoding) {
   // A real 8x6 depth PNG with its IHDR rewritten to 60000 x 60000: as found, the chunk's
   // checksum refuses it; with the checksum made right, the size does.
@@ -44,6 +53,16 @@ TEST(ImageFuzzRegressions, PngClaimingHugeSizeIsRefusedBeforeDecoding) {
                     {"d.png", "60000x60000", "larger than"});
   test::expectError([&] { decodeLabelPng(png.data(), png.size(), "l.png"); }, {"l.png"});
   test::expectError([&] { decodeColor(png.data(), png.size(), "c.png"); }, {"c.png"});
+}
+
+TEST(ImageFuzzRegressions, BytesThatOnlyLookLikeAJpegNeverReachAnotherDecoder) {
+  // SOI, then no marker: OpenCV's JPEG decoder does not claim these bytes, and cv::imdecode
+  // offered them to its other decoders; under the fuzzer GDAL took some through a temporary
+  // file left in /tmp. They are refused before imdecode now.
+  const std::vector<uint8_t> bytes = {0xFF, 0xD8, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xFF, 0xD9};
+  EXPECT_FALSE(isCompleteJpeg(bytes.data(), bytes.size()));
+  test::expectError([&] { decodeColor(bytes.data(), bytes.size(), "c.jpg"); },
+                    {"c.jpg", "not a JPEG/PNG"});
 }
 
 TEST(ImageFuzzRegressions, ImagesUpToTheLimitStillDecode) {

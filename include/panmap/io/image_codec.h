@@ -33,8 +33,8 @@ std::vector<uint8_t> encodeDepthPng(const DepthImage& image);
 /// Throws Error for labels outside [0, 2^24).
 std::vector<uint8_t> encodeLabelPng(const LabelImage& image);
 
-/// True when JPEG bytes start with SOI and end with EOI (a truncated file does not; libjpeg
-/// would otherwise decode it with a grey tail and only a warning).
+/// True when JPEG bytes start with SOI and a marker and end with EOI (a truncated file does not;
+/// libjpeg would otherwise decode it with a grey tail and only a warning).
 bool isCompleteJpeg(const uint8_t* data, size_t size);
 
 /// Decodes a JPEG or 8-bit PNG into RGB. Throws Error naming `what` when the bytes are not a
