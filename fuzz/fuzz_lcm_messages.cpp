@@ -9,6 +9,7 @@
 #include "panmap/command_t.hpp"
 #include "panmap/graph/optimiser.h"
 #include "panmap/lcm/conversions.h"
+#include "panmap/lcm/correction_conversions.h"
 #include "panmap/lcm/decode.h"
 #include "panmap/lcm/graph_conversions.h"
 #include "panmap/lcm/message_types.h"
@@ -34,6 +35,15 @@ void convert(const panmap::octomap_t& m) {
   if (m.tree_type != "OcTree") return;
   panmap::treeFromBinaryData(std::string(m.data.begin(), m.data.end()), m.resolution_m);
 }
+void convert(const panmap::pose_correction_t& m) {
+  // Applied to the trajectory the map was built with (three frames 0.1 s apart here).
+  static const std::vector<panmap::StampedPose> kTrajectory = [] {
+    std::vector<panmap::StampedPose> t(3);
+    for (int i = 0; i < 3; ++i) t[i].utime = 1000 + 100000 * i;
+    return t;
+  }();
+  panmap::applyCorrection(kTrajectory, panmap::fromMessage(m), 50000);
+}
 void convert(const panmap::status_t&) {}   // read field by field by tools only
 void convert(const panmap::command_t&) {}  // switch on the command (LiveMapper::onCommand)
 
@@ -57,7 +67,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
   const uint8_t* body = data + 1;
   const size_t n = size - 1;
-  switch (data[0] % 9) {
+  switch (data[0] % 10) {
     case 0:
       fuzzType<panmap::rgbd_frame_t>(body, n);
       break;
@@ -82,8 +92,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     case 7:
       fuzzType<panmap::graph_labels_t>(body, n);
       break;
-    default:
+    case 8:
       fuzzType<panmap::command_t>(body, n);
+      break;
+    default:
+      fuzzType<panmap::pose_correction_t>(body, n);
       break;
   }
   return 0;

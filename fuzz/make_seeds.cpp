@@ -19,6 +19,7 @@
 #include "panmap/io/image_codec.h"
 #include "panmap/io/ply.h"
 #include "panmap/lcm/conversions.h"
+#include "panmap/lcm/correction_conversions.h"
 #include "panmap/lcm/graph_conversions.h"
 #include "panmap/lcm/mapping_session.h"
 #include "panmap/lcm/object_conversions.h"
@@ -413,6 +414,11 @@ void lcmSeeds() {
   command.command = panmap::command_t::COMMAND_SAVE;
   command.argument = "/tmp/map.panmap";
   seed("lcm_messages", "command", selected(8, command));
+  panmap::PoseCorrection correction;
+  correction.utime = 14;
+  correction.correction_id = 1;
+  correction.poses = {tinyPose(1000, 0, 0.5), tinyPose(100000, 1, 0.6)};
+  seed("lcm_messages", "pose_correction", selected(9, panmap::toMessage(correction)));
 
   // The session: two frames with poses and masks, one without a pose, noise on the side.
   std::vector<Entry> stream;

@@ -7,9 +7,11 @@
 #include "panmap/core/error.h"
 #include "panmap/graph_labels_t.hpp"
 #include "panmap/lcm/conversions.h"
+#include "panmap/lcm/correction_conversions.h"
 #include "panmap/object_list_t.hpp"
 #include "panmap/octomap_t.hpp"
 #include "panmap/panoptic_t.hpp"
+#include "panmap/pose_correction_t.hpp"
 #include "panmap/pose_t.hpp"
 #include "panmap/rgbd_frame_t.hpp"
 #include "panmap/status_t.hpp"
@@ -22,6 +24,7 @@ namespace {
 void deepCheck(const rgbd_frame_t& m) { fromMessage(m); }
 void deepCheck(const pose_t& m) { fromMessage(m); }
 void deepCheck(const panoptic_t& m) { fromMessage(m); }
+void deepCheck(const pose_correction_t& m) { fromMessage(m); }
 template <typename T>
 void deepCheck(const T&) {}
 
@@ -73,7 +76,8 @@ const std::vector<TypeEntry>& types() {
   static const std::vector<TypeEntry> kTypes = {
       PANMAP_TYPE(rgbd_frame_t),       PANMAP_TYPE(pose_t),         PANMAP_TYPE(panoptic_t),
       PANMAP_TYPE(status_t),           PANMAP_TYPE(object_list_t),  PANMAP_TYPE(octomap_t),
-      PANMAP_TYPE(superpoint_graph_t), PANMAP_TYPE(graph_labels_t), PANMAP_TYPE(command_t)};
+      PANMAP_TYPE(superpoint_graph_t), PANMAP_TYPE(graph_labels_t), PANMAP_TYPE(command_t),
+      PANMAP_TYPE(pose_correction_t)};
   return kTypes;
 }
 

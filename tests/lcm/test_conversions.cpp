@@ -161,7 +161,7 @@ TEST(MessageTypes, IdentifiesAndChecks) {
   cmd.argument = "/tmp/map.panmap";
   const auto cmd_bytes = encode(cmd);
   EXPECT_TRUE(checkMessage(cmd_bytes.data(), cmd_bytes.size(), true).ok);
-  EXPECT_EQ(messageTypeNames().size(), 9u);
+  EXPECT_EQ(messageTypeNames().size(), 10u);
 }
 
 }  // namespace

@@ -12,5 +12,6 @@ constexpr const char* kChannelOctomap = "PANMAP_OCTOMAP";
 constexpr const char* kChannelGraph = "PANMAP_GRAPH";
 constexpr const char* kChannelLabels = "PANMAP_LABELS";
 constexpr const char* kChannelCommand = "PANMAP_COMMAND";
+constexpr const char* kChannelPoseCorrection = "PANMAP_POSE_CORRECTION";
 
 }  // namespace panmap

@@ -1,0 +1,105 @@
+#include "panmap/loop/pose_correction.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+#include "panmap/core/error.h"
+
+namespace panmap {
+
+void PoseCorrection::check() const {
+  const std::string what = "pose correction " + std::to_string(correction_id);
+  if (poses.empty()) throw Error(what + ": no pose");
+  // Matching subtracts utimes: beyond 2^61 us (73,000 years) the differences overflow int64.
+  constexpr int64_t kMaxUtime = int64_t{1} << 61;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    const StampedPose& p = poses[i];
+    if (p.utime < -kMaxUtime || p.utime > kMaxUtime) {
+      throw Error(what + ": utime " + std::to_string(p.utime) + " is out of range");
+    }
+    if (i > 0 && p.utime <= poses[i - 1].utime) {
+      throw Error(what + ": pose utimes must increase (" + std::to_string(p.utime) + " after " +
+                  std::to_string(poses[i - 1].utime) + ")");
+    }
+    std::string why;
+    if (!isRigidTransform(p.T_W_C.matrix(), 1e-6, &why)) {
+      throw Error(what + ": pose at " + std::to_string(p.utime) + " is not rigid (" + why + ")");
+    }
+  }
+}
+
+namespace {
+
+// The frame of `trajectory` nearest to utime within tolerance, or -1.
+int nearestFrame(const std::vector<StampedPose>& trajectory, int64_t utime, int64_t tolerance) {
+  const auto it = std::lower_bound(trajectory.begin(), trajectory.end(), utime,
+                                   [](const StampedPose& p, int64_t t) { return p.utime < t; });
+  int best = -1;
+  int64_t best_gap = tolerance;
+  for (auto c : {it, it == trajectory.begin() ? trajectory.end() : it - 1}) {
+    if (c == trajectory.end()) continue;
+    const int64_t gap = std::abs(c->utime - utime);
+    if (gap <= best_gap && (best < 0 || gap < best_gap)) {
+      best = static_cast<int>(c - trajectory.begin());
+      best_gap = gap;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+CorrectedTrajectory applyCorrection(const std::vector<StampedPose>& trajectory,
+                                    const PoseCorrection& correction, int64_t tolerance_us) {
+  correction.check();
+  for (size_t i = 1; i < trajectory.size(); ++i) {
+    if (trajectory[i].utime < trajectory[i - 1].utime) {
+      throw Error("trajectory to correct is not sorted by utime");
+    }
+  }
+  CorrectedTrajectory out;
+  out.poses = trajectory;
+  out.translation_m.assign(trajectory.size(), 0.0);
+  out.rotation_rad.assign(trajectory.size(), 0.0);
+  // Matched frames in time order with their world-frame correction.
+  std::vector<std::pair<int, Eigen::Isometry3d>> anchors;
+  for (const StampedPose& p : correction.poses) {
+    const int k = nearestFrame(trajectory, p.utime, std::max<int64_t>(tolerance_us, 0));
+    if (k < 0 || (!anchors.empty() && anchors.back().first == k)) {
+      out.unknown_utimes.push_back(p.utime);
+      continue;
+    }
+    anchors.emplace_back(k, p.T_W_C * trajectory[k].T_W_C.inverse());
+  }
+  out.matched = static_cast<int>(anchors.size());
+  if (anchors.empty()) return out;
+  size_t next = 0;  // first anchor at or after frame i
+  for (size_t i = 0; i < trajectory.size(); ++i) {
+    while (next < anchors.size() && anchors[next].first < static_cast<int>(i)) ++next;
+    Eigen::Isometry3d D;
+    if (next == anchors.size()) {
+      D = anchors.back().second;
+    } else if (anchors[next].first == static_cast<int>(i) || next == 0) {
+      D = anchors[next].second;
+    } else {
+      const auto& [a, Da] = anchors[next - 1];
+      const auto& [b, Db] = anchors[next];
+      const double span = static_cast<double>(trajectory[b].utime - trajectory[a].utime);
+      const double s =
+          span > 0 ? static_cast<double>(trajectory[i].utime - trajectory[a].utime) / span : 0.0;
+      D = interpolatePose(Da, Db, s);
+    }
+    const Eigen::Isometry3d& before = trajectory[i].T_W_C;
+    const Eigen::Isometry3d after = D * before;
+    out.poses[i].T_W_C = after;
+    out.translation_m[i] = (after.translation() - before.translation()).norm();
+    out.rotation_rad[i] = Eigen::AngleAxisd(before.linear().transpose() * after.linear()).angle();
+    out.max_translation_m = std::max(out.max_translation_m, out.translation_m[i]);
+    out.max_rotation_rad = std::max(out.max_rotation_rad, out.rotation_rad[i]);
+  }
+  return out;
+}
+
+}  // namespace panmap
