@@ -10,6 +10,7 @@ import datetime
 import itertools
 import json
 import os
+import shutil
 import sys
 import time
 
@@ -53,7 +54,8 @@ def main():
             suite.run([suite.tool("panmap-mapper"), "-q", "--no-snapshots", "--export-only",
                        "--load", map_file, "--config", cfg, "--out", folder])
             out[name] = suite.evaluate(folder, seq)
-            suite.drop_map(folder)
+            # Only the scores are kept: a grid's meshes for every map filled the disk.
+            shutil.rmtree(folder)
         return out
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         scores = list(pool.map(lambda it: score(*it), enumerate(grid)))
