@@ -118,10 +118,17 @@ def render(work, spec):
     return folder
 
 
-def evaluate(pred_dir, seq_dir):
+# Diagnostics leave GT vertices within 1.5 voxels of another class out of the count of
+# super-points that span two classes: the voxel a boundary crosses takes either class, and the
+# nearest-vertex label transfer moves labels by up to half a voxel more (panmap-eval --help).
+BOUNDARY_BAND_VOXELS = 1.5
+
+
+def evaluate(pred_dir, seq_dir, voxel_m=0.02):
     """Scores a mapper output folder against the sequence's ground truth (eval.json)."""
     cmd = [tool("panmap-eval"), "--pred", os.path.join(pred_dir, "mesh_instance.ply"),
            "--gt", os.path.join(seq_dir, "gt", "mesh.ply"),
+           "--boundary-band", "%g" % (BOUNDARY_BAND_VOXELS * voxel_m),
            "--json", os.path.join(pred_dir, "eval.json")]
     objects = os.path.join(pred_dir, "objects.json")
     if os.path.exists(objects):
@@ -171,7 +178,7 @@ def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
     if spec.runs == "full":
         # The full method as a user runs it: default tracking (refines drifting poses).
         run(base + extra + ["--log", log_path, "--out", os.path.join(out, "A")], log)
-        results["full"] = evaluate(os.path.join(out, "A"), seq_dir)
+        results["full"] = evaluate(os.path.join(out, "A"), seq_dir, voxel_m)
         if drifting:
             ate["refined"] = trajectory_ate(seq_dir, os.path.join(out, "A", "trajectory.txt"),
                                             os.path.join(out, "ate_refined.json"), log)
@@ -180,7 +187,7 @@ def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
         if drifting and spec.runs == "all":
             refined = os.path.join(out, "A_refined")
             run(base + extra + ["--tracking", "auto", "--log", log_path, "--out", refined], log)
-            results[REFINED] = evaluate(refined, seq_dir)
+            results[REFINED] = evaluate(refined, seq_dir, voxel_m)
             ate["refined"] = trajectory_ate(seq_dir, os.path.join(refined, "trajectory.txt"),
                                             os.path.join(out, "ate_refined.json"), log)
         tracking = "auto" if spec.runs == "tracked" else "off"
@@ -204,7 +211,7 @@ def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
                 run([tool("panmap-mapper"), "-q", "--no-snapshots", "--export-only", "--load",
                      os.path.join(out, source, "map.panmap"), "--out", folder] + flags + extra,
                     log)
-            results[variant] = evaluate(folder, seq_dir)
+            results[variant] = evaluate(folder, seq_dir, voxel_m)
             if folder not in (os.path.join(out, "A"), os.path.join(out, "B")):
                 drop_map(folder)
     if drifting:

@@ -152,6 +152,8 @@ json toJson(const panmap::SceneDiagnostics& d) {
           {"superpoint_class_purity", number(d.superpoint_class_purity)},
           {"num_superpoints", d.num_superpoints},
           {"num_bridging_superpoints", d.num_bridging_superpoints},
+          {"num_bridging_superpoints_with_boundaries", d.num_bridging_superpoints_with_boundaries},
+          {"boundary_band_m", d.boundary_band_m},
           {"bridge_share", d.bridge_share},
           {"worst_second_class_share", d.worst_second_class_share},
           {"bridges", bridges},
@@ -278,6 +280,12 @@ int main(int argc, char** argv) {
   app.add_option("--json", json_path, "write the results as JSON to this file");
   app.add_option("--max-distance", config.max_distance_m, "label transfer radius, metres")
       ->capture_default_str();
+  double boundary_band_m = 0.03;
+  app.add_option("--boundary-band", boundary_band_m,
+                 "diagnostics: GT vertices this close to another class are left out of the "
+                 "count of super-points that span two classes (1.5 voxels of the map), metres")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_flag("--paper-compatible", config.paper_compatible,
                "score matched predictions at confidence 1 (the released scripts' quirk)");
   auto* traj_option = app.add_option("--traj", traj_path,
@@ -322,7 +330,8 @@ int main(int argc, char** argv) {
           panmap::evaluateTransferred(gt, transferred, confidences, config);
       std::printf("%s", panmap::formatEvalTable(result).c_str());
       out = toJson(result);
-      const panmap::SceneDiagnostics diagnostics = panmap::diagnose(gt, transferred, confidences);
+      const panmap::SceneDiagnostics diagnostics =
+          panmap::diagnose(gt, transferred, confidences, 5, boundary_band_m);
       std::printf("%s", panmap::formatDiagnostics(diagnostics).c_str());
       out["diagnostics"] = toJson(diagnostics);
     }

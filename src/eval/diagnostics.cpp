@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <unordered_map>
 
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
@@ -33,10 +34,68 @@ double stuffIoU(const LabelledMesh& gt, const TransferredLabels& pred, int32_t c
   return tp + fp + fn > 0 ? static_cast<double>(tp) / static_cast<double>(tp + fp + fn) : kNaN;
 }
 
+// Annotated GT vertices with no annotated vertex of another class within band_m: where the
+// class is certain at the map's resolution. A hash grid of band_m cells; the 27 cells around a
+// vertex hold every vertex within band_m of it.
+std::vector<bool> awayFromClassBoundaries(const LabelledMesh& gt, double band_m) {
+  const size_t n = gt.numVertices();
+  std::vector<bool> away(n, false);
+  for (size_t v = 0; v < n; ++v) away[v] = gt.semantic[v] > 0;
+  if (!(band_m > 0.0)) return away;
+  auto cell = [band_m](float x) { return static_cast<int64_t>(std::floor(x / band_m)); };
+  auto key = [](int64_t x, int64_t y, int64_t z) {
+    return ((x & 0x1FFFFF) << 42) | ((y & 0x1FFFFF) << 21) | (z & 0x1FFFFF);
+  };
+  std::unordered_map<int64_t, std::vector<uint32_t>> grid;
+  for (size_t v = 0; v < n; ++v) {
+    if (gt.semantic[v] <= 0) continue;
+    const Eigen::Vector3f& p = gt.vertices[v];
+    grid[key(cell(p.x()), cell(p.y()), cell(p.z()))].push_back(static_cast<uint32_t>(v));
+  }
+  const double band2 = band_m * band_m;
+  for (size_t v = 0; v < n; ++v) {
+    if (!away[v]) continue;
+    const Eigen::Vector3f& p = gt.vertices[v];
+    const int64_t cx = cell(p.x()), cy = cell(p.y()), cz = cell(p.z());
+    for (int64_t dx = -1; dx <= 1 && away[v]; ++dx) {
+      for (int64_t dy = -1; dy <= 1 && away[v]; ++dy) {
+        for (int64_t dz = -1; dz <= 1 && away[v]; ++dz) {
+          const auto it = grid.find(key(cx + dx, cy + dy, cz + dz));
+          if (it == grid.end()) continue;
+          for (const uint32_t w : it->second) {
+            if (gt.semantic[w] != gt.semantic[v] &&
+                (gt.vertices[w] - p).cast<double>().squaredNorm() <= band2) {
+              away[v] = false;
+              break;
+            }
+          }
+        }
+      }
+    }
+  }
+  return away;
+}
+
+// Class mix of one super-point, largest first, and its vertex count.
+std::pair<std::vector<std::pair<int32_t, double>>, int64_t> classMix(
+    const std::map<int32_t, int64_t>& classes) {
+  std::vector<std::pair<int32_t, int64_t>> counts(classes.begin(), classes.end());
+  std::stable_sort(counts.begin(), counts.end(),
+                   [](const auto& a, const auto& b) { return a.second > b.second; });
+  int64_t sum = 0;
+  for (const auto& c : counts) sum += c.second;
+  std::vector<std::pair<int32_t, double>> mix;
+  for (const auto& [cls, count] : counts) {
+    mix.emplace_back(cls, static_cast<double>(count) / static_cast<double>(sum));
+  }
+  return {mix, sum};
+}
+
 }  // namespace
 
 SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
-                          const std::map<int32_t, double>& objects, int num_bins) {
+                          const std::map<int32_t, double>& objects, int num_bins,
+                          double boundary_band_m) {
   const size_t n = gt.numVertices();
   if (gt.semantic.size() != n || gt.instance.size() != n) {
     throw Error("diagnose: ground-truth mesh lacks semantic or instance labels");
@@ -46,11 +105,17 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
     throw Error("diagnose: transferred labels do not match the ground-truth vertex count");
   }
   if (num_bins < 1) throw Error("diagnose: num_bins must be >= 1");
+  if (!(boundary_band_m >= 0.0) || !std::isfinite(boundary_band_m)) {
+    throw Error("diagnose: boundary_band_m must be finite and >= 0, got " +
+                std::to_string(boundary_band_m));
+  }
   SceneDiagnostics d;
+  d.boundary_band_m = boundary_band_m;
+  const std::vector<bool> away = awayFromClassBoundaries(gt, boundary_band_m);
 
   // Super-points: identities and classes of their annotated vertices.
   std::map<int32_t, std::map<std::pair<int32_t, int32_t>, int64_t>> sp_identities;
-  std::map<int32_t, std::map<int32_t, int64_t>> sp_classes;
+  std::map<int32_t, std::map<int32_t, int64_t>> sp_classes, sp_classes_away;
   std::map<int32_t, std::pair<int64_t, int64_t>> sp_size;  // all, unannotated
   for (size_t v = 0; v < n; ++v) {
     const int32_t s = pred.superpoint[v];
@@ -63,6 +128,7 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
     }
     ++sp_identities[s][identity(gt.semantic[v], gt.instance[v])];
     ++sp_classes[s][gt.semantic[v]];
+    if (away[v]) ++sp_classes_away[s][gt.semantic[v]];
   }
   int64_t total = 0, majority = 0, class_majority = 0;
   for (const auto& [s, ids] : sp_identities) {
@@ -70,19 +136,20 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
     for (const auto& [id, count] : ids) sum += count, best = std::max(best, count);
     total += sum;
     majority += best;
-    std::vector<std::pair<int32_t, int64_t>> counts(sp_classes[s].begin(), sp_classes[s].end());
-    std::stable_sort(counts.begin(), counts.end(),
-                     [](const auto& a, const auto& b) { return a.second > b.second; });
-    class_majority += counts[0].second;
-    std::vector<std::pair<int32_t, double>> mix;
-    for (const auto& [cls, count] : counts) {
-      mix.emplace_back(cls, static_cast<double>(count) / static_cast<double>(sum));
+    int64_t top_class = 0;
+    for (const auto& [cls, count] : sp_classes[s]) top_class = std::max(top_class, count);
+    class_majority += top_class;
+    const auto [mix_all, sum_all] = classMix(sp_classes[s]);
+    if (sum_all >= d.min_superpoint_vertices && mix_all.size() > 1 &&
+        mix_all[1].second > d.bridge_share) {
+      ++d.num_bridging_superpoints_with_boundaries;
     }
-    if (sum >= d.min_superpoint_vertices && mix.size() > 1) {
+    const auto [mix, sum_away] = classMix(sp_classes_away[s]);
+    if (sum_away >= d.min_superpoint_vertices && mix.size() > 1) {
       d.worst_second_class_share = std::max(d.worst_second_class_share, mix[1].second);
       if (mix[1].second > d.bridge_share) {
         ++d.num_bridging_superpoints;
-        d.bridges.push_back({s, sum, mix});
+        d.bridges.push_back({s, sum_away, mix});
       }
     }
   }
@@ -283,10 +350,12 @@ std::string formatDiagnostics(const SceneDiagnostics& d) {
   char line[512];
   std::snprintf(line, sizeof(line),
                 "super-points: purity %.3f (by class %.3f) over %lld; %d span two classes by "
-                "> %.0f %% each (worst second class %.2f)\n",
+                "> %.0f %% each beyond %.1f cm of a class boundary (worst second class %.2f), "
+                "%d counting the boundaries\n",
                 d.superpoint_purity, d.superpoint_class_purity,
                 static_cast<long long>(d.num_superpoints), d.num_bridging_superpoints,
-                100 * d.bridge_share, d.worst_second_class_share);
+                100 * d.bridge_share, 100 * d.boundary_band_m, d.worst_second_class_share,
+                d.num_bridging_superpoints_with_boundaries);
   out += line;
   std::string mix;
   for (size_t k = 0; k < d.largest_class_mix.size() && k < 5; ++k) {

@@ -19,7 +19,8 @@ struct Case {
            bool reached = true) {
     for (int k = 0; k < count; ++k) {
       pred.reached.push_back(reached ? 1 : 0);
-      gt.vertices.emplace_back(0.0f, 0.0f, 0.0f);
+      // 1 m apart: no vertex is near a class boundary, so every one counts for bridging.
+      gt.vertices.emplace_back(static_cast<float>(gt.vertices.size()), 0.0f, 0.0f);
       gt.semantic.push_back(cls);
       gt.instance.push_back(inst);
       pred.semantic.push_back(p_cls);
@@ -168,6 +169,59 @@ TEST(Diagnostics, WithoutAnObjectListEveryMeshInstanceIsAnObject) {
   const SceneDiagnostics d = diagnose(c.gt, c.pred, {});
   EXPECT_EQ(d.num_objects, 4);        // 7, 8, 9, 10
   EXPECT_EQ(d.confident_objects, 3);  // 10 is unverifiable
+}
+
+// A 50 x 50 cm wall sampled every centimetre with a 20 x 20 cm picture on it (vertex indices
+// 10-29 in x and y), and one super-point over the picture and the wall within `from`-`to`.
+struct PictureOnWall {
+  LabelledMesh gt;
+  TransferredLabels pred;
+  PictureOnWall(int from, int to) {
+    for (int j = 0; j < 50; ++j) {
+      for (int i = 0; i < 50; ++i) {
+        const bool picture = i >= 10 && i < 30 && j >= 10 && j < 30;
+        const bool inside = i >= from && i < to && j >= from && j < to;
+        gt.vertices.emplace_back(0.01f * i, 0.01f * j, 0.0f);
+        gt.semantic.push_back(picture ? 11 : 1);
+        gt.instance.push_back(picture ? 2 : 1);
+        pred.semantic.push_back(inside ? 11 : 1);
+        pred.instance.push_back(inside ? 2 : 0);
+        pred.superpoint.push_back(inside ? 1 : 2);
+      }
+    }
+  }
+};
+
+TEST(Diagnostics, AOneVoxelRimIsResolutionNotABridge) {
+  // The super-point holds the picture and a 1 cm rim of wall: 84 wall of 484 vertices (17 %).
+  const PictureOnWall rim(9, 31);
+  const SceneDiagnostics raw = diagnose(rim.gt, rim.pred, {}, 5, 0.0);
+  EXPECT_EQ(raw.num_bridging_superpoints, 1);
+  EXPECT_EQ(raw.num_bridging_superpoints_with_boundaries, 1);
+  EXPECT_NEAR(raw.worst_second_class_share, 84.0 / 484.0, 1e-12);
+  // With a 1.5 cm band every rim vertex (1 or 1.41 cm from the picture) is left out, and so are
+  // the picture's own outer ring (76): 324 picture vertices, no wall.
+  const SceneDiagnostics banded = diagnose(rim.gt, rim.pred, {}, 5, 0.015);
+  EXPECT_EQ(banded.num_bridging_superpoints, 0);
+  EXPECT_EQ(banded.num_bridging_superpoints_with_boundaries, 1);
+  EXPECT_EQ(banded.worst_second_class_share, 0.0);
+  EXPECT_NEAR(banded.superpoint_purity, raw.superpoint_purity, 1e-12);  // purity keeps all
+}
+
+TEST(Diagnostics, ASuperPointReachingWellIntoTheWallStillBridges) {
+  // 5 cm of wall around the picture: 500 wall vertices, 84 of them within the band, 416 away;
+  // 324 picture vertices away from the wall. Wall share 416 / 740.
+  const PictureOnWall wide(5, 35);
+  const SceneDiagnostics d = diagnose(wide.gt, wide.pred, {}, 5, 0.015);
+  EXPECT_EQ(d.num_bridging_superpoints, 1);
+  ASSERT_EQ(d.bridges.size(), 1u);
+  EXPECT_EQ(d.bridges[0].superpoint, 1);
+  EXPECT_EQ(d.bridges[0].vertices, 740);
+  ASSERT_EQ(d.bridges[0].class_mix.size(), 2u);
+  EXPECT_EQ(d.bridges[0].class_mix[0].first, 1);
+  EXPECT_NEAR(d.bridges[0].class_mix[0].second, 416.0 / 740.0, 1e-12);
+  EXPECT_NEAR(d.bridges[0].class_mix[1].second, 324.0 / 740.0, 1e-12);
+  EXPECT_THROW(diagnose(wide.gt, wide.pred, {}, 5, -0.01), Error);
 }
 
 TEST(Diagnostics, RefusesMismatchedInput) {

@@ -25,11 +25,18 @@ struct SceneDiagnostics {
   int64_t num_superpoints = 0;  ///< super-points on at least one annotated GT vertex
 
   /// Super-points where two GT classes each hold more than `bridge_share` of its annotated
-  /// vertices (only super-points of at least `min_superpoint_vertices` annotated vertices).
+  /// vertices (only super-points of at least `min_superpoint_vertices` such vertices), counting
+  /// only GT vertices farther than `boundary_band_m` from an annotated vertex of another class.
+  /// A voxel map cannot place a class boundary more exactly: the first ring of wall vertices
+  /// around a picture is a 10-20 % share of a small picture's super-point, and is resolution,
+  /// not a super-point that chains classes.
   int num_bridging_superpoints = 0;
+  /// The same count with every annotated vertex, boundary bands included.
+  int num_bridging_superpoints_with_boundaries = 0;
   double bridge_share = 0.1;
   int64_t min_superpoint_vertices = 100;
-  /// Largest share of a second GT class in any such super-point.
+  double boundary_band_m = 0.0;  ///< as given to diagnose()
+  /// Largest share of a second GT class in any such super-point (boundary bands left out).
   double worst_second_class_share = 0.0;
   /// One super-point that spans two classes: its id, annotated vertices and class mix
   /// (NYU40 id, share), largest first.
@@ -125,8 +132,12 @@ struct SceneDiagnostics {
 ///     instance on the mesh with confidence 1. Ids in the list that no GT vertex carries are
 ///     objects too (unmatched).
 /// @param num_bins reliability bins over [0, 1]
+/// @param boundary_band_m GT vertices this close to another class are left out of the bridging
+///        count (0: none left out). 1.5 voxels: the voxel a boundary crosses can take either
+///        class, and the nearest-vertex transfer moves labels by up to half a voxel more.
 SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
-                          const std::map<int32_t, double>& objects, int num_bins = 5);
+                          const std::map<int32_t, double>& objects, int num_bins = 5,
+                          double boundary_band_m = 0.03);
 
 /// "matched", "unobserved", "wrong class", "unlabelled", "merged" or "split".
 const char* missCauseName(SceneDiagnostics::MissCause cause);
