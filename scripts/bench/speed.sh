@@ -59,7 +59,7 @@ fi
 
 targets="panmap-bench-mapping panmap-bench-memory panmap-bench-renderer panmap-bench-segmentation
   panmap-bench-block-hash panmap-bench-optimiser panmap-bench-tracking panmap-bench-occupancy
-  panmap-synth"
+  panmap-bench-frame-store panmap-synth"
 open3d=1
 scripts/setup.sh --skip-network --with-open3d --targets "$targets panmap-bench-open3d" >&2 || {
   echo "speed.sh: building with Open3D failed; measuring without it" >&2
@@ -116,6 +116,8 @@ occupancy=$(build/panmap-bench-occupancy --benchmark_format=csv --benchmark_filt
 # Separate run: the CSV reporter needs the same counters in every row.
 occupancy+=$'\n'$(build/panmap-bench-occupancy --benchmark_format=csv --benchmark_filter=BM_OctomapInsertPointCloud 2>/dev/null | python3 scripts/bench/gb_counters.py median_ms p95_ms)
 hash=$(gb build/panmap-bench-block-hash | awk -F, '{gsub(/"/,"",$1); printf "| %s | %.2f ms |\n", $1, $3}')
+echo "bench: loop-closure frame store" >&2
+frame_store=$(build/panmap-bench-frame-store --data "$data" 2>/dev/null)
 
 memory_text=$(memory_section "$memory_rows")
 # The soak and building sections belong to scripts/bench/soak.py and building.sh: kept as
@@ -222,6 +224,15 @@ lookups in runs of 8 and 11k inserts (\`panmap-bench-block-hash\`):
 | benchmark | time |
 |---|---|
 ${hash}
+
+Loop-closure frame store (\`panmap-bench-frame-store\`, docs/LOOP_CLOSURE.md: every frame of
+7scenes-200 stored with its depth, the per-pixel super-point labels of a geometry-only mapping
+run, pose and intrinsics; budget of roadmap issue 22: <= 150 kB per frame; \`add()\` includes
+an fsync of each file, of its folder and of the index):
+
+\`\`\`
+${frame_store}
+\`\`\`
 MD
 [ -n "$soak" ] && printf '\n%s\n' "$soak" >> "$out"
 [ -n "$building" ] && printf '\n%s\n' "$building" >> "$out"

@@ -66,15 +66,17 @@ std::vector<uint8_t> encodePng(const ColorImage& image) {
   return bytes;
 }
 
-std::vector<uint8_t> encodeDepthPng(const DepthImage& image) {
+std::vector<uint8_t> encodeDepthPng(const DepthImage& image, int compression) {
+  if (compression < 0 || compression > 9) throw Error("PNG compression level outside 0..9");
   std::vector<uint8_t> bytes;
-  if (!cv::imencode(".png", asMat(image), bytes, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+  if (!cv::imencode(".png", asMat(image), bytes, {cv::IMWRITE_PNG_COMPRESSION, compression})) {
     throw Error("depth PNG encoding failed");
   }
   return bytes;
 }
 
-std::vector<uint8_t> encodeLabelPng(const LabelImage& image) {
+std::vector<uint8_t> encodeLabelPng(const LabelImage& image, int compression) {
+  if (compression < 0 || compression > 9) throw Error("PNG compression level outside 0..9");
   cv::Mat bgr(image.height(), image.width(), CV_8UC3);
   for (int v = 0; v < image.height(); ++v) {
     const int32_t* src = image.row(v);
@@ -88,7 +90,7 @@ std::vector<uint8_t> encodeLabelPng(const LabelImage& image) {
     }
   }
   std::vector<uint8_t> bytes;
-  if (!cv::imencode(".png", bgr, bytes, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+  if (!cv::imencode(".png", bgr, bytes, {cv::IMWRITE_PNG_COMPRESSION, compression})) {
     throw Error("label PNG encoding failed");
   }
   return bytes;

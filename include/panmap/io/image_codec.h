@@ -27,11 +27,14 @@ std::vector<uint8_t> encodeJpeg(const ColorImage& image, int quality = 90);
 std::vector<uint8_t> encodePng(const ColorImage& image);
 
 /// 16-bit greyscale PNG file bytes of a depth image (lossless).
-std::vector<uint8_t> encodeDepthPng(const DepthImage& image);
+/// @param compression zlib level 0..9: 1 (the default) is fastest; files kept on disk (the
+///        frame store) trade encoding time for bytes with a higher one
+std::vector<uint8_t> encodeDepthPng(const DepthImage& image, int compression = 1);
 
 /// 8-bit RGB PNG of a label image in the COCO panoptic encoding id = R + 256 G + 65536 B.
 /// Throws Error for labels outside [0, 2^24).
-std::vector<uint8_t> encodeLabelPng(const LabelImage& image);
+/// @param compression zlib level 0..9, as for encodeDepthPng()
+std::vector<uint8_t> encodeLabelPng(const LabelImage& image, int compression = 1);
 
 /// True when JPEG bytes start with SOI and a marker and end with EOI (a truncated file does not;
 /// libjpeg would otherwise decode it with a grey tail and only a warning).

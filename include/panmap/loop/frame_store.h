@@ -1,0 +1,178 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "panmap/core/camera.h"
+#include "panmap/core/frame.h"
+#include "panmap/core/image.h"
+#include "panmap/core/pose.h"
+
+namespace panmap {
+
+/// Where and what the frame store keeps (docs/LOOP_CLOSURE.md, repair step 1).
+struct FrameStoreConfig {
+  /// Folder of the store (created when missing); empty: no store (off).
+  std::string folder;
+  /// Keep each frame's colour as a JPEG. Off by default: the repair re-integrates geometry and
+  /// labels, colour is cosmetic and costs bytes on every frame.
+  bool store_color = false;
+  /// JPEG quality of the stored colour, 1..100 (only with store_color).
+  int color_quality = 50;
+  /// zlib level of the depth and label PNGs, 0..9 (lossless at every level): 6 keeps a
+  /// 7-Scenes frame within the 150 kB budget, 1 encodes twice as fast but does not
+  /// (docs/LOOP_CLOSURE.md, panmap-bench-frame-store).
+  int png_compression = 6;
+  /// Throws Error naming the bad field.
+  void check() const;
+};
+
+/// One frame as the store gives it back: exactly what was integrated, to re-integrate it at a
+/// corrected pose.
+struct StoredFrame {
+  /// utime, camera (intrinsics), depth_scale_m, depth (as integrated, lossless) and colour
+  /// (decoded JPEG, empty when not stored). frame_id and camera_name are not stored.
+  RgbdFrame rgbd;
+  /// T_W_C (camera to world, optical frame) the frame was last integrated with: the pose
+  /// given to add(), or the latest updatePose(); exact to the last bit of each double.
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+  /// Per pixel the super-point label it voted for (as assigned when integrated, merges not
+  /// resolved), 0 = none; lossless for every int32.
+  LabelImage labels;
+};
+
+/// The frames a map was built from, on disk, so that a loop closure can re-integrate them at
+/// their corrected poses (docs/LOOP_CLOSURE.md).
+///
+/// Layout of the folder: `index.txt` (a version line, then one line per added frame and per
+/// pose update, each ending in its CRC-32) and `frames/<utime>.depth.png` (16-bit, as
+/// integrated), `.labels.png` (label bits 0-23, COCO panoptic RGB), `.labels-hi.png` (bits
+/// 24-31, only when some label needs them) and `.color.jpg` (store_color only). Each file is
+/// written atomically (AtomicFileWriter) before the frame's index line is appended and synced,
+/// so a crash at any moment leaves whole frames, a frame missing from the index, or a cut last
+/// index line, which reopening names and drops.
+///
+/// Thread-safety: every member function may be called from several threads at once. A mutex
+/// guards the index; encoding, decoding and file writes run outside it, so add() and load()
+/// of different frames overlap.
+class FrameStore {
+ public:
+  /// How much of each frame reopening checks.
+  enum class Check {
+    kSizes,     ///< every file exists with the size the index gives (stat only)
+    kContents,  ///< and its bytes have the CRC-32 the index gives (reads every file)
+  };
+
+  /// Opens the store in config.folder, creating the folder and an empty index when there is
+  /// none, and reading the frames already there otherwise (as open() does, with kContents);
+  /// added frames use this config's colour settings. Throws Error when the config is invalid,
+  /// the folder is empty (store off) or cannot be created, or the index is not a frame store's.
+  explicit FrameStore(const FrameStoreConfig& config);
+  /// Closes the index.
+  ~FrameStore();
+  FrameStore(const FrameStore&) = delete;
+  FrameStore& operator=(const FrameStore&) = delete;
+
+  /// Reopens the store in `folder`: rebuilds the frame list from its index, checks each
+  /// frame's files, and keeps every frame that passes. A frame whose files are missing, cut or
+  /// corrupt, or whose index line is, is named in problems() and left out; a cut last index
+  /// line (a crash while adding) is removed from the file. Throws Error naming the folder when
+  /// there is no store there or its index is not a frame store's (version line).
+  /// @param config_template colour settings for frames added after reopening (folder ignored)
+  static std::unique_ptr<FrameStore> open(const std::string& folder, Check check = Check::kContents,
+                                          const FrameStoreConfig& config_template = {});
+
+  /// Stores one integrated frame. Throws Error, storing nothing, when the utime is already
+  /// stored (a corrected pose goes through updatePose()), the camera is invalid, an image size
+  /// differs from the camera's, depth_scale_m is not positive, the pose is not a finite rigid
+  /// transform, or a file cannot be written.
+  /// @param utime the frame's capture time, microseconds (its key in the store)
+  /// @param T_W_C camera-to-world pose (optical frame) it was integrated with
+  /// @param camera depth camera intrinsics it was integrated with
+  /// @param depth_scale_m metres per depth unit
+  /// @param depth depth image as integrated, in depth_scale_m units
+  /// @param labels super-point label per pixel it voted for, 0 = none
+  /// @param color registered colour, or null; stored only when config.store_color
+  void add(int64_t utime, const Eigen::Isometry3d& T_W_C, const PinholeCamera& camera,
+           double depth_scale_m, const DepthImage& depth, const LabelImage& labels,
+           const ColorImage* color = nullptr);
+  /// add() with the frame's utime, camera, depth scale, depth and colour (if any).
+  /// @param T_W_C camera-to-world pose (optical frame) it was integrated with
+  void add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const LabelImage& labels);
+
+  /// Records that a frame is now integrated at T_W_C (a repair moved it); durable on return.
+  /// Throws Error naming the utime when it is not stored, or when the pose is not rigid.
+  /// @param T_W_C camera-to-world pose (optical frame) of the re-integration
+  void updatePose(int64_t utime, const Eigen::Isometry3d& T_W_C);
+
+  /// Reads and decodes one frame. Throws Error naming the utime when it is not stored, and
+  /// naming the file when one is missing, corrupt or differs from its checksum.
+  StoredFrame load(int64_t utime) const;
+
+  /// Number of frames stored.
+  size_t size() const;
+  /// The stored frames' utimes, increasing.
+  std::vector<int64_t> utimes() const;
+  /// Each stored frame's current pose by utime, increasing (frame_id -1, source unknown): the
+  /// trajectory applyCorrection() takes.
+  std::vector<StampedPose> trajectory() const;
+  /// Bytes of the stored frames' files plus the index.
+  uint64_t bytesOnDisk() const;
+  /// What opening found wrong, one line each (a frame left out, a cut or corrupt index line).
+  std::vector<std::string> problems() const;
+  /// Frames named in problems() and left out when opening.
+  size_t skipped() const;
+  /// The config in use.
+  const FrameStoreConfig& config() const { return config_; }
+
+  /// Bytes of one frame's files, as add() wrote them (for measurements).
+  struct FrameBytes {
+    uint64_t depth = 0;
+    uint64_t labels = 0;  ///< both label planes
+    uint64_t color = 0;
+    uint64_t total() const { return depth + labels + color; }
+  };
+  /// The file sizes of a stored frame; throws Error naming the utime when it is not stored.
+  FrameBytes frameBytes(int64_t utime) const;
+
+ private:
+  /// A stored file: its bytes and CRC-32 (size 0: no file).
+  struct FileRecord {
+    uint64_t size = 0;
+    uint32_t crc = 0;
+  };
+  /// Everything the index says about one frame.
+  struct Entry {
+    Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+    PinholeCamera camera;
+    double depth_scale_m = 0.0;
+    FileRecord depth, labels, labels_hi, color;
+  };
+
+  FrameStore(const FrameStoreConfig& config, bool create, Check check);
+  void readIndex(Check check);
+  void appendIndexLine(const std::string& line);
+  std::string framePath(int64_t utime, const char* suffix) const;
+  std::string checkFiles(int64_t utime, const Entry& entry, Check check) const;
+
+  FrameStoreConfig config_;
+  std::string index_path_;
+  mutable std::mutex mutex_;  ///< guards everything below
+  int index_fd_ = -1;
+  std::map<int64_t, Entry> entries_;
+  std::set<int64_t> pending_;  ///< utimes being added (files written, index line not yet)
+  uint64_t frame_bytes_ = 0;   ///< files of the entries
+  uint64_t index_bytes_ = 0;
+  std::vector<std::string> problems_;
+  size_t skipped_ = 0;
+};
+
+}  // namespace panmap
