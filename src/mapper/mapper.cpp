@@ -97,7 +97,9 @@ MeshUpdate Mapper::updateMesh(const GraphLabels* labels) {
     if (next != all.end() && next->first == update.blocks[i]) {
       update.meshes[i] = std::move((next++)->second);
     } else {
-      update.meshes[i] = labelBlockMesh(*map_, *mesher_->find(update.blocks[i]), labellers[0]);
+      // A block dropped by a rebuild and not meshed since has no surface any more.
+      const BlockMesh* mesh = mesher_->find(update.blocks[i]);
+      if (mesh) update.meshes[i] = labelBlockMesh(*map_, *mesh, labellers[0]);
     }
   }
   return update;

@@ -34,9 +34,13 @@ void IncrementalMesher::rebuild(const TsdfMap& map) {
 
 std::vector<BlockIndex> IncrementalMesher::takeChangedBlocks() {
   std::vector<BlockIndex> out;
-  out.reserve(changed_.size());
+  out.reserve(changed_.size() + dropped_.size());
   for (uint64_t key : changed_) out.push_back(meshes_.at(key).index);
+  for (const auto& [key, index] : dropped_) {
+    if (!changed_.contains(key)) out.push_back(index);
+  }
   changed_.clear();
+  dropped_.clear();
   std::sort(out.begin(), out.end(), blockIndexLess);
   return out;
 }
@@ -46,9 +50,16 @@ const BlockMesh* IncrementalMesher::find(const BlockIndex& index) const {
   return it == meshes_.end() ? nullptr : &it->second;
 }
 
+void IncrementalMesher::invalidateAll() {
+  for (const auto& [key, mesh] : meshes_) dropped_.emplace(key, mesh.index);
+  meshes_.clear();
+  changed_.clear();
+}
+
 void IncrementalMesher::clear() {
   meshes_.clear();
   changed_.clear();
+  dropped_.clear();
   last_remeshed_ = 0;
   total_remeshed_ = 0;
 }

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -106,6 +107,26 @@ struct FrameStats {
   }
 };
 
+/// Loads an integrated frame again for re-integration: its RGB-D data (with the utime asked
+/// for) and the super-point label each pixel voted for (empty: geometry only). Throws Error
+/// naming the frame when it cannot.
+using FrameLoader = std::function<void(int64_t utime, RgbdFrame* frame, LabelImage* labels)>;
+
+/// Called after each re-integrated frame with (frames done, frames in all); returning false
+/// abandons the re-integration (a newer correction supersedes it), leaving the map as it was.
+using ReintegrationProgress = std::function<bool(size_t done, size_t total)>;
+
+/// What Mapper::reintegrate() did.
+struct ReintegrationStats {
+  bool completed = false;      ///< false: abandoned through the progress callback, map unchanged
+  size_t frames = 0;           ///< frames re-integrated
+  size_t frames_moved = 0;     ///< of those, frames whose pose changed
+  size_t blocks_before = 0;    ///< TSDF blocks before
+  size_t blocks_after = 0;     ///< and after
+  uint64_t votes_evicted = 0;  ///< label votes that pushed out a weaker one while rebuilding
+  double seconds = 0.0;        ///< wall time
+};
+
 /// The mapping core: takes (RGB-D frame, T_W_C, panoptic segmentation) and keeps a label-TSDF
 /// whose voxels belong to semantically consistent super-points. No middleware inside.
 class Mapper {
@@ -152,6 +173,23 @@ class Mapper {
   const std::array<int64_t, kAlignmentStatusCount>& trackingCounts() const {
     return tracking_counts_;
   }
+
+  /// The super-point label each pixel of the last integrated frame voted for (0 = none): what
+  /// a frame store keeps so that the frame can be re-integrated at a corrected pose.
+  const LabelImage& lastPixelLabels() const { return association_.pixel_labels; }
+
+  /// Rebuilds the label-TSDF and the occupancy map from every integrated frame at new poses: the
+  /// repair after a loop closure (docs/LOOP_CLOSURE.md). Each frame votes again for the
+  /// super-points it voted for (merges since are resolved as always), so super-point ids,
+  /// their frame counts, co-observations and the graph survive, and objects move with their
+  /// surfaces. The new maps are built aside and swapped in at the end: when a frame cannot
+  /// be loaded (Error) or the progress callback abandons the work, the map is unchanged.
+  /// The next updateMesh() lists every block, those without surface any more as empty.
+  /// @param poses the new pose of every frame of trajectory(), same order and utimes
+  /// @param load gives each frame back by its utime
+  /// @param progress optional; see ReintegrationProgress
+  ReintegrationStats reintegrate(const std::vector<StampedPose>& poses, const FrameLoader& load,
+                                 const ReintegrationProgress& progress = {});
 
   /// The labelled mesh of the current map: marching cubes re-run only on changed blocks;
   /// per vertex the super-point (argmax of its voxel's votes, merges resolved), and the

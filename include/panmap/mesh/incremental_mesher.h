@@ -46,7 +46,8 @@ class IncrementalMesher {
   /// triggered them (an export between two calls loses nothing).
   std::vector<BlockIndex> takeChangedBlocks();
 
-  /// The stored mesh of a block, or null when the block was never meshed.
+  /// The stored mesh of a block, or null when the block was never meshed (or was dropped by
+  /// invalidateAll() and not meshed since).
   const BlockMesh* find(const BlockIndex& index) const;
 
   /// Blocks re-meshed by the last update() or rebuild().
@@ -57,6 +58,10 @@ class IncrementalMesher {
   size_t numBlockMeshes() const { return meshes_.size(); }
   /// Forgets every block mesh: the next update() meshes the whole map.
   void clear();
+  /// Forgets every block mesh, for a map that was rebuilt: the next update() meshes the whole
+  /// map, and takeChangedBlocks() also lists the blocks meshed before (those the new map does
+  /// not mesh come back with an empty mesh), so a viewer drops what moved away.
+  void invalidateAll();
   /// The config in use.
   const MarchingCubesConfig& config() const { return config_; }
 
@@ -66,8 +71,9 @@ class IncrementalMesher {
 
   MarchingCubesConfig config_;
   ThreadPool* pool_;
-  absl::flat_hash_map<uint64_t, BlockMesh> meshes_;  // by TsdfMap::key of the block
-  absl::flat_hash_set<uint64_t> changed_;            // re-meshed since takeChangedBlocks()
+  absl::flat_hash_map<uint64_t, BlockMesh> meshes_;    // by TsdfMap::key of the block
+  absl::flat_hash_set<uint64_t> changed_;              // re-meshed since takeChangedBlocks()
+  absl::flat_hash_map<uint64_t, BlockIndex> dropped_;  // meshed before invalidateAll()
   size_t last_remeshed_ = 0;
   uint64_t total_remeshed_ = 0;
 };

@@ -1,0 +1,231 @@
+#include <array>
+#include <cstring>
+#include <map>
+#include <set>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "box_scene.h"
+#include "panmap/core/error.h"
+#include "panmap/io/atomic_file.h"
+#include "panmap/mapper/mapper.h"
+#include "test_helpers.h"
+
+namespace panmap {
+namespace {
+
+// What a frame store would keep of each integrated frame: the frame and its pixel labels.
+struct Recorded {
+  RgbdFrame frame;
+  LabelImage labels;
+};
+
+class Reintegration : public BoxScene {
+ protected:
+  // Maps `frames` frames, keeping each one as a frame store would.
+  std::unique_ptr<Mapper> record(int frames) {
+    auto mapper = std::make_unique<Mapper>(config());
+    for (int k = 0; k < frames; ++k) {
+      Recorded r;
+      PanopticFrame panoptic;
+      frameAt(k, &r.frame, &panoptic);
+      mapper->integrate(r.frame, pose(k), &panoptic);
+      r.labels = mapper->lastPixelLabels();
+      stored_[r.frame.utime] = r;
+    }
+    return mapper;
+  }
+  FrameLoader loader() const {
+    return [this](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
+      const auto it = stored_.find(utime);
+      if (it == stored_.end()) throw Error("no stored frame of utime " + std::to_string(utime));
+      *frame = it->second.frame;
+      *labels = it->second.labels;
+    };
+  }
+  // The trajectory moved by a world-frame correction D (new pose = D * old pose).
+  static std::vector<StampedPose> moved(const Mapper& mapper, const Eigen::Isometry3d& D) {
+    std::vector<StampedPose> poses = mapper.trajectory();
+    for (StampedPose& p : poses) p.T_W_C = D * p.T_W_C;
+    return poses;
+  }
+  static std::vector<uint8_t> bytes(const Mapper& mapper) { return mapper.serialize(); }
+
+  std::map<int64_t, Recorded> stored_;
+};
+
+// The voxel at global voxel coordinates, or null when its block is not allocated.
+const Voxel* voxelAt(const TsdfMap& map, const Eigen::Vector3i& global) {
+  auto floorDiv = [](int a) {
+    return a >= 0 ? a / kBlockSide : -((-a + kBlockSide - 1) / kBlockSide);
+  };
+  const BlockIndex block(floorDiv(global.x()), floorDiv(global.y()), floorDiv(global.z()));
+  const Block* b = map.findBlock(block);
+  if (!b) return nullptr;
+  const Eigen::Vector3i local = global - block * kBlockSide;
+  return &b->at(local.x(), local.y(), local.z());
+}
+
+TEST_F(Reintegration, AtTheSamePosesTheMapIsRebuiltBitForBit) {
+  auto mapper = record(6);
+  const std::vector<uint8_t> before = bytes(*mapper);
+  const ReintegrationStats stats = mapper->reintegrate(mapper->trajectory(), loader());
+  EXPECT_TRUE(stats.completed);
+  EXPECT_EQ(stats.frames, 6u);
+  EXPECT_EQ(stats.frames_moved, 0u);
+  EXPECT_EQ(stats.blocks_after, stats.blocks_before);
+  // Same TSDF, votes, colours, occupancy, super-points and trajectory: the same map file.
+  EXPECT_EQ(bytes(*mapper), before);
+}
+
+TEST_F(Reintegration, ARigidCorrectionMovesExactlyTheSurfaces) {
+  auto mapper = record(6);
+  auto reference = record(6);
+  const float voxel_m = mapper->map().voxelSize();
+  // One block (8 voxels) along x: every voxel's content should reappear one block further (a
+  // shift by part of a block would change which blocks the truncation band allocates).
+  Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
+  D.translation() = Eigen::Vector3d(kBlockSide * voxel_m, 0.0, 0.0);
+  const ReintegrationStats stats = mapper->reintegrate(moved(*mapper, D), loader());
+  ASSERT_TRUE(stats.completed);
+  EXPECT_EQ(stats.frames_moved, 6u);
+  // Every observed voxel one block on, with the same distance, weight and votes up to float
+  // noise: the shift changes the rounding of each voxel centre, so a voxel at the edge of a
+  // pixel or a point at the face of a voxel may land next door (0.4 % here, bound 1 %).
+  size_t compared = 0, missing = 0, sdf_off = 0, weight_off = 0, votes_off = 0;
+  for (const auto& block : reference->map().blocks()) {
+    for (int i = 0; i < kBlockVoxels; ++i) {
+      const Voxel& a = block->voxels[i];
+      if (a.weight <= 0.0f) continue;
+      const Eigen::Vector3i local(i % kBlockSide, (i / kBlockSide) % kBlockSide,
+                                  i / (kBlockSide * kBlockSide));
+      const Voxel* b = voxelAt(
+          mapper->map(), block->index * kBlockSide + local + Eigen::Vector3i(kBlockSide, 0, 0));
+      ++compared;
+      if (!b) {
+        ++missing;
+      } else if (std::abs(b->sdf_m - a.sdf_m) > 1e-4f) {
+        ++sdf_off;
+      } else if (std::abs(b->weight - a.weight) > 1e-4f * a.weight) {
+        ++weight_off;
+      } else if (std::memcmp(a.votes, b->votes, sizeof(a.votes)) != 0) {
+        ++votes_off;
+      }
+    }
+  }
+  EXPECT_GT(compared, 10000u);
+  const size_t differing = missing + sdf_off + weight_off + votes_off;
+  EXPECT_EQ(missing, 0u);
+  EXPECT_LE(differing, compared / 100)
+      << compared << " voxels: " << missing << " missing, " << sdf_off << " distance, "
+      << weight_off << " weight, " << votes_off << " votes";
+  // The mesh moved with the voxels, its super-points and classes with it.
+  const LabelledMesh a = reference->extractMesh(), b = mapper->extractMesh();
+  std::map<std::array<int, 3>, std::array<int32_t, 2>> shifted;
+  for (size_t v = 0; v < a.numVertices(); ++v) {
+    const Eigen::Vector3f p = a.vertices[v] + Eigen::Vector3f(kBlockSide * voxel_m, 0.0f, 0.0f);
+    shifted[{static_cast<int>(std::lround(p.x() / 1e-4f)),
+             static_cast<int>(std::lround(p.y() / 1e-4f)),
+             static_cast<int>(std::lround(p.z() / 1e-4f))}] = {a.superpoint[v], a.semantic[v]};
+  }
+  size_t found = 0, same_labels = 0;
+  for (size_t v = 0; v < b.numVertices(); ++v) {
+    const auto it = shifted.find({static_cast<int>(std::lround(b.vertices[v].x() / 1e-4f)),
+                                  static_cast<int>(std::lround(b.vertices[v].y() / 1e-4f)),
+                                  static_cast<int>(std::lround(b.vertices[v].z() / 1e-4f))});
+    if (it == shifted.end()) continue;
+    ++found;
+    same_labels += it->second == std::array<int32_t, 2>{b.superpoint[v], b.semantic[v]};
+  }
+  EXPECT_GE(found, b.numVertices() * 999 / 1000) << found << " of " << b.numVertices();
+  EXPECT_GE(same_labels, found * 99 / 100);
+  // The trajectory now holds the corrected poses.
+  for (size_t i = 0; i < mapper->trajectory().size(); ++i) {
+    EXPECT_TRUE(
+        mapper->trajectory()[i].T_W_C.isApprox(D * reference->trajectory()[i].T_W_C, 1e-12));
+  }
+}
+
+TEST_F(Reintegration, TheLiveMeshDropsWhatMovedAway) {
+  auto mapper = record(6);
+  std::map<std::array<int, 3>, LabelledMesh> view;
+  auto apply = [&view](const MeshUpdate& update) {
+    for (size_t i = 0; i < update.blocks.size(); ++i) {
+      const BlockIndex& b = update.blocks[i];
+      view[{b.x(), b.y(), b.z()}] = update.meshes[i];
+    }
+  };
+  apply(mapper->updateMesh());
+  Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
+  D.translation() = Eigen::Vector3d(0.0, 0.0, 0.5);  // half a metre up: most blocks change
+  ASSERT_TRUE(mapper->reintegrate(moved(*mapper, D), loader()).completed);
+  apply(mapper->updateMesh());
+  // What the viewer holds is exactly the new mesh: nothing left where the surfaces were.
+  std::set<std::array<float, 3>> held, exported;
+  for (const auto& [key, mesh] : view) {
+    for (const Eigen::Vector3f& p : mesh.vertices) held.insert({p.x(), p.y(), p.z()});
+  }
+  const LabelledMesh whole = mapper->extractMesh();
+  for (const Eigen::Vector3f& p : whole.vertices) exported.insert({p.x(), p.y(), p.z()});
+  EXPECT_GT(exported.size(), 1000u);
+  EXPECT_EQ(held, exported);
+}
+
+TEST_F(Reintegration, FailureOrAbandonLeavesTheMapAsItWas) {
+  auto mapper = record(5);
+  const std::vector<uint8_t> before = bytes(*mapper);
+  Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
+  D.translation() = Eigen::Vector3d(0.1, 0.0, 0.0);
+  const std::vector<StampedPose> poses = moved(*mapper, D);
+
+  // Abandoned after 3 of 5 frames (a newer correction arrived).
+  std::vector<size_t> seen;
+  const ReintegrationStats abandoned =
+      mapper->reintegrate(poses, loader(), [&seen](size_t done, size_t total) {
+        EXPECT_EQ(total, 5u);
+        seen.push_back(done);
+        return done < 3;
+      });
+  EXPECT_FALSE(abandoned.completed);
+  EXPECT_EQ(seen, (std::vector<size_t>{1, 2, 3}));
+  EXPECT_EQ(bytes(*mapper), before);
+
+  // A frame that cannot be loaded: the error names it.
+  stored_.erase(std::next(stored_.begin(), 2));
+  try {
+    mapper->reintegrate(poses, loader());
+    FAIL() << "a missing frame was not reported";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("utime 66666"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(bytes(*mapper), before);
+
+  // Poses that do not match the trajectory, or are not rigid.
+  std::vector<StampedPose> short_list(poses.begin(), poses.end() - 1);
+  EXPECT_THROW(mapper->reintegrate(short_list, loader()), Error);
+  std::vector<StampedPose> renamed = poses;
+  renamed[1].utime += 1;
+  EXPECT_THROW(mapper->reintegrate(renamed, loader()), Error);
+  std::vector<StampedPose> scaled = poses;
+  scaled[0].T_W_C.linear() *= 1.5;
+  EXPECT_THROW(mapper->reintegrate(scaled, loader()), Error);
+  EXPECT_THROW(mapper->reintegrate(poses, FrameLoader()), Error);
+  EXPECT_EQ(bytes(*mapper), before);
+}
+
+TEST_F(Reintegration, ASavedMapKeepsWhatTheNextRepairNeeds) {
+  auto mapper = record(5);
+  test::TempDir dir;
+  mapper->save(dir.path("map.panmap"));
+  auto loaded = Mapper::load(dir.path("map.panmap"));
+  Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
+  D.linear() = Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  D.translation() = Eigen::Vector3d(0.04, -0.02, 0.0);
+  ASSERT_TRUE(mapper->reintegrate(moved(*mapper, D), loader()).completed);
+  ASSERT_TRUE(loaded->reintegrate(moved(*loaded, D), loader()).completed);
+  EXPECT_EQ(bytes(*loaded), bytes(*mapper));
+}
+
+}  // namespace
+}  // namespace panmap
