@@ -1,0 +1,47 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "panmap/loop/frame_store.h"
+#include "panmap/loop/pose_correction.h"
+#include "panmap/mapper/mapper.h"
+
+namespace panmap {
+
+/// How a correction is turned into a repair.
+struct MapRepairConfig {
+  /// A corrected utime matches the mapped frame nearest in time within this, microseconds
+  /// (0: exactly; a back-end that republishes the utimes it was given needs no more).
+  int64_t match_tolerance_us = 0;
+  /// Throws Error naming the bad field.
+  void check() const;
+};
+
+/// What one repair did.
+struct MapRepairResult {
+  int64_t correction_id = 0;
+  int matched = 0;                      ///< corrected utimes that matched a mapped frame
+  std::vector<int64_t> unknown_utimes;  ///< corrected utimes of no mapped frame: not used
+  double max_translation_m = 0.0;       ///< largest move of a camera centre
+  double max_rotation_rad = 0.0;        ///< largest turn of a camera
+  ReintegrationStats reintegration;     ///< completed = false: abandoned, map unchanged
+};
+
+/// The repair after a loop closure (docs/LOOP_CLOSURE.md): spreads the correction over every
+/// mapped frame (applyCorrection), re-integrates the frames from the store at their new poses
+/// (Mapper::reintegrate) and records the new poses in the store, so that the next correction
+/// starts from them. Throws Error, changing nothing, when the correction is invalid, when none
+/// of its utimes is a mapped frame (named), or when a mapped frame is missing from the store.
+/// Corrected utimes that match no frame are returned, never guessed.
+/// @param progress optional; returning false abandons the repair (map and store unchanged)
+MapRepairResult repairMap(Mapper* mapper, FrameStore* store, const PoseCorrection& correction,
+                          const MapRepairConfig& config = {},
+                          const ReintegrationProgress& progress = {});
+
+/// One line for logs and the status channel: "correction 7: 12 of 13 poses matched (unknown
+/// utime 123), 600 frames re-integrated in 4.1 s, largest move 0.21 m / 3.2 deg".
+std::string describe(const MapRepairResult& result);
+
+}  // namespace panmap

@@ -1,0 +1,76 @@
+#include "panmap/loop/map_repair.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "panmap/core/error.h"
+
+namespace panmap {
+
+void MapRepairConfig::check() const {
+  if (match_tolerance_us < 0) throw Error("map repair match_tolerance_us must be >= 0");
+}
+
+MapRepairResult repairMap(Mapper* mapper, FrameStore* store, const PoseCorrection& correction,
+                          const MapRepairConfig& config, const ReintegrationProgress& progress) {
+  config.check();
+  const std::string name = "correction " + std::to_string(correction.correction_id);
+  try {
+    correction.check();
+  } catch (const Error& e) {
+    throw Error(name + ": " + e.what());
+  }
+  const CorrectedTrajectory corrected =
+      applyCorrection(mapper->trajectory(), correction, config.match_tolerance_us);
+  MapRepairResult result;
+  result.correction_id = correction.correction_id;
+  result.matched = corrected.matched;
+  result.unknown_utimes = corrected.unknown_utimes;
+  result.max_translation_m = corrected.max_translation_m;
+  result.max_rotation_rad = corrected.max_rotation_rad;
+  if (corrected.matched == 0) {
+    throw Error(name + ": none of its " + std::to_string(correction.poses.size()) +
+                " utimes is a mapped frame (first " +
+                std::to_string(correction.poses.front().utime) + ")");
+  }
+  const FrameLoader load = [store](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
+    StoredFrame stored = store->load(utime);
+    *frame = std::move(stored.rgbd);
+    *labels = std::move(stored.labels);
+  };
+  result.reintegration = mapper->reintegrate(corrected.poses, load, progress);
+  if (result.reintegration.completed) {
+    // Only what moved: the store's poses are the ones the frames are now integrated with.
+    for (size_t i = 0; i < corrected.poses.size(); ++i) {
+      if (corrected.translation_m[i] > 0.0 || corrected.rotation_rad[i] > 0.0) {
+        store->updatePose(corrected.poses[i].utime, corrected.poses[i].T_W_C);
+      }
+    }
+  }
+  return result;
+}
+
+std::string describe(const MapRepairResult& r) {
+  char line[256];
+  std::string unknown;
+  if (!r.unknown_utimes.empty()) {
+    unknown = " (unknown utime" + std::string(r.unknown_utimes.size() > 1 ? "s " : " ") +
+              std::to_string(r.unknown_utimes.front()) +
+              (r.unknown_utimes.size() > 1 ? ", ..." : "") + ")";
+  }
+  const int total = r.matched + static_cast<int>(r.unknown_utimes.size());
+  if (!r.reintegration.completed) {
+    std::snprintf(line, sizeof(line), "correction %lld: %d of %d poses matched%s, abandoned",
+                  static_cast<long long>(r.correction_id), r.matched, total, unknown.c_str());
+    return line;
+  }
+  std::snprintf(line, sizeof(line),
+                "correction %lld: %d of %d poses matched%s, %zu frames re-integrated (%zu moved) "
+                "in %.2f s, largest move %.3f m / %.2f deg",
+                static_cast<long long>(r.correction_id), r.matched, total, unknown.c_str(),
+                r.reintegration.frames, r.reintegration.frames_moved, r.reintegration.seconds,
+                r.max_translation_m, r.max_rotation_rad * 180.0 / M_PI);
+  return line;
+}
+
+}  // namespace panmap
