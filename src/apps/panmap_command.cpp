@@ -57,7 +57,12 @@ nlohmann::json statusJson(const panmap::status_t& s) {
           {"num_voxels", s.num_voxels},
           {"num_superpoints", s.num_superpoints},
           {"num_instances", s.num_instances},
-          {"vote_evictions", s.vote_evictions}};
+          {"vote_evictions", s.vote_evictions},
+          {"corrections_applied", s.corrections_applied},
+          {"last_correction_id", s.last_correction_id},
+          {"repair_frames_done", s.repair_frames_done},
+          {"repair_frames_total", s.repair_frames_total},
+          {"last_repair_s", s.last_repair_s}};
 }
 
 struct StatusCatcher {

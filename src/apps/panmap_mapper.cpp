@@ -23,6 +23,7 @@
 #include "panmap/lcm/live_mapper.h"
 #include "panmap/lcm/object_conversions.h"
 #include "panmap/lcm/offline_mapping.h"
+#include "panmap/loop/frame_store.h"
 #include "panmap/mapper/config_file.h"
 #include "panmap/mapper/graph_json.h"
 #include "panmap/mapper/objects.h"
@@ -46,7 +47,13 @@ nlohmann::json sessionJson(const panmap::SessionStats& s) {
           {"rejected", s.rejected},
           {"geometry_only_frames", s.sync.geometry_only},
           {"unmatched_panoptic", s.sync.unmatched_panoptic},
-          {"timings", timings}};
+          {"timings", timings},
+          {"corrections",
+           {{"received", s.corrections_received},
+            {"applied", s.corrections_applied},
+            {"frames_reintegrated", s.frames_reintegrated},
+            {"last_repair_s", s.last_repair_s},
+            {"repairs", s.repairs}}}};
 }
 
 nlohmann::json trackingJson(const panmap::Mapper& mapper) {
@@ -195,6 +202,12 @@ int main(int argc, char** argv) {
   app.add_option("--channel-rgbd", options.channel_rgbd)->capture_default_str();
   app.add_option("--channel-pose", options.channel_pose)->capture_default_str();
   app.add_option("--channel-panoptic", options.channel_panoptic)->capture_default_str();
+  app.add_option("--channel-correction", options.channel_correction)->capture_default_str();
+  std::string frame_store_dir;
+  app.add_option("--frame-store", frame_store_dir,
+                 "keep every integrated frame in this folder (depth and pixel labels, ~110 kB "
+                 "each) so that loop-closure corrections on --channel-correction repair the map "
+                 "(docs/LOOP_CLOSURE.md); without it corrections are refused and counted");
   app.add_flag("--no-snapshots", no_snapshots, "skip the overview PNGs");
   std::string graph_json;
   app.add_option("--graph-json", graph_json,
@@ -269,6 +282,22 @@ int main(int argc, char** argv) {
     } else {
       mapper = load_path.empty() ? std::make_unique<panmap::Mapper>(config)
                                  : panmap::Mapper::load(load_path);
+    }
+    std::unique_ptr<panmap::FrameStore> frame_store;
+    if (!frame_store_dir.empty() && !export_only) {
+      panmap::FrameStoreConfig store_config;
+      store_config.folder = frame_store_dir;
+      frame_store = std::make_unique<panmap::FrameStore>(store_config);
+      for (const std::string& problem : frame_store->problems()) {
+        std::fprintf(stderr, "panmap-mapper: frame store: %s\n", problem.c_str());
+      }
+      // A new map must not inherit frames of another run: a repair would re-integrate them.
+      if (frame_store->size() > 0 && load_path.empty() && resume_dir.empty()) {
+        throw panmap::Error("frame store " + frame_store_dir + " already holds " +
+                            std::to_string(frame_store->size()) +
+                            " frames; give an empty folder, or --load / --resume their map");
+      }
+      options.frame_store = frame_store.get();
     }
     // Offline runs can be replayed from their log, so they autosave only when asked to.
     const bool offline = !log_path.empty() || export_only;

@@ -37,8 +37,19 @@ LiveMapper::LiveMapper(lcm::LCM* lcm, const LiveOptions& options, Mapper* mapper
   options_.check();
   if (hook) session_.setFrameHook(std::move(hook));
   if (!lcm_ || !lcm_->good()) throw Error("LCM is not ready");
-  for (const std::string& channel : {options_.session.channel_rgbd, options_.session.channel_pose,
-                                     options_.session.channel_panoptic}) {
+  // Repairs run on the worker: the status says so while frames wait in the queue.
+  session_.setRepairHook([this](const SessionStats& s) {
+    const auto now = std::chrono::steady_clock::now();
+    if (s.repair_frames_done < s.repair_frames_total &&
+        now - last_repair_status_ < std::chrono::duration<double>(options_.status_period_s)) {
+      return;
+    }
+    last_repair_status_ = now;
+    publishStatus("repairing");
+  });
+  for (const std::string& channel :
+       {options_.session.channel_rgbd, options_.session.channel_pose,
+        options_.session.channel_panoptic, options_.session.channel_correction}) {
     subscriptions_.push_back(lcm_->subscribe(channel, &LiveMapper::onInput, this));
   }
   subscriptions_.push_back(lcm_->subscribe(options_.channel_command, &LiveMapper::onCommand, this));
@@ -226,6 +237,11 @@ status_t LiveMapper::status(const std::string& state) const {
   msg.num_superpoints = static_cast<int32_t>(mapper_->superpoints().states().size());
   msg.num_instances = mapper_->superpoints().numInstances();
   msg.vote_evictions = static_cast<int64_t>(mapper_->voteEvictions());
+  msg.corrections_applied = s.corrections_applied;
+  msg.last_correction_id = s.last_correction_id;
+  msg.repair_frames_done = s.repair_frames_done;
+  msg.repair_frames_total = s.repair_frames_total;
+  msg.last_repair_s = static_cast<float>(s.last_repair_s);
   return msg;
 }
 

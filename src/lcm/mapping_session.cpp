@@ -1,10 +1,12 @@
 #include "panmap/lcm/mapping_session.h"
 
 #include <algorithm>
+#include <chrono>
 
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
 #include "panmap/lcm/conversions.h"
+#include "panmap/lcm/correction_conversions.h"
 #include "panmap/lcm/decode.h"
 
 namespace panmap {
@@ -47,13 +49,23 @@ void MappingSession::sanitise(PanopticFrame* panoptic) {
 bool MappingSession::handle(const std::string& channel, const void* data, size_t size,
                             int64_t now_utime) {
   if (channel != options_.channel_rgbd && channel != options_.channel_pose &&
-      channel != options_.channel_panoptic) {
+      channel != options_.channel_panoptic && channel != options_.channel_correction) {
     return false;
   }
   ++stats_.messages;
   if (done_) return true;
   try {
-    if (channel == options_.channel_rgbd) {
+    if (channel == options_.channel_correction) {
+      pose_correction_t msg;
+      if (!decodeExactly(data, size, &msg)) {
+        ++stats_.rejected["malformed " + channel];
+        return true;
+      }
+      const PoseCorrection correction = fromMessage(msg);
+      ++stats_.corrections_received;
+      repair(correction);
+      return true;
+    } else if (channel == options_.channel_rgbd) {
       rgbd_frame_t msg;
       if (!decodeExactly(data, size, &msg)) {
         ++stats_.rejected["malformed " + channel];
@@ -95,6 +107,49 @@ bool MappingSession::handle(const std::string& channel, const void* data, size_t
   return true;
 }
 
+void MappingSession::repair(const PoseCorrection& correction) {
+  if (!options_.frame_store) {
+    ++stats_.rejected["correction: no frame store (panmap-mapper --frame-store)"];
+    return;
+  }
+  if (stats_.corrections_applied > 0 && correction.correction_id <= stats_.last_correction_id) {
+    ++stats_.rejected["correction: not newer than the last one applied"];
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  stats_.repair_frames_done = 0;
+  stats_.repair_frames_total = static_cast<int64_t>(mapper_->trajectory().size());
+  auto progress = [this](size_t done, size_t total) {
+    stats_.repair_frames_done = static_cast<int64_t>(done);
+    stats_.repair_frames_total = static_cast<int64_t>(total);
+    if (repair_hook_) repair_hook_(stats());
+    return true;
+  };
+  try {
+    const MapRepairResult result =
+        repairMap(mapper_, options_.frame_store, correction, options_.repair, progress);
+    if (!result.unknown_utimes.empty()) {
+      stats_.rejected["correction: utime of no mapped frame"] +=
+          static_cast<int64_t>(result.unknown_utimes.size());
+    }
+    stats_.repairs.push_back(describe(result));
+    if (result.reintegration.completed) {
+      ++stats_.corrections_applied;
+      stats_.last_correction_id = correction.correction_id;
+      stats_.frames_reintegrated += static_cast<int64_t>(result.reintegration.frames);
+      stats_.last_repair_s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+  } catch (const Error& e) {
+    // "correction 7: none of its ... (first 123)": counted by what went wrong.
+    const std::string what = e.what();
+    const auto colon = what.find(": ");
+    const std::string rest = colon == std::string::npos ? what : what.substr(colon + 2);
+    ++stats_.rejected["correction: " + reasonOf(rest.substr(0, rest.find(" (")))];
+    stats_.repairs.push_back(what);
+  }
+}
+
 void MappingSession::flush() {
   if (!done_) integrate(sync_.flush());
 }
@@ -108,6 +163,19 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
       for (const auto& [stage, ms] : s.stageTimes()) times_ms_[stage].push_back(ms);
       ++stats_.frames_integrated;
       stats_.last_frame_utime = std::max(stats_.last_frame_utime, f.frame.utime);
+      if (options_.frame_store) {
+        // The map holds the frame either way; a frame the store lacks makes a later repair
+        // fail by name, so the failure is counted now.
+        const auto start = std::chrono::steady_clock::now();
+        try {
+          options_.frame_store->add(f.frame, s.T_W_C, mapper_->lastPixelLabels());
+        } catch (const Error& e) {
+          ++stats_.rejected["frame store: " + reasonOf(e.what())];
+        }
+        times_ms_["frame_store"].push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count());
+      }
       if (options_.max_frames > 0 && stats_.frames_integrated >= options_.max_frames) done_ = true;
       if (hook_) {
         try {

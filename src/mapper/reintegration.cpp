@@ -78,7 +78,8 @@ ReintegrationStats Mapper::reintegrate(const std::vector<StampedPose>& poses,
   if (occupancy) occupancy_ = std::move(occupancy);
   mesher_->invalidateAll();
   for (size_t i = 0; i < poses.size(); ++i) trajectory_[i].T_W_C = poses[i].T_W_C;
-  vote_evictions_ += stats.votes_evicted;
+  // The evictions of building this map, which replaces the old one and its history.
+  vote_evictions_ = stats.votes_evicted;
   stats.completed = true;
   stats.blocks_after = map_->numBlocks();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -7,6 +7,7 @@
 #include <iterator>
 #include <limits>
 
+#include "panmap/lcm/correction_conversions.h"
 #include "panmap/lcm/mapping_session.h"
 #include "synthetic_stream.h"
 #include "test_helpers.h"
@@ -143,6 +144,90 @@ TEST_F(MappingSessionTest, MaxFramesStopsIntegration) {
   EXPECT_TRUE(session.done());
   EXPECT_EQ(session.stats().frames_integrated, 3);
   EXPECT_EQ(mapper.framesIntegrated(), 3);
+}
+
+// A loop-closure correction in the stream repairs the map from the frame store: the result is
+// the map the same frames give at the corrected poses; without a store it is refused, counted.
+TEST_F(MappingSessionTest, ACorrectionRepairsTheMapFromTheFrameStore) {
+  std::vector<test::Encoded> messages = stream_.messages();
+  // The back-end moves keyframe 6 by D; every frame follows (one keyframe corrected).
+  Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
+  D.linear() = Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  D.translation() = Eigen::Vector3d(0.03, 0.02, 0.0);
+  PoseCorrection correction;
+  correction.correction_id = 3;
+  StampedPose keyframe = stream_.poses[6];
+  keyframe.T_W_C = D * keyframe.T_W_C;
+  correction.poses.push_back(keyframe);
+  messages.push_back(encodeMessage(kChannelPoseCorrection, toMessage(correction)));
+
+  test::TempDir dir;
+  FrameStoreConfig store_config;
+  store_config.folder = dir.path("store");
+  FrameStore store(store_config);
+  SessionOptions options;
+  options.frame_store = &store;
+  Mapper mapper(test::streamMapperConfig());
+  MappingSession session(options, &mapper);
+  std::vector<int64_t> progress;
+  session.setRepairHook([&progress](const SessionStats& s) {
+    progress.push_back(s.repair_frames_done);
+    EXPECT_EQ(s.repair_frames_total, 12);
+  });
+  feed(&session, messages);
+  const SessionStats stats = session.stats();
+  EXPECT_EQ(stats.frames_integrated, 12);
+  EXPECT_EQ(store.size(), 12u);
+  EXPECT_EQ(stats.corrections_received, 1);
+  EXPECT_EQ(stats.corrections_applied, 1);
+  EXPECT_EQ(stats.last_correction_id, 3);
+  EXPECT_EQ(stats.frames_reintegrated, 12);
+  EXPECT_EQ(progress.size(), 12u);
+  ASSERT_EQ(stats.repairs.size(), 1u);
+  EXPECT_NE(stats.repairs[0].find("correction 3: 1 of 1 poses matched"), std::string::npos)
+      << stats.repairs[0];
+  EXPECT_EQ(stats.timings.count("frame_store"), 1u);
+  EXPECT_TRUE(stats.rejected.empty());
+
+  // The same frames mapped at the corrected poses, with the labels they voted with.
+  Mapper clean(test::streamMapperConfig());
+  MappingSession plain(SessionOptions{}, &clean);
+  feed(&plain, stream_.messages());
+  const FrameLoader load = [&store](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
+    StoredFrame stored = store.load(utime);
+    *frame = stored.rgbd;
+    *labels = stored.labels;
+  };
+  ASSERT_TRUE(clean.reintegrate(mapper.trajectory(), load).completed);
+  EXPECT_EQ(test::mapBytes(mapper), test::mapBytes(clean));
+  for (size_t k = 0; k < mapper.trajectory().size(); ++k) {
+    EXPECT_TRUE(mapper.trajectory()[k].T_W_C.isApprox(D * stream_.poses[k].T_W_C, 1e-9)) << k;
+  }
+
+  // The same correction again is stale; a newer one naming no mapped frame is refused.
+  PoseCorrection stranger = correction;
+  stranger.correction_id = 4;
+  stranger.poses[0].utime += 1;
+  const std::vector<test::Encoded> more = {
+      encodeMessage(kChannelPoseCorrection, toMessage(correction)),
+      encodeMessage(kChannelPoseCorrection, toMessage(stranger)),
+      {kChannelPoseCorrection, {1, 2, 3}}};
+  const std::string before = test::mapBytes(mapper);
+  feed(&session, more);
+  const SessionStats after = session.stats();
+  EXPECT_EQ(after.corrections_applied, 1);
+  EXPECT_EQ(after.rejected.at("correction: not newer than the last one applied"), 1);
+  EXPECT_EQ(after.rejected.at("correction: none of its 1 utimes is a mapped frame"), 1);
+  EXPECT_EQ(after.rejected.at("malformed PANMAP_POSE_CORRECTION"), 1);
+  EXPECT_EQ(test::mapBytes(mapper), before);
+
+  // Without a frame store the correction is refused and counted.
+  Mapper no_store(test::streamMapperConfig());
+  MappingSession without(SessionOptions{}, &no_store);
+  feed(&without, messages);
+  EXPECT_EQ(without.stats().rejected.at("correction: no frame store (panmap-mapper --frame-store)"),
+            1);
+  EXPECT_EQ(test::mapBytes(no_store), clean_);
 }
 
 }  // namespace

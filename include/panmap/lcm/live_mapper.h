@@ -1,6 +1,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -127,6 +128,7 @@ class LiveMapper {
   LiveOptions options_;
   Mapper* mapper_;
   MappingSession session_;
+  std::chrono::steady_clock::time_point last_repair_status_{};  // throttles "repairing"
   std::vector<lcm::Subscription*> subscriptions_;
   Publisher publisher_;
   CommandHandler command_handler_;

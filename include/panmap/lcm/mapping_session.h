@@ -7,6 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "panmap/lcm/channels.h"
+#include "panmap/loop/frame_store.h"
+#include "panmap/loop/map_repair.h"
 #include "panmap/mapper/frame_sync.h"
 #include "panmap/mapper/mapper.h"
 
@@ -17,7 +20,13 @@ struct SessionOptions {
   std::string channel_rgbd = "CAMERA_RGBD";
   std::string channel_pose = "CAMERA_POSE";
   std::string channel_panoptic = "PANOPTIC";
+  /// Loop-closure corrections (pose_correction_t); they repair the map from frame_store.
+  std::string channel_correction = kChannelPoseCorrection;
   SyncConfig sync;
+  /// Where every integrated frame is kept for loop-closure repairs (not owned); null: no
+  /// store, and corrections are refused (counted).
+  FrameStore* frame_store = nullptr;
+  MapRepairConfig repair;
   int64_t max_frames = 0;  ///< stop integrating after this many frames (0 = all)
   /// Frames at or before this utime are refused (counted): a resumed map already holds them.
   int64_t resume_after_utime = INT64_MIN;
@@ -39,13 +48,23 @@ struct SessionStats {
   std::map<std::string, int64_t> rejected;  ///< reason -> frames (or messages) refused
   SyncStats sync;
   std::map<std::string, StageTiming> timings;  ///< by stage name
+  int64_t corrections_received = 0;            ///< pose_correction_t messages that decoded
+  int64_t corrections_applied = 0;             ///< of those, repairs that completed
+  int64_t last_correction_id = 0;              ///< correction_id of the newest repair
+  int64_t frames_reintegrated = 0;             ///< frames re-integrated by all repairs
+  int64_t repair_frames_done = 0;              ///< progress of the repair running or last run
+  int64_t repair_frames_total = 0;             ///< frames it re-integrates
+  double last_repair_s = 0.0;                  ///< wall time of the last completed repair
+  std::vector<std::string> repairs;            ///< describe() of every repair, in order
 };
 
 /// One mapping run over a stream of LCM messages, the same for the offline reader and the
 /// live process so that both treat input identically: decodes each message (counting
-/// malformed ones), sanitises it, synchronises frames with poses and masks, and integrates
-/// the ready frames. Bad input is refused with a counted reason and never touches the map.
-/// Not thread-safe: one thread feeds it.
+/// malformed ones), sanitises it, synchronises frames with poses and masks, integrates
+/// the ready frames (keeping each in the frame store, if any), and repairs the map when a
+/// loop-closure correction arrives (synchronously: frames wait in the queues meanwhile). Bad input
+/// is refused with a counted reason and never touches the map. Not thread-safe: one thread feeds
+/// it.
 class MappingSession {
  public:
   /// Called after each integrated frame (e.g. to update the occupancy tree).
@@ -68,15 +87,21 @@ class MappingSession {
   SessionStats stats() const;
   /// Called after every integrated frame.
   void setFrameHook(FrameHook hook) { hook_ = std::move(hook); }
+  /// Called after every frame a repair re-integrates (e.g. to publish the status).
+  void setRepairHook(std::function<void(const SessionStats&)> hook) {
+    repair_hook_ = std::move(hook);
+  }
 
  private:
   void integrate(std::vector<SyncedFrame> ready);
   void sanitise(PanopticFrame* panoptic);
+  void repair(const PoseCorrection& correction);
 
   SessionOptions options_;
   Mapper* mapper_;
   FrameSynchronizer sync_;
   FrameHook hook_;
+  std::function<void(const SessionStats&)> repair_hook_;
   SessionStats stats_;
   std::map<std::string, std::vector<double>> times_ms_;
   int64_t newest_utime_ = INT64_MIN;
