@@ -11,7 +11,10 @@
 #include "panmap/core/error.h"
 #include "panmap/core/progress.h"
 #include "panmap/io/tum_trajectory.h"
+#include "panmap/lcm/channels.h"
+#include "panmap/lcm/correction_conversions.h"
 #include "panmap/lcm/log_import.h"
+#include "panmap/lcm/log_writer.h"
 #include "panmap/sim/pose_drift.h"
 
 namespace {
@@ -100,6 +103,13 @@ int main(int argc, char** argv) {
   app.add_option("--seed", drift_seed, "seed of the injected drift")
       ->needs(drift_option)
       ->capture_default_str();
+  size_t correction_every = 0;
+  app.add_option("--correction-every", correction_every,
+                 "with --drift: end the log with the loop-closure correction a SLAM back-end "
+                 "would publish on PANMAP_POSE_CORRECTION: the recorded poses of every Nth frame "
+                 "(keyframes) and of the last one (docs/LOOP_CLOSURE.md)")
+      ->needs(drift_option)
+      ->check(CLI::PositiveNumber);
   app.add_option("--reference", reference_path,
                  "with --drift: TUM file for the recorded poses (default: LOG minus .lcmlog + "
                  ".reference.txt); the drifted ones go to .input.txt beside it")
@@ -163,6 +173,22 @@ int main(int argc, char** argv) {
       std::printf("drift %s, seed %llu: recorded poses -> %s, drifted -> %s\n", drift.c_str(),
                   static_cast<unsigned long long>(drift_seed), reference_path.c_str(),
                   input_path.c_str());
+    }
+    if (correction_every > 0 && !s.recorded_poses.empty()) {
+      panmap::PoseCorrection correction;
+      correction.correction_id = 1;
+      const std::vector<panmap::StampedPose>& recorded = s.recorded_poses;
+      for (size_t i = 0; i < recorded.size(); ++i) {
+        if (i % correction_every == 0 || i + 1 == recorded.size()) {
+          correction.poses.push_back(recorded[i]);
+        }
+      }
+      // Published a second after the last frame, as a back-end does once it closes the loop.
+      correction.utime = recorded.back().utime + 1000000;
+      panmap::LogWriter writer(log_path, /*append=*/true);
+      writer.write(panmap::kChannelPoseCorrection, correction.utime, panmap::toMessage(correction));
+      std::printf("correction 1 on %s: recorded poses of %zu keyframes (every %zu frames)\n",
+                  panmap::kChannelPoseCorrection, correction.poses.size(), correction_every);
     }
     if (s.skipped_invalid_pose) {
       std::printf("skipped %zu frames with invalid poses (first: %s)\n", s.skipped_invalid_pose,

@@ -63,6 +63,10 @@ bool MappingSession::handle(const std::string& channel, const void* data, size_t
       }
       const PoseCorrection correction = fromMessage(msg);
       ++stats_.corrections_received;
+      // Frames that are ready by now go in first: the correction names frames up to its
+      // time, and the repair moves every frame the map holds.
+      newest_utime_ = std::max(newest_utime_, correction.utime);
+      integrate(sync_.popReady(now_utime >= 0 ? now_utime : newest_utime_));
       repair(correction);
       return true;
     } else if (channel == options_.channel_rgbd) {

@@ -1,9 +1,12 @@
 // panmap-import --drift: the recorded poses become the reference trajectory, the written ones
 // are exactly the drift model's estimate of them, flagged as SLAM poses.
 #include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include "panmap/io/dataset_reader.h"
 #include "panmap/io/tum_trajectory.h"
+#include "panmap/lcm/correction_conversions.h"
+#include "panmap/lcm/decode.h"
 #include "panmap/lcm/log_import.h"
 #include "panmap/sim/pose_drift.h"
 #include "test_helpers.h"
@@ -50,6 +53,42 @@ TEST(ImportDrift, ReferenceIsRecordedAndInputIsTheDriftModel) {
   EXPECT_EQ(stats.written_poses[2].source, PoseSource::kSlam);
   EXPECT_TRUE(stats.written_poses[2].T_W_C.isApprox(drifted[2], 1e-12));
   EXPECT_TRUE(stats.recorded_poses[2].T_W_C.isApprox(recorded[2], 1e-12));
+}
+
+TEST(ImportDrift, TheLogEndsWithTheCorrectionABackEndWouldPublish) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  const auto r = runCommand(binPath("panmap-import") +
+                            " --quiet --max-frames 12 --drift heavy --correction-every 5 " +
+                            test::dataDir("7scenes-200") + " " + dir.path("s.lcmlog"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::vector<StampedPose> reference = readTumTrajectory(dir.path("s.reference.txt"));
+  lcm::LogFile log(dir.path("s.lcmlog"), "r");
+  const lcm::LogEvent* last = nullptr;
+  int events = 0;
+  while (const lcm::LogEvent* e = log.readNextEvent()) {
+    ++events;
+    if (e->channel == "PANMAP_POSE_CORRECTION") {
+      EXPECT_EQ(last, nullptr) << "more than one correction";
+      last = e;
+      break;
+    }
+  }
+  ASSERT_NE(last, nullptr);
+  EXPECT_EQ(events, 25);  // 12 poses, 12 frames, then the correction
+  pose_correction_t msg;
+  ASSERT_TRUE(decodeExactly(last->data, static_cast<size_t>(last->datalen), &msg));
+  const PoseCorrection c = fromMessage(msg);
+  // Keyframes 0, 5, 10 and the last frame, 11, at their recorded poses.
+  ASSERT_EQ(c.poses.size(), 4u);
+  const size_t keyframes[] = {0, 5, 10, 11};
+  for (size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(c.poses[k].utime, reference[keyframes[k]].utime);
+    EXPECT_NEAR((c.poses[k].T_W_C.matrix() - reference[keyframes[k]].T_W_C.matrix()).norm(), 0.0,
+                1e-6);
+  }
+  EXPECT_EQ(c.utime, reference[11].utime + 1000000);
+  EXPECT_EQ(log.readNextEvent(), nullptr);
 }
 
 TEST(ImportDrift, UnknownPresetFailsWithOneLine) {

@@ -13,8 +13,10 @@ namespace panmap {
 /// Appends LCM messages to a log file (lcm::LogFile), stamping each event with a utime.
 class LogWriter {
  public:
-  /// Opens (truncates) the log. Throws Error naming the path when it cannot.
-  explicit LogWriter(const std::string& path) : path_(path), log_(path, "w") {
+  /// Opens the log, truncating it (or appending to it, e.g. a correction after an import).
+  /// Throws Error naming the path when it cannot.
+  explicit LogWriter(const std::string& path, bool append = false)
+      : path_(path), log_(path, append ? "a" : "w") {
     if (!log_.good()) throw Error("cannot write log " + path);
   }
 
