@@ -38,9 +38,9 @@ LiveMapper::LiveMapper(lcm::LCM* lcm, const LiveOptions& options, Mapper* mapper
   if (hook) session_.setFrameHook(std::move(hook));
   if (!lcm_ || !lcm_->good()) throw Error("LCM is not ready");
   // Repairs run on the worker: the status says so while frames wait in the queue.
-  session_.setRepairHook([this](const SessionStats& s) {
+  session_.setRepairHook([this](int64_t done, int64_t total) {
     const auto now = std::chrono::steady_clock::now();
-    if (s.repair_frames_done < s.repair_frames_total &&
+    if (done < total &&
         now - last_repair_status_ < std::chrono::duration<double>(options_.status_period_s)) {
       return;
     }

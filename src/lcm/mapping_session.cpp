@@ -126,7 +126,7 @@ void MappingSession::repair(const PoseCorrection& correction) {
   auto progress = [this](size_t done, size_t total) {
     stats_.repair_frames_done = static_cast<int64_t>(done);
     stats_.repair_frames_total = static_cast<int64_t>(total);
-    if (repair_hook_) repair_hook_(stats());
+    if (repair_hook_) repair_hook_(stats_.repair_frames_done, stats_.repair_frames_total);
     return true;
   };
   try {

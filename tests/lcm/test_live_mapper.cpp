@@ -7,6 +7,7 @@
 #include <iterator>
 
 #include "panmap/command_t.hpp"
+#include "panmap/lcm/correction_conversions.h"
 #include "panmap/lcm/live_mapper.h"
 #include "panmap/lcm/optimizer_node.h"
 #include "synthetic_stream.h"
@@ -89,6 +90,57 @@ TEST(LiveMapper, MapsLikeTheSessionAndAnswersStatus) {
   EXPECT_GT(last.num_blocks, 0);
   EXPECT_GT(last.memory_bytes, 0);
   EXPECT_GE(last.num_stages, 5);
+}
+
+// A loop-closure correction over LCM repairs the live map from its frame store, and the
+// status says so: "repairing" with its progress while it runs, then the repair's counts.
+TEST(LiveMapper, ACorrectionRepairsTheLiveMapAndTheStatusReportsIt) {
+  const test::SyntheticStream& stream = test::syntheticStream();
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  StatusInbox inbox;
+  lcm.subscribe("PANMAP_STATUS", &StatusInbox::onStatus, &inbox);
+  test::TempDir dir;
+  FrameStoreConfig store_config;
+  store_config.folder = dir.path("store");
+  FrameStore store(store_config);
+  LiveOptions options = testOptions();
+  options.session.frame_store = &store;
+  Mapper mapper(test::streamMapperConfig());
+  LiveMapper live(&lcm, options, &mapper);
+  publishAll(&lcm, stream.messages());
+  PoseCorrection correction;
+  correction.correction_id = 1;
+  StampedPose keyframe = stream.poses[4];
+  keyframe.T_W_C.translation() += Eigen::Vector3d(0.05, 0.0, 0.0);
+  correction.poses.push_back(keyframe);
+  const pose_correction_t msg = toMessage(correction);
+  lcm.publish("PANMAP_POSE_CORRECTION", &msg);
+  publishCommand(&lcm, command_t::COMMAND_FINISH);
+  std::atomic<bool> stop{false};
+  EXPECT_TRUE(live.run(stop));
+  live.drain();
+  while (lcm.handleTimeout(0) > 0) {
+  }
+  EXPECT_EQ(live.stats().corrections_applied, 1);
+  EXPECT_EQ(store.size(), stream.frames.size());
+  for (size_t k = 0; k < stream.frames.size(); ++k) {
+    const Eigen::Vector3d moved =
+        mapper.trajectory()[k].T_W_C.translation() - stream.poses[k].T_W_C.translation();
+    EXPECT_NEAR((moved - Eigen::Vector3d(0.05, 0.0, 0.0)).norm(), 0.0, 1e-9) << k;
+  }
+  bool saw_repairing = false;
+  for (const status_t& s : inbox.received) {
+    if (s.state != "repairing") continue;
+    saw_repairing = true;
+    EXPECT_EQ(s.repair_frames_total, static_cast<int64_t>(stream.frames.size()));
+  }
+  EXPECT_TRUE(saw_repairing);
+  const status_t& last = inbox.received.back();
+  EXPECT_EQ(last.corrections_applied, 1);
+  EXPECT_EQ(last.last_correction_id, 1);
+  EXPECT_EQ(last.repair_frames_done, static_cast<int64_t>(stream.frames.size()));
+  EXPECT_GT(last.last_repair_s, 0.0f);
 }
 
 TEST(LiveMapper, FullQueueDropsTheOldestFramesAndCountsThem) {

@@ -170,9 +170,10 @@ TEST_F(MappingSessionTest, ACorrectionRepairsTheMapFromTheFrameStore) {
   Mapper mapper(test::streamMapperConfig());
   MappingSession session(options, &mapper);
   std::vector<int64_t> progress;
-  session.setRepairHook([&progress](const SessionStats& s) {
-    progress.push_back(s.repair_frames_done);
-    EXPECT_EQ(s.repair_frames_total, 12);
+  session.setRepairHook([&progress, &session](int64_t done, int64_t total) {
+    progress.push_back(done);
+    EXPECT_EQ(total, 12);
+    EXPECT_EQ(session.stats().repair_frames_done, done);
   });
   feed(&session, messages);
   const SessionStats stats = session.stats();

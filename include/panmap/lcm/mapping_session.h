@@ -87,8 +87,9 @@ class MappingSession {
   SessionStats stats() const;
   /// Called after every integrated frame.
   void setFrameHook(FrameHook hook) { hook_ = std::move(hook); }
-  /// Called after every frame a repair re-integrates (e.g. to publish the status).
-  void setRepairHook(std::function<void(const SessionStats&)> hook) {
+  /// Called after every frame a repair re-integrates with (frames done, frames in all), e.g.
+  /// to publish the status (stats() then shows the same progress).
+  void setRepairHook(std::function<void(int64_t done, int64_t total)> hook) {
     repair_hook_ = std::move(hook);
   }
 
@@ -101,7 +102,7 @@ class MappingSession {
   Mapper* mapper_;
   FrameSynchronizer sync_;
   FrameHook hook_;
-  std::function<void(const SessionStats&)> repair_hook_;
+  std::function<void(int64_t, int64_t)> repair_hook_;
   SessionStats stats_;
   std::map<std::string, std::vector<double>> times_ms_;
   int64_t newest_utime_ = INT64_MIN;
