@@ -168,9 +168,10 @@ def bridge_note(rows):
     evidence = ""
     if clean:
         evidence = (" With clean masks (ground-truth labels) and ground-truth poses the count "
-                    "with every vertex is %.1f-%.1f per scene and %.1f-%.1f beyond the band: a "
-                    "small object's first ring of neighbouring GT vertices, 2-2.5 cm from its "
-                    "edge, transfers to its super-point (pictures, mirrors, papers, books)." % (
+                    "with every vertex is %.1f-%.1f per scene and %.1f-%.1f beyond the band: "
+                    "with labels that cannot be wrong, what the band removes is resolution at "
+                    "class boundaries (a small object's neighbouring GT vertices transfer to "
+                    "its super-point: pictures, mirrors, papers, books)." % (
                         min(clean), max(clean), min(clean_banded), max(clean_banded)))
     return ("A bridging super-point has two GT classes each above 10 % of its vertices, counting "
             "only GT vertices farther than 1.5 voxels (3 cm) from an annotated vertex of another "
