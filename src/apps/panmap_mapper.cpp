@@ -384,7 +384,8 @@ int main(int argc, char** argv) {
       return 0;
     }
 
-    // Live: LCM in, LCM out.
+    // Live: LCM in, LCM out. Repairs run beside the mapping: frames keep coming meanwhile.
+    live.session.background_repair = true;
     lcm::LCM lcm(lcm_url);
     if (!lcm.good()) throw panmap::Error("cannot open LCM URL '" + lcm_url + "'");
     panmap::LiveMapper node(&lcm, live, mapper.get(),

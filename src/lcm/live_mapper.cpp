@@ -37,7 +37,8 @@ LiveMapper::LiveMapper(lcm::LCM* lcm, const LiveOptions& options, Mapper* mapper
   options_.check();
   if (hook) session_.setFrameHook(std::move(hook));
   if (!lcm_ || !lcm_->good()) throw Error("LCM is not ready");
-  // Repairs run on the worker: the status says so while frames wait in the queue.
+  // A repair that runs on the worker (without SessionOptions::background_repair) blocks it:
+  // the status says so while frames wait in the queue.
   session_.setRepairHook([this](int64_t done, int64_t total) {
     const auto now = std::chrono::steady_clock::now();
     if (done < total &&
@@ -265,7 +266,10 @@ bool LiveMapper::run(const std::atomic<bool>& stop) {
       next_status = now + period(options_.status_period_s);
       const std::string channel = options_.channel_status;
       post(Item{"", {}, [this, channel](Mapper*) {
-                  const status_t msg = status("mapping");
+                  // A background repair that caught up is swapped in even when no frame comes.
+                  session_.poll();
+                  const status_t msg =
+                      status(session_.stats().repair_running ? "repairing" : "mapping");
                   std::lock_guard<std::mutex> lock(outbox_mutex_);
                   outbox_.push_back(encodeMessage(channel, msg));
                 }});

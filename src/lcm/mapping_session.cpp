@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
@@ -108,6 +109,7 @@ bool MappingSession::handle(const std::string& channel, const void* data, size_t
     return true;
   }
   integrate(sync_.popReady(now_utime >= 0 ? now_utime : newest_utime_));
+  poll();
   return true;
 }
 
@@ -116,11 +118,31 @@ void MappingSession::repair(const PoseCorrection& correction) {
     ++stats_.rejected["correction: no frame store (panmap-mapper --frame-store)"];
     return;
   }
-  if (stats_.corrections_applied > 0 && correction.correction_id <= stats_.last_correction_id) {
+  const bool running = background_ && background_->running();
+  if ((stats_.corrections_applied > 0 && correction.correction_id <= stats_.last_correction_id) ||
+      (running && correction.correction_id <= running_correction_id_)) {
     ++stats_.rejected["correction: not newer than the last one applied"];
     return;
   }
-  const auto start = std::chrono::steady_clock::now();
+  if (options_.background_repair) {
+    if (!background_) {
+      background_ =
+          std::make_unique<BackgroundRepair>(mapper_, options_.frame_store, options_.repair);
+    }
+    try {
+      const MapRepairResult started = background_->start(correction);
+      if (running) ++stats_.corrections_superseded;
+      running_correction_id_ = correction.correction_id;
+      if (!started.unknown_utimes.empty()) {
+        stats_.rejected["correction: utime of no mapped frame"] +=
+            static_cast<int64_t>(started.unknown_utimes.size());
+      }
+      if (repair_hook_) repair_hook_(0, background_->framesTotal());
+    } catch (const Error& e) {
+      countRepairError(e.what());
+    }
+    return;
+  }
   stats_.repair_frames_done = 0;
   stats_.repair_frames_total = static_cast<int64_t>(mapper_->trajectory().size());
   auto progress = [this](size_t done, size_t total) {
@@ -136,26 +158,43 @@ void MappingSession::repair(const PoseCorrection& correction) {
       stats_.rejected["correction: utime of no mapped frame"] +=
           static_cast<int64_t>(result.unknown_utimes.size());
     }
-    stats_.repairs.push_back(describe(result));
-    if (result.reintegration.completed) {
-      ++stats_.corrections_applied;
-      stats_.last_correction_id = correction.correction_id;
-      stats_.frames_reintegrated += static_cast<int64_t>(result.reintegration.frames);
-      stats_.last_repair_s =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    }
+    recordRepair(result);
   } catch (const Error& e) {
-    // "correction 7: none of its ... (first 123)": counted by what went wrong.
-    const std::string what = e.what();
-    const auto colon = what.find(": ");
-    const std::string rest = colon == std::string::npos ? what : what.substr(colon + 2);
-    ++stats_.rejected["correction: " + reasonOf(rest.substr(0, rest.find(" (")))];
-    stats_.repairs.push_back(what);
+    countRepairError(e.what());
   }
+}
+
+void MappingSession::recordRepair(const MapRepairResult& result) {
+  stats_.repairs.push_back(describe(result));
+  if (result.reintegration.completed) {
+    ++stats_.corrections_applied;
+    stats_.last_correction_id = result.correction_id;
+    stats_.frames_reintegrated += static_cast<int64_t>(result.reintegration.frames);
+    stats_.last_repair_s = result.reintegration.seconds;
+    stats_.repair_frames_done = static_cast<int64_t>(result.reintegration.frames);
+    stats_.repair_frames_total = static_cast<int64_t>(result.reintegration.frames);
+  } else if (!result.failure.empty()) {
+    ++stats_.rejected["correction: repair failed"];
+  }
+}
+
+void MappingSession::countRepairError(const std::string& what) {
+  // "correction 7: none of its ... (first 123)": counted by what went wrong.
+  const auto colon = what.find(": ");
+  const std::string rest = colon == std::string::npos ? what : what.substr(colon + 2);
+  ++stats_.rejected["correction: " + reasonOf(rest.substr(0, rest.find(" (")))];
+  stats_.repairs.push_back(what);
+}
+
+void MappingSession::poll() {
+  if (!background_) return;
+  if (std::optional<MapRepairResult> result = background_->poll()) recordRepair(*result);
 }
 
 void MappingSession::flush() {
   if (!done_) integrate(sync_.flush());
+  if (!background_) return;
+  if (std::optional<MapRepairResult> result = background_->finish()) recordRepair(*result);
 }
 
 void MappingSession::integrate(std::vector<SyncedFrame> ready) {
@@ -180,6 +219,8 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count());
       }
+      // The repaired map must hold every frame the live one does.
+      if (background_) background_->frameIntegrated();
       if (options_.max_frames > 0 && stats_.frames_integrated >= options_.max_frames) done_ = true;
       if (hook_) {
         try {
@@ -191,6 +232,7 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
     } catch (const Error& e) {
       ++stats_.rejected["frame: " + reasonOf(e.what())];
     }
+    poll();
   }
 }
 
@@ -211,6 +253,11 @@ SessionStats MappingSession::stats() const {
     if (n) out.rejected[reason] += n;
   }
   for (const auto& [stage, list] : times_ms_) out.timings[stage] = summariseTimes(list);
+  if (background_ && background_->running()) {
+    out.repair_running = true;
+    out.repair_frames_done = background_->framesDone();
+    out.repair_frames_total = background_->framesTotal();
+  }
   return out;
 }
 

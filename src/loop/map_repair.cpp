@@ -62,7 +62,7 @@ std::string describe(const MapRepairResult& r) {
   if (!r.reintegration.completed) {
     std::snprintf(line, sizeof(line), "correction %lld: %d of %d poses matched%s, abandoned",
                   static_cast<long long>(r.correction_id), r.matched, total, unknown.c_str());
-    return line;
+    return r.failure.empty() ? std::string(line) : line + (": " + r.failure);
   }
   std::snprintf(line, sizeof(line),
                 "correction %lld: %d of %d poses matched%s, %zu frames re-integrated (%zu moved) "

@@ -107,6 +107,11 @@ MeshUpdate Mapper::updateMesh(const GraphLabels* labels) {
 
 void Mapper::validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
                       const PanopticFrame* panoptic) const {
+  checkFrame(config_, frame, T_W_C, panoptic);
+}
+
+void checkFrame(const MapperConfig& config, const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
+                const PanopticFrame* panoptic) {
   std::string why;
   if (!isRigidTransform(T_W_C.matrix(), 1e-4, &why)) throw Error("pose: " + why);
   if (!frame.camera.isValid(&why)) throw Error("intrinsics: " + why);
@@ -134,8 +139,7 @@ void Mapper::validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
     const double reach =
         T_W_C.translation().norm() +
         65535.0 * frame.depth_scale_m * std::sqrt(1.0 + tan_x * tan_x + tan_y * tan_y);
-    const double extent =
-        0.5 * kBlockSide * config_.map.voxel_size_m * static_cast<double>(1 << 20);
+    const double extent = 0.5 * kBlockSide * config.map.voxel_size_m * static_cast<double>(1 << 20);
     if (!(reach < extent)) {
       std::ostringstream s;
       s << "extent: with its pose, depth scale and intrinsics the frame reaches " << reach

@@ -4,9 +4,39 @@
 #include <utility>
 
 #include "panmap/core/error.h"
+#include "panmap/mapper/frame_prefetcher.h"
 #include "panmap/mapper/mapper.h"
 
 namespace panmap {
+
+std::unique_ptr<MapRebuild> Mapper::beginRebuild(ThreadPool* pool) const {
+  return std::make_unique<MapRebuild>(config_, pool ? pool : pool_.get());
+}
+
+void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild) {
+  if (!rebuild) throw Error("commitRebuild: no rebuild");
+  const std::vector<StampedPose>& poses = rebuild->poses();
+  if (poses.size() != trajectory_.size()) {
+    throw Error("commitRebuild: the rebuild holds " + std::to_string(poses.size()) +
+                " frames, the map " + std::to_string(trajectory_.size()));
+  }
+  for (size_t i = 0; i < poses.size(); ++i) {
+    if (poses[i].utime != trajectory_[i].utime) {
+      throw Error("commitRebuild: frame " + std::to_string(i) + " of the rebuild has utime " +
+                  std::to_string(poses[i].utime) + ", the map's " +
+                  std::to_string(trajectory_[i].utime));
+    }
+  }
+  if (static_cast<bool>(rebuild->occupancy_) != static_cast<bool>(occupancy_)) {
+    throw Error("commitRebuild: the rebuild was made with another occupancy setting");
+  }
+  map_ = std::move(rebuild->map_);
+  if (occupancy_) occupancy_ = std::move(rebuild->occupancy_);
+  mesher_->invalidateAll();
+  for (size_t i = 0; i < poses.size(); ++i) trajectory_[i].T_W_C = poses[i].T_W_C;
+  // The evictions of building this map, which replaces the old one and its history.
+  vote_evictions_ = rebuild->votesEvicted();
+}
 
 ReintegrationStats Mapper::reintegrate(const std::vector<StampedPose>& poses,
                                        const FrameLoader& load,
@@ -30,59 +60,45 @@ ReintegrationStats Mapper::reintegrate(const std::vector<StampedPose>& poses,
   }
   ReintegrationStats stats;
   stats.blocks_before = map_->numBlocks();
+  const auto seconds = [&start] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   // Built aside: the live maps stay whole until the last frame is in.
-  auto map = std::make_unique<TsdfMap>(config_.map);
-  std::unique_ptr<OccupancyMap> occupancy;
-  if (occupancy_) occupancy = std::make_unique<OccupancyMap>(config_.occupancy);
+  std::unique_ptr<MapRebuild> rebuild = beginRebuild();
+  std::vector<int64_t> utimes;
+  utimes.reserve(poses.size());
+  for (const StampedPose& p : poses) utimes.push_back(p.utime);
+  // Decoding the next frame while this one is integrated keeps the second core busy.
+  FramePrefetcher frames(load, std::move(utimes));
   RgbdFrame frame;
   LabelImage labels;
   for (size_t i = 0; i < poses.size(); ++i) {
     const int64_t utime = poses[i].utime;
-    frame = RgbdFrame();
-    labels = LabelImage();
-    load(utime, &frame, &labels);
+    frames.next(&frame, &labels);
     if (frame.utime != utime) {
       throw Error("reintegrate: asked for the frame of utime " + std::to_string(utime) + ", got " +
                   std::to_string(frame.utime));
     }
     try {
-      validate(frame, poses[i].T_W_C, nullptr);
+      rebuild->add(frame, poses[i].T_W_C, &labels);
     } catch (const Error& e) {
-      throw Error("reintegrate: frame of utime " + std::to_string(utime) + ": " + e.what());
+      throw Error(std::string("reintegrate: ") + e.what());
     }
-    const bool labelled = !labels.empty();
-    if (labelled &&
-        (labels.width() != frame.camera.width || labels.height() != frame.camera.height)) {
-      throw Error("reintegrate: frame of utime " + std::to_string(utime) + ": label image " +
-                  std::to_string(labels.width()) + "x" + std::to_string(labels.height()) +
-                  ", depth " + std::to_string(frame.camera.width) + "x" +
-                  std::to_string(frame.camera.height));
-    }
-    const IntegrationStats integration =
-        integrator_->integrate(frame, poses[i].T_W_C, labelled ? &labels : nullptr, map.get());
-    stats.votes_evicted += integration.votes_evicted;
-    if (occupancy) occupancy->integrate(frame, poses[i].T_W_C);
     ++stats.frames;
     stats.frames_moved += poses[i].T_W_C.matrix() != trajectory_[i].T_W_C.matrix();
     if (progress && !progress(i + 1, poses.size())) {
       stats.frames = 0;
       stats.frames_moved = 0;
-      stats.votes_evicted = 0;
       stats.blocks_after = stats.blocks_before;
-      stats.seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      stats.seconds = seconds();
       return stats;
     }
   }
-  map_ = std::move(map);
-  if (occupancy) occupancy_ = std::move(occupancy);
-  mesher_->invalidateAll();
-  for (size_t i = 0; i < poses.size(); ++i) trajectory_[i].T_W_C = poses[i].T_W_C;
-  // The evictions of building this map, which replaces the old one and its history.
-  vote_evictions_ = stats.votes_evicted;
+  stats.votes_evicted = rebuild->votesEvicted();
+  commitRebuild(std::move(rebuild));
   stats.completed = true;
   stats.blocks_after = map_->numBlocks();
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats.seconds = seconds();
   return stats;
 }
 

@@ -94,7 +94,9 @@ TEST(LiveMapper, MapsLikeTheSessionAndAnswersStatus) {
 
 // A loop-closure correction over LCM repairs the live map from its frame store, and the
 // status says so: "repairing" with its progress while it runs, then the repair's counts.
-TEST(LiveMapper, ACorrectionRepairsTheLiveMapAndTheStatusReportsIt) {
+// A correction over LCM repairs the live map (on the worker, or on a thread of its own beside
+// it), and the status channel shows the repair running, then its counts.
+void checkLiveRepair(bool background) {
   const test::SyntheticStream& stream = test::syntheticStream();
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
@@ -106,6 +108,7 @@ TEST(LiveMapper, ACorrectionRepairsTheLiveMapAndTheStatusReportsIt) {
   FrameStore store(store_config);
   LiveOptions options = testOptions();
   options.session.frame_store = &store;
+  options.session.background_repair = background;
   Mapper mapper(test::streamMapperConfig());
   LiveMapper live(&lcm, options, &mapper);
   publishAll(&lcm, stream.messages());
@@ -142,6 +145,10 @@ TEST(LiveMapper, ACorrectionRepairsTheLiveMapAndTheStatusReportsIt) {
   EXPECT_EQ(last.repair_frames_done, static_cast<int64_t>(stream.frames.size()));
   EXPECT_GT(last.last_repair_s, 0.0f);
 }
+
+TEST(LiveMapper, ACorrectionRepairsTheLiveMapAndTheStatusReportsIt) { checkLiveRepair(false); }
+
+TEST(LiveMapper, ABackgroundRepairRepairsTheLiveMapAndTheStatusReportsIt) { checkLiveRepair(true); }
 
 TEST(LiveMapper, FullQueueDropsTheOldestFramesAndCountsThem) {
   const test::SyntheticStream& stream = test::syntheticStream();

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <map>
+#include <tuple>
 
 #include "panmap/lcm/correction_conversions.h"
 #include "panmap/lcm/mapping_session.h"
@@ -229,6 +231,78 @@ TEST_F(MappingSessionTest, ACorrectionRepairsTheMapFromTheFrameStore) {
   EXPECT_EQ(without.stats().rejected.at("correction: no frame store (panmap-mapper --frame-store)"),
             1);
   EXPECT_EQ(test::mapBytes(no_store), clean_);
+}
+
+// With background repairs (the live process), a correction in the middle of the stream is
+// repaired while the frames after it are mapped: the six frames the correction covered end
+// at their corrected poses, the others at theirs, and the map's geometry is what integrating
+// every frame at those poses gives, whenever the repair happened to be swapped in.
+TEST_F(MappingSessionTest, ABackgroundRepairTakesTheFramesMappedMeanwhile) {
+  const std::vector<test::Encoded> stream = stream_.messages();
+  Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
+  D.linear() = Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  D.translation() = Eigen::Vector3d(0.03, 0.02, 0.0);
+  PoseCorrection correction;
+  correction.correction_id = 3;
+  correction.utime = stream_.poses[5].utime;
+  StampedPose keyframe = stream_.poses[2];
+  keyframe.T_W_C = D * keyframe.T_W_C;
+  correction.poses.push_back(keyframe);
+  std::vector<test::Encoded> messages(stream.begin(), stream.begin() + 18);  // frames 0-5
+  messages.push_back(encodeMessage(kChannelPoseCorrection, toMessage(correction)));
+  messages.insert(messages.end(), stream.begin() + 18, stream.end());
+
+  test::TempDir dir;
+  FrameStoreConfig store_config;
+  store_config.folder = dir.path("store");
+  FrameStore store(store_config);
+  SessionOptions options;
+  options.frame_store = &store;
+  options.background_repair = true;
+  Mapper mapper(test::streamMapperConfig());
+  MappingSession session(options, &mapper);
+  feed(&session, messages);  // flush() waits for the repair
+  const SessionStats stats = session.stats();
+  EXPECT_FALSE(stats.repair_running);
+  EXPECT_EQ(stats.frames_integrated, 12);
+  EXPECT_EQ(stats.corrections_applied, 1);
+  EXPECT_EQ(stats.corrections_superseded, 0);
+  // The six frames the correction covered and those mapped before the repair was swapped in
+  // (when that was depends on thread timing; the map does not).
+  EXPECT_GE(stats.frames_reintegrated, 6);
+  EXPECT_LE(stats.frames_reintegrated, 12);
+  ASSERT_EQ(stats.repairs.size(), 1u);
+  EXPECT_NE(stats.repairs[0].find("correction 3: 1 of 1 poses matched, "), std::string::npos)
+      << stats.repairs[0];
+  EXPECT_NE(stats.repairs[0].find(" frames re-integrated (6 moved)"), std::string::npos)
+      << stats.repairs[0];
+  EXPECT_TRUE(stats.rejected.empty());
+  for (size_t k = 0; k < 12; ++k) {
+    const Eigen::Isometry3d expected = k < 6 ? D * stream_.poses[k].T_W_C : stream_.poses[k].T_W_C;
+    EXPECT_TRUE(mapper.trajectory()[k].T_W_C.isApprox(expected, 1e-9)) << k;
+  }
+
+  Mapper reference(test::streamMapperConfig());
+  MappingSession plain(SessionOptions{}, &reference);
+  feed(&plain, stream_.messages());
+  const FrameLoader load = [&store](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
+    StoredFrame stored = store.load(utime);
+    *frame = stored.rgbd;
+    *labels = stored.labels;
+  };
+  ASSERT_TRUE(reference.reintegrate(mapper.trajectory(), load).completed);
+  ASSERT_EQ(mapper.map().numBlocks(), reference.map().numBlocks());
+  std::map<std::tuple<int, int, int>, const Block*> blocks;
+  for (const auto& b : reference.map().blocks()) {
+    blocks[{b->index.x(), b->index.y(), b->index.z()}] = b.get();
+  }
+  for (const auto& b : mapper.map().blocks()) {
+    const Block* other = blocks.at({b->index.x(), b->index.y(), b->index.z()});
+    for (int v = 0; v < kBlockVoxels; ++v) {
+      ASSERT_EQ(b->voxels[v].sdf_m, other->voxels[v].sdf_m);
+      ASSERT_EQ(b->voxels[v].weight, other->voxels[v].weight);
+    }
+  }
 }
 
 }  // namespace

@@ -4,10 +4,12 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "panmap/lcm/channels.h"
+#include "panmap/loop/background_repair.h"
 #include "panmap/loop/frame_store.h"
 #include "panmap/loop/map_repair.h"
 #include "panmap/mapper/frame_sync.h"
@@ -27,6 +29,10 @@ struct SessionOptions {
   /// store, and corrections are refused (counted).
   FrameStore* frame_store = nullptr;
   MapRepairConfig repair;
+  /// Repairs run on a thread of their own while frames keep being integrated (the live
+  /// process); false: each repair runs to its end before the next frame (offline runs, whose
+  /// maps must not depend on thread timing).
+  bool background_repair = false;
   int64_t max_frames = 0;  ///< stop integrating after this many frames (0 = all)
   /// Frames at or before this utime are refused (counted): a resumed map already holds them.
   int64_t resume_after_utime = INT64_MIN;
@@ -55,6 +61,8 @@ struct SessionStats {
   int64_t repair_frames_done = 0;              ///< progress of the repair running or last run
   int64_t repair_frames_total = 0;             ///< frames it re-integrates
   double last_repair_s = 0.0;                  ///< wall time of the last completed repair
+  bool repair_running = false;                 ///< a background repair is under way
+  int64_t corrections_superseded = 0;          ///< background repairs a newer one abandoned
   std::vector<std::string> repairs;            ///< describe() of every repair, in order
 };
 
@@ -62,7 +70,8 @@ struct SessionStats {
 /// live process so that both treat input identically: decodes each message (counting
 /// malformed ones), sanitises it, synchronises frames with poses and masks, integrates
 /// the ready frames (keeping each in the frame store, if any), and repairs the map when a
-/// loop-closure correction arrives (synchronously: frames wait in the queues meanwhile). Bad input
+/// loop-closure correction arrives (SessionOptions::background_repair: on its own thread while
+/// frames keep coming, else before the next frame). Bad input
 /// is refused with a counted reason and never touches the map. Not thread-safe: one thread feeds
 /// it.
 class MappingSession {
@@ -79,8 +88,12 @@ class MappingSession {
   bool handle(const std::string& channel, const void* data, size_t size, int64_t now_utime = -1);
   /// Counts a message dropped before it reached the session (e.g. a full queue).
   void countDropped(const std::string& reason, int64_t n = 1);
-  /// Maps what is still waiting at the end of the stream (frames with a pose), rejects the rest.
+  /// Maps what is still waiting at the end of the stream (frames with a pose), rejects the rest,
+  /// and waits for a background repair to finish.
   void flush();
+  /// Swaps in a background repair that has caught up with the map (also done after every
+  /// message; call it when no message comes for a while).
+  void poll();
   /// True once max_frames frames are integrated.
   bool done() const { return done_; }
   /// Counters and stage timings so far.
@@ -88,7 +101,8 @@ class MappingSession {
   /// Called after every integrated frame.
   void setFrameHook(FrameHook hook) { hook_ = std::move(hook); }
   /// Called after every frame a repair re-integrates with (frames done, frames in all), e.g.
-  /// to publish the status (stats() then shows the same progress).
+  /// to publish the status (stats() then shows the same progress); a background repair calls
+  /// it once, when it starts (0, frames), and its progress shows in stats() meanwhile.
   void setRepairHook(std::function<void(int64_t done, int64_t total)> hook) {
     repair_hook_ = std::move(hook);
   }
@@ -97,6 +111,8 @@ class MappingSession {
   void integrate(std::vector<SyncedFrame> ready);
   void sanitise(PanopticFrame* panoptic);
   void repair(const PoseCorrection& correction);
+  void recordRepair(const MapRepairResult& result);
+  void countRepairError(const std::string& what);
 
   SessionOptions options_;
   Mapper* mapper_;
@@ -107,6 +123,8 @@ class MappingSession {
   std::map<std::string, std::vector<double>> times_ms_;
   int64_t newest_utime_ = INT64_MIN;
   bool done_ = false;
+  std::unique_ptr<BackgroundRepair> background_;  // with background_repair, once needed
+  int64_t running_correction_id_ = 0;             // of the background repair under way
 };
 
 /// Median / p95 / last of a list of times.

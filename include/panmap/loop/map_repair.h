@@ -27,6 +27,7 @@ struct MapRepairResult {
   double max_translation_m = 0.0;       ///< largest move of a camera centre
   double max_rotation_rad = 0.0;        ///< largest turn of a camera
   ReintegrationStats reintegration;     ///< completed = false: abandoned, map unchanged
+  std::string failure;                  ///< why a background repair gave up (empty: it did not)
 };
 
 /// The repair after a loop closure (docs/LOOP_CLOSURE.md): spreads the correction over every

@@ -19,6 +19,7 @@
 #include "panmap/map/projective_integrator.h"
 #include "panmap/map/tsdf_map.h"
 #include "panmap/mapper/final_labels.h"
+#include "panmap/mapper/map_rebuild.h"
 #include "panmap/mesh/incremental_mesher.h"
 #include "panmap/occupancy/occupancy_map.h"
 #include "panmap/segmentation/panoptic_geometric.h"
@@ -75,6 +76,12 @@ struct MapperConfig {
   void check() const;
 };
 
+/// Checks a frame before it touches a map: finite rigid pose, valid intrinsics matching the
+/// depth size, colour and mask sizes, positive unique segment ids, scores in [0, 1], every
+/// point within the map's extent. Throws Error with a one-line reason.
+void checkFrame(const MapperConfig& config, const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
+                const PanopticFrame* panoptic);
+
 /// Timings and counts of one integrated frame.
 struct FrameStats {
   double segmentation_ms = 0.0;  ///< III-A
@@ -109,7 +116,8 @@ struct FrameStats {
 
 /// Loads an integrated frame again for re-integration: its RGB-D data (with the utime asked
 /// for) and the super-point label each pixel voted for (empty: geometry only). Throws Error
-/// naming the frame when it cannot.
+/// naming the frame when it cannot. Re-integration calls it on a thread of its own (one call
+/// at a time, in order), so that decoding overlaps integrating.
 using FrameLoader = std::function<void(int64_t utime, RgbdFrame* frame, LabelImage* labels)>;
 
 /// Called after each re-integrated frame with (frames done, frames in all); returning false
@@ -190,6 +198,17 @@ class Mapper {
   /// @param progress optional; see ReintegrationProgress
   ReintegrationStats reintegrate(const std::vector<StampedPose>& poses, const FrameLoader& load,
                                  const ReintegrationProgress& progress = {});
+
+  /// An empty rebuild with this mapper's configuration, for reintegrate() or for a repair that
+  /// builds on another thread while this mapper keeps mapping (loop/background_repair.h).
+  /// @param pool threads the rebuild integrates with (null: this mapper's own, which only the
+  ///        mapping thread may then use)
+  std::unique_ptr<MapRebuild> beginRebuild(ThreadPool* pool = nullptr) const;
+  /// Swaps a finished rebuild in: the label-TSDF and occupancy map become the rebuild's, each
+  /// frame's pose in trajectory() becomes the one it was re-integrated with, and the next
+  /// updateMesh() lists every block. Throws Error, changing nothing, unless the rebuild holds
+  /// exactly the frames of trajectory(), in order.
+  void commitRebuild(std::unique_ptr<MapRebuild> rebuild);
 
   /// The labelled mesh of the current map: marching cubes re-run only on changed blocks;
   /// per vertex the super-point (argmax of its voxel's votes, merges resolved), and the

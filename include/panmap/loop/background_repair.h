@@ -1,0 +1,106 @@
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "panmap/core/thread_pool.h"
+#include "panmap/loop/frame_store.h"
+#include "panmap/loop/map_repair.h"
+#include "panmap/loop/pose_correction.h"
+#include "panmap/mapper/mapper.h"
+
+namespace panmap {
+
+/// A loop closure's repair (docs/LOOP_CLOSURE.md) on a thread of its own, while the mapping
+/// thread keeps integrating frames: the repair re-integrates the frames the map held when the
+/// correction came, at their corrected poses, then every frame integrated since, at the pose it
+/// was mapped with; once it has caught up, poll() swaps the repaired map in between two frames.
+/// A newer correction abandons a running repair and starts again from the map (superseded).
+///
+/// Threads: every member function is called from the mapping thread (the one that calls
+/// Mapper::integrate); the repair's thread only loads frames and builds a MapRebuild with its
+/// own thread pool, and never touches the mapper.
+class BackgroundRepair {
+ public:
+  /// @param mapper the live map (not owned; must outlive this)
+  /// @param load gives each frame back by its utime; it is called on the repair's thread
+  /// @param store if not null, where the corrected poses are recorded when a repair commits
+  BackgroundRepair(Mapper* mapper, FrameLoader load, FrameStore* store = nullptr,
+                   const MapRepairConfig& config = {});
+  /// Loads the frames from `store` (thread-safe) and records the corrected poses there.
+  BackgroundRepair(Mapper* mapper, FrameStore* store, const MapRepairConfig& config = {});
+  /// Abandons a running repair (the map stays as it is).
+  ~BackgroundRepair();
+  BackgroundRepair(const BackgroundRepair&) = delete;
+  BackgroundRepair& operator=(const BackgroundRepair&) = delete;
+
+  /// Starts the repair for `correction` from the map as it is now, abandoning a running one
+  /// first (counted in superseded()). Throws Error like repairMap(), leaving a running repair
+  /// alone, when the correction is invalid or none of its utimes is a mapped frame.
+  /// @return how the correction matched the map (reintegration is filled by poll())
+  MapRepairResult start(const PoseCorrection& correction);
+  /// Call after each frame the mapper integrated while running(): the repair takes it too.
+  void frameIntegrated();
+  /// Between two frames: when the running repair is at most kFramesLeftToCommit frames behind
+  /// the map, re-integrates those here, swaps the repaired map in and returns what it did; when it
+  /// failed (a frame could not be loaded), returns that with reintegration.completed false and
+  /// `failure` set, the map unchanged. Else nothing.
+  std::optional<MapRepairResult> poll();
+  /// Waits until the running repair has caught up, then as poll() (end of a stream).
+  std::optional<MapRepairResult> finish();
+  /// Abandons the running repair, if any; the map stays as it is.
+  void cancel();
+
+  /// A repair is running (started and not yet returned by poll() or finish()).
+  bool running() const { return worker_.joinable(); }
+  /// Frames the running (or last) repair has re-integrated, and the frames it has to.
+  int64_t framesDone() const { return frames_done_.load(); }
+  int64_t framesTotal() const;
+  /// Repairs abandoned for a newer correction.
+  int64_t superseded() const { return superseded_; }
+  /// poll() swaps the repair in once it is this many frames behind the map or fewer, and
+  /// re-integrates them itself (a few frames' delay on the mapping thread): frames keep coming,
+  /// so the repair's thread alone is never quite done when asked.
+  static constexpr size_t kFramesLeftToCommit = 2;
+
+ private:
+  void work();
+  void stopWorker();
+  MapRepairResult commit();
+  /// Loads one frame and adds it to the rebuild at the job's pose; throws Error.
+  void reintegrate(const StampedPose& job, RgbdFrame* frame, LabelImage* labels);
+
+  Mapper* mapper_;
+  FrameLoader load_;
+  FrameStore* store_;
+  MapRepairConfig config_;
+  ThreadPool pool_{1};  // the repair's thread integrates alone: the mapper has the others
+
+  // Set by start() on the mapping thread, read by it only, except rebuild_ (the worker's).
+  MapRepairResult result_;
+  CorrectedTrajectory corrected_;
+  std::unique_ptr<MapRebuild> rebuild_;
+  std::chrono::steady_clock::time_point started_;
+  size_t blocks_before_ = 0;
+  int64_t superseded_ = 0;
+
+  std::thread worker_;
+  mutable std::mutex mutex_;  // guards what follows
+  std::condition_variable cv_;
+  std::vector<StampedPose> jobs_;  // frames to re-integrate, in order, with their poses
+  size_t next_ = 0;                // jobs_ done by the worker
+  bool idle_ = false;              // the worker waits for a job
+  bool stop_ = false;              // the worker must return
+  std::string failure_;            // why the worker gave up
+  std::atomic<int64_t> frames_done_{0};
+};
+
+}  // namespace panmap

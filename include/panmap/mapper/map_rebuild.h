@@ -1,0 +1,61 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "panmap/core/frame.h"
+#include "panmap/core/image.h"
+#include "panmap/core/pose.h"
+#include "panmap/core/thread_pool.h"
+#include "panmap/map/projective_integrator.h"
+#include "panmap/map/tsdf_map.h"
+#include "panmap/occupancy/occupancy_map.h"
+
+namespace panmap {
+
+struct MapperConfig;
+class Mapper;
+
+/// A label-TSDF and occupancy map built again from stored frames, aside from the live map: the
+/// repair after a loop closure (docs/LOOP_CLOSURE.md). Mapper::beginRebuild() makes one with
+/// the mapper's configuration; add() every frame the mapper holds, in the order it integrated
+/// them, each at its new pose; Mapper::commitRebuild() swaps it in. It shares nothing with
+/// the mapper but the thread pool it is given, so one thread may build it while another keeps
+/// mapping (each with its own pool).
+class MapRebuild {
+ public:
+  /// @param config the mapper's configuration (map, integrator and occupancy parts are used)
+  /// @param pool threads to integrate with (not owned; must outlive the rebuild)
+  MapRebuild(const MapperConfig& config, ThreadPool* pool);
+  ~MapRebuild();
+  MapRebuild(const MapRebuild&) = delete;
+  MapRebuild& operator=(const MapRebuild&) = delete;
+
+  /// Integrates one frame at T_W_C with the super-point label each pixel voted for (null or
+  /// empty: geometry only). Throws Error naming the frame's utime when the frame or the label
+  /// image is invalid; the rebuild is then unchanged.
+  void add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const LabelImage* labels);
+
+  /// The frames added so far: utime and the pose each was integrated with, in order.
+  const std::vector<StampedPose>& poses() const { return poses_; }
+  /// Label votes that pushed out a weaker one while building.
+  uint64_t votesEvicted() const { return votes_evicted_; }
+  /// The label-TSDF built so far.
+  const TsdfMap& map() const { return *map_; }
+
+ private:
+  friend class Mapper;
+
+  std::unique_ptr<MapperConfig> config_;
+  std::unique_ptr<ProjectiveIntegrator> integrator_;
+  std::unique_ptr<TsdfMap> map_;
+  std::unique_ptr<OccupancyMap> occupancy_;  // null when the mapper keeps none
+  std::vector<StampedPose> poses_;
+  uint64_t votes_evicted_ = 0;
+};
+
+}  // namespace panmap

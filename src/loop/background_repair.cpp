@@ -1,0 +1,229 @@
+// BackgroundRepair: a loop closure's repair on its own thread while mapping goes on.
+#include "panmap/loop/background_repair.h"
+
+#include <chrono>
+#include <utility>
+
+#include "panmap/core/error.h"
+#include "panmap/mapper/frame_prefetcher.h"
+
+namespace panmap {
+
+BackgroundRepair::BackgroundRepair(Mapper* mapper, FrameLoader load, FrameStore* store,
+                                   const MapRepairConfig& config)
+    : mapper_(mapper), load_(std::move(load)), store_(store), config_(config) {
+  if (!mapper_) throw Error("BackgroundRepair: no mapper");
+  if (!load_) throw Error("BackgroundRepair: no frame loader");
+  config_.check();
+}
+
+BackgroundRepair::BackgroundRepair(Mapper* mapper, FrameStore* store, const MapRepairConfig& config)
+    : BackgroundRepair(
+          mapper,
+          [store](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
+            if (!store) throw Error("BackgroundRepair: no frame store");
+            StoredFrame stored = store->load(utime);
+            *frame = std::move(stored.rgbd);
+            *labels = std::move(stored.labels);
+          },
+          store, config) {}
+
+BackgroundRepair::~BackgroundRepair() { stopWorker(); }
+
+int64_t BackgroundRepair::framesTotal() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return static_cast<int64_t>(jobs_.size());
+}
+
+void BackgroundRepair::stopWorker() {
+  if (!worker_.joinable()) return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  worker_.join();
+}
+
+void BackgroundRepair::cancel() {
+  stopWorker();
+  rebuild_.reset();
+}
+
+MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
+  const std::string name = "correction " + std::to_string(correction.correction_id);
+  try {
+    correction.check();
+  } catch (const Error& e) {
+    throw Error(name + ": " + e.what());
+  }
+  CorrectedTrajectory corrected =
+      applyCorrection(mapper_->trajectory(), correction, config_.match_tolerance_us);
+  if (corrected.matched == 0) {
+    throw Error(name + ": none of its " + std::to_string(correction.poses.size()) +
+                " utimes is a mapped frame (first " +
+                std::to_string(correction.poses.front().utime) + ")");
+  }
+  if (running()) {
+    cancel();
+    ++superseded_;
+  }
+  result_ = MapRepairResult();
+  result_.correction_id = correction.correction_id;
+  result_.matched = corrected.matched;
+  result_.unknown_utimes = corrected.unknown_utimes;
+  result_.max_translation_m = corrected.max_translation_m;
+  result_.max_rotation_rad = corrected.max_rotation_rad;
+  corrected_ = std::move(corrected);
+  started_ = std::chrono::steady_clock::now();
+  blocks_before_ = mapper_->map().numBlocks();
+  rebuild_ = mapper_->beginRebuild(&pool_);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    jobs_ = corrected_.poses;
+    next_ = 0;
+    idle_ = false;
+    stop_ = false;
+    failure_.clear();
+  }
+  frames_done_ = 0;
+  worker_ = std::thread(&BackgroundRepair::work, this);
+  return result_;
+}
+
+void BackgroundRepair::frameIntegrated() {
+  if (!running() || mapper_->trajectory().empty()) return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    jobs_.push_back(mapper_->trajectory().back());
+  }
+  cv_.notify_all();
+}
+
+void BackgroundRepair::reintegrate(const StampedPose& job, RgbdFrame* frame, LabelImage* labels) {
+  *frame = RgbdFrame();
+  *labels = LabelImage();
+  load_(job.utime, frame, labels);
+  if (frame->utime != job.utime) {
+    throw Error("asked for the frame of utime " + std::to_string(job.utime) + ", got " +
+                std::to_string(frame->utime));
+  }
+  rebuild_->add(*frame, job.T_W_C, labels);
+}
+
+void BackgroundRepair::work() {
+  RgbdFrame frame;
+  LabelImage labels;
+  // The frames the correction covers are decoded ahead on another thread; those mapped since
+  // come one by one, as the mapping thread hands them over.
+  std::vector<int64_t> covered;
+  for (const StampedPose& p : corrected_.poses) covered.push_back(p.utime);
+  FramePrefetcher prefetched(load_, std::move(covered));
+  for (;;) {
+    StampedPose job;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (next_ == jobs_.size()) {
+        idle_ = true;
+        cv_.notify_all();
+        cv_.wait(lock, [this] { return stop_ || next_ < jobs_.size(); });
+        idle_ = false;
+      }
+      if (stop_) return;
+      job = jobs_[next_];
+    }
+    try {
+      if (next_ < corrected_.poses.size()) {
+        prefetched.next(&frame, &labels);
+        if (frame.utime != job.utime) {
+          throw Error("asked for the frame of utime " + std::to_string(job.utime) + ", got " +
+                      std::to_string(frame.utime));
+        }
+        rebuild_->add(frame, job.T_W_C, &labels);
+      } else {
+        reintegrate(job, &frame, &labels);
+      }
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      failure_ = e.what();
+      idle_ = true;
+      cv_.notify_all();
+      return;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++next_;
+    frames_done_ = static_cast<int64_t>(next_);
+  }
+}
+
+MapRepairResult BackgroundRepair::commit() {
+  // The worker has returned: everything below is this thread's.
+  MapRepairResult result = std::move(result_);
+  ReintegrationStats& stats = result.reintegration;
+  stats.blocks_before = blocks_before_;
+  stats.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  if (!failure_.empty()) {
+    result.failure = failure_;
+    stats.blocks_after = blocks_before_;
+    rebuild_.reset();
+    return result;
+  }
+  stats.frames = rebuild_->poses().size();
+  stats.votes_evicted = rebuild_->votesEvicted();
+  for (size_t i = 0; i < corrected_.poses.size(); ++i) {
+    stats.frames_moved += corrected_.translation_m[i] > 0.0 || corrected_.rotation_rad[i] > 0.0;
+  }
+  try {
+    mapper_->commitRebuild(std::move(rebuild_));
+  } catch (const Error& e) {
+    result.failure = e.what();
+    stats.frames = 0;
+    stats.frames_moved = 0;
+    stats.blocks_after = blocks_before_;
+    return result;
+  }
+  if (store_) {
+    for (size_t i = 0; i < corrected_.poses.size(); ++i) {
+      if (corrected_.translation_m[i] > 0.0 || corrected_.rotation_rad[i] > 0.0) {
+        store_->updatePose(corrected_.poses[i].utime, corrected_.poses[i].T_W_C);
+      }
+    }
+  }
+  stats.completed = true;
+  stats.blocks_after = mapper_->map().numBlocks();
+  return result;
+}
+
+std::optional<MapRepairResult> BackgroundRepair::poll() {
+  if (!running()) return std::nullopt;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    // Frames keep coming while the worker catches up, so it is never quite done when asked:
+    // the last few frames are re-integrated here instead.
+    if (failure_.empty() && jobs_.size() - next_ > kFramesLeftToCommit) return std::nullopt;
+  }
+  stopWorker();  // it finishes the frame it is on
+  if (failure_.empty()) {
+    RgbdFrame frame;
+    LabelImage labels;
+    try {
+      for (; next_ < jobs_.size(); ++next_) reintegrate(jobs_[next_], &frame, &labels);
+      frames_done_ = static_cast<int64_t>(next_);
+    } catch (const std::exception& e) {
+      failure_ = e.what();
+    }
+  }
+  return commit();
+}
+
+std::optional<MapRepairResult> BackgroundRepair::finish() {
+  if (!running()) return std::nullopt;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait(lock, [this] { return !failure_.empty() || (idle_ && next_ == jobs_.size()); });
+  }
+  return poll();
+}
+
+}  // namespace panmap

@@ -1,0 +1,72 @@
+// FramePrefetcher: stored frames decoded ahead on a thread of their own.
+#include "panmap/mapper/frame_prefetcher.h"
+
+#include <string>
+#include <utility>
+
+#include "panmap/core/error.h"
+
+namespace panmap {
+
+FramePrefetcher::FramePrefetcher(FrameLoader load, std::vector<int64_t> utimes, size_t ahead)
+    : load_(std::move(load)), utimes_(std::move(utimes)), ahead_(ahead) {
+  if (!load_) throw Error("FramePrefetcher: no frame loader");
+  if (ahead_ < 1) throw Error("FramePrefetcher: ahead must be at least 1");
+  thread_ = std::thread(&FramePrefetcher::work, this);
+}
+
+FramePrefetcher::~FramePrefetcher() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  thread_.join();
+}
+
+void FramePrefetcher::work() {
+  for (const int64_t utime : utimes_) {
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      cv_.wait(lock, [this] { return stop_ || ready_.size() < ahead_; });
+      if (stop_) return;
+    }
+    Loaded loaded;
+    try {
+      load_(utime, &loaded.frame, &loaded.labels);
+    } catch (...) {
+      loaded.error = std::current_exception();
+    }
+    const bool failed = static_cast<bool>(loaded.error);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ready_.push_back(std::move(loaded));
+    }
+    cv_.notify_all();
+    if (failed) return;  // next() rethrows it; nothing after a failure is wanted
+  }
+}
+
+void FramePrefetcher::next(RgbdFrame* frame, LabelImage* labels) {
+  if (taken_ >= utimes_.size()) {
+    throw Error("FramePrefetcher: all " + std::to_string(utimes_.size()) + " frames taken");
+  }
+  if (failed_) throw Error("FramePrefetcher: an earlier frame failed to load");
+  Loaded loaded;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait(lock, [this] { return !ready_.empty(); });
+    loaded = std::move(ready_.front());
+    ready_.pop_front();
+  }
+  cv_.notify_all();
+  ++taken_;
+  if (loaded.error) {
+    failed_ = true;
+    std::rethrow_exception(loaded.error);
+  }
+  *frame = std::move(loaded.frame);
+  *labels = std::move(loaded.labels);
+}
+
+}  // namespace panmap

@@ -1,0 +1,46 @@
+// MapRebuild: the maps of a repair, built aside from the live ones.
+#include "panmap/mapper/map_rebuild.h"
+
+#include <string>
+
+#include "panmap/core/error.h"
+#include "panmap/mapper/mapper.h"
+
+namespace panmap {
+
+MapRebuild::MapRebuild(const MapperConfig& config, ThreadPool* pool)
+    : config_(std::make_unique<MapperConfig>(config)) {
+  if (!pool) throw Error("MapRebuild: no thread pool");
+  integrator_ = std::make_unique<ProjectiveIntegrator>(config_->integrator, pool);
+  map_ = std::make_unique<TsdfMap>(config_->map);
+  if (config_->occupancy_enabled) occupancy_ = std::make_unique<OccupancyMap>(config_->occupancy);
+}
+
+MapRebuild::~MapRebuild() = default;
+
+void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
+                     const LabelImage* labels) {
+  const std::string name = "frame of utime " + std::to_string(frame.utime);
+  try {
+    checkFrame(*config_, frame, T_W_C, nullptr);
+  } catch (const Error& e) {
+    throw Error(name + ": " + e.what());
+  }
+  const bool labelled = labels && !labels->empty();
+  if (labelled &&
+      (labels->width() != frame.camera.width || labels->height() != frame.camera.height)) {
+    throw Error(name + ": label image " + std::to_string(labels->width()) + "x" +
+                std::to_string(labels->height()) + ", depth " + std::to_string(frame.camera.width) +
+                "x" + std::to_string(frame.camera.height));
+  }
+  const IntegrationStats integration =
+      integrator_->integrate(frame, T_W_C, labelled ? labels : nullptr, map_.get());
+  votes_evicted_ += integration.votes_evicted;
+  if (occupancy_) occupancy_->integrate(frame, T_W_C);
+  StampedPose pose;
+  pose.utime = frame.utime;
+  pose.T_W_C = T_W_C;
+  poses_.push_back(pose);
+}
+
+}  // namespace panmap
