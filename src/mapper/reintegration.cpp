@@ -36,6 +36,9 @@ void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild) {
   for (size_t i = 0; i < poses.size(); ++i) trajectory_[i].T_W_C = poses[i].T_W_C;
   // The evictions of building this map, which replaces the old one and its history.
   vote_evictions_ = rebuild->votesEvicted();
+  // The correction's keyframes now sit at the back-end's poses, and the newest frames at what
+  // its corrected odometry gives them: what the tracker had learnt of the old drift is void.
+  drift_ = DriftFilter(config_.drift);
 }
 
 ReintegrationStats Mapper::reintegrate(const std::vector<StampedPose>& poses,

@@ -79,6 +79,30 @@ TEST_F(Reintegration, AtTheSamePosesTheMapIsRebuiltBitForBit) {
   EXPECT_EQ(bytes(*mapper), before);
 }
 
+// Tracking had learnt a correction of the given poses (they were 2 cm off from the 7th frame
+// on); after a repair the map sits at the back-end's corrected poses, so the correction starts
+// again from identity instead of pushing the next frames off by the old drift.
+TEST_F(Reintegration, ARepairRestartsTheCorrectionOfTrackedPoses) {
+  MapperConfig c = config();
+  c.tracking_mode = MapperConfig::TrackingMode::kOn;
+  Mapper mapper(c);
+  Eigen::Isometry3d off = Eigen::Isometry3d::Identity();
+  off.translation() = Eigen::Vector3d(0.02, 0.0, 0.0);
+  for (int k = 0; k < 9; ++k) {
+    Recorded r;
+    PanopticFrame panoptic;
+    frameAt(k, &r.frame, &panoptic);
+    mapper.integrate(r.frame, k < 6 ? pose(k) : off * pose(k), &panoptic);
+    r.labels = mapper.lastPixelLabels();
+    stored_[r.frame.utime] = r;
+  }
+  ASSERT_GT(mapper.poseCorrection().translation().norm(), 0.005)
+      << "tracking did not learn the offset";
+  ASSERT_TRUE(mapper.reintegrate(mapper.trajectory(), loader()).completed);
+  EXPECT_TRUE(mapper.poseCorrection().isApprox(Eigen::Isometry3d::Identity(), 0.0));
+  EXPECT_EQ(mapper.poseCorrection().matrix(), Eigen::Matrix4d::Identity());
+}
+
 TEST_F(Reintegration, ARigidCorrectionMovesExactlyTheSurfaces) {
   auto mapper = record(6);
   auto reference = record(6);

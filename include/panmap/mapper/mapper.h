@@ -177,6 +177,8 @@ class Mapper {
   const OccupancyMap* occupancy() const { return occupancy_.get(); }
   /// Every integrated frame's pose as used (refined where tracking ran), in order.
   const std::vector<StampedPose>& trajectory() const { return trajectory_; }
+  /// The running correction of tracked poses: refined pose = poseCorrection() * given pose.
+  const Eigen::Isometry3d& poseCorrection() const { return drift_.correction(); }
   /// Pose refinement outcomes so far, by AlignmentStatus.
   const std::array<int64_t, kAlignmentStatusCount>& trackingCounts() const {
     return tracking_counts_;
@@ -206,8 +208,10 @@ class Mapper {
   std::unique_ptr<MapRebuild> beginRebuild(ThreadPool* pool = nullptr) const;
   /// Swaps a finished rebuild in: the label-TSDF and occupancy map become the rebuild's, each
   /// frame's pose in trajectory() becomes the one it was re-integrated with, and the next
-  /// updateMesh() lists every block. Throws Error, changing nothing, unless the rebuild holds
-  /// exactly the frames of trajectory(), in order.
+  /// updateMesh() lists every block. The running correction of tracked poses starts again from
+  /// identity: the repaired map sits where the SLAM back-end's corrected poses put it, and
+  /// those are what its next poses build on (docs/LOOP_CLOSURE.md). Throws Error, changing
+  /// nothing, unless the rebuild holds exactly the frames of trajectory(), in order.
   void commitRebuild(std::unique_ptr<MapRebuild> rebuild);
 
   /// The labelled mesh of the current map: marching cubes re-run only on changed blocks;
