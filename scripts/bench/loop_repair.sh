@@ -38,7 +38,7 @@ import json, sys
 work = sys.argv[1]
 r = json.load(open(work + "/repaired/report.json"))
 print("repair:", "; ".join(r["corrections"]["repairs"]) or "none")
-print("frame store: %.1f MB for %d frames, %.1f ms median per frame (add)" % (
+print("frame store: %.1f MB for %d frames, %.1f ms median per frame on the mapping thread (queued for the writer thread)" % (
     sum(__import__("os").path.getsize(__import__("os").path.join(d, f))
         for d, _, fs in __import__("os").walk(work + "/store") for f in fs) / 1e6,
     r["frames_integrated"], r["timings"]["frame_store"]["median_ms"]))

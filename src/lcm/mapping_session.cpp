@@ -30,6 +30,15 @@ std::string reasonOf(const std::string& what) {
 MappingSession::MappingSession(const SessionOptions& options, Mapper* mapper)
     : options_(options), mapper_(mapper), sync_(options.sync) {
   if (!mapper_) throw Error("MappingSession: no mapper");
+  if (options_.frame_store) writer_ = std::make_unique<FrameStoreWriter>(options_.frame_store);
+}
+
+void MappingSession::countStoreErrors() {
+  if (!writer_) return;
+  // The map holds the frame either way; a frame the store lacks makes a later repair fail by
+  // name, so the failure is counted as soon as it is known.
+  for (const std::string& e : writer_->takeErrors())
+    ++stats_.rejected["frame store: " + reasonOf(e)];
 }
 
 void MappingSession::countDropped(const std::string& reason, int64_t n) {
@@ -126,8 +135,15 @@ void MappingSession::repair(const PoseCorrection& correction) {
   }
   if (options_.background_repair) {
     if (!background_) {
-      background_ =
-          std::make_unique<BackgroundRepair>(mapper_, options_.frame_store, options_.repair);
+      FrameStoreWriter* writer = writer_.get();
+      background_ = std::make_unique<BackgroundRepair>(
+          mapper_,
+          [writer](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
+            StoredFrame stored = writer->load(utime);  // waits for a frame still queued
+            *frame = std::move(stored.rgbd);
+            *labels = std::move(stored.labels);
+          },
+          options_.frame_store, options_.repair);
     }
     try {
       const MapRepairResult started = background_->start(correction);
@@ -143,6 +159,8 @@ void MappingSession::repair(const PoseCorrection& correction) {
     }
     return;
   }
+  writer_->flush();  // the repair reads the store directly
+  countStoreErrors();
   stats_.repair_frames_done = 0;
   stats_.repair_frames_total = static_cast<int64_t>(mapper_->trajectory().size());
   auto progress = [this](size_t done, size_t total) {
@@ -193,8 +211,13 @@ void MappingSession::poll() {
 
 void MappingSession::flush() {
   if (!done_) integrate(sync_.flush());
-  if (!background_) return;
-  if (std::optional<MapRepairResult> result = background_->finish()) recordRepair(*result);
+  if (background_) {
+    if (std::optional<MapRepairResult> result = background_->finish()) recordRepair(*result);
+  }
+  if (writer_) {
+    writer_->flush();
+    countStoreErrors();
+  }
 }
 
 void MappingSession::integrate(std::vector<SyncedFrame> ready) {
@@ -206,15 +229,16 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
       for (const auto& [stage, ms] : s.stageTimes()) times_ms_[stage].push_back(ms);
       ++stats_.frames_integrated;
       stats_.last_frame_utime = std::max(stats_.last_frame_utime, f.frame.utime);
-      if (options_.frame_store) {
-        // The map holds the frame either way; a frame the store lacks makes a later repair
-        // fail by name, so the failure is counted now.
+      if (writer_) {
+        // What the mapping thread pays: a copy into the writer's queue (and a wait when the
+        // disk has fallen max_queued frames behind).
         const auto start = std::chrono::steady_clock::now();
         try {
-          options_.frame_store->add(f.frame, s.T_W_C, mapper_->lastPixelLabels());
+          writer_->add(f.frame, s.T_W_C, mapper_->lastPixelLabels());
         } catch (const Error& e) {
           ++stats_.rejected["frame store: " + reasonOf(e.what())];
         }
+        countStoreErrors();
         times_ms_["frame_store"].push_back(
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count());

@@ -11,6 +11,7 @@
 #include "panmap/lcm/channels.h"
 #include "panmap/loop/background_repair.h"
 #include "panmap/loop/frame_store.h"
+#include "panmap/loop/frame_store_writer.h"
 #include "panmap/loop/map_repair.h"
 #include "panmap/mapper/frame_sync.h"
 #include "panmap/mapper/mapper.h"
@@ -25,8 +26,9 @@ struct SessionOptions {
   /// Loop-closure corrections (pose_correction_t); they repair the map from frame_store.
   std::string channel_correction = kChannelPoseCorrection;
   SyncConfig sync;
-  /// Where every integrated frame is kept for loop-closure repairs (not owned); null: no
-  /// store, and corrections are refused (counted).
+  /// Where every integrated frame is kept for loop-closure repairs (not owned; written by a
+  /// thread of the session's own, FrameStoreWriter); null: no store, and corrections are
+  /// refused (counted).
   FrameStore* frame_store = nullptr;
   MapRepairConfig repair;
   /// Repairs run on a thread of their own while frames keep being integrated (the live
@@ -113,6 +115,7 @@ class MappingSession {
   void repair(const PoseCorrection& correction);
   void recordRepair(const MapRepairResult& result);
   void countRepairError(const std::string& what);
+  void countStoreErrors();
 
   SessionOptions options_;
   Mapper* mapper_;
@@ -123,6 +126,7 @@ class MappingSession {
   std::map<std::string, std::vector<double>> times_ms_;
   int64_t newest_utime_ = INT64_MIN;
   bool done_ = false;
+  std::unique_ptr<FrameStoreWriter> writer_;      // with a frame store: writes it off this thread
   std::unique_ptr<BackgroundRepair> background_;  // with background_repair, once needed
   int64_t running_correction_id_ = 0;             // of the background repair under way
 };
