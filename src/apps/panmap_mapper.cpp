@@ -51,6 +51,7 @@ nlohmann::json sessionJson(const panmap::SessionStats& s) {
           {"corrections",
            {{"received", s.corrections_received},
             {"applied", s.corrections_applied},
+            {"superseded", s.corrections_superseded},
             {"frames_reintegrated", s.frames_reintegrated},
             {"last_repair_s", s.last_repair_s},
             {"repairs", s.repairs}}}};
