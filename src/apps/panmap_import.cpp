@@ -175,16 +175,8 @@ int main(int argc, char** argv) {
                   input_path.c_str());
     }
     if (correction_every > 0 && !s.recorded_poses.empty()) {
-      panmap::PoseCorrection correction;
-      correction.correction_id = 1;
-      const std::vector<panmap::StampedPose>& recorded = s.recorded_poses;
-      for (size_t i = 0; i < recorded.size(); ++i) {
-        if (i % correction_every == 0 || i + 1 == recorded.size()) {
-          correction.poses.push_back(recorded[i]);
-        }
-      }
-      // Published a second after the last frame, as a back-end does once it closes the loop.
-      correction.utime = recorded.back().utime + 1000000;
+      const panmap::PoseCorrection correction =
+          panmap::keyframeCorrection(s.recorded_poses, correction_every);
       panmap::LogWriter writer(log_path, /*append=*/true);
       writer.write(panmap::kChannelPoseCorrection, correction.utime, panmap::toMessage(correction));
       std::printf("correction 1 on %s: recorded poses of %zu keyframes (every %zu frames)\n",

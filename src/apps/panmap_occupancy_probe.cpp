@@ -131,14 +131,30 @@ int main(int argc, char** argv) {
   app.add_option("--segment", segment, "is the straight segment A-B free (world, metres)")
       ->expected(6)
       ->type_name("AX AY AZ BX BY BZ");
+  std::string compare;
+  app.add_option("--compare", compare,
+                 "compare the tree cell by cell with this .bt file: prints the share of cells "
+                 "known in both whose states agree, and the cells known in only one");
   CLI11_PARSE(app, argc, argv);
   try {
-    if (point.empty() && segment.empty()) {
-      throw panmap::Error("nothing to ask: give --point and/or --segment (see --help)");
+    if (point.empty() && segment.empty() && compare.empty()) {
+      throw panmap::Error("nothing to ask: give --point, --segment or --compare (see --help)");
     }
     std::unique_ptr<octomap::OcTree> tree =
         file.empty() ? receiveTree(url, channel, timeout_s) : panmap::readBtFile(file);
     std::vector<std::string> answers;
+    if (!compare.empty()) {
+      const panmap::OccupancyAgreement a =
+          panmap::compareOccupancy(*tree, *panmap::readBtFile(compare));
+      char line[256];
+      std::snprintf(line, sizeof(line),
+                    "agree on %.2f %% of %llu cells known in both; known only here %llu, only "
+                    "in %s %llu",
+                    100.0 * a.agreement(), static_cast<unsigned long long>(a.known_in_both),
+                    static_cast<unsigned long long>(a.only_in_a), compare.c_str(),
+                    static_cast<unsigned long long>(a.only_in_b));
+      answers.push_back(line);
+    }
     if (!point.empty()) {
       answers.push_back(panmap::occupancyName(
           panmap::occupancyAt(*tree, Eigen::Vector3d(point[0], point[1], point[2]))));

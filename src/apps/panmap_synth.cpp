@@ -3,6 +3,7 @@
 // along a camera trajectory into an LCM log with RGB-D frames, drifting poses and simulated
 // panoptic masks, plus the ground truth to evaluate against.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,7 @@
 #include "panmap/io/scannet_ground_truth.h"
 #include "panmap/lcm/channels.h"
 #include "panmap/lcm/conversions.h"
+#include "panmap/lcm/correction_conversions.h"
 #include "panmap/lcm/log_writer.h"
 #include "panmap/sim/procedural_room.h"
 #include "panmap/sim/sequence.h"
@@ -180,10 +182,26 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"clean", "m2f", "hard"}));
   app.add_option("--poses", poses, "pose preset: gt, slam, slam-hard, light, heavy")
       ->capture_default_str()
-      ->check(CLI::IsMember({"gt", "slam", "slam-hard"}));
+      ->check(CLI::IsMember({"gt", "slam", "slam-hard", "light", "heavy"}));
   app.add_option("--seed", seed, "seed of trajectory, noise, masks and drift")
       ->capture_default_str();
   app.add_flag("--no-depth-noise", no_depth_noise, "exact depth (quantised to 1 mm)");
+  size_t correction_every = 0;
+  panmap::CorrectionResidual residual;
+  double residual_cm = 0.0, residual_deg = 0.0;
+  app.add_option("--correction-every", correction_every,
+                 "end the log with the loop-closure correction a SLAM back-end would publish on "
+                 "PANMAP_POSE_CORRECTION once the survey is back at its start (--laps 2): the "
+                 "ground-truth poses of every Nth frame (keyframes) and of the last one "
+                 "(docs/LOOP_CLOSURE.md)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--correction-residual-cm", residual_cm,
+                 "the correction's residual error: each keyframe pose off by this much per axis "
+                 "(standard deviation, drawn with --seed)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--correction-residual-deg", residual_deg,
+                 "and turned by this much per axis (standard deviation)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--unannotate", unannotate_config.fraction,
                  "leave this share of the ground truth's vertices without a class (whole objects "
                  "and clutter patches, drawn with --seed; vertices already without one count)")
@@ -295,6 +313,16 @@ int main(int argc, char** argv) {
       progress.update(k + 1, synth.size());
     }
     progress.finish();
+    size_t correction_poses = 0;
+    if (correction_every > 0) {
+      residual.sigma_m = residual_cm / 100.0;
+      residual.sigma_rad = residual_deg * M_PI / 180.0;
+      residual.seed = seed;
+      const panmap::PoseCorrection correction =
+          panmap::keyframeCorrection(synth.groundTruthTrajectory(), correction_every, 1, residual);
+      log.write(panmap::kChannelPoseCorrection, correction.utime, panmap::toMessage(correction));
+      correction_poses = correction.poses.size();
+    }
 
     panmap::writePly(out_dir + "/gt/mesh.ply", gt_mesh);
     panmap::writeScanNetInstanceFile(out_dir + "/gt/instances.txt", gt_mesh);
@@ -345,6 +373,11 @@ int main(int argc, char** argv) {
           {"clutter_instances", scene.clutter_instances},
           {"masks", unannotated_masks}}},
         {"poses", posesJson(config.poses)},
+        {"correction",
+         {{"every", correction_every},
+          {"keyframes", correction_poses},
+          {"residual_cm", residual_cm},
+          {"residual_deg", residual_deg}}},
         {"depth_noise", depthJson(config.depth)},
         {"coverage",
          {{"thing_instances", cov.thing_instances},

@@ -3,11 +3,42 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <random>
 #include <string>
 
 #include "panmap/core/error.h"
 
 namespace panmap {
+
+PoseCorrection keyframeCorrection(const std::vector<StampedPose>& reference, size_t every,
+                                  int64_t correction_id, const CorrectionResidual& residual) {
+  if (reference.empty()) throw Error("keyframe correction: no reference pose");
+  if (every == 0) throw Error("keyframe correction: every must be at least 1");
+  if (!(residual.sigma_m >= 0.0) || !(residual.sigma_rad >= 0.0)) {
+    throw Error("keyframe correction: residual sigmas must be >= 0");
+  }
+  std::mt19937_64 rng(residual.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  PoseCorrection correction;
+  correction.correction_id = correction_id;
+  for (size_t i = 0; i < reference.size(); ++i) {
+    if (i % every != 0 && i + 1 != reference.size()) continue;
+    StampedPose p = reference[i];
+    if (residual.sigma_m > 0.0 || residual.sigma_rad > 0.0) {
+      const Eigen::Vector3d t(normal(rng), normal(rng), normal(rng));
+      const Eigen::Vector3d r(normal(rng), normal(rng), normal(rng));
+      const Eigen::Vector3d w = r * residual.sigma_rad;
+      Eigen::Isometry3d E = Eigen::Isometry3d::Identity();
+      if (w.norm() > 0.0)
+        E.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+      E.translation() = t * residual.sigma_m;
+      p.T_W_C = p.T_W_C * E;
+    }
+    correction.poses.push_back(p);
+  }
+  correction.utime = reference.back().utime + 1000000;
+  return correction;
+}
 
 void PoseCorrection::check() const {
   const std::string what = "pose correction " + std::to_string(correction_id);

@@ -131,3 +131,56 @@ TEST(PoseCorrection, BadCorrectionsNameTheirProblem) {
 
 }  // namespace
 }  // namespace panmap
+
+namespace panmap {
+namespace {
+
+std::vector<StampedPose> line(int n) {
+  std::vector<StampedPose> poses(n);
+  for (int i = 0; i < n; ++i) {
+    poses[i].utime = 1000 * (i + 1);
+    poses[i].T_W_C.translation() = Eigen::Vector3d(0.1 * i, 0.0, 1.0);
+  }
+  return poses;
+}
+
+// Test data of a loop closure: the reference poses of every Nth frame and of the last one,
+// exactly, or off by a seeded residual error.
+TEST(KeyframeCorrection, EveryNthFrameAndTheLastOneWithTheirReferencePoses) {
+  const std::vector<StampedPose> reference = line(7);
+  const PoseCorrection c = keyframeCorrection(reference, 4, 9);
+  EXPECT_EQ(c.correction_id, 9);
+  ASSERT_EQ(c.poses.size(), 3u);  // frames 0, 4 and the last, 6
+  EXPECT_EQ(c.poses[0].utime, 1000);
+  EXPECT_EQ(c.poses[1].utime, 5000);
+  EXPECT_EQ(c.poses[2].utime, 7000);
+  EXPECT_EQ(c.poses[1].T_W_C.matrix(), reference[4].T_W_C.matrix());
+  EXPECT_EQ(c.utime, 8000 + 1000000 - 1000);  // a second after the last frame
+  EXPECT_NO_THROW(c.check());
+  EXPECT_EQ(keyframeCorrection(reference, 1).poses.size(), 7u);
+
+  CorrectionResidual residual;
+  residual.sigma_m = 0.01;
+  residual.sigma_rad = 0.002;
+  residual.seed = 5;
+  const PoseCorrection noisy = keyframeCorrection(line(301), 1, 1, residual);
+  const std::vector<StampedPose> exact = line(301);
+  double sum_sq_m = 0.0, sum_sq_rad = 0.0;
+  for (size_t i = 0; i < noisy.poses.size(); ++i) {
+    const Eigen::Isometry3d E = exact[i].T_W_C.inverse() * noisy.poses[i].T_W_C;
+    sum_sq_m += E.translation().squaredNorm();
+    sum_sq_rad += std::pow(Eigen::AngleAxisd(E.linear()).angle(), 2);
+  }
+  // Three axes of sigma each: the RMS offset is sigma * sqrt(3), within sampling error.
+  EXPECT_NEAR(std::sqrt(sum_sq_m / 301), 0.01 * std::sqrt(3.0), 0.0015);
+  EXPECT_NEAR(std::sqrt(sum_sq_rad / 301), 0.002 * std::sqrt(3.0), 0.0003);
+  EXPECT_NO_THROW(noisy.check());
+  const PoseCorrection again = keyframeCorrection(line(301), 1, 1, residual);
+  EXPECT_EQ(again.poses[17].T_W_C.matrix(), noisy.poses[17].T_W_C.matrix());  // seeded
+
+  EXPECT_THROW(keyframeCorrection({}, 3), Error);
+  EXPECT_THROW(keyframeCorrection(reference, 0), Error);
+}
+
+}  // namespace
+}  // namespace panmap

@@ -19,6 +19,22 @@ struct PoseCorrection {
   void check() const;
 };
 
+/// The residual error of a back-end's corrected poses: each keyframe pose is moved by a random
+/// rotation and translation of these standard deviations (per axis), from `seed`.
+struct CorrectionResidual {
+  double sigma_m = 0.0;
+  double sigma_rad = 0.0;
+  uint64_t seed = 1;
+};
+
+/// The correction a SLAM back-end publishes once it closes a loop, for test data: the
+/// reference poses of every `every`-th frame (keyframes) and of the last one, each with the
+/// residual error given, published a second after the last frame. Throws Error when
+/// `reference` is empty or `every` is 0.
+PoseCorrection keyframeCorrection(const std::vector<StampedPose>& reference, size_t every,
+                                  int64_t correction_id = 1,
+                                  const CorrectionResidual& residual = {});
+
 /// What a correction does to a trajectory (the poses frames were integrated with).
 struct CorrectedTrajectory {
   std::vector<StampedPose> poses;  ///< every frame of the trajectory, corrected, same order

@@ -42,4 +42,21 @@ struct SegmentCheck {
 SegmentCheck checkSegment(const octomap::OcTree& tree, const Eigen::Vector3d& a_W,
                           const Eigen::Vector3d& b_W);
 
+/// How two occupancy trees of the same resolution agree, counted in finest-level cells (a
+/// pruned leaf counts as every cell it covers).
+struct OccupancyAgreement {
+  uint64_t known_in_both = 0;  ///< cells free or occupied in both
+  uint64_t agree = 0;          ///< of those, with the same state in both
+  uint64_t only_in_a = 0;      ///< known in a, unknown in b
+  uint64_t only_in_b = 0;      ///< known in b, unknown in a
+  /// agree / known_in_both (1 when nothing is known in both).
+  double agreement() const {
+    return known_in_both ? static_cast<double>(agree) / static_cast<double>(known_in_both) : 1.0;
+  }
+};
+
+/// Compares two trees cell by cell, e.g. the occupancy of a repaired map against the one from
+/// ground-truth poses. Throws Error when their resolutions differ.
+OccupancyAgreement compareOccupancy(const octomap::OcTree& a, const octomap::OcTree& b);
+
 }  // namespace panmap
