@@ -150,9 +150,8 @@ int main(int argc, char** argv) {
       load_ms.push_back(msSince(start));
       load_total_ms += load_ms.back();
     }
-    panmap::Mapper* m = &mapper;
-    const panmap::PoseCorrection first = driftCorrection(m->trajectory(), 1);
-    const panmap::MapRepairResult blocking = panmap::repairMap(m, &store, first);
+    const panmap::PoseCorrection first = driftCorrection(mapper.trajectory(), 1);
+    const panmap::MapRepairResult blocking = panmap::repairMap(&mapper, &store, first);
     std::printf("blocking repair:   %s\n", panmap::describe(blocking).c_str());
     std::printf("  loading frames   %.2f s alone (%.1f ms median per frame)\n",
                 load_total_ms / 1000.0, median(load_ms));
@@ -161,7 +160,7 @@ int main(int argc, char** argv) {
 
     // On its own thread while frames keep coming at rate_hz.
     panmap::BackgroundRepair repair(&mapper, &store);
-    const panmap::PoseCorrection second = driftCorrection(m->trajectory(), 2);
+    const panmap::PoseCorrection second = driftCorrection(mapper.trajectory(), 2);
     map_ms.clear();
     const auto period =
         std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate_hz));

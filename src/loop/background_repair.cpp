@@ -18,17 +18,14 @@ BackgroundRepair::BackgroundRepair(Mapper* mapper, FrameLoader load, FrameStore*
 }
 
 BackgroundRepair::BackgroundRepair(Mapper* mapper, FrameStore* store, const MapRepairConfig& config)
-    : BackgroundRepair(
-          mapper,
-          [store](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
-            if (!store) throw Error("BackgroundRepair: no frame store");
-            StoredFrame stored = store->load(utime);
-            *frame = std::move(stored.rgbd);
-            *labels = std::move(stored.labels);
-          },
-          store, config) {}
+    : BackgroundRepair(mapper, storeLoader(store), store, config) {}
 
 BackgroundRepair::~BackgroundRepair() { stopWorker(); }
+
+int64_t BackgroundRepair::framesDone() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return static_cast<int64_t>(next_);
+}
 
 int64_t BackgroundRepair::framesTotal() const {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -86,7 +83,6 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
     stop_ = false;
     failure_.clear();
   }
-  frames_done_ = 0;
   worker_ = std::thread(&BackgroundRepair::work, this);
   return result_;
 }
@@ -104,11 +100,16 @@ void BackgroundRepair::reintegrate(const StampedPose& job, RgbdFrame* frame, Lab
   *frame = RgbdFrame();
   *labels = LabelImage();
   load_(job.utime, frame, labels);
-  if (frame->utime != job.utime) {
+  addLoaded(job, *frame, *labels);
+}
+
+void BackgroundRepair::addLoaded(const StampedPose& job, const RgbdFrame& frame,
+                                 const LabelImage& labels) {
+  if (frame.utime != job.utime) {
     throw Error("asked for the frame of utime " + std::to_string(job.utime) + ", got " +
-                std::to_string(frame->utime));
+                std::to_string(frame.utime));
   }
-  rebuild_->add(*frame, job.T_W_C, labels);
+  rebuild_->add(frame, job.T_W_C, &labels);
 }
 
 void BackgroundRepair::work() {
@@ -135,11 +136,7 @@ void BackgroundRepair::work() {
     try {
       if (next_ < corrected_.poses.size()) {
         prefetched.next(&frame, &labels);
-        if (frame.utime != job.utime) {
-          throw Error("asked for the frame of utime " + std::to_string(job.utime) + ", got " +
-                      std::to_string(frame.utime));
-        }
-        rebuild_->add(frame, job.T_W_C, &labels);
+        addLoaded(job, frame, labels);
       } else {
         reintegrate(job, &frame, &labels);
       }
@@ -152,7 +149,6 @@ void BackgroundRepair::work() {
     }
     std::lock_guard<std::mutex> lock(mutex_);
     ++next_;
-    frames_done_ = static_cast<int64_t>(next_);
   }
 }
 
@@ -209,7 +205,6 @@ std::optional<MapRepairResult> BackgroundRepair::poll() {
     LabelImage labels;
     try {
       for (; next_ < jobs_.size(); ++next_) reintegrate(jobs_[next_], &frame, &labels);
-      frames_done_ = static_cast<int64_t>(next_);
     } catch (const std::exception& e) {
       failure_ = e.what();
     }

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "panmap/core/error.h"
 
@@ -9,6 +10,15 @@ namespace panmap {
 
 void MapRepairConfig::check() const {
   if (match_tolerance_us < 0) throw Error("map repair match_tolerance_us must be >= 0");
+}
+
+FrameLoader storeLoader(const FrameStore* store) {
+  if (!store) throw Error("frame loader: no frame store");
+  return [store](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
+    StoredFrame stored = store->load(utime);
+    *frame = std::move(stored.rgbd);
+    *labels = std::move(stored.labels);
+  };
 }
 
 MapRepairResult repairMap(Mapper* mapper, FrameStore* store, const PoseCorrection& correction,
@@ -33,12 +43,7 @@ MapRepairResult repairMap(Mapper* mapper, FrameStore* store, const PoseCorrectio
                 " utimes is a mapped frame (first " +
                 std::to_string(correction.poses.front().utime) + ")");
   }
-  const FrameLoader load = [store](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
-    StoredFrame stored = store->load(utime);
-    *frame = std::move(stored.rgbd);
-    *labels = std::move(stored.labels);
-  };
-  result.reintegration = mapper->reintegrate(corrected.poses, load, progress);
+  result.reintegration = mapper->reintegrate(corrected.poses, storeLoader(store), progress);
   if (result.reintegration.completed) {
     // Only what moved: the store's poses are the ones the frames are now integrated with.
     for (size_t i = 0; i < corrected.poses.size(); ++i) {

@@ -23,15 +23,6 @@ void feed(MappingSession* session, const std::vector<test::Encoded>& messages) {
   session->flush();
 }
 
-// Gives each stored frame back, for re-integrating a reference map.
-FrameLoader loaderOf(FrameStore* store) {
-  return [store](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
-    StoredFrame stored = store->load(utime);
-    *frame = std::move(stored.rgbd);
-    *labels = std::move(stored.labels);
-  };
-}
-
 class MappingSessionTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -205,7 +196,7 @@ TEST_F(MappingSessionTest, ACorrectionRepairsTheMapFromTheFrameStore) {
   Mapper clean(test::streamMapperConfig());
   MappingSession plain(SessionOptions{}, &clean);
   feed(&plain, stream_.messages());
-  const FrameLoader load = loaderOf(&store);
+  const FrameLoader load = storeLoader(&store);
   ASSERT_TRUE(clean.reintegrate(mapper.trajectory(), load).completed);
   EXPECT_EQ(test::mapBytes(mapper), test::mapBytes(clean));
   for (size_t k = 0; k < mapper.trajectory().size(); ++k) {
@@ -290,7 +281,7 @@ TEST_F(MappingSessionTest, ABackgroundRepairTakesTheFramesMappedMeanwhile) {
   Mapper reference(test::streamMapperConfig());
   MappingSession plain(SessionOptions{}, &reference);
   feed(&plain, stream_.messages());
-  const FrameLoader load = loaderOf(&store);
+  const FrameLoader load = storeLoader(&store);
   ASSERT_TRUE(reference.reintegrate(mapper.trajectory(), load).completed);
   ASSERT_EQ(mapper.map().numBlocks(), reference.map().numBlocks());
   std::map<std::tuple<int, int, int>, const Block*> blocks;

@@ -93,13 +93,6 @@ class BackgroundRepairTest : public BoxScene {
     c.poses.push_back(p);
     return c;
   }
-  static FrameLoader loaderOf(FrameStore* store) {
-    return [store](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
-      StoredFrame stored = store->load(utime);
-      *frame = std::move(stored.rgbd);
-      *labels = std::move(stored.labels);
-    };
-  }
 };
 
 // The repair holds at its first frame while two more frames are mapped; once let go it takes
@@ -113,7 +106,7 @@ TEST_F(BackgroundRepairTest, FramesMappedDuringTheRepairAreInTheRepairedMap) {
   const PoseCorrection correction = keyframeCorrection(*mapper, 3, D, 7);
 
   Gate gate;
-  const FrameLoader store_loader = loaderOf(&store);
+  const FrameLoader store_loader = storeLoader(&store);
   int loads = 0;  // the repair's thread only
   BackgroundRepair repair(
       mapper.get(),
@@ -157,7 +150,7 @@ TEST_F(BackgroundRepairTest, FramesMappedDuringTheRepairAreInTheRepairedMap) {
   test::TempDir other;
   FrameStore reference_store(storeConfig(other.path("store")));
   auto reference = mapWithStore(8, &reference_store);
-  ASSERT_TRUE(reference->reintegrate(poses, loaderOf(&store)).completed);
+  ASSERT_TRUE(reference->reintegrate(poses, storeLoader(&store)).completed);
   EXPECT_EQ(geometryOf(mapper->map()), geometryOf(reference->map()));
   EXPECT_GT(mapper->map().numBlocks(), 0u);
 }
@@ -211,7 +204,7 @@ TEST_F(BackgroundRepairTest, BadCorrectionsAndLostFramesChangeNothing) {
   FrameStore store(storeConfig(dir.path("store")));
   auto mapper = mapWithStore(5, &store);
   const std::vector<uint8_t> before = mapper->serialize();
-  const FrameLoader store_loader = loaderOf(&store);
+  const FrameLoader store_loader = storeLoader(&store);
   const int64_t lost = mapper->trajectory()[3].utime;
   BackgroundRepair repair(mapper.get(), [&](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
     if (utime == lost) throw Error("frame store: no frame of utime " + std::to_string(utime));

@@ -76,12 +76,7 @@ TEST_F(MapRepair, AKeyframeCorrectionRepairsTheMapFromTheStore) {
   for (size_t i = 0; i < poses.size(); ++i) {
     EXPECT_TRUE(poses[i].T_W_C.isApprox(D * reference->trajectory()[i].T_W_C, 1e-12)) << i;
   }
-  const FrameLoader load = [&reference_store](int64_t utime, RgbdFrame* f, LabelImage* l) {
-    StoredFrame s = reference_store.load(utime);
-    *f = s.rgbd;
-    *l = s.labels;
-  };
-  ASSERT_TRUE(reference->reintegrate(poses, load).completed);
+  ASSERT_TRUE(reference->reintegrate(poses, storeLoader(&reference_store)).completed);
   EXPECT_EQ(mapper->serialize(), reference->serialize());
 
   // The store holds the poses the frames are now integrated with, also after reopening.

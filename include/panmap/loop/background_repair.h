@@ -1,6 +1,5 @@
 #pragma once
 
-#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -62,7 +61,7 @@ class BackgroundRepair {
   /// A repair is running (started and not yet returned by poll() or finish()).
   bool running() const { return worker_.joinable(); }
   /// Frames the running (or last) repair has re-integrated, and the frames it has to.
-  int64_t framesDone() const { return frames_done_.load(); }
+  int64_t framesDone() const;
   int64_t framesTotal() const;
   /// Repairs abandoned for a newer correction.
   int64_t superseded() const { return superseded_; }
@@ -77,6 +76,8 @@ class BackgroundRepair {
   MapRepairResult commit();
   /// Loads one frame and adds it to the rebuild at the job's pose; throws Error.
   void reintegrate(const StampedPose& job, RgbdFrame* frame, LabelImage* labels);
+  /// Adds a loaded frame at the job's pose; throws Error when it is another frame.
+  void addLoaded(const StampedPose& job, const RgbdFrame& frame, const LabelImage& labels);
 
   Mapper* mapper_;
   FrameLoader load_;
@@ -100,7 +101,6 @@ class BackgroundRepair {
   bool idle_ = false;              // the worker waits for a job
   bool stop_ = false;              // the worker must return
   std::string failure_;            // why the worker gave up
-  std::atomic<int64_t> frames_done_{0};
 };
 
 }  // namespace panmap

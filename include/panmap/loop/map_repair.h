@@ -19,6 +19,10 @@ struct MapRepairConfig {
   void check() const;
 };
 
+/// A FrameLoader that gives back the frames of `store` (FrameStore::load; callable from any
+/// thread). Throws Error when `store` is null.
+FrameLoader storeLoader(const FrameStore* store);
+
 /// What one repair did.
 struct MapRepairResult {
   int64_t correction_id = 0;
