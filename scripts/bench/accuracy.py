@@ -433,7 +433,13 @@ def main():
           "**Voxblox++-like** = spatial-only merging and frame-count labels, no graph "
           "optimisation (same object output stage). These map the poses as given "
           "(`--tracking off`); **full, `slam` poses** maps SLAM-like poses with the default "
-          "tracking (`auto`: each pose refined against the map).", ""]
+          "tracking (`auto`: each pose refined against the map).", "",
+          "A map built from drifting poses lives in the world frame of its trajectory, which "
+          "differs from the ground truth's by a rigid transform no mapper can observe (the "
+          "drift of the first poses fixes it). Before scoring, such a mesh is moved by the "
+          "rigid alignment of the trajectory it was built with to the ground-truth trajectory: "
+          "the alignment ATE itself applies (`panmap-eval --align-pred`). Errors inside the "
+          "map (doubled surfaces, bent walls) are not removed by it.", ""]
     for title, specs, intro in [
             ("Real ScanNet scene geometry", real,
              "`panmap-synth --scannet DIR` renders the scene's reconstructed mesh along a "

@@ -124,12 +124,21 @@ def render(work, spec):
 BOUNDARY_BAND_VOXELS = 1.5
 
 
-def evaluate(pred_dir, seq_dir, voxel_m=0.02):
-    """Scores a mapper output folder against the sequence's ground truth (eval.json)."""
+def evaluate(pred_dir, seq_dir, voxel_m=0.02, trajectory=None):
+    """Scores a mapper output folder against the sequence's ground truth (eval.json).
+
+    trajectory: the poses the map was built with (trajectory.txt), when they are not the
+    ground truth. A map from estimated poses lives in the estimate's world frame, which differs
+    from the ground truth's by a rigid transform no mapper can observe (the first poses' drift
+    fixes it): the mesh is moved by the trajectory's ATE alignment before scoring, as ATE itself
+    is (panmap-eval --align-pred)."""
     cmd = [tool("panmap-eval"), "--pred", os.path.join(pred_dir, "mesh_instance.ply"),
            "--gt", os.path.join(seq_dir, "gt", "mesh.ply"),
            "--boundary-band", "%g" % (BOUNDARY_BAND_VOXELS * voxel_m),
            "--json", os.path.join(pred_dir, "eval.json")]
+    if trajectory:
+        cmd += ["--traj", trajectory, "--gt-traj",
+                os.path.join(seq_dir, "gt", "trajectory_gt.txt"), "--align-pred"]
     objects = os.path.join(pred_dir, "objects.json")
     if os.path.exists(objects):
         cmd += ["--confidences", objects]
@@ -174,11 +183,15 @@ def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
     with open(os.path.join(seq_dir, "info.json")) as f:
         info = json.load(f)
     drifting = spec.poses != "gt"
+
+    def built_with(map_dir):
+        return os.path.join(map_dir, "trajectory.txt") if drifting else None
     results, ate = {}, {}
     if spec.runs == "full":
         # The full method as a user runs it: default tracking (refines drifting poses).
         run(base + extra + ["--log", log_path, "--out", os.path.join(out, "A")], log)
-        results["full"] = evaluate(os.path.join(out, "A"), seq_dir, voxel_m)
+        results["full"] = evaluate(os.path.join(out, "A"), seq_dir, voxel_m,
+                                   built_with(os.path.join(out, "A")))
         if drifting:
             ate["refined"] = trajectory_ate(seq_dir, os.path.join(out, "A", "trajectory.txt"),
                                             os.path.join(out, "ate_refined.json"), log)
@@ -187,7 +200,7 @@ def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
         if drifting and spec.runs == "all":
             refined = os.path.join(out, "A_refined")
             run(base + extra + ["--tracking", "auto", "--log", log_path, "--out", refined], log)
-            results[REFINED] = evaluate(refined, seq_dir, voxel_m)
+            results[REFINED] = evaluate(refined, seq_dir, voxel_m, built_with(refined))
             ate["refined"] = trajectory_ate(seq_dir, os.path.join(refined, "trajectory.txt"),
                                             os.path.join(out, "ate_refined.json"), log)
         tracking = "auto" if spec.runs == "tracked" else "off"
@@ -211,7 +224,8 @@ def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
                 run([tool("panmap-mapper"), "-q", "--no-snapshots", "--export-only", "--load",
                      os.path.join(out, source, "map.panmap"), "--out", folder] + flags + extra,
                     log)
-            results[variant] = evaluate(folder, seq_dir, voxel_m)
+            results[variant] = evaluate(folder, seq_dir, voxel_m,
+                                        built_with(os.path.join(out, source)))
             if folder not in (os.path.join(out, "A"), os.path.join(out, "B")):
                 drop_map(folder)
     if drifting:
@@ -237,7 +251,8 @@ def reexport(work, spec, config=""):
     run([tool("panmap-mapper"), "-q", "--no-snapshots", "--export-only", "--load",
          os.path.join(folder, "map.panmap"), "--out", folder] +
         (["--config", config] if config else []), os.path.join(out, "commands.log"))
-    return {"results": {"full": evaluate(folder, seq_dir)}}
+    trajectory = os.path.join(folder, "trajectory.txt") if spec.poses != "gt" else None
+    return {"results": {"full": evaluate(folder, seq_dir, trajectory=trajectory)}}
 
 
 def run_all(work, specs, voxel_m, jobs, keep_logs, config="", variants=None, label="suite",

@@ -294,6 +294,13 @@ int main(int argc, char** argv) {
       app.add_option("--gt-traj", gt_traj_path, "ground-truth trajectory, TUM format");
   traj_option->needs(gt_traj_option);
   gt_traj_option->needs(traj_option);
+  bool align_pred = false;
+  app.add_flag("--align-pred", align_pred,
+               "move the predicted mesh by the trajectory's rigid alignment (the ATE's T_gt_est) "
+               "before the label transfer: a map built from estimated poses lives in the "
+               "estimate's world frame, which differs from the ground truth's by a rigid "
+               "transform no mapper can observe")
+      ->needs(traj_option);
   app.add_option("--max-time-difference", traj_config.max_time_difference_s,
                  "largest stamp difference of associated poses, seconds")
       ->capture_default_str();
@@ -316,10 +323,21 @@ int main(int argc, char** argv) {
           "nothing to evaluate: give --pred with --gt or --gt-scannet, and/or --traj with "
           "--gt-traj");
     }
+    if (align_pred && !mesh_eval) throw panmap::Error("--align-pred needs --pred");
     json out;
+    panmap::TrajectoryError trajectory_error;
+    if (!traj_path.empty()) {
+      trajectory_error =
+          panmap::evaluateTrajectory(panmap::readTumTrajectory(traj_path),
+                                     panmap::readTumTrajectory(gt_traj_path), traj_config);
+    }
     if (mesh_eval) {
       if (!classes_text.empty()) config.classes = panmap::parseClassList(classes_text);
-      const panmap::LabelledMesh pred = panmap::readPly(pred_path);
+      panmap::LabelledMesh pred = panmap::readPly(pred_path);
+      if (align_pred) {
+        const Eigen::Isometry3f T_gt_est = trajectory_error.T_gt_est.cast<float>();
+        for (Eigen::Vector3f& p : pred.vertices) p = T_gt_est * p;
+      }
       const panmap::LabelledMesh gt =
           loadGroundTruth(gt_path, scannet_dir, scannet_labels, gt_instances_path);
       std::map<int32_t, double> confidences;
@@ -336,11 +354,9 @@ int main(int argc, char** argv) {
       out["diagnostics"] = toJson(diagnostics);
     }
     if (!traj_path.empty()) {
-      const panmap::TrajectoryError error =
-          panmap::evaluateTrajectory(panmap::readTumTrajectory(traj_path),
-                                     panmap::readTumTrajectory(gt_traj_path), traj_config);
-      std::printf("%s", panmap::formatTrajectoryError(error).c_str());
-      out["trajectory"] = toJson(error, traj_config);
+      std::printf("%s", panmap::formatTrajectoryError(trajectory_error).c_str());
+      out["trajectory"] = toJson(trajectory_error, traj_config);
+      if (align_pred) out["pred_aligned_by_trajectory"] = true;
     }
     if (!json_path.empty()) {
       std::ofstream file(json_path);
