@@ -206,9 +206,15 @@ int main(int argc, char** argv) {
   app.add_option("--channel-correction", options.channel_correction)->capture_default_str();
   std::string frame_store_dir;
   app.add_option("--frame-store", frame_store_dir,
-                 "keep every integrated frame in this folder (depth and pixel labels, ~110 kB "
-                 "each) so that loop-closure corrections on --channel-correction repair the map "
-                 "(docs/LOOP_CLOSURE.md); without it corrections are refused and counted");
+                 "keep every integrated frame in this folder (depth, pixel labels and panoptic "
+                 "masks, ~120 kB each) so that loop-closure corrections on --channel-correction "
+                 "repair the map (docs/LOOP_CLOSURE.md); without it corrections are refused and "
+                 "counted");
+  bool repair_reintegrate_only = false;
+  app.add_flag("--repair-reintegrate-only", repair_reintegrate_only,
+               "repair by re-integrating the stored frames with the super-points they had, "
+               "never by mapping them again with their masks (faster; objects formed under "
+               "large drift stay as they were)");
   app.add_flag("--no-snapshots", no_snapshots, "skip the overview PNGs");
   std::string graph_json;
   app.add_option("--graph-json", graph_json,
@@ -299,6 +305,7 @@ int main(int argc, char** argv) {
                             " frames; give an empty folder, or --load / --resume their map");
       }
       options.frame_store = frame_store.get();
+      options.repair.reassociate = !repair_reintegrate_only;
     }
     // Offline runs can be replayed from their log, so they autosave only when asked to.
     const bool offline = !log_path.empty() || export_only;

@@ -234,7 +234,8 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
         // disk has fallen max_queued frames behind).
         const auto start = std::chrono::steady_clock::now();
         try {
-          writer_->add(f.frame, s.T_W_C, mapper_->lastPixelLabels());
+          writer_->add(f.frame, s.T_W_C, mapper_->lastPixelLabels(),
+                       f.panoptic ? &*f.panoptic : nullptr);
         } catch (const Error& e) {
           ++stats_.rejected["frame store: " + reasonOf(e.what())];
         }

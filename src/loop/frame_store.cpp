@@ -31,6 +31,7 @@ constexpr double kRigidTolerance = 1e-4;
 // Tokens of an index line, its CRC included.
 constexpr size_t kFrameTokens = 30;
 constexpr size_t kPoseTokens = 15;
+constexpr size_t kMaskTokens = 9;
 
 uint32_t crcOf(const uint8_t* data, size_t size) {
   uLong crc = crc32(0L, Z_NULL, 0);
@@ -285,8 +286,32 @@ void FrameStore::readIndex(Check check) {
         continue;
       }
       // A frame added again after it was left out (its files lost) replaces the older line.
-      entries_[utime] = e;
+      entries_[utime] = e;  // its masks line, if any, follows
       frame_line[utime] = line_number;
+    } else if (tokens.size() + 1 == kMaskTokens && tokens[0] == "masks" &&
+               parseInt64(tokens[1], &utime)) {
+      const auto it = entries_.find(utime);
+      if (it == entries_.end()) {
+        problems_.push_back(where + ": masks of utime " + std::to_string(utime) +
+                            ", which no earlier line adds, ignored");
+        continue;
+      }
+      Entry& e = it->second;
+      FileRecord records[3];
+      bool ok = true;
+      for (int f = 0; f < 3 && ok; ++f) {
+        uint64_t crc = 0;
+        ok = parseUint(tokens[2 + 2 * f], 10, &records[f].size) &&
+             parseUint(tokens[3 + 2 * f], 16, &crc) && crc <= 0xffffffffu;
+        records[f].crc = static_cast<uint32_t>(crc);
+      }
+      if (!ok || records[0].size == 0 || records[2].size == 0) {
+        problems_.push_back(where + ": not a valid masks line, ignored");
+        continue;
+      }
+      e.masks = records[0];
+      e.masks_hi = records[1];
+      e.segments = records[2];
     } else if (tokens.size() + 1 == kPoseTokens && tokens[0] == "pose" &&
                parseInt64(tokens[1], &utime)) {
       Eigen::Isometry3d T;
@@ -309,8 +334,7 @@ void FrameStore::readIndex(Check check) {
   for (auto it = entries_.begin(); it != entries_.end();) {
     const std::string problem = checkFiles(it->first, it->second, check);
     if (problem.empty()) {
-      const Entry& e = it->second;
-      frame_bytes_ += e.depth.size + e.labels.size + e.labels_hi.size + e.color.size;
+      frame_bytes_ += it->second.bytes();
       ++it;
     } else {
       problems_.push_back(problem + " (" + kIndexName + " line " +
@@ -322,10 +346,11 @@ void FrameStore::readIndex(Check check) {
 }
 
 std::string FrameStore::checkFiles(int64_t utime, const Entry& entry, Check check) const {
-  const std::pair<const FileRecord*, const char*> files[4] = {{&entry.depth, ".depth.png"},
-                                                              {&entry.labels, ".labels.png"},
-                                                              {&entry.labels_hi, ".labels-hi.png"},
-                                                              {&entry.color, ".color.jpg"}};
+  const std::pair<const FileRecord*, const char*> files[7] = {
+      {&entry.depth, ".depth.png"},         {&entry.labels, ".labels.png"},
+      {&entry.labels_hi, ".labels-hi.png"}, {&entry.color, ".color.jpg"},
+      {&entry.masks, ".masks.png"},         {&entry.masks_hi, ".masks-hi.png"},
+      {&entry.segments, ".segments.txt"}};
   const std::string what = "frame " + std::to_string(utime) + ": ";
   for (const auto& [record, suffix] : files) {
     if (record->size == 0) continue;
@@ -372,7 +397,7 @@ void FrameStore::appendIndexLine(const std::string& line) {
 
 void FrameStore::add(int64_t utime, const Eigen::Isometry3d& T_W_C, const PinholeCamera& camera,
                      double depth_scale_m, const DepthImage& depth, const LabelImage& labels,
-                     const ColorImage* color) {
+                     const ColorImage* color, const PanopticFrame* panoptic) {
   const std::string what = "frame store: frame " + std::to_string(utime);
   std::string why;
   if (!camera.isValid(&why)) throw Error(what + ": intrinsics: " + why);
@@ -394,6 +419,9 @@ void FrameStore::add(int64_t utime, const Eigen::Isometry3d& T_W_C, const Pinhol
   const bool with_color = config_.store_color && color && !color->empty();
   if (with_color && !sizeMatches(color->width(), color->height())) {
     throw Error(what + ": colour image is not " + camera_size + " as the intrinsics say");
+  }
+  if (panoptic && !sizeMatches(panoptic->segment_ids.width(), panoptic->segment_ids.height())) {
+    throw Error(what + ": panoptic segment image is not " + camera_size + " as the intrinsics say");
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -423,27 +451,51 @@ void FrameStore::add(int64_t utime, const Eigen::Isometry3d& T_W_C, const Pinhol
     rec->crc = crcOf(bytes.data(), bytes.size());
   };
   store(encodeDepthPng(depth, config_.png_compression), ".depth.png", &entry.depth);
-  // The label PNG holds 24 bits per pixel (COCO panoptic RGB); super-point ids count up from
-  // 1 and stay far below 2^24 in practice, but an int32 has 8 more bits: they go to a second
-  // plane written only when some label uses them, so every int32 (negative ones too)
-  // round-trips.
-  LabelImage low(labels.width(), labels.height());
-  LabelImage high(labels.width(), labels.height());
-  bool any_high = false;
-  for (size_t i = 0; i < labels.size(); ++i) {
-    const uint32_t bits = static_cast<uint32_t>(labels.data()[i]);
-    low.data()[i] = static_cast<int32_t>(bits & 0xffffffu);
-    high.data()[i] = static_cast<int32_t>(bits >> 24);
-    any_high = any_high || (bits >> 24) != 0;
-  }
-  store(encodeLabelPng(low, config_.png_compression), ".labels.png", &entry.labels);
-  if (any_high) {
-    store(encodeLabelPng(high, config_.png_compression), ".labels-hi.png", &entry.labels_hi);
-  }
+  // A label PNG holds 24 bits per pixel (COCO panoptic RGB); super-point and segment ids stay
+  // far below 2^24 in practice, but an int32 has 8 more bits: they go to a second plane
+  // written only when some id uses them, so every int32 (negative ones too) round-trips.
+  // Returns whether the second plane was written.
+  const auto storePlanes = [&](const LabelImage& ids, const char* suffix, const char* hi_suffix,
+                               FileRecord* rec, FileRecord* hi_rec) {
+    LabelImage low(ids.width(), ids.height());
+    LabelImage high(ids.width(), ids.height());
+    bool any_high = false;
+    for (size_t i = 0; i < ids.size(); ++i) {
+      const uint32_t bits = static_cast<uint32_t>(ids.data()[i]);
+      low.data()[i] = static_cast<int32_t>(bits & 0xffffffu);
+      high.data()[i] = static_cast<int32_t>(bits >> 24);
+      any_high = any_high || (bits >> 24) != 0;
+    }
+    store(encodeLabelPng(low, config_.png_compression), suffix, rec);
+    if (any_high) store(encodeLabelPng(high, config_.png_compression), hi_suffix, hi_rec);
+    return any_high;
+  };
+  const bool labels_high =
+      storePlanes(labels, ".labels.png", ".labels-hi.png", &entry.labels, &entry.labels_hi);
   if (with_color) store(encodeJpeg(*color, config_.color_quality), ".color.jpg", &entry.color);
+  bool masks_high = false;
+  if (panoptic) {
+    masks_high = storePlanes(panoptic->segment_ids, ".masks.png", ".masks-hi.png", &entry.masks,
+                             &entry.masks_hi);
+    std::string text;
+    char row[128];
+    for (const PanopticSegment& seg : panoptic->segments) {
+      // %.9g: every float reads back to the same bits.
+      std::snprintf(row, sizeof(row), "%d %d %d %d %.9g\n", seg.id, seg.category,
+                    seg.source_category, seg.is_thing ? 1 : 0, static_cast<double>(seg.score));
+      text += row;
+    }
+    if (text.empty()) text = "\n";  // a segmentation without segments is still one
+    store(std::vector<uint8_t>(text.begin(), text.end()), ".segments.txt", &entry.segments);
+  }
   // Files an earlier, interrupted add() of this utime may have left (never in the index).
-  if (!any_high) std::remove(framePath(utime, ".labels-hi.png").c_str());
+  if (!labels_high) std::remove(framePath(utime, ".labels-hi.png").c_str());
   if (!with_color) std::remove(framePath(utime, ".color.jpg").c_str());
+  if (!masks_high) std::remove(framePath(utime, ".masks-hi.png").c_str());
+  if (!panoptic) {
+    std::remove(framePath(utime, ".masks.png").c_str());
+    std::remove(framePath(utime, ".segments.txt").c_str());
+  }
 
   std::string line = "frame " + std::to_string(utime);
   for (double v : {camera.fx, camera.fy, camera.cx, camera.cy}) appendDouble(&line, v);
@@ -453,16 +505,26 @@ void FrameStore::add(int64_t utime, const Eigen::Isometry3d& T_W_C, const Pinhol
   for (const FileRecord* rec : {&entry.depth, &entry.labels, &entry.labels_hi, &entry.color}) {
     line += " " + std::to_string(rec->size) + " " + hex32(rec->crc);
   }
+  std::string lines = sealed(line);
+  if (panoptic) {
+    // Appended in the same write as the frame line: a crash cuts at most the last line, and
+    // a frame whose masks line was cut is re-integrated, not associated again.
+    std::string masks = "masks " + std::to_string(utime);
+    for (const FileRecord* rec : {&entry.masks, &entry.masks_hi, &entry.segments}) {
+      masks += " " + std::to_string(rec->size) + " " + hex32(rec->crc);
+    }
+    lines += "\n" + sealed(masks);
+  }
   std::lock_guard<std::mutex> lock(mutex_);
-  appendIndexLine(sealed(line));
+  appendIndexLine(lines);
   entries_[utime] = entry;
-  frame_bytes_ += entry.depth.size + entry.labels.size + entry.labels_hi.size + entry.color.size;
+  frame_bytes_ += entry.bytes();
 }
 
 void FrameStore::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
-                     const LabelImage& labels) {
+                     const LabelImage& labels, const PanopticFrame* panoptic) {
   add(frame.utime, T_W_C, frame.camera, frame.depth_scale_m, frame.depth, labels,
-      frame.color.empty() ? nullptr : &frame.color);
+      frame.color.empty() ? nullptr : &frame.color, panoptic);
 }
 
 void FrameStore::updatePose(int64_t utime, const Eigen::Isometry3d& T_W_C) {
@@ -512,20 +574,51 @@ StoredFrame FrameStore::load(int64_t utime) const {
     const std::vector<uint8_t> bytes = read(".depth.png", entry.depth);
     out.rgbd.depth = decodeDepthPng(bytes.data(), bytes.size(), name + "depth");
   }
-  {
-    const std::vector<uint8_t> bytes = read(".labels.png", entry.labels);
-    out.labels = decodeLabelPng(bytes.data(), bytes.size(), name + "labels");
-  }
-  if (entry.labels_hi.size > 0) {
-    const std::vector<uint8_t> bytes = read(".labels-hi.png", entry.labels_hi);
-    const LabelImage high = decodeLabelPng(bytes.data(), bytes.size(), name + "labels-hi");
-    if (high.width() != out.labels.width() || high.height() != out.labels.height()) {
-      throw Error(name + "the two label planes differ in size");
+  const auto readPlanes = [&](const char* suffix, const FileRecord& rec, const char* hi_suffix,
+                              const FileRecord& hi_rec, const std::string& what) {
+    const std::vector<uint8_t> bytes = read(suffix, rec);
+    LabelImage ids = decodeLabelPng(bytes.data(), bytes.size(), name + what);
+    if (hi_rec.size > 0) {
+      const std::vector<uint8_t> hi_bytes = read(hi_suffix, hi_rec);
+      const LabelImage high = decodeLabelPng(hi_bytes.data(), hi_bytes.size(), name + what + "-hi");
+      if (high.width() != ids.width() || high.height() != ids.height()) {
+        throw Error(name + "the two " + what + " planes differ in size");
+      }
+      for (size_t i = 0; i < high.size(); ++i) {
+        const uint32_t bits =
+            static_cast<uint32_t>(ids.data()[i]) | (static_cast<uint32_t>(high.data()[i]) << 24);
+        ids.data()[i] = static_cast<int32_t>(bits);
+      }
     }
-    for (size_t i = 0; i < high.size(); ++i) {
-      const uint32_t bits = static_cast<uint32_t>(out.labels.data()[i]) |
-                            (static_cast<uint32_t>(high.data()[i]) << 24);
-      out.labels.data()[i] = static_cast<int32_t>(bits);
+    return ids;
+  };
+  out.labels = readPlanes(".labels.png", entry.labels, ".labels-hi.png", entry.labels_hi, "labels");
+  if (entry.masks.size > 0) {
+    out.has_panoptic = true;
+    out.panoptic.utime = utime;
+    out.panoptic.segment_ids =
+        readPlanes(".masks.png", entry.masks, ".masks-hi.png", entry.masks_hi, "masks");
+    const std::vector<uint8_t> bytes = read(".segments.txt", entry.segments);
+    std::istringstream in(std::string(bytes.begin(), bytes.end()));
+    std::string row;
+    while (std::getline(in, row)) {
+      if (row.empty()) continue;
+      const std::vector<std::string> t = splitSpaces(row);
+      PanopticSegment seg;
+      int64_t id = 0, category = 0, source = 0, thing = 0;
+      double score = 0.0;
+      if (t.size() != 5 || !parseInt64(t[0], &id) || !parseInt64(t[1], &category) ||
+          !parseInt64(t[2], &source) || !parseInt64(t[3], &thing) || thing < 0 || thing > 1 ||
+          !parseDouble(t[4], &score) || id != static_cast<int32_t>(id) ||
+          category != static_cast<int32_t>(category) || source != static_cast<int32_t>(source)) {
+        throw Error(name + "segments: not a segment line: '" + row.substr(0, 80) + "'");
+      }
+      seg.id = static_cast<int32_t>(id);
+      seg.category = static_cast<int32_t>(category);
+      seg.source_category = static_cast<int32_t>(source);
+      seg.is_thing = thing == 1;
+      seg.score = static_cast<float>(score);
+      out.panoptic.segments.push_back(seg);
     }
   }
   if (entry.color.size > 0) {
@@ -536,7 +629,9 @@ StoredFrame FrameStore::load(int64_t utime) const {
   const auto sized = [&](int iw, int ih) { return iw == w && ih == h; };
   if (!sized(out.rgbd.depth.width(), out.rgbd.depth.height()) ||
       !sized(out.labels.width(), out.labels.height()) ||
-      (!out.rgbd.color.empty() && !sized(out.rgbd.color.width(), out.rgbd.color.height()))) {
+      (!out.rgbd.color.empty() && !sized(out.rgbd.color.width(), out.rgbd.color.height())) ||
+      (out.has_panoptic &&
+       !sized(out.panoptic.segment_ids.width(), out.panoptic.segment_ids.height()))) {
     throw Error(name + "an image's size differs from the stored intrinsics");
   }
   return out;
@@ -545,6 +640,13 @@ StoredFrame FrameStore::load(int64_t utime) const {
 size_t FrameStore::size() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return entries_.size();
+}
+
+size_t FrameStore::sizeWithPanoptic() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  size_t n = 0;
+  for (const auto& [utime, entry] : entries_) n += entry.masks.size > 0;
+  return n;
 }
 
 std::vector<int64_t> FrameStore::utimes() const {
@@ -593,6 +695,7 @@ FrameStore::FrameBytes FrameStore::frameBytes(int64_t utime) const {
   out.depth = it->second.depth.size;
   out.labels = it->second.labels.size + it->second.labels_hi.size;
   out.color = it->second.color.size;
+  out.masks = it->second.masks.size + it->second.masks_hi.size + it->second.segments.size;
   return out;
 }
 

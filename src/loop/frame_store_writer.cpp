@@ -24,8 +24,9 @@ FrameStoreWriter::~FrameStoreWriter() {
 }
 
 void FrameStoreWriter::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
-                           const LabelImage& labels) {
-  Job job{frame, T_W_C, labels};  // copied before the lock: a few MB
+                           const LabelImage& labels, const PanopticFrame* panoptic) {
+  // Copied before the lock: a few MB.
+  Job job{frame, T_W_C, labels, panoptic != nullptr, panoptic ? *panoptic : PanopticFrame()};
   std::unique_lock<std::mutex> lock(mutex_);
   if (unwritten_.count(frame.utime)) {
     throw Error("frame store: frame " + std::to_string(frame.utime) + " is already queued");
@@ -50,7 +51,7 @@ void FrameStoreWriter::work() {
     cv_.notify_all();  // room in the queue
     std::string error;
     try {
-      store_->add(job.frame, job.T_W_C, job.labels);
+      store_->add(job.frame, job.T_W_C, job.labels, job.has_panoptic ? &job.panoptic : nullptr);
     } catch (const std::exception& e) {
       error = e.what();
     }

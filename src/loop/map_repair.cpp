@@ -21,6 +21,16 @@ FrameLoader storeLoader(const FrameStore* store) {
   };
 }
 
+PanopticFrameLoader storePanopticLoader(const FrameStore* store) {
+  if (!store) throw Error("frame loader: no frame store");
+  return [store](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic) {
+    StoredFrame stored = store->load(utime);
+    *frame = std::move(stored.rgbd);
+    *panoptic = std::move(stored.panoptic);
+    return stored.has_panoptic;
+  };
+}
+
 MapRepairResult repairMap(Mapper* mapper, FrameStore* store, const PoseCorrection& correction,
                           const MapRepairConfig& config, const ReintegrationProgress& progress) {
   config.check();
@@ -43,7 +53,13 @@ MapRepairResult repairMap(Mapper* mapper, FrameStore* store, const PoseCorrectio
                 " utimes is a mapped frame (first " +
                 std::to_string(correction.poses.front().utime) + ")");
   }
-  result.reintegration = mapper->reintegrate(corrected.poses, storeLoader(store), progress);
+  // Association under the old poses may have joined surfaces to the wrong super-points;
+  // with the segmentations stored, the frames are associated again.
+  if (config.reassociate && store->size() > 0 && store->sizeWithPanoptic() == store->size()) {
+    result.reintegration = mapper->remap(corrected.poses, storePanopticLoader(store), progress);
+  } else {
+    result.reintegration = mapper->reintegrate(corrected.poses, storeLoader(store), progress);
+  }
   if (result.reintegration.completed) {
     // Only what moved: the store's poses are the ones the frames are now integrated with.
     for (size_t i = 0; i < corrected.poses.size(); ++i) {
@@ -70,11 +86,13 @@ std::string describe(const MapRepairResult& r) {
     return r.failure.empty() ? std::string(line) : line + (": " + r.failure);
   }
   std::snprintf(line, sizeof(line),
-                "correction %lld: %d of %d poses matched%s, %zu frames re-integrated (%zu moved) "
+                "correction %lld: %d of %d poses matched%s, %zu frames %s (%zu moved) "
                 "in %.2f s, largest move %.3f m / %.2f deg",
                 static_cast<long long>(r.correction_id), r.matched, total, unknown.c_str(),
-                r.reintegration.frames, r.reintegration.frames_moved, r.reintegration.seconds,
-                r.max_translation_m, r.max_rotation_rad * 180.0 / M_PI);
+                r.reintegration.frames,
+                r.reintegration.reassociated ? "mapped again" : "re-integrated",
+                r.reintegration.frames_moved, r.reintegration.seconds, r.max_translation_m,
+                r.max_rotation_rad * 180.0 / M_PI);
   return line;
 }
 

@@ -46,21 +46,7 @@ ReintegrationStats Mapper::reintegrate(const std::vector<StampedPose>& poses,
                                        const ReintegrationProgress& progress) {
   const auto start = std::chrono::steady_clock::now();
   if (!load) throw Error("reintegrate: no frame loader");
-  if (poses.size() != trajectory_.size()) {
-    throw Error("reintegrate: " + std::to_string(poses.size()) + " poses for " +
-                std::to_string(trajectory_.size()) + " integrated frames");
-  }
-  for (size_t i = 0; i < poses.size(); ++i) {
-    if (poses[i].utime != trajectory_[i].utime) {
-      throw Error("reintegrate: pose " + std::to_string(i) + " has utime " +
-                  std::to_string(poses[i].utime) + ", the frame integrated there " +
-                  std::to_string(trajectory_[i].utime));
-    }
-    std::string why;
-    if (!isRigidTransform(poses[i].T_W_C.matrix(), 1e-4, &why)) {
-      throw Error("reintegrate: pose of utime " + std::to_string(poses[i].utime) + ": " + why);
-    }
-  }
+  checkRepairPoses(poses, "reintegrate");
   ReintegrationStats stats;
   stats.blocks_before = map_->numBlocks();
   const auto seconds = [&start] {

@@ -192,12 +192,14 @@ TEST_F(MappingSessionTest, ACorrectionRepairsTheMapFromTheFrameStore) {
   EXPECT_EQ(stats.timings.count("frame_store"), 1u);
   EXPECT_TRUE(stats.rejected.empty());
 
-  // The same frames mapped at the corrected poses, with the labels they voted with.
+  // The store kept every frame's masks, so the repair mapped the frames again at the
+  // corrected poses: the same as remapping a map of the same stream.
+  EXPECT_EQ(store.sizeWithPanoptic(), 12u);
+  EXPECT_NE(stats.repairs[0].find("12 frames mapped again"), std::string::npos) << stats.repairs[0];
   Mapper clean(test::streamMapperConfig());
   MappingSession plain(SessionOptions{}, &clean);
   feed(&plain, stream_.messages());
-  const FrameLoader load = storeLoader(&store);
-  ASSERT_TRUE(clean.reintegrate(mapper.trajectory(), load).completed);
+  ASSERT_TRUE(clean.remap(mapper.trajectory(), storePanopticLoader(&store)).completed);
   EXPECT_EQ(test::mapBytes(mapper), test::mapBytes(clean));
   for (size_t k = 0; k < mapper.trajectory().size(); ++k) {
     EXPECT_TRUE(mapper.trajectory()[k].T_W_C.isApprox(D * stream_.poses[k].T_W_C, 1e-9)) << k;

@@ -394,6 +394,98 @@ TEST(FrameStore, ConfigCheckRejectsBadValues) {
   expectError([&] { FrameStore store(bad); }, {"color_quality"});
 }
 
+// A segmentation as a network gives it: ids up to 2^24 and beyond (and -1 on one pixel, which
+// no segment names), scores that are not short decimals.
+PanopticFrame segmentation() {
+  PanopticFrame p;
+  p.segment_ids = LabelImage(kWidth, kHeight, 0);
+  for (int v = 0; v < kHeight; ++v) {
+    for (int u = 0; u < kWidth; ++u) p.segment_ids(u, v) = u < 20 ? 3 : (v < 10 ? 0 : 70001);
+  }
+  p.segment_ids(5, 5) = (1 << 24) + 5;
+  p.segment_ids(6, 5) = -1;
+  p.segments = {{3, 5, 1001, true, 0.123456789f},
+                {70001, 1, 2, false, 1.0f},
+                {(1 << 24) + 5, 40, 40, true, 1.0f / 3.0f}};
+  return p;
+}
+
+TEST(FrameStore, PanopticSegmentationsRoundTripExactly) {
+  TempDir dir;
+  const PanopticFrame p = segmentation();
+  {
+    FrameStore store(configIn(dir));
+    store.add(2000, pose(0.5), camera(), 0.001, depth(3), LabelImage(kWidth, kHeight, 9), nullptr,
+              &p);
+    addFrame(&store, 0);  // without one
+    EXPECT_EQ(store.size(), 2u);
+    EXPECT_EQ(store.sizeWithPanoptic(), 1u);
+    EXPECT_GT(store.frameBytes(2000).masks, 0u);
+    EXPECT_EQ(store.frameBytes(1000).masks, 0u);
+  }
+  const auto store = FrameStore::open(dir.path("store"));
+  EXPECT_TRUE(store->problems().empty());
+  EXPECT_EQ(store->sizeWithPanoptic(), 1u);
+  const StoredFrame f = store->load(2000);
+  ASSERT_TRUE(f.has_panoptic);
+  EXPECT_EQ(f.panoptic.utime, 2000);
+  EXPECT_TRUE(f.panoptic.segment_ids == p.segment_ids);
+  EXPECT_EQ(f.panoptic.segments, p.segments);
+  EXPECT_TRUE(fs::exists(dir.path("store/frames/2000.masks-hi.png")));
+  const StoredFrame g = store->load(1000);
+  EXPECT_FALSE(g.has_panoptic);
+  expectFrame(g, 0);
+  // A segmentation of another size is refused, storing nothing.
+  PanopticFrame small = p;
+  small.segment_ids = LabelImage(8, 8, 3);
+  expectError(
+      [&] {
+        store->add(3000, pose(0.1), camera(), 0.001, depth(1), LabelImage(kWidth, kHeight, 1),
+                   nullptr, &small);
+      },
+      {"frame 3000", "panoptic segment image"});
+  EXPECT_EQ(store->size(), 2u);
+}
+
+TEST(FrameStore, DamagedMasksLeaveTheFrameOutByName) {
+  TempDir dir;
+  const PanopticFrame p = segmentation();
+  {
+    FrameStore store(configIn(dir));
+    for (int64_t utime : {10, 11}) {
+      store.add(utime, pose(0.5), camera(), 0.001, depth(3), LabelImage(kWidth, kHeight, 9),
+                nullptr, &p);
+    }
+  }
+  flipByte(dir.path("store/frames/11.segments.txt"), 2);
+  const auto store = FrameStore::open(dir.path("store"));
+  EXPECT_EQ(store->utimes(), std::vector<int64_t>{10});
+  ASSERT_EQ(store->problems().size(), 1u);
+  EXPECT_NE(store->problems()[0].find("11.segments.txt is corrupt"), std::string::npos)
+      << store->problems()[0];
+  EXPECT_TRUE(store->load(10).has_panoptic);
+}
+
+// A crash while appending a frame's two lines can cut the second: the frame stays, without
+// its segmentation, and a repair re-integrates instead of associating again.
+TEST(FrameStore, ACutMasksLineKeepsTheFrameWithoutItsSegmentation) {
+  TempDir dir;
+  const PanopticFrame p = segmentation();
+  {
+    FrameStore store(configIn(dir));
+    store.add(10, pose(0.5), camera(), 0.001, depth(3), LabelImage(kWidth, kHeight, 9), nullptr,
+              &p);
+  }
+  const std::string index = dir.path("store/index.txt");
+  fs::resize_file(index, fs::file_size(index) - 5);
+  const auto store = FrameStore::open(dir.path("store"));
+  EXPECT_EQ(store->utimes(), std::vector<int64_t>{10});
+  EXPECT_EQ(store->sizeWithPanoptic(), 0u);
+  EXPECT_FALSE(store->load(10).has_panoptic);
+  ASSERT_EQ(store->problems().size(), 1u);
+  EXPECT_NE(store->problems()[0].find("cut last line"), std::string::npos);
+}
+
 TEST(FrameStore, ThreadsAddingAtOnceLoseNoFrame) {
   TempDir dir;
   FrameStore store(configIn(dir));

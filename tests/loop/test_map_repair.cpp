@@ -16,14 +16,15 @@ namespace {
 // The box scene mapped with every frame kept in a frame store, as the mapper process does.
 class MapRepair : public BoxScene {
  protected:
-  std::unique_ptr<Mapper> mapWithStore(int frames, FrameStore* store) {
+  // with_masks: the store also keeps each frame's segmentation (the mapper process does).
+  std::unique_ptr<Mapper> mapWithStore(int frames, FrameStore* store, bool with_masks = false) {
     auto mapper = std::make_unique<Mapper>(config());
     for (int k = 0; k < frames; ++k) {
       RgbdFrame frame;
       PanopticFrame panoptic;
       frameAt(k, &frame, &panoptic);
       const FrameStats stats = mapper->integrate(frame, pose(k), &panoptic);
-      store->add(frame, stats.T_W_C, mapper->lastPixelLabels());
+      store->add(frame, stats.T_W_C, mapper->lastPixelLabels(), with_masks ? &panoptic : nullptr);
     }
     return mapper;
   }
@@ -87,6 +88,40 @@ TEST_F(MapRepair, AKeyframeCorrectionRepairsTheMapFromTheStore) {
     EXPECT_EQ(stored[i].utime, mapper->trajectory()[i].utime);
     EXPECT_TRUE(stored[i].T_W_C.isApprox(mapper->trajectory()[i].T_W_C, 1e-15)) << i;
   }
+}
+
+// With the segmentations stored, the frames are mapped again at the corrected poses (the map
+// of a mapper that had those poses from the start); told not to, or with a frame stored
+// without its segmentation, the repair re-integrates.
+TEST_F(MapRepair, WithTheMasksStoredTheFramesAreMappedAgain) {
+  test::TempDir dir;
+  FrameStore store(storeConfig(dir.path("store")));
+  auto mapper = mapWithStore(6, &store, true);
+  ASSERT_EQ(store.sizeWithPanoptic(), 6u);
+  const Eigen::Isometry3d D = correction();
+  const MapRepairResult result = repairMap(mapper.get(), &store, keyframeCorrection(*mapper, 3, D));
+  ASSERT_TRUE(result.reintegration.completed);
+  EXPECT_TRUE(result.reintegration.reassociated);
+  EXPECT_NE(describe(result).find("6 frames mapped again"), std::string::npos) << describe(result);
+  // The stored frames (their colour is a JPEG) at the repaired poses.
+  Mapper reference(config());
+  for (const StampedPose& p : mapper->trajectory()) {
+    StoredFrame stored = store.load(p.utime);
+    stored.rgbd.frame_id = p.frame_id;  // not stored; the repaired trajectory keeps its own
+    reference.integrate(stored.rgbd, p.T_W_C, &stored.panoptic);
+  }
+  EXPECT_EQ(mapper->serialize(), reference.serialize());
+
+  test::TempDir other;
+  FrameStore kept(storeConfig(other.path("store")));
+  auto reintegrated = mapWithStore(6, &kept, true);
+  MapRepairConfig config;
+  config.reassociate = false;
+  const MapRepairResult plain =
+      repairMap(reintegrated.get(), &kept, keyframeCorrection(*reintegrated, 3, D), config);
+  ASSERT_TRUE(plain.reintegration.completed);
+  EXPECT_FALSE(plain.reintegration.reassociated);
+  EXPECT_NE(describe(plain).find("re-integrated"), std::string::npos);
 }
 
 TEST_F(MapRepair, UnknownUtimesAreCountedNamedAndNeverGuessed) {

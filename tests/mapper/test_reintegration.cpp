@@ -19,6 +19,7 @@ namespace {
 struct Recorded {
   RgbdFrame frame;
   LabelImage labels;
+  PanopticFrame panoptic;
 };
 
 class Reintegration : public BoxScene {
@@ -28,13 +29,21 @@ class Reintegration : public BoxScene {
     auto mapper = std::make_unique<Mapper>(config());
     for (int k = 0; k < frames; ++k) {
       Recorded r;
-      PanopticFrame panoptic;
-      frameAt(k, &r.frame, &panoptic);
-      mapper->integrate(r.frame, pose(k), &panoptic);
+      frameAt(k, &r.frame, &r.panoptic);
+      mapper->integrate(r.frame, pose(k), &r.panoptic);
       r.labels = mapper->lastPixelLabels();
       stored_[r.frame.utime] = r;
     }
     return mapper;
+  }
+  PanopticFrameLoader panopticLoader() const {
+    return [this](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic) {
+      const auto it = stored_.find(utime);
+      if (it == stored_.end()) throw Error("no stored frame of utime " + std::to_string(utime));
+      *frame = it->second.frame;
+      *panoptic = it->second.panoptic;
+      return true;
+    };
   }
   FrameLoader loader() const {
     return [this](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
@@ -249,6 +258,67 @@ TEST_F(Reintegration, ASavedMapKeepsWhatTheNextRepairNeeds) {
   ASSERT_TRUE(mapper->reintegrate(moved(*mapper, D), loader()).completed);
   ASSERT_TRUE(loaded->reintegrate(moved(*loaded, D), loader()).completed);
   EXPECT_EQ(bytes(*loaded), bytes(*mapper));
+}
+
+// Mapping the frames again at new poses gives the map of a mapper that got them with those
+// poses in the first place (TSDF, votes, super-points, graph, trajectory: the same map file),
+// and the mapper maps on from there on the new map.
+TEST_F(Reintegration, ARemapIsTheMapOfTheFramesMappedAtTheNewPoses) {
+  auto mapper = record(6);
+  Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
+  D.linear() = Eigen::AngleAxisd(0.04, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  D.translation() = Eigen::Vector3d(0.05, -0.03, 0.01);
+  const std::vector<StampedPose> poses = moved(*mapper, D);
+  const ReintegrationStats stats = mapper->remap(poses, panopticLoader());
+  ASSERT_TRUE(stats.completed);
+  EXPECT_TRUE(stats.reassociated);
+  EXPECT_EQ(stats.frames, 6u);
+  EXPECT_EQ(stats.frames_moved, 6u);
+
+  Mapper reference(config());
+  for (int k = 0; k < 6; ++k) {
+    const Recorded& r = std::next(stored_.begin(), k)->second;
+    reference.integrate(r.frame, D * pose(k), &r.panoptic);
+  }
+  EXPECT_EQ(bytes(*mapper), bytes(reference));
+  // Mapping goes on with the new state (its thread pool came with it).
+  RgbdFrame frame;
+  PanopticFrame panoptic;
+  frameAt(6, &frame, &panoptic);
+  mapper->integrate(frame, D * pose(6), &panoptic);
+  reference.integrate(frame, D * pose(6), &panoptic);
+  EXPECT_EQ(bytes(*mapper), bytes(reference));
+  EXPECT_EQ(mapper->extractMesh().vertices, reference.extractMesh().vertices);
+}
+
+TEST_F(Reintegration, AFailedOrAbandonedRemapLeavesTheMapAsItWas) {
+  auto mapper = record(5);
+  const std::vector<uint8_t> before = bytes(*mapper);
+  Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
+  D.translation() = Eigen::Vector3d(0.1, 0.0, 0.0);
+  const std::vector<StampedPose> poses = moved(*mapper, D);
+  const ReintegrationStats abandoned =
+      mapper->remap(poses, panopticLoader(), [](size_t done, size_t) { return done < 2; });
+  EXPECT_FALSE(abandoned.completed);
+  EXPECT_EQ(bytes(*mapper), before);
+  stored_.erase(std::next(stored_.begin(), 3));
+  try {
+    mapper->remap(poses, panopticLoader());
+    FAIL() << "a missing frame was not reported";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no stored frame"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(bytes(*mapper), before);
+  std::vector<StampedPose> renamed = poses;
+  renamed[1].utime += 1;
+  EXPECT_THROW(mapper->remap(renamed, panopticLoader()), Error);
+  EXPECT_THROW(mapper->remap(poses, PanopticFrameLoader()), Error);
+  EXPECT_EQ(bytes(*mapper), before);
+  // The mapper still maps.
+  RgbdFrame frame;
+  PanopticFrame panoptic;
+  frameAt(5, &frame, &panoptic);
+  EXPECT_NO_THROW(mapper->integrate(frame, pose(5), &panoptic));
 }
 
 }  // namespace

@@ -47,15 +47,25 @@ struct StoredFrame {
   /// Per pixel the super-point label it voted for (as assigned when integrated, merges not
   /// resolved), 0 = none; lossless for every int32.
   LabelImage labels;
+  /// True when the frame's panoptic segmentation was stored with it (`panoptic` holds it):
+  /// what a repair needs to associate the frame again at its corrected pose.
+  bool has_panoptic = false;
+  /// The frame's 2D panoptic segmentation (segment ids lossless for every int32, segments'
+  /// scores exact), utime and frame_id set to the frame's utime and 0.
+  PanopticFrame panoptic;
 };
 
 /// The frames a map was built from, on disk, so that a loop closure can re-integrate them at
 /// their corrected poses (docs/LOOP_CLOSURE.md).
 ///
 /// Layout of the folder: `index.txt` (a version line, then one line per added frame and per
-/// pose update, each ending in its CRC-32) and `frames/<utime>.depth.png` (16-bit, as
-/// integrated), `.labels.png` (label bits 0-23, COCO panoptic RGB), `.labels-hi.png` (bits
-/// 24-31, only when some label needs them) and `.color.jpg` (store_color only). Each file is
+/// pose update, each ending in its CRC-32; a frame stored with its panoptic segmentation has a
+/// `masks` line right after its frame line, appended with it) and `frames/<utime>.depth.png`
+/// (16-bit, as integrated), `.labels.png` (label bits 0-23, COCO panoptic RGB),
+/// `.labels-hi.png` (bits 24-31, only when some label needs them), `.color.jpg` (store_color
+/// only), and with a segmentation `.masks.png` / `.masks-hi.png` (segment ids, as the labels)
+/// and `.segments.txt` (one segment per line: id, category, source category, thing 0/1,
+/// score). Each file is
 /// written atomically (AtomicFileWriter) before the frame's index line is appended and synced,
 /// so a crash at any moment leaves whole frames, a frame missing from the index, or a cut last
 /// index line, which reopening names and drops.
@@ -101,12 +111,16 @@ class FrameStore {
   /// @param depth depth image as integrated, in depth_scale_m units
   /// @param labels super-point label per pixel it voted for, 0 = none
   /// @param color registered colour, or null; stored only when config.store_color
+  /// @param panoptic the frame's panoptic segmentation, or null (its segment image must have
+  ///        the camera's size)
   void add(int64_t utime, const Eigen::Isometry3d& T_W_C, const PinholeCamera& camera,
            double depth_scale_m, const DepthImage& depth, const LabelImage& labels,
-           const ColorImage* color = nullptr);
+           const ColorImage* color = nullptr, const PanopticFrame* panoptic = nullptr);
   /// add() with the frame's utime, camera, depth scale, depth and colour (if any).
   /// @param T_W_C camera-to-world pose (optical frame) it was integrated with
-  void add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const LabelImage& labels);
+  /// @param panoptic the frame's panoptic segmentation, or null
+  void add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const LabelImage& labels,
+           const PanopticFrame* panoptic = nullptr);
 
   /// Records that a frame is now integrated at T_W_C (a repair moved it); durable on return.
   /// Throws Error naming the utime when it is not stored, or when the pose is not rigid.
@@ -119,6 +133,8 @@ class FrameStore {
 
   /// Number of frames stored.
   size_t size() const;
+  /// Number of them stored with their panoptic segmentation.
+  size_t sizeWithPanoptic() const;
   /// The stored frames' utimes, increasing.
   std::vector<int64_t> utimes() const;
   /// Each stored frame's current pose by utime, increasing (frame_id -1, source unknown): the
@@ -138,7 +154,8 @@ class FrameStore {
     uint64_t depth = 0;
     uint64_t labels = 0;  ///< both label planes
     uint64_t color = 0;
-    uint64_t total() const { return depth + labels + color; }
+    uint64_t masks = 0;  ///< segment id planes and segment list
+    uint64_t total() const { return depth + labels + color + masks; }
   };
   /// The file sizes of a stored frame; throws Error naming the utime when it is not stored.
   FrameBytes frameBytes(int64_t utime) const;
@@ -155,6 +172,11 @@ class FrameStore {
     PinholeCamera camera;
     double depth_scale_m = 0.0;
     FileRecord depth, labels, labels_hi, color;
+    FileRecord masks, masks_hi, segments;  ///< all size 0: no segmentation stored
+    uint64_t bytes() const {
+      return depth.size + labels.size + labels_hi.size + color.size + masks.size + masks_hi.size +
+             segments.size;
+    }
   };
 
   FrameStore(const FrameStoreConfig& config, bool create, Check check);

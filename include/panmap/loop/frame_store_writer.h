@@ -38,7 +38,9 @@ class FrameStoreWriter {
   /// takeErrors(), the store unchanged. Throws Error when the frame's utime is already queued.
   /// @param T_W_C camera-to-world pose (optical frame) it was integrated with
   /// @param labels the super-point label each pixel voted for
-  void add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const LabelImage& labels);
+  /// @param panoptic the frame's panoptic segmentation, or null
+  void add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const LabelImage& labels,
+           const PanopticFrame* panoptic = nullptr);
   /// Waits until every frame queued so far is written (or has failed).
   void flush();
   /// FrameStore::load(), after waiting for the frame if it is still queued or being written.
@@ -55,6 +57,8 @@ class FrameStoreWriter {
     RgbdFrame frame;
     Eigen::Isometry3d T_W_C;
     LabelImage labels;
+    bool has_panoptic = false;
+    PanopticFrame panoptic;
   };
   void work();
 

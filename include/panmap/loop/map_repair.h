@@ -15,6 +15,11 @@ struct MapRepairConfig {
   /// A corrected utime matches the mapped frame nearest in time within this, microseconds
   /// (0: exactly; a back-end that republishes the utimes it was given needs no more).
   int64_t match_tolerance_us = 0;
+  /// When every stored frame has its panoptic segmentation, map the frames again
+  /// (Mapper::remap: super-points, graph and objects made anew) instead of re-integrating
+  /// them with the super-points association gave them under the old poses. Costs the whole
+  /// pipeline per frame instead of integration alone (docs/LOOP_CLOSURE.md).
+  bool reassociate = true;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -22,6 +27,10 @@ struct MapRepairConfig {
 /// A FrameLoader that gives back the frames of `store` (FrameStore::load; callable from any
 /// thread). Throws Error when `store` is null.
 FrameLoader storeLoader(const FrameStore* store);
+
+/// A PanopticFrameLoader that gives back the frames of `store` with their segmentations
+/// (callable from any thread). Throws Error when `store` is null.
+PanopticFrameLoader storePanopticLoader(const FrameStore* store);
 
 /// What one repair did.
 struct MapRepairResult {
@@ -35,8 +44,9 @@ struct MapRepairResult {
 };
 
 /// The repair after a loop closure (docs/LOOP_CLOSURE.md): spreads the correction over every
-/// mapped frame (applyCorrection), re-integrates the frames from the store at their new poses
-/// (Mapper::reintegrate) and records the new poses in the store, so that the next correction
+/// mapped frame (applyCorrection), maps the frames from the store again at their new poses
+/// (Mapper::remap when config.reassociate and every stored frame has its segmentation, else
+/// Mapper::reintegrate) and records the new poses in the store, so that the next correction
 /// starts from them. Throws Error, changing nothing, when the correction is invalid, when none
 /// of its utimes is a mapped frame (named), or when a mapped frame is missing from the store.
 /// Corrected utimes that match no frame are returned, never guessed.

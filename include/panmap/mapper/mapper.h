@@ -120,6 +120,11 @@ struct FrameStats {
 /// at a time, in order), so that decoding overlaps integrating.
 using FrameLoader = std::function<void(int64_t utime, RgbdFrame* frame, LabelImage* labels)>;
 
+/// Gives a stored frame back for Mapper::remap(): the frame and, when it was mapped with one,
+/// its panoptic segmentation (returns whether it has one). Throws Error when it cannot.
+using PanopticFrameLoader =
+    std::function<bool(int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic)>;
+
 /// Called after each re-integrated frame with (frames done, frames in all); returning false
 /// abandons the re-integration (a newer correction supersedes it), leaving the map as it was.
 using ReintegrationProgress = std::function<bool(size_t done, size_t total)>;
@@ -133,6 +138,9 @@ struct ReintegrationStats {
   size_t blocks_after = 0;     ///< and after
   uint64_t votes_evicted = 0;  ///< label votes that pushed out a weaker one while rebuilding
   double seconds = 0.0;        ///< wall time
+  /// The frames were mapped again with their segmentations (Mapper::remap), not only
+  /// re-integrated: super-points, graph and objects were made anew.
+  bool reassociated = false;
 };
 
 /// The mapping core: takes (RGB-D frame, T_W_C, panoptic segmentation) and keeps a label-TSDF
@@ -201,6 +209,21 @@ class Mapper {
   ReintegrationStats reintegrate(const std::vector<StampedPose>& poses, const FrameLoader& load,
                                  const ReintegrationProgress& progress = {});
 
+  /// Maps every frame again from the start at new poses, with its panoptic segmentation:
+  /// segmentation, super-point association, integration, graph and occupancy, as if the
+  /// frames had come with these poses (pose refinement off). The repair after a large loop
+  /// closure: association under drift joins surfaces to the wrong super-points (a second pass
+  /// sees the first pass's surfaces displaced), and reintegrate() keeps what association
+  /// decided. Super-point ids, graph and objects are made anew; the counts of pose refinement
+  /// and the frame poses' sources are kept. Built aside and swapped in at the end, as
+  /// reintegrate() does: a frame that cannot be loaded or mapped (Error) or an abandoned remap
+  /// leaves the map unchanged. The next updateMesh() lists every block.
+  /// @param poses the new pose of every frame of trajectory(), same order and utimes
+  /// @param load gives each frame back by its utime, with its segmentation
+  /// @param progress optional; see ReintegrationProgress
+  ReintegrationStats remap(const std::vector<StampedPose>& poses, const PanopticFrameLoader& load,
+                           const ReintegrationProgress& progress = {});
+
   /// An empty rebuild with this mapper's configuration, for reintegrate() or for a repair that
   /// builds on another thread while this mapper keeps mapping (loop/background_repair.h).
   /// @param pool threads the rebuild integrates with (null: this mapper's own, which only the
@@ -246,6 +269,9 @@ class Mapper {
  private:
   void validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
                 const PanopticFrame* panoptic) const;
+  /// Throws Error (prefixed with `what`) unless `poses` are rigid and have trajectory()'s
+  /// utimes, in order.
+  void checkRepairPoses(const std::vector<StampedPose>& poses, const char* what) const;
   void forgetUnvotedSuperpoints();
   /// Labels mesh vertices; `cache` holds each super-point's labels once looked up (a mesh
   /// has millions of vertices but thousands of super-points).

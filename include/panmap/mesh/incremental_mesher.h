@@ -62,6 +62,9 @@ class IncrementalMesher {
   /// map, and takeChangedBlocks() also lists the blocks meshed before (those the new map does
   /// not mesh come back with an empty mesh), so a viewer drops what moved away.
   void invalidateAll();
+  /// The threads to mesh with from now on (null: the calling thread only), for a mapper
+  /// whose pool was replaced.
+  void setPool(ThreadPool* pool) { pool_ = pool; }
   /// The config in use.
   const MarchingCubesConfig& config() const { return config_; }
 
