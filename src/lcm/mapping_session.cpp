@@ -143,7 +143,13 @@ void MappingSession::repair(const PoseCorrection& correction) {
             *frame = std::move(stored.rgbd);
             *labels = std::move(stored.labels);
           },
-          options_.frame_store, options_.repair);
+          options_.frame_store, options_.repair,
+          [writer](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic) {
+            StoredFrame stored = writer->load(utime);
+            *frame = std::move(stored.rgbd);
+            *panoptic = std::move(stored.panoptic);
+            return stored.has_panoptic;
+          });
     }
     try {
       const MapRepairResult started = background_->start(correction);

@@ -10,15 +10,19 @@
 namespace panmap {
 
 BackgroundRepair::BackgroundRepair(Mapper* mapper, FrameLoader load, FrameStore* store,
-                                   const MapRepairConfig& config)
-    : mapper_(mapper), load_(std::move(load)), store_(store), config_(config) {
+                                   const MapRepairConfig& config, PanopticFrameLoader panoptic_load)
+    : mapper_(mapper),
+      load_(std::move(load)),
+      store_(store),
+      config_(config),
+      panoptic_load_(std::move(panoptic_load)) {
   if (!mapper_) throw Error("BackgroundRepair: no mapper");
   if (!load_) throw Error("BackgroundRepair: no frame loader");
   config_.check();
 }
 
 BackgroundRepair::BackgroundRepair(Mapper* mapper, FrameStore* store, const MapRepairConfig& config)
-    : BackgroundRepair(mapper, storeLoader(store), store, config) {}
+    : BackgroundRepair(mapper, storeLoader(store), store, config, storePanopticLoader(store)) {}
 
 BackgroundRepair::~BackgroundRepair() { stopWorker(); }
 
@@ -74,7 +78,11 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
   corrected_ = std::move(corrected);
   started_ = std::chrono::steady_clock::now();
   blocks_before_ = mapper_->map().numBlocks();
-  rebuild_ = mapper_->beginRebuild(&pool_);
+  // Frames still queued for the store are in neither count; they come with the segmentation
+  // they were mapped with, if any.
+  remap_ = config_.reassociate && panoptic_load_ && store_ && store_->size() > 0 &&
+           store_->sizeWithPanoptic() == store_->size();
+  rebuild_ = mapper_->beginRebuild(&pool_, remap_);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     jobs_ = corrected_.poses;
@@ -96,30 +104,40 @@ void BackgroundRepair::frameIntegrated() {
   cv_.notify_all();
 }
 
-void BackgroundRepair::reintegrate(const StampedPose& job, RgbdFrame* frame, LabelImage* labels) {
+void BackgroundRepair::reintegrate(const StampedPose& job, RgbdFrame* frame, LabelImage* labels,
+                                   PanopticFrame* panoptic) {
   *frame = RgbdFrame();
   *labels = LabelImage();
-  load_(job.utime, frame, labels);
-  addLoaded(job, *frame, *labels);
+  if (remap_) {
+    *panoptic = PanopticFrame();
+    const bool has_panoptic = panoptic_load_(job.utime, frame, panoptic);
+    addLoaded(job, *frame, *labels, has_panoptic ? panoptic : nullptr);
+  } else {
+    load_(job.utime, frame, labels);
+    addLoaded(job, *frame, *labels, nullptr);
+  }
 }
 
 void BackgroundRepair::addLoaded(const StampedPose& job, const RgbdFrame& frame,
-                                 const LabelImage& labels) {
+                                 const LabelImage& labels, const PanopticFrame* panoptic) {
   if (frame.utime != job.utime) {
     throw Error("asked for the frame of utime " + std::to_string(job.utime) + ", got " +
                 std::to_string(frame.utime));
   }
-  rebuild_->add(frame, job.T_W_C, &labels);
+  rebuild_->add(frame, job.T_W_C, &labels, panoptic);
 }
 
 void BackgroundRepair::work() {
   RgbdFrame frame;
   LabelImage labels;
+  PanopticFrame panoptic;
   // The frames the correction covers are decoded ahead on another thread; those mapped since
   // come one by one, as the mapping thread hands them over.
   std::vector<int64_t> covered;
   for (const StampedPose& p : corrected_.poses) covered.push_back(p.utime);
-  FramePrefetcher prefetched(load_, std::move(covered));
+  std::unique_ptr<FramePrefetcher> prefetched =
+      remap_ ? std::make_unique<FramePrefetcher>(panoptic_load_, std::move(covered))
+             : std::make_unique<FramePrefetcher>(load_, std::move(covered));
   for (;;) {
     StampedPose job;
     {
@@ -135,10 +153,10 @@ void BackgroundRepair::work() {
     }
     try {
       if (next_ < corrected_.poses.size()) {
-        prefetched.next(&frame, &labels);
-        addLoaded(job, frame, labels);
+        const bool has_panoptic = prefetched->next(&frame, &labels, &panoptic);
+        addLoaded(job, frame, labels, has_panoptic ? &panoptic : nullptr);
       } else {
-        reintegrate(job, &frame, &labels);
+        reintegrate(job, &frame, &labels, &panoptic);
       }
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -166,6 +184,7 @@ MapRepairResult BackgroundRepair::commit() {
     return result;
   }
   stats.frames = rebuild_->poses().size();
+  stats.reassociated = rebuild_->remaps();
   stats.votes_evicted = rebuild_->votesEvicted();
   for (size_t i = 0; i < corrected_.poses.size(); ++i) {
     stats.frames_moved += corrected_.translation_m[i] > 0.0 || corrected_.rotation_rad[i] > 0.0;
@@ -203,8 +222,11 @@ std::optional<MapRepairResult> BackgroundRepair::poll() {
   if (failure_.empty()) {
     RgbdFrame frame;
     LabelImage labels;
+    PanopticFrame panoptic;
     try {
-      for (; next_ < jobs_.size(); ++next_) reintegrate(jobs_[next_], &frame, &labels);
+      for (; next_ < jobs_.size(); ++next_) {
+        reintegrate(jobs_[next_], &frame, &labels, &panoptic);
+      }
     } catch (const std::exception& e) {
       failure_ = e.what();
     }

@@ -9,6 +9,23 @@
 namespace panmap {
 
 FramePrefetcher::FramePrefetcher(FrameLoader load, std::vector<int64_t> utimes, size_t ahead)
+    : FramePrefetcher(
+          load ? std::function<void(int64_t, Loaded*)>(
+                     [load](int64_t utime, Loaded* out) { load(utime, &out->frame, &out->labels); })
+               : nullptr,
+          std::move(utimes), ahead) {}
+
+FramePrefetcher::FramePrefetcher(PanopticFrameLoader load, std::vector<int64_t> utimes,
+                                 size_t ahead)
+    : FramePrefetcher(
+          load ? std::function<void(int64_t, Loaded*)>([load](int64_t utime, Loaded* out) {
+            out->has_panoptic = load(utime, &out->frame, &out->panoptic);
+          })
+               : nullptr,
+          std::move(utimes), ahead) {}
+
+FramePrefetcher::FramePrefetcher(std::function<void(int64_t, Loaded*)> load,
+                                 std::vector<int64_t> utimes, size_t ahead)
     : load_(std::move(load)), utimes_(std::move(utimes)), ahead_(ahead) {
   if (!load_) throw Error("FramePrefetcher: no frame loader");
   if (ahead_ < 1) throw Error("FramePrefetcher: ahead must be at least 1");
@@ -33,7 +50,7 @@ void FramePrefetcher::work() {
     }
     Loaded loaded;
     try {
-      load_(utime, &loaded.frame, &loaded.labels);
+      load_(utime, &loaded);
     } catch (...) {
       loaded.error = std::current_exception();
     }
@@ -47,7 +64,7 @@ void FramePrefetcher::work() {
   }
 }
 
-void FramePrefetcher::next(RgbdFrame* frame, LabelImage* labels) {
+bool FramePrefetcher::next(RgbdFrame* frame, LabelImage* labels, PanopticFrame* panoptic) {
   if (taken_ >= utimes_.size()) {
     throw Error("FramePrefetcher: all " + std::to_string(utimes_.size()) + " frames taken");
   }
@@ -67,6 +84,8 @@ void FramePrefetcher::next(RgbdFrame* frame, LabelImage* labels) {
   }
   *frame = std::move(loaded.frame);
   *labels = std::move(loaded.labels);
+  if (panoptic) *panoptic = std::move(loaded.panoptic);
+  return loaded.has_panoptic;
 }
 
 }  // namespace panmap

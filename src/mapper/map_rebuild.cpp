@@ -8,9 +8,16 @@
 
 namespace panmap {
 
-MapRebuild::MapRebuild(const MapperConfig& config, ThreadPool* pool)
+MapRebuild::MapRebuild(const MapperConfig& config, ThreadPool* pool, bool remap)
     : config_(std::make_unique<MapperConfig>(config)) {
   if (!pool) throw Error("MapRebuild: no thread pool");
+  if (remap) {
+    // The poses are the back-end's corrected ones: nothing to refine them against. The
+    // mapper keeps the configured thread count: its pool becomes the live mapper's.
+    config_->tracking_mode = MapperConfig::TrackingMode::kOff;
+    mapper_ = std::make_unique<Mapper>(*config_);
+    return;
+  }
   integrator_ = std::make_unique<ProjectiveIntegrator>(config_->integrator, pool);
   map_ = std::make_unique<TsdfMap>(config_->map);
   if (config_->occupancy_enabled) occupancy_ = std::make_unique<OccupancyMap>(config_->occupancy);
@@ -18,9 +25,24 @@ MapRebuild::MapRebuild(const MapperConfig& config, ThreadPool* pool)
 
 MapRebuild::~MapRebuild() = default;
 
+const TsdfMap& MapRebuild::map() const { return mapper_ ? mapper_->map() : *map_; }
+
 void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
-                     const LabelImage* labels) {
+                     const LabelImage* labels, const PanopticFrame* panoptic) {
   const std::string name = "frame of utime " + std::to_string(frame.utime);
+  StampedPose pose;
+  pose.utime = frame.utime;
+  pose.T_W_C = T_W_C;
+  if (mapper_) {
+    try {
+      mapper_->integrate(frame, T_W_C, panoptic);
+    } catch (const Error& e) {
+      throw Error(name + ": " + e.what());
+    }
+    votes_evicted_ = mapper_->voteEvictions();
+    poses_.push_back(pose);
+    return;
+  }
   try {
     checkFrame(*config_, frame, T_W_C, nullptr);
   } catch (const Error& e) {
@@ -37,9 +59,6 @@ void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
       integrator_->integrate(frame, T_W_C, labelled ? labels : nullptr, map_.get());
   votes_evicted_ += integration.votes_evicted;
   if (occupancy_) occupancy_->integrate(frame, T_W_C);
-  StampedPose pose;
-  pose.utime = frame.utime;
-  pose.T_W_C = T_W_C;
   poses_.push_back(pose);
 }
 

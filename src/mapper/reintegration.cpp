@@ -9,8 +9,8 @@
 
 namespace panmap {
 
-std::unique_ptr<MapRebuild> Mapper::beginRebuild(ThreadPool* pool) const {
-  return std::make_unique<MapRebuild>(config_, pool ? pool : pool_.get());
+std::unique_ptr<MapRebuild> Mapper::beginRebuild(ThreadPool* pool, bool remap) const {
+  return std::make_unique<MapRebuild>(config_, pool ? pool : pool_.get(), remap);
 }
 
 void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild) {
@@ -27,15 +27,22 @@ void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild) {
                   std::to_string(trajectory_[i].utime));
     }
   }
-  if (static_cast<bool>(rebuild->occupancy_) != static_cast<bool>(occupancy_)) {
-    throw Error("commitRebuild: the rebuild was made with another occupancy setting");
+  if (rebuild->remaps()) {
+    if (rebuild->mapper_->config_.occupancy_enabled != config_.occupancy_enabled) {
+      throw Error("commitRebuild: the rebuild was made with another occupancy setting");
+    }
+    adoptRemapped(rebuild->mapper_.get());
+  } else {
+    if (static_cast<bool>(rebuild->occupancy_) != static_cast<bool>(occupancy_)) {
+      throw Error("commitRebuild: the rebuild was made with another occupancy setting");
+    }
+    map_ = std::move(rebuild->map_);
+    if (occupancy_) occupancy_ = std::move(rebuild->occupancy_);
+    // The evictions of building this map, which replaces the old one and its history.
+    vote_evictions_ = rebuild->votesEvicted();
   }
-  map_ = std::move(rebuild->map_);
-  if (occupancy_) occupancy_ = std::move(rebuild->occupancy_);
   mesher_->invalidateAll();
   for (size_t i = 0; i < poses.size(); ++i) trajectory_[i].T_W_C = poses[i].T_W_C;
-  // The evictions of building this map, which replaces the old one and its history.
-  vote_evictions_ = rebuild->votesEvicted();
   // The correction's keyframes now sit at the back-end's poses, and the newest frames at what
   // its corrected odometry gives them: what the tracker had learnt of the old drift is void.
   drift_ = DriftFilter(config_.drift);

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "panmap/core/error.h"
+#include "panmap/mapper/map_rebuild.h"
 #include "panmap/mapper/mapper.h"
 
 namespace panmap {
@@ -40,9 +41,7 @@ ReintegrationStats Mapper::remap(const std::vector<StampedPose>& poses,
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   // A mapper of its own, with the poses as given: the live one stays whole until the end.
-  MapperConfig config = config_;
-  config.tracking_mode = MapperConfig::TrackingMode::kOff;
-  Mapper fresh(config);
+  std::unique_ptr<MapRebuild> rebuild = beginRebuild(nullptr, true);
   RgbdFrame frame;
   PanopticFrame panoptic;
   for (size_t i = 0; i < poses.size(); ++i) {
@@ -53,8 +52,7 @@ ReintegrationStats Mapper::remap(const std::vector<StampedPose>& poses,
                   std::to_string(frame.utime));
     }
     try {
-      fresh.integrate(frame, poses[i].T_W_C, has_panoptic ? &panoptic : nullptr,
-                      trajectory_[i].source);
+      rebuild->add(frame, poses[i].T_W_C, nullptr, has_panoptic ? &panoptic : nullptr);
     } catch (const Error& e) {
       throw Error(std::string("remap: ") + e.what());
     }
@@ -68,28 +66,26 @@ ReintegrationStats Mapper::remap(const std::vector<StampedPose>& poses,
       return stats;
     }
   }
-  // Every part that holds the fresh mapper's thread pool moves over with the pool; the mesher
-  // stays (it knows which blocks a viewer holds) and is pointed at the new pool.
-  std::swap(pool_, fresh.pool_);
-  std::swap(map_, fresh.map_);
-  std::swap(segmenter_, fresh.segmenter_);
-  std::swap(tracker_, fresh.tracker_);
-  std::swap(integrator_, fresh.integrator_);
-  std::swap(graph_, fresh.graph_);
-  std::swap(occupancy_, fresh.occupancy_);
-  mesher_->setPool(pool_.get());
-  mesher_->invalidateAll();
-  for (size_t i = 0; i < poses.size(); ++i) trajectory_[i].T_W_C = poses[i].T_W_C;
-  vote_evictions_ = fresh.vote_evictions_;
-  superpoints_forgotten_ += fresh.superpoints_forgotten_;
-  edges_pruned_ += fresh.edges_pruned_;
-  // As after reintegrate(): the old drift estimate is void (commitRebuild).
-  drift_ = DriftFilter(config_.drift);
-  stats.votes_evicted = fresh.vote_evictions_;
+  stats.votes_evicted = rebuild->votesEvicted();
+  commitRebuild(std::move(rebuild));
   stats.completed = true;
   stats.blocks_after = map_->numBlocks();
   stats.seconds = seconds();
   return stats;
+}
+
+void Mapper::adoptRemapped(Mapper* fresh) {
+  std::swap(pool_, fresh->pool_);
+  std::swap(map_, fresh->map_);
+  std::swap(segmenter_, fresh->segmenter_);
+  std::swap(tracker_, fresh->tracker_);
+  std::swap(integrator_, fresh->integrator_);
+  std::swap(graph_, fresh->graph_);
+  std::swap(occupancy_, fresh->occupancy_);
+  mesher_->setPool(pool_.get());
+  vote_evictions_ = fresh->vote_evictions_;
+  superpoints_forgotten_ += fresh->superpoints_forgotten_;
+  edges_pruned_ += fresh->edges_pruned_;
 }
 
 }  // namespace panmap

@@ -19,9 +19,10 @@
 namespace panmap {
 
 /// A loop closure's repair (docs/LOOP_CLOSURE.md) on a thread of its own, while the mapping
-/// thread keeps integrating frames: the repair re-integrates the frames the map held when the
-/// correction came, at their corrected poses, then every frame integrated since, at the pose it
-/// was mapped with; once it has caught up, poll() swaps the repaired map in between two frames.
+/// thread keeps integrating frames: the repair re-integrates (or, with the segmentations
+/// stored, maps again) the frames the map held when the correction came, at their corrected
+/// poses, then every frame integrated since, at the pose it was mapped with; once it has
+/// caught up, poll() swaps the repaired map in between two frames.
 /// A newer correction abandons a running repair and starts again from the map (superseded).
 ///
 /// Threads: every member function is called from the mapping thread (the one that calls
@@ -32,9 +33,14 @@ class BackgroundRepair {
   /// @param mapper the live map (not owned; must outlive this)
   /// @param load gives each frame back by its utime; it is called on the repair's thread
   /// @param store if not null, where the corrected poses are recorded when a repair commits
+  /// @param panoptic_load if given (and config.reassociate), gives each frame back with its
+  ///        segmentation, and a repair started while every frame of `store` has one maps the
+  ///        frames again (Mapper::remap) instead of re-integrating them; called on the
+  ///        repair's thread
   BackgroundRepair(Mapper* mapper, FrameLoader load, FrameStore* store = nullptr,
-                   const MapRepairConfig& config = {});
-  /// Loads the frames from `store` (thread-safe) and records the corrected poses there.
+                   const MapRepairConfig& config = {}, PanopticFrameLoader panoptic_load = {});
+  /// Loads the frames from `store` (thread-safe, with their segmentations) and records the
+  /// corrected poses there.
   BackgroundRepair(Mapper* mapper, FrameStore* store, const MapRepairConfig& config = {});
   /// Abandons a running repair (the map stays as it is).
   ~BackgroundRepair();
@@ -75,20 +81,24 @@ class BackgroundRepair {
   void stopWorker();
   MapRepairResult commit();
   /// Loads one frame and adds it to the rebuild at the job's pose; throws Error.
-  void reintegrate(const StampedPose& job, RgbdFrame* frame, LabelImage* labels);
+  void reintegrate(const StampedPose& job, RgbdFrame* frame, LabelImage* labels,
+                   PanopticFrame* panoptic);
   /// Adds a loaded frame at the job's pose; throws Error when it is another frame.
-  void addLoaded(const StampedPose& job, const RgbdFrame& frame, const LabelImage& labels);
+  void addLoaded(const StampedPose& job, const RgbdFrame& frame, const LabelImage& labels,
+                 const PanopticFrame* panoptic);
 
   Mapper* mapper_;
   FrameLoader load_;
   FrameStore* store_;
   MapRepairConfig config_;
+  PanopticFrameLoader panoptic_load_;
   ThreadPool pool_{1};  // the repair's thread integrates alone: the mapper has the others
 
   // Set by start() on the mapping thread, read by it only, except rebuild_ (the worker's).
   MapRepairResult result_;
   CorrectedTrajectory corrected_;
   std::unique_ptr<MapRebuild> rebuild_;
+  bool remap_ = false;  // the running repair maps the frames again
   std::chrono::steady_clock::time_point started_;
   size_t blocks_before_ = 0;
   int64_t superseded_ = 0;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <deque>
 #include <exception>
+#include <functional>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -23,6 +24,9 @@ class FramePrefetcher {
   /// @param utimes the frames to load, in the order next() gives them
   /// @param ahead frames loaded and not yet taken at most (>= 1)
   FramePrefetcher(FrameLoader load, std::vector<int64_t> utimes, size_t ahead = 2);
+  /// Loads frames with their segmentations (for a remap); next() gives them back.
+  /// @param load called on the prefetcher's thread only, once per utime, in order
+  FramePrefetcher(PanopticFrameLoader load, std::vector<int64_t> utimes, size_t ahead = 2);
   /// Stops loading (a load under way finishes first) and joins the thread.
   ~FramePrefetcher();
   FramePrefetcher(const FramePrefetcher&) = delete;
@@ -30,17 +34,24 @@ class FramePrefetcher {
 
   /// The next frame of the list; rethrows what the loader threw for it (nothing is loaded
   /// after a failure). Throws Error when every frame has been taken or one before failed.
-  void next(RgbdFrame* frame, LabelImage* labels);
+  /// @param labels its pixel labels (empty from a PanopticFrameLoader)
+  /// @param panoptic if not null, its segmentation (empty from a FrameLoader)
+  /// @return whether it has a segmentation
+  bool next(RgbdFrame* frame, LabelImage* labels, PanopticFrame* panoptic = nullptr);
 
  private:
   struct Loaded {
     RgbdFrame frame;
     LabelImage labels;
+    PanopticFrame panoptic;
+    bool has_panoptic = false;
     std::exception_ptr error;
   };
+  FramePrefetcher(std::function<void(int64_t, Loaded*)> load, std::vector<int64_t> utimes,
+                  size_t ahead);
   void work();
 
-  FrameLoader load_;
+  std::function<void(int64_t, Loaded*)> load_;
   std::vector<int64_t> utimes_;
   size_t ahead_;
   size_t taken_ = 0;

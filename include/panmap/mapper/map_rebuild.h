@@ -23,29 +23,38 @@ class Mapper;
 /// A label-TSDF and occupancy map built again from stored frames, aside from the live map: the
 /// repair after a loop closure (docs/LOOP_CLOSURE.md). Mapper::beginRebuild() makes one with
 /// the mapper's configuration; add() every frame the mapper holds, in the order it integrated
-/// them, each at its new pose; Mapper::commitRebuild() swaps it in. It shares nothing with
-/// the mapper but the thread pool it is given, so one thread may build it while another keeps
-/// mapping (each with its own pool).
+/// them, each at its new pose; Mapper::commitRebuild() swaps it in. Two kinds: a
+/// re-integration (each frame votes for the super-points it voted for) or a remap (each frame
+/// mapped again with its segmentation by a mapper of the rebuild's own: super-points, graph
+/// and objects made anew). It shares nothing with the live mapper, so one thread may build it
+/// while another keeps mapping.
 class MapRebuild {
  public:
-  /// @param config the mapper's configuration (map, integrator and occupancy parts are used)
-  /// @param pool threads to integrate with (not owned; must outlive the rebuild)
-  MapRebuild(const MapperConfig& config, ThreadPool* pool);
+  /// @param config the mapper's configuration (map, integrator and occupancy parts are used;
+  ///        all of it, pose refinement off, for a remap)
+  /// @param pool threads to integrate with (not owned; must outlive the rebuild); a remap's
+  ///        mapper has a pool of the configured size instead, which becomes the live mapper's
+  /// @param remap map the frames again with their segmentations instead of re-integrating
+  MapRebuild(const MapperConfig& config, ThreadPool* pool, bool remap = false);
   ~MapRebuild();
   MapRebuild(const MapRebuild&) = delete;
   MapRebuild& operator=(const MapRebuild&) = delete;
 
   /// Integrates one frame at T_W_C with the super-point label each pixel voted for (null or
-  /// empty: geometry only). Throws Error naming the frame's utime when the frame or the label
-  /// image is invalid; the rebuild is then unchanged.
-  void add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const LabelImage* labels);
+  /// empty: geometry only), or for a remap maps it with its segmentation (null: geometry
+  /// only; the labels are not used). Throws Error naming the frame's utime when the frame,
+  /// the label image or the segmentation is invalid; the rebuild is then unchanged.
+  void add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const LabelImage* labels,
+           const PanopticFrame* panoptic = nullptr);
+  /// True for a remap.
+  bool remaps() const { return static_cast<bool>(mapper_); }
 
   /// The frames added so far: utime and the pose each was integrated with, in order.
   const std::vector<StampedPose>& poses() const { return poses_; }
   /// Label votes that pushed out a weaker one while building.
   uint64_t votesEvicted() const { return votes_evicted_; }
   /// The label-TSDF built so far.
-  const TsdfMap& map() const { return *map_; }
+  const TsdfMap& map() const;
 
  private:
   friend class Mapper;
@@ -54,6 +63,7 @@ class MapRebuild {
   std::unique_ptr<ProjectiveIntegrator> integrator_;
   std::unique_ptr<TsdfMap> map_;
   std::unique_ptr<OccupancyMap> occupancy_;  // null when the mapper keeps none
+  std::unique_ptr<Mapper> mapper_;           // a remap's mapper (then the three above are null)
   std::vector<StampedPose> poses_;
   uint64_t votes_evicted_ = 0;
 };

@@ -227,14 +227,17 @@ class Mapper {
   /// An empty rebuild with this mapper's configuration, for reintegrate() or for a repair that
   /// builds on another thread while this mapper keeps mapping (loop/background_repair.h).
   /// @param pool threads the rebuild integrates with (null: this mapper's own, which only the
-  ///        mapping thread may then use)
-  std::unique_ptr<MapRebuild> beginRebuild(ThreadPool* pool = nullptr) const;
+  ///        mapping thread may then use; a remap's mapper makes its own pool)
+  /// @param remap map the frames again with their segmentations (see remap()) instead of
+  ///        re-integrating them
+  std::unique_ptr<MapRebuild> beginRebuild(ThreadPool* pool = nullptr, bool remap = false) const;
   /// Swaps a finished rebuild in: the label-TSDF and occupancy map become the rebuild's, each
   /// frame's pose in trajectory() becomes the one it was re-integrated with, and the next
   /// updateMesh() lists every block. The running correction of tracked poses starts again from
   /// identity: the repaired map sits where the SLAM back-end's corrected poses put it, and
-  /// those are what its next poses build on (docs/LOOP_CLOSURE.md). Throws Error, changing
-  /// nothing, unless the rebuild holds exactly the frames of trajectory(), in order.
+  /// those are what its next poses build on (docs/LOOP_CLOSURE.md). A remap's super-points,
+  /// graph and their counters replace this mapper's too. Throws Error, changing nothing,
+  /// unless the rebuild holds exactly the frames of trajectory(), in order.
   void commitRebuild(std::unique_ptr<MapRebuild> rebuild);
 
   /// The labelled mesh of the current map: marching cubes re-run only on changed blocks;
@@ -272,6 +275,9 @@ class Mapper {
   /// Throws Error (prefixed with `what`) unless `poses` are rigid and have trajectory()'s
   /// utimes, in order.
   void checkRepairPoses(const std::vector<StampedPose>& poses, const char* what) const;
+  /// Takes a remap's mapper's state (commitRebuild): every part that holds its thread pool
+  /// moves over with the pool; the mesher stays and is pointed at it.
+  void adoptRemapped(Mapper* fresh);
   void forgetUnvotedSuperpoints();
   /// Labels mesh vertices; `cache` holds each super-point's labels once looked up (a mesh
   /// has millions of vertices but thousands of super-points).
