@@ -78,10 +78,8 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
   corrected_ = std::move(corrected);
   started_ = std::chrono::steady_clock::now();
   blocks_before_ = mapper_->map().numBlocks();
-  // Frames still queued for the store are in neither count; they come with the segmentation
-  // they were mapped with, if any.
-  remap_ = config_.reassociate && panoptic_load_ && store_ && store_->size() > 0 &&
-           store_->sizeWithPanoptic() == store_->size();
+  // As repairMap() decides: a store holding segmentations keeps every frame's.
+  remap_ = config_.reassociate && panoptic_load_ && store_ && store_->sizeWithPanoptic() > 0;
   rebuild_ = mapper_->beginRebuild(&pool_, remap_);
   {
     std::lock_guard<std::mutex> lock(mutex_);

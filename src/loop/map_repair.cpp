@@ -54,8 +54,9 @@ MapRepairResult repairMap(Mapper* mapper, FrameStore* store, const PoseCorrectio
                 std::to_string(correction.poses.front().utime) + ")");
   }
   // Association under the old poses may have joined surfaces to the wrong super-points;
-  // with the segmentations stored, the frames are associated again.
-  if (config.reassociate && store->size() > 0 && store->sizeWithPanoptic() == store->size()) {
+  // with the segmentations stored, the frames are associated again. A store that holds some
+  // keeps every frame's: one stored without was mapped without (and is mapped so again).
+  if (config.reassociate && store->sizeWithPanoptic() > 0) {
     result.reintegration = mapper->remap(corrected.poses, storePanopticLoader(store), progress);
   } else {
     result.reintegration = mapper->reintegrate(corrected.poses, storeLoader(store), progress);

@@ -16,15 +16,19 @@ namespace {
 // The box scene mapped with every frame kept in a frame store, as the mapper process does.
 class MapRepair : public BoxScene {
  protected:
-  // with_masks: the store also keeps each frame's segmentation (the mapper process does).
-  std::unique_ptr<Mapper> mapWithStore(int frames, FrameStore* store, bool with_masks = false) {
+  // with_masks: the store also keeps each frame's segmentation (the mapper process does);
+  // frames from `unmasked_from` on are mapped (and stored) without one, as when a mask comes
+  // too late.
+  std::unique_ptr<Mapper> mapWithStore(int frames, FrameStore* store, bool with_masks = false,
+                                       int unmasked_from = 1 << 30) {
     auto mapper = std::make_unique<Mapper>(config());
     for (int k = 0; k < frames; ++k) {
       RgbdFrame frame;
       PanopticFrame panoptic;
       frameAt(k, &frame, &panoptic);
-      const FrameStats stats = mapper->integrate(frame, pose(k), &panoptic);
-      store->add(frame, stats.T_W_C, mapper->lastPixelLabels(), with_masks ? &panoptic : nullptr);
+      const PanopticFrame* used = k < unmasked_from ? &panoptic : nullptr;
+      const FrameStats stats = mapper->integrate(frame, pose(k), used);
+      store->add(frame, stats.T_W_C, mapper->lastPixelLabels(), with_masks ? used : nullptr);
     }
     return mapper;
   }
@@ -91,13 +95,13 @@ TEST_F(MapRepair, AKeyframeCorrectionRepairsTheMapFromTheStore) {
 }
 
 // With the segmentations stored, the frames are mapped again at the corrected poses (the map
-// of a mapper that had those poses from the start); told not to, or with a frame stored
-// without its segmentation, the repair re-integrates.
+// of a mapper that had those poses from the start; frames mapped without masks again
+// without); told not to, the repair re-integrates.
 TEST_F(MapRepair, WithTheMasksStoredTheFramesAreMappedAgain) {
   test::TempDir dir;
   FrameStore store(storeConfig(dir.path("store")));
-  auto mapper = mapWithStore(6, &store, true);
-  ASSERT_EQ(store.sizeWithPanoptic(), 6u);
+  auto mapper = mapWithStore(6, &store, true, 4);  // the last two mapped without masks
+  ASSERT_EQ(store.sizeWithPanoptic(), 4u);
   const Eigen::Isometry3d D = correction();
   const MapRepairResult result = repairMap(mapper.get(), &store, keyframeCorrection(*mapper, 3, D));
   ASSERT_TRUE(result.reintegration.completed);
@@ -108,7 +112,7 @@ TEST_F(MapRepair, WithTheMasksStoredTheFramesAreMappedAgain) {
   for (const StampedPose& p : mapper->trajectory()) {
     StoredFrame stored = store.load(p.utime);
     stored.rgbd.frame_id = p.frame_id;  // not stored; the repaired trajectory keeps its own
-    reference.integrate(stored.rgbd, p.T_W_C, &stored.panoptic);
+    reference.integrate(stored.rgbd, p.T_W_C, stored.has_panoptic ? &stored.panoptic : nullptr);
   }
   EXPECT_EQ(mapper->serialize(), reference.serialize());
 

@@ -34,7 +34,7 @@ class BackgroundRepair {
   /// @param load gives each frame back by its utime; it is called on the repair's thread
   /// @param store if not null, where the corrected poses are recorded when a repair commits
   /// @param panoptic_load if given (and config.reassociate), gives each frame back with its
-  ///        segmentation, and a repair started while every frame of `store` has one maps the
+  ///        segmentation, and a repair started while `store` holds segmentations maps the
   ///        frames again (Mapper::remap) instead of re-integrating them; called on the
   ///        repair's thread
   BackgroundRepair(Mapper* mapper, FrameLoader load, FrameStore* store = nullptr,

@@ -111,8 +111,9 @@ class FrameStore {
   /// @param depth depth image as integrated, in depth_scale_m units
   /// @param labels super-point label per pixel it voted for, 0 = none
   /// @param color registered colour, or null; stored only when config.store_color
-  /// @param panoptic the frame's panoptic segmentation, or null (its segment image must have
-  ///        the camera's size)
+  /// @param panoptic the segmentation the frame was mapped with, or null when it was mapped
+  ///        without one (a repair then maps it again without); its segment image must have
+  ///        the camera's size. A store holding any keeps every frame's (MapRepairConfig).
   void add(int64_t utime, const Eigen::Isometry3d& T_W_C, const PinholeCamera& camera,
            double depth_scale_m, const DepthImage& depth, const LabelImage& labels,
            const ColorImage* color = nullptr, const PanopticFrame* panoptic = nullptr);

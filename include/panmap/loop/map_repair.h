@@ -15,10 +15,12 @@ struct MapRepairConfig {
   /// A corrected utime matches the mapped frame nearest in time within this, microseconds
   /// (0: exactly; a back-end that republishes the utimes it was given needs no more).
   int64_t match_tolerance_us = 0;
-  /// When every stored frame has its panoptic segmentation, map the frames again
-  /// (Mapper::remap: super-points, graph and objects made anew) instead of re-integrating
-  /// them with the super-points association gave them under the old poses. Costs the whole
-  /// pipeline per frame instead of integration alone (docs/LOOP_CLOSURE.md).
+  /// When the store holds panoptic segmentations, map the frames again (Mapper::remap:
+  /// super-points, graph and objects made anew; a frame stored without one is mapped without,
+  /// as it was) instead of re-integrating them with the super-points association gave them
+  /// under the old poses. Costs the whole pipeline per frame instead of integration alone
+  /// (docs/LOOP_CLOSURE.md). Once a repair has mapped the frames again, the pixel labels in
+  /// the store name super-points that are gone: only a remap repairs such a map correctly.
   bool reassociate = true;
   /// Throws Error naming the bad field.
   void check() const;
@@ -45,7 +47,7 @@ struct MapRepairResult {
 
 /// The repair after a loop closure (docs/LOOP_CLOSURE.md): spreads the correction over every
 /// mapped frame (applyCorrection), maps the frames from the store again at their new poses
-/// (Mapper::remap when config.reassociate and every stored frame has its segmentation, else
+/// (Mapper::remap when config.reassociate and the store holds segmentations, else
 /// Mapper::reintegrate) and records the new poses in the store, so that the next correction
 /// starts from them. Throws Error, changing nothing, when the correction is invalid, when none
 /// of its utimes is a mapped frame (named), or when a mapped frame is missing from the store.
