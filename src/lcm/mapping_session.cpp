@@ -149,7 +149,9 @@ void MappingSession::repair(const PoseCorrection& correction) {
             *frame = std::move(stored.rgbd);
             *panoptic = std::move(stored.panoptic);
             return stored.has_panoptic;
-          });
+          },
+          // The writer may not have written any frame yet: what was handed to it counts.
+          [this] { return stored_segmentation_ || options_.frame_store->sizeWithPanoptic() > 0; });
     }
     try {
       const MapRepairResult started = background_->start(correction);
@@ -242,6 +244,7 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
         try {
           writer_->add(f.frame, s.T_W_C, mapper_->lastPixelLabels(),
                        f.panoptic ? &*f.panoptic : nullptr);
+          stored_segmentation_ = stored_segmentation_ || f.panoptic.has_value();
         } catch (const Error& e) {
           ++stats_.rejected["frame store: " + reasonOf(e.what())];
         }

@@ -10,12 +10,14 @@
 namespace panmap {
 
 BackgroundRepair::BackgroundRepair(Mapper* mapper, FrameLoader load, FrameStore* store,
-                                   const MapRepairConfig& config, PanopticFrameLoader panoptic_load)
+                                   const MapRepairConfig& config, PanopticFrameLoader panoptic_load,
+                                   std::function<bool()> holds_segmentations)
     : mapper_(mapper),
       load_(std::move(load)),
       store_(store),
       config_(config),
-      panoptic_load_(std::move(panoptic_load)) {
+      panoptic_load_(std::move(panoptic_load)),
+      holds_segmentations_(std::move(holds_segmentations)) {
   if (!mapper_) throw Error("BackgroundRepair: no mapper");
   if (!load_) throw Error("BackgroundRepair: no frame loader");
   config_.check();
@@ -79,7 +81,9 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
   started_ = std::chrono::steady_clock::now();
   blocks_before_ = mapper_->map().numBlocks();
   // As repairMap() decides: a store holding segmentations keeps every frame's.
-  remap_ = config_.reassociate && panoptic_load_ && store_ && store_->sizeWithPanoptic() > 0;
+  const bool holds =
+      holds_segmentations_ ? holds_segmentations_() : store_ && store_->sizeWithPanoptic() > 0;
+  remap_ = config_.reassociate && panoptic_load_ && holds;
   rebuild_ = mapper_->beginRebuild(&pool_, remap_);
   {
     std::lock_guard<std::mutex> lock(mutex_);

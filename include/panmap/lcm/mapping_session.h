@@ -127,6 +127,7 @@ class MappingSession {
   int64_t newest_utime_ = INT64_MIN;
   bool done_ = false;
   std::unique_ptr<FrameStoreWriter> writer_;      // with a frame store: writes it off this thread
+  bool stored_segmentation_ = false;              // a frame went to the store with its masks
   std::unique_ptr<BackgroundRepair> background_;  // with background_repair, once needed
   int64_t running_correction_id_ = 0;             // of the background repair under way
 };

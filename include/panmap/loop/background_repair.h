@@ -3,6 +3,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -37,8 +38,12 @@ class BackgroundRepair {
   ///        segmentation, and a repair started while `store` holds segmentations maps the
   ///        frames again (Mapper::remap) instead of re-integrating them; called on the
   ///        repair's thread
+  /// @param holds_segmentations if given, says at start() whether the store holds
+  ///        segmentations, frames still on their way to it included (a store written by a
+  ///        thread of its own lags behind); else the store's own count decides
   BackgroundRepair(Mapper* mapper, FrameLoader load, FrameStore* store = nullptr,
-                   const MapRepairConfig& config = {}, PanopticFrameLoader panoptic_load = {});
+                   const MapRepairConfig& config = {}, PanopticFrameLoader panoptic_load = {},
+                   std::function<bool()> holds_segmentations = {});
   /// Loads the frames from `store` (thread-safe, with their segmentations) and records the
   /// corrected poses there.
   BackgroundRepair(Mapper* mapper, FrameStore* store, const MapRepairConfig& config = {});
@@ -92,6 +97,7 @@ class BackgroundRepair {
   FrameStore* store_;
   MapRepairConfig config_;
   PanopticFrameLoader panoptic_load_;
+  std::function<bool()> holds_segmentations_;
   ThreadPool pool_{1};  // the repair's thread integrates alone: the mapper has the others
 
   // Set by start() on the mapping thread, read by it only, except rebuild_ (the worker's).
