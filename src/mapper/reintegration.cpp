@@ -51,34 +51,52 @@ void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild) {
 ReintegrationStats Mapper::reintegrate(const std::vector<StampedPose>& poses,
                                        const FrameLoader& load,
                                        const ReintegrationProgress& progress) {
-  const auto start = std::chrono::steady_clock::now();
   if (!load) throw Error("reintegrate: no frame loader");
   checkRepairPoses(poses, "reintegrate");
+  std::vector<int64_t> utimes;
+  for (const StampedPose& p : poses) utimes.push_back(p.utime);
+  FramePrefetcher frames(load, std::move(utimes));
+  return rebuildFrom(poses, &frames, false, "reintegrate", progress);
+}
+
+ReintegrationStats Mapper::remap(const std::vector<StampedPose>& poses,
+                                 const PanopticFrameLoader& load,
+                                 const ReintegrationProgress& progress) {
+  if (!load) throw Error("remap: no frame loader");
+  checkRepairPoses(poses, "remap");
+  std::vector<int64_t> utimes;
+  for (const StampedPose& p : poses) utimes.push_back(p.utime);
+  FramePrefetcher frames(load, std::move(utimes));
+  return rebuildFrom(poses, &frames, true, "remap", progress);
+}
+
+ReintegrationStats Mapper::rebuildFrom(const std::vector<StampedPose>& poses,
+                                       FramePrefetcher* frames, bool remap, const char* what,
+                                       const ReintegrationProgress& progress) {
+  const auto start = std::chrono::steady_clock::now();
   ReintegrationStats stats;
+  stats.reassociated = remap;
   stats.blocks_before = map_->numBlocks();
   const auto seconds = [&start] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  // Built aside: the live maps stay whole until the last frame is in.
-  std::unique_ptr<MapRebuild> rebuild = beginRebuild();
-  std::vector<int64_t> utimes;
-  utimes.reserve(poses.size());
-  for (const StampedPose& p : poses) utimes.push_back(p.utime);
-  // Decoding the next frame while this one is integrated keeps the second core busy.
-  FramePrefetcher frames(load, std::move(utimes));
+  // Built aside: the live maps stay whole until the last frame is in. The prefetcher decodes
+  // the next frame while this one is integrated, which keeps the second core busy.
+  std::unique_ptr<MapRebuild> rebuild = beginRebuild(nullptr, remap);
   RgbdFrame frame;
   LabelImage labels;
+  PanopticFrame panoptic;
   for (size_t i = 0; i < poses.size(); ++i) {
     const int64_t utime = poses[i].utime;
-    frames.next(&frame, &labels);
+    const bool has_panoptic = frames->next(&frame, &labels, &panoptic);
     if (frame.utime != utime) {
-      throw Error("reintegrate: asked for the frame of utime " + std::to_string(utime) + ", got " +
-                  std::to_string(frame.utime));
+      throw Error(std::string(what) + ": asked for the frame of utime " + std::to_string(utime) +
+                  ", got " + std::to_string(frame.utime));
     }
     try {
-      rebuild->add(frame, poses[i].T_W_C, &labels);
+      rebuild->add(frame, poses[i].T_W_C, &labels, has_panoptic ? &panoptic : nullptr);
     } catch (const Error& e) {
-      throw Error(std::string("reintegrate: ") + e.what());
+      throw Error(std::string(what) + ": " + e.what());
     }
     ++stats.frames;
     stats.frames_moved += poses[i].T_W_C.matrix() != trajectory_[i].T_W_C.matrix();

@@ -145,6 +145,8 @@ struct ReintegrationStats {
 
 /// The mapping core: takes (RGB-D frame, T_W_C, panoptic segmentation) and keeps a label-TSDF
 /// whose voxels belong to semantically consistent super-points. No middleware inside.
+class FramePrefetcher;
+
 class Mapper {
  public:
   /// Throws Error when the config is invalid.
@@ -278,6 +280,11 @@ class Mapper {
   /// Takes a remap's mapper's state (commitRebuild): every part that holds its thread pool
   /// moves over with the pool; the mesher stays and is pointed at it.
   void adoptRemapped(Mapper* fresh);
+  /// Builds a rebuild (a remap or a re-integration) from the prefetched frames at `poses` and
+  /// commits it; `what` prefixes errors.
+  ReintegrationStats rebuildFrom(const std::vector<StampedPose>& poses, FramePrefetcher* frames,
+                                 bool remap, const char* what,
+                                 const ReintegrationProgress& progress);
   void forgetUnvotedSuperpoints();
   /// Labels mesh vertices; `cache` holds each super-point's labels once looked up (a mesh
   /// has millions of vertices but thousands of super-points).
