@@ -18,17 +18,23 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import suite  # noqa: E402  (same folder)
 from suite import Spec  # noqa: E402
 
-# III-D clustering (join_affinity, min_coverage) and III-C's pairwise weight K_C.
-GRID = {"join_affinity": [0.4, 0.5, 0.6, 0.7],
-        "min_coverage": [0.05, 0.1, 0.2],
-        "K_C": [15.0, 30.0, 60.0, 120.0]}
-START = {"join_affinity": 0.5, "min_coverage": 0.1, "K_C": 15.0}
+# III-D clustering (join_affinity, min_coverage), III-C's pairwise weight K_C (0: no pairwise
+# term, the argmax labels of w/o III-C, as the grid's own reference) and what its links are
+# scaled by (optimiser.link_scale).
+GRID = {"join_affinity": [0.5, 0.6, 0.7],
+        "min_coverage": [0.05, 0.1],
+        "K_C": [0.0, 15.0, 30.0, 60.0, 120.0],
+        "link_scale": ["smaller", "geometric"]}
+HEADER = "| join_affinity | min_coverage | K_C | link_scale | mAP50 | mAP75 | PQ50 | mIoU |"
+RULE = "|---:|---:|---:|---|---:|---:|---:|---:|"
+START = {"join_affinity": 0.5, "min_coverage": 0.1, "K_C": 15.0, "link_scale": "smaller"}
 
 
 def config_yaml(path, t):
     with open(path, "w") as f:
         f.write("%%YAML:1.0\n---\noptimiser:\n   join_affinity: %g\n   min_coverage: %g\n"
-                "   K_C: %g\n" % (t["join_affinity"], t["min_coverage"], t["K_C"]))
+                "   K_C: %g\n   link_scale: \"%s\"\n" % (
+                    t["join_affinity"], t["min_coverage"], t["K_C"], t["link_scale"]))
 
 
 def main():
@@ -64,7 +70,8 @@ def main():
         return suite.mean([s[k][metric] for k in maps])
 
     def distance(t):
-        return sum(abs(t[k] - START[k]) / START[k] for k in t)
+        return sum((t[k] != START[k]) if isinstance(t[k], str) else
+                   abs(t[k] - START[k]) / START[k] for k in t)
     # K_C acts on classes: mIoU breaks the ties mAP50 and PQ50 leave.
     ranked = sorted(range(len(grid)), key=lambda i: (-overall(scores[i], "map50"),
                                                      -overall(scores[i], "pq50"),
@@ -87,14 +94,21 @@ def main():
               ", ".join(map(str, suite.TUNING_SCANNET_LIKE)), 100 * args.voxel_size, len(grid),
               json.dumps(GRID), json.dumps(START)), "",
           "## Top of the grid", "",
-          "| join_affinity | min_coverage | K_C | mAP50 | mAP75 | PQ50 | mIoU |",
-          "|---:|---:|---:|---:|---:|---:|---:|"]
-    for i in ranked[:12]:
+          HEADER, RULE]
+
+    def row(i):
         t = grid[i]
-        md.append("| %g | %g | %g | %.1f | %.1f | %.1f | %.1f |" % (
-            t["join_affinity"], t["min_coverage"], t["K_C"], 100 * overall(scores[i], "map50"),
-            100 * overall(scores[i], "map75"), 100 * overall(scores[i], "pq50"),
-            100 * overall(scores[i], "miou")))
+        return "| %g | %g | %g | %s | %.1f | %.1f | %.1f | %.1f |" % (
+            t["join_affinity"], t["min_coverage"], t["K_C"], t["link_scale"],
+            100 * overall(scores[i], "map50"), 100 * overall(scores[i], "map75"),
+            100 * overall(scores[i], "pq50"), 100 * overall(scores[i], "miou"))
+    md += [row(i) for i in ranked[:12]]
+    md += ["", "Best point of each K_C and link scale (K_C 0: no pairwise term, as without III-C):",
+           "", HEADER, RULE]
+    for k_c in GRID["K_C"]:
+        for scale in GRID["link_scale"]:
+            md.append(row(next(i for i in ranked if grid[i]["K_C"] == k_c and
+                               grid[i]["link_scale"] == scale)))
     worst = ranked[-1]
     start_index = grid.index(START) if START in grid else None
     md += ["", "Worst point: %s, mAP50 %.1f.%s" % (
@@ -102,8 +116,9 @@ def main():
         " Starting values: mAP50 %.1f." % (100 * overall(scores[start_index], "map50"))
         if start_index is not None else ""), "", "## Chosen", "",
         "As YAML (`optimiser` section):", "", "```yaml",
-        "   join_affinity: %g\n   min_coverage: %g\n   K_C: %g" % (
-            best["join_affinity"], best["min_coverage"], best["K_C"]), "```", "",
+        "   join_affinity: %g\n   min_coverage: %g\n   K_C: %g\n   link_scale: \"%s\"" % (
+            best["join_affinity"], best["min_coverage"], best["K_C"], best["link_scale"]),
+        "```", "",
         "The paper's instance-refinement rules (theta_D, theta_O, theta_L; "
         "`optimiser.refinement: paper`) were tuned on box rooms before issue 19 (theta_D 0, "
         "theta_O 0.05, theta_L 0.3: weak-link splits only lost accuracy there) and stay at "

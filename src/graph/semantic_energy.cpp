@@ -56,8 +56,8 @@ EdgeTerms edgeTerms(const SuperpointGraph& graph, const ClassSet& classes, const
     const GraphEdge& e = graph.edges[k];
     const int a = index(e.a);
     const int b = index(e.b);
-    const double c =
-        normalisedConfidence(edgeEvidence(e, classes, config), score_sum[a], score_sum[b]);
+    const double c = normalisedConfidence(edgeEvidence(e, classes, config), score_sum[a],
+                                          score_sum[b], config.link_scale);
     if (!(c > 0.0)) continue;
     terms.confidence[k] = c;
     total[a] += c;

@@ -286,6 +286,14 @@ PanmapConfig loadConfig(const std::string& path) {
     } else {
       s.fail("optimiser.weighting must be surface, shared or none, not \"" + weighting + "\"");
     }
+    std::string link_scale =
+        o.link_scale == OptimiserConfig::LinkScale::kGeometric ? "geometric" : "smaller";
+    s.readString("link_scale", &link_scale);
+    if (link_scale != "smaller" && link_scale != "geometric") {
+      s.fail("optimiser.link_scale must be smaller or geometric, not \"" + link_scale + "\"");
+    }
+    o.link_scale = link_scale == "geometric" ? OptimiserConfig::LinkScale::kGeometric
+                                             : OptimiserConfig::LinkScale::kSmaller;
     std::string refinement =
         o.refinement == OptimiserConfig::Refinement::kPaperRules ? "paper" : "clustering";
     s.readString("refinement", &refinement);
@@ -454,6 +462,10 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   weighting: \"" << weightingName(o.weighting)
     << "\"   # Eq. 7 terms per voxel (surface; shared: edges split each super-point's voxels)"
        " or per super-point and edge (none, the paper)\n"
+    << "   link_scale: \""
+    << (o.link_scale == OptimiserConfig::LinkScale::kGeometric ? "geometric" : "smaller")
+    << "\"   # Eq. 9 co-observation over the smaller (smaller) or geometric mean (geometric) of"
+       " the two score sums\n"
     << "   refinement: \""
     << (o.refinement == OptimiserConfig::Refinement::kPaperRules ? "paper" : "clustering")
     << "\"   # III-D: clustering by one-mask / two-mask evidence, or the paper's rules\n"

@@ -144,5 +144,26 @@ TEST(ConfigFile, EnergyWeightingReadsEveryValue) {
             OptimiserConfig::Weighting::kShared);
 }
 
+TEST(ConfigFile, LinkScaleRoundTripsAndABadValueIsNamed) {
+  test::TempDir dir;
+  const PanmapConfig geometric =
+      loadConfig(write(dir, "%YAML:1.0\n---\noptimiser:\n   link_scale: \"geometric\"\n"));
+  EXPECT_EQ(geometric.optimiser.link_scale, OptimiserConfig::LinkScale::kGeometric);
+  EXPECT_EQ(loadConfig(write(dir, configToYaml(geometric))).optimiser.link_scale,
+            OptimiserConfig::LinkScale::kGeometric);
+  const PanmapConfig smaller =
+      loadConfig(write(dir, "%YAML:1.0\n---\noptimiser:\n   link_scale: \"smaller\"\n"));
+  EXPECT_EQ(loadConfig(write(dir, configToYaml(smaller))).optimiser.link_scale,
+            OptimiserConfig::LinkScale::kSmaller);
+  try {
+    loadConfig(write(dir, "%YAML:1.0\n---\noptimiser:\n   link_scale: \"mean\"\n"));
+    FAIL() << "an unknown link_scale loads";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("optimiser.link_scale must be smaller or geometric"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace panmap

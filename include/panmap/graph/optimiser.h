@@ -28,6 +28,15 @@ struct OptimiserConfig {
   /// neighbours it has (opt-in: not yet through the tuning suite).
   enum class Weighting : int8_t { kNone = 0, kSurface = 1, kShared = 2 };
   Weighting weighting = Weighting::kSurface;
+  /// What Eq. 9's co-observation sum_C P_eps^C is divided by to make it scale-free. kSmaller:
+  /// the smaller of the two vertices' score sums, so a fragment observed once under a chair's
+  /// mask is as strongly linked to the chair as a part seen under it in every frame. kGeometric:
+  /// their geometric mean (the cosine of the two super-points' observations), so a link is
+  /// strong only when the co-observation is a large share of both vertices' observations
+  /// (docs/MAPPING.md: a chair of 41 small super-points turned floor through 920 links to
+  /// barely observed fragments around it).
+  enum class LinkScale : int8_t { kSmaller = 0, kGeometric = 1 };
+  LinkScale link_scale = LinkScale::kSmaller;
   /// Floor of the normalised score P_nu^C / sum_C' P_nu^C' in the unary (Eq. 8): a class
   /// without score costs -log(score_floor) (13.8 for 1e-6) instead of infinity.
   double score_floor = 1e-6;

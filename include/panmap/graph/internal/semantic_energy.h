@@ -20,13 +20,17 @@ inline double unaryPotential(double score, double score_sum, double floor) {
 }
 
 /// sum_C P_eps^C(S1, S2) made scale-free: divided by the smaller of the two vertices' score
-/// sums, the most co-observation the weaker super-point could have had (Eq. 6 adds at most
-/// P_o min(N1, N2) where Eq. 5 adds P_o N to each). Raw sums grow with frames and voxels like
-/// the scores do; leaving them raw while normalising the scores made every disagreement cost
-/// about K_C, enough to relabel a fridge as the cabinet it touches through a few boundary
-/// voxels. 0 when either vertex has no score (the edge then costs nothing).
-inline double normalisedConfidence(double confidence_sum, double score_sum_a, double score_sum_b) {
-  const double scale = std::min(score_sum_a, score_sum_b);
+/// sums (kSmaller), the most co-observation the weaker super-point could have had (Eq. 6 adds
+/// at most P_o min(N1, N2) where Eq. 5 adds P_o N to each), or by their geometric mean
+/// (kGeometric), which is 1 only when the two were always observed together. Raw sums grow with
+/// frames and voxels like the scores do; leaving them raw while normalising the scores made every
+/// disagreement cost about K_C, enough to relabel a fridge as the cabinet it touches through a few
+/// boundary voxels. 0 when either vertex has no score (the edge then costs nothing).
+inline double normalisedConfidence(double confidence_sum, double score_sum_a, double score_sum_b,
+                                   OptimiserConfig::LinkScale link_scale) {
+  const double scale = link_scale == OptimiserConfig::LinkScale::kGeometric
+                           ? std::sqrt(score_sum_a * score_sum_b)
+                           : std::min(score_sum_a, score_sum_b);
   return scale > 0.0 ? confidence_sum / scale : 0.0;
 }
 
