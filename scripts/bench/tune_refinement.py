@@ -19,22 +19,29 @@ import suite  # noqa: E402  (same folder)
 from suite import Spec  # noqa: E402
 
 # III-D clustering (join_affinity, min_coverage), III-C's pairwise weight K_C (0: no pairwise
-# term, the argmax labels of w/o III-C, as the grid's own reference) and what its links are
-# scaled by (optimiser.link_scale).
-GRID = {"join_affinity": [0.5, 0.6, 0.7],
-        "min_coverage": [0.05, 0.1],
-        "K_C": [0.0, 15.0, 30.0, 60.0, 120.0],
-        "link_scale": ["smaller", "geometric"]}
-HEADER = "| join_affinity | min_coverage | K_C | link_scale | mAP50 | mAP75 | PQ50 | mIoU |"
-RULE = "|---:|---:|---:|---|---:|---:|---:|---:|"
-START = {"join_affinity": 0.5, "min_coverage": 0.1, "K_C": 15.0, "link_scale": "smaller"}
+# term, the argmax labels of w/o III-C, as the grid's own reference), what its links are
+# scaled by (optimiser.link_scale) and how they are trusted by their less observed end
+# (optimiser.link_half_observations). The grid of 2026-11-26 found min_coverage 0.05-0.2
+# and K_C 15-120 tied on mAP50 and join_affinity 0.6 best.
+GRID = {"join_affinity": [0.6, 0.7],
+        "min_coverage": [0.05],
+        "K_C": [0.0, 30.0, 60.0, 120.0],
+        "link_scale": ["smaller", "geometric"],
+        "link_half_observations": [0.0, 1.0, 3.0]}
+HEADER = ("| join_affinity | min_coverage | K_C | link_scale | link_half_observations | mAP50 | "
+          "mAP75 | PQ50 | mIoU |")
+RULE = "|---:|---:|---:|---|---:|---:|---:|---:|---:|"
+# The defaults before this grid: ties go to the point nearest them.
+START = {"join_affinity": 0.6, "min_coverage": 0.05, "K_C": 120.0, "link_scale": "smaller",
+         "link_half_observations": 0.0}
 
 
 def config_yaml(path, t):
     with open(path, "w") as f:
         f.write("%%YAML:1.0\n---\noptimiser:\n   join_affinity: %g\n   min_coverage: %g\n"
-                "   K_C: %g\n   link_scale: \"%s\"\n" % (
-                    t["join_affinity"], t["min_coverage"], t["K_C"], t["link_scale"]))
+                "   K_C: %g\n   link_scale: \"%s\"\n   link_half_observations: %g\n" % (
+                    t["join_affinity"], t["min_coverage"], t["K_C"], t["link_scale"],
+                    t["link_half_observations"]))
 
 
 def main():
@@ -70,7 +77,7 @@ def main():
         return suite.mean([s[k][metric] for k in maps])
 
     def distance(t):
-        return sum((t[k] != START[k]) if isinstance(t[k], str) else
+        return sum((t[k] != START[k]) if isinstance(t[k], str) or not START[k] else
                    abs(t[k] - START[k]) / START[k] for k in t)
     # K_C acts on classes: mIoU breaks the ties mAP50 and PQ50 leave.
     ranked = sorted(range(len(grid)), key=lambda i: (-overall(scores[i], "map50"),
@@ -98,17 +105,20 @@ def main():
 
     def row(i):
         t = grid[i]
-        return "| %g | %g | %g | %s | %.1f | %.1f | %.1f | %.1f |" % (
+        return "| %g | %g | %g | %s | %g | %.1f | %.1f | %.1f | %.1f |" % (
             t["join_affinity"], t["min_coverage"], t["K_C"], t["link_scale"],
+            t["link_half_observations"],
             100 * overall(scores[i], "map50"), 100 * overall(scores[i], "map75"),
             100 * overall(scores[i], "pq50"), 100 * overall(scores[i], "miou"))
     md += [row(i) for i in ranked[:12]]
-    md += ["", "Best point of each K_C and link scale (K_C 0: no pairwise term, as without III-C):",
-           "", HEADER, RULE]
+    md += ["", "Best point of each K_C, link scale and link trust (K_C 0: no pairwise term, as "
+           "without III-C):", "", HEADER, RULE]
     for k_c in GRID["K_C"]:
         for scale in GRID["link_scale"]:
-            md.append(row(next(i for i in ranked if grid[i]["K_C"] == k_c and
-                               grid[i]["link_scale"] == scale)))
+            for half in GRID["link_half_observations"]:
+                md.append(row(next(i for i in ranked if grid[i]["K_C"] == k_c and
+                                   grid[i]["link_scale"] == scale and
+                                   grid[i]["link_half_observations"] == half)))
     worst = ranked[-1]
     start_index = grid.index(START) if START in grid else None
     md += ["", "Worst point: %s, mAP50 %.1f.%s" % (
@@ -116,8 +126,10 @@ def main():
         " Starting values: mAP50 %.1f." % (100 * overall(scores[start_index], "map50"))
         if start_index is not None else ""), "", "## Chosen", "",
         "As YAML (`optimiser` section):", "", "```yaml",
-        "   join_affinity: %g\n   min_coverage: %g\n   K_C: %g\n   link_scale: \"%s\"" % (
-            best["join_affinity"], best["min_coverage"], best["K_C"], best["link_scale"]),
+        "   join_affinity: %g\n   min_coverage: %g\n   K_C: %g\n   link_scale: \"%s\"\n"
+        "   link_half_observations: %g" % (
+            best["join_affinity"], best["min_coverage"], best["K_C"], best["link_scale"],
+            best["link_half_observations"]),
         "```", "",
         "The paper's instance-refinement rules (theta_D, theta_O, theta_L; "
         "`optimiser.refinement: paper`) were tuned on box rooms before issue 19 (theta_D 0, "

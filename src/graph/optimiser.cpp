@@ -32,6 +32,10 @@ void checkThresholds(const OptimiserConfig::Thresholds& t, const std::string& fi
 }  // namespace
 
 void OptimiserConfig::check() const {
+  if (!(std::isfinite(link_half_observations) && link_half_observations >= 0.0)) {
+    throw Error("OptimiserConfig.link_half_observations: " +
+                std::to_string(link_half_observations) + " (must be finite, >= 0)");
+  }
   if (!(std::isfinite(K_C) && K_C >= 0.0)) {
     throw Error("OptimiserConfig.K_C: " + std::to_string(K_C) + " (must be finite, >= 0)");
   }
@@ -58,7 +62,8 @@ void OptimiserConfig::check() const {
                 " (must be finite, >= 0)");
   }
   for (const double w : {objects.bias, objects.area, objects.support, objects.share}) {
-    if (!std::isfinite(w)) throw Error("OptimiserConfig.objects: confidence weights must be finite");
+    if (!std::isfinite(w))
+      throw Error("OptimiserConfig.objects: confidence weights must be finite");
   }
   for (const auto& [c, t] : class_thresholds) {
     checkThresholds(t, "OptimiserConfig.class_thresholds[" + std::to_string(c) + "]");

@@ -57,7 +57,10 @@ EdgeTerms edgeTerms(const SuperpointGraph& graph, const ClassSet& classes, const
     const int a = index(e.a);
     const int b = index(e.b);
     const double c = normalisedConfidence(edgeEvidence(e, classes, config), score_sum[a],
-                                          score_sum[b], config.link_scale);
+                                          score_sum[b], config.link_scale) *
+                     linkTrust(std::min(observationsPerVoxel(graph.vertices[a], score_sum[a]),
+                                        observationsPerVoxel(graph.vertices[b], score_sum[b])),
+                               config.link_half_observations);
     if (!(c > 0.0)) continue;
     terms.confidence[k] = c;
     total[a] += c;

@@ -294,6 +294,7 @@ PanmapConfig loadConfig(const std::string& path) {
     }
     o.link_scale = link_scale == "geometric" ? OptimiserConfig::LinkScale::kGeometric
                                              : OptimiserConfig::LinkScale::kSmaller;
+    s.read("link_half_observations", &o.link_half_observations);
     std::string refinement =
         o.refinement == OptimiserConfig::Refinement::kPaperRules ? "paper" : "clustering";
     s.readString("refinement", &refinement);
@@ -466,6 +467,8 @@ std::string configToYaml(const PanmapConfig& c) {
     << (o.link_scale == OptimiserConfig::LinkScale::kGeometric ? "geometric" : "smaller")
     << "\"   # Eq. 9 co-observation over the smaller (smaller) or geometric mean (geometric) of"
        " the two score sums\n"
+    << "   link_half_observations: " << o.link_half_observations
+    << "   # a link counts n / (n + this), n its less observed end's observations per voxel\n"
     << "   refinement: \""
     << (o.refinement == OptimiserConfig::Refinement::kPaperRules ? "paper" : "clustering")
     << "\"   # III-D: clustering by one-mask / two-mask evidence, or the paper's rules\n"

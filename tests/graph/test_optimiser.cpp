@@ -196,6 +196,15 @@ TEST(SemanticEnergy, SurfaceWeightingCountsEachTermPerVoxel) {
   EXPECT_NEAR(semanticEnergy(graph, {{1, 1}, {2, 2}}, config),
               4.0 * 0.2876820724517809 + 15.0 * std::exp(-2.0 * std::sqrt(2.0)), 1e-12);
   config.link_scale = OptimiserConfig::LinkScale::kSmaller;
+  // Trusting the link by its less observed end: vertex 1 has 4 / 4 = 1 observation per voxel,
+  // vertex 2 2 / 1 = 2; with half at 1 the link counts 1 / (1 + 1): c = 0.375 and
+  // k = 0.75 * 1 / (2 * 0.25 * 0.375) = 4.
+  config.link_half_observations = 1.0;
+  EXPECT_NEAR(semanticEnergy(graph, {{1, 1}, {2, 2}}, config),
+              4.0 * 0.2876820724517809 + 15.0 * std::exp(-4.0), 1e-12);
+  config.link_half_observations = -1.0;
+  EXPECT_THROW(semanticEnergy(graph, {{1, 1}, {2, 2}}, config), Error);
+  config.link_half_observations = 0.0;
   // A vertex without voxels weighs as one.
   graph.vertices[0].num_voxels = 0;
   EXPECT_NEAR(semanticEnergy(graph, {{1, 2}, {2, 2}}, config), 1.3862943611198906, 1e-12);
@@ -290,6 +299,11 @@ TEST(AlphaBetaSwap, GeometricLinkScaleKeepsAnObjectAmongBarelyObservedFragments)
   config.weighting = OptimiserConfig::Weighting::kSurface;
   config.link_scale = OptimiserConfig::LinkScale::kSmaller;
   EXPECT_EQ(optimise(graph, config).semantic.at(1), 2);
+  // Trusted by how often their less observed end was seen (the fragments: 1 / 6 observations
+  // per voxel, so a link counts 0.14 with half at 1), the same links let the chair be.
+  config.link_half_observations = 1.0;
+  EXPECT_EQ(optimise(graph, config).semantic.at(1), 5);
+  config.link_half_observations = 0.0;
   config.link_scale = OptimiserConfig::LinkScale::kGeometric;
   const GraphLabels result = optimise(graph, config);
   EXPECT_EQ(result.semantic.at(1), 5);
@@ -304,6 +318,7 @@ TEST(AlphaBetaSwap, TwoLabelsReachTheGlobalMinimum) {
     if (seed >= 50) config.weighting = OptimiserConfig::Weighting::kSurface;
     if (seed >= 100) config.weighting = OptimiserConfig::Weighting::kShared;
     if (seed % 3 == 1) config.link_scale = OptimiserConfig::LinkScale::kGeometric;
+    if (seed % 3 == 2) config.link_half_observations = 1.0;
     const SuperpointGraph graph =
         randomGraph(seed, seed % 5 ? 8 : 12, {3, 7}, seed % 2 ? 0.6 : 0.3);
     double best = INFINITY;
@@ -345,6 +360,7 @@ TEST(AlphaBetaSwap, ManyLabelsEndInASwapLocalMinimumBelowTheStart) {
     if (seed >= 150) config.weighting = OptimiserConfig::Weighting::kSurface;
     if (seed >= 200) config.weighting = OptimiserConfig::Weighting::kShared;
     if (seed % 3 == 1) config.link_scale = OptimiserConfig::LinkScale::kGeometric;
+    if (seed % 3 == 2) config.link_half_observations = 1.0;
     const std::vector<int32_t> classes =
         seed % 2 ? std::vector<int32_t>{1, 2, 3} : std::vector<int32_t>{1, 2, 3, 4};
     const SuperpointGraph graph =

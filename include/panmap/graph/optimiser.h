@@ -37,6 +37,12 @@ struct OptimiserConfig {
   /// barely observed fragments around it).
   enum class LinkScale : int8_t { kSmaller = 0, kGeometric = 1 };
   LinkScale link_scale = LinkScale::kSmaller;
+  /// How much a link is trusted, by how often its less observed end was seen: the normalised
+  /// co-observation is multiplied by n / (n + link_half_observations), n the smaller of the
+  /// two vertices' score sums per voxel (confidence-weighted observations per voxel). A
+  /// fragment seen once or twice then pulls on its neighbours weakly, a surface seen in many
+  /// frames as before. 0: every link fully trusted (docs/MAPPING.md).
+  double link_half_observations = 0.0;
   /// Floor of the normalised score P_nu^C / sum_C' P_nu^C' in the unary (Eq. 8): a class
   /// without score costs -log(score_floor) (13.8 for 1e-6) instead of infinity.
   double score_floor = 1e-6;

@@ -34,6 +34,19 @@ inline double normalisedConfidence(double confidence_sum, double score_sum_a, do
   return scale > 0.0 ? confidence_sum / scale : 0.0;
 }
 
+/// A vertex's score sum per voxel it holds (at least one): confidence-weighted observations
+/// per voxel.
+inline double observationsPerVoxel(const GraphVertex& vertex, double score_sum) {
+  return score_sum / std::max<double>(1.0, vertex.num_voxels);
+}
+
+/// The share of a link trusted when its less observed end has n observations per voxel:
+/// n / (n + half), 1 when half is 0 (OptimiserConfig::link_half_observations).
+inline double linkTrust(double n, double half) {
+  if (half <= 0.0) return 1.0;
+  return n > 0.0 ? n / (n + half) : 0.0;
+}
+
 /// The edge factor of Eq. 9, 1 / (2 theta^2 c) with c the normalised confidence
 /// (normalisedConfidence); 0 for an edge without confidence, which then costs nothing.
 inline double edgeFactor(double confidence_sum, double theta) {
