@@ -292,8 +292,8 @@ def tuning_args(description, out_name):
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 2)
     parser.add_argument("--keep-logs", action="store_true")
     parser.add_argument("--reuse-maps", action="store_true",
-                        help="keep the maps of an earlier run in --work when all are there "
-                             "(re-run only what follows the mapping)")
+                        help="keep the maps of an earlier run in --work and map only the "
+                             "sequences without one (re-run only what follows the mapping)")
     args = parser.parse_args()
     return args, scene_dirs(args.scannet)
 
