@@ -40,6 +40,9 @@ int main(int argc, char** argv) {
 
   try {
     config.check();
+    // Trajectories first: a bad file fails before the frames are read.
+    std::vector<std::vector<panmap::StampedPose>> poses;
+    for (const std::string& path : trajectories) poses.push_back(panmap::readTumTrajectory(path));
     panmap::DatasetOptions options;
     options.layout = panmap::parseDatasetLayout(layout);
     const auto reader = panmap::openDataset(data_dir, options);
@@ -62,8 +65,6 @@ int main(int argc, char** argv) {
       }
     }
     std::fprintf(stderr, "\n");
-    std::vector<std::vector<panmap::StampedPose>> poses;
-    for (const std::string& path : trajectories) poses.push_back(panmap::readTumTrajectory(path));
     const std::vector<panmap::PhotometricResult> results =
         panmap::photometricConsistency(frames, poses, config);
     nlohmann::json out = nlohmann::json::array();
