@@ -31,6 +31,19 @@ double ateRmse(const std::vector<StampedPose>& estimate, const std::vector<Stamp
   return evaluateTrajectory(estimate, gt).ate_m.rmse;
 }
 
+/// Every frame of the 7-Scenes sample, with its recorded pose and utime.
+std::vector<DatasetFrame> readSevenScenes(std::vector<Eigen::Isometry3d>* recorded,
+                                          std::vector<int64_t>* utimes) {
+  const auto reader = openDataset(test::dataDir("7scenes-200"), DatasetOptions{});
+  std::vector<DatasetFrame> frames;
+  for (size_t i = 0; i < reader->size(); ++i) {
+    frames.push_back(reader->read(i));
+    recorded->push_back(*frames.back().T_W_C);
+    utimes->push_back(frames.back().rgbd.utime);
+  }
+  return frames;
+}
+
 MapperConfig driftConfig() {
   MapperConfig config;
   config.map.voxel_size_m = 0.02f;
@@ -104,15 +117,9 @@ TEST(DriftCorrection, GroundTruthPosesAreNotTouched) {
 // misaligned frames double it) than the map from the recorded poses, with or without drift.
 TEST(DriftCorrection, SevenScenesRefinedMapsAreMoreConsistentThanTheRecordedPoses) {
   PANMAP_REQUIRE_DATA("7scenes-200");
-  const auto reader = openDataset(test::dataDir("7scenes-200"), DatasetOptions{});
   std::vector<Eigen::Isometry3d> recorded;
   std::vector<int64_t> utimes;
-  std::vector<DatasetFrame> frames;
-  for (size_t i = 0; i < reader->size(); ++i) {
-    frames.push_back(reader->read(i));
-    recorded.push_back(*frames.back().T_W_C);
-    utimes.push_back(frames.back().rgbd.utime);
-  }
+  std::vector<DatasetFrame> frames = readSevenScenes(&recorded, &utimes);
   const std::vector<StampedPose> reference = stamped(recorded, utimes);
   auto mapArea = [&](const std::vector<Eigen::Isometry3d>& poses, PoseSource source, double* ate) {
     MapperConfig config = driftConfig();
@@ -152,15 +159,9 @@ TEST(DriftCorrection, SevenScenesRefinedMapsAreMoreConsistentThanTheRecordedPose
 // 13.5-14.2 against 14.3-14.7 grey levels over every drift, seed and voxel size).
 TEST(DriftCorrection, SevenScenesRefinedPosesAgreeBetterWithColourThanTheRecordedOnes) {
   PANMAP_REQUIRE_DATA("7scenes-200");
-  const auto reader = openDataset(test::dataDir("7scenes-200"), DatasetOptions{});
   std::vector<Eigen::Isometry3d> recorded;
   std::vector<int64_t> utimes;
-  std::vector<DatasetFrame> frames;
-  for (size_t i = 0; i < reader->size(); ++i) {
-    frames.push_back(reader->read(i));
-    recorded.push_back(*frames.back().T_W_C);
-    utimes.push_back(frames.back().rgbd.utime);
-  }
+  std::vector<DatasetFrame> frames = readSevenScenes(&recorded, &utimes);
   auto refine = [&](const std::vector<Eigen::Isometry3d>& poses) {
     MapperConfig config = driftConfig();
     config.fusion.geometry_only = true;
