@@ -3,12 +3,15 @@
 // median and p95 per stage; the periodic outputs (incremental mesh update, occupancy tree
 // export) timed every --outputs-every frames; peak memory and bytes per voxel.
 //   panmap-bench-mapping [--data DIR | --log FILE] [--voxel-size M] [--threads N] [--frames N]
-//                        [--outputs-every N] [--json FILE] [--markdown-row]
+//                        [--outputs-every N] [--json FILE] [--markdown-row] [--mesh-change]
+// --mesh-change: how much the blocks an update re-meshes moved since their previous mesh
+// (issue 23: which of them a cheaper change test could skip).
 
 #include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <utility>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -18,6 +21,7 @@
 #include "panmap/lcm/offline_mapping.h"
 #include "panmap/mapper/config_file.h"
 #include "panmap/mapper/mapper.h"
+#include "panmap/mesh/marching_cubes.h"
 
 namespace {
 
@@ -27,11 +31,17 @@ double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
+struct BlockLess {
+  bool operator()(const panmap::BlockIndex& a, const panmap::BlockIndex& b) const {
+    return panmap::blockIndexLess(a, b);
+  }
+};
+
 // Per-stage samples, plus the periodic outputs a live mapper produces (mesh, octree).
 class Recorder {
  public:
-  Recorder(panmap::Mapper* mapper, int outputs_every)
-      : mapper_(mapper), outputs_every_(outputs_every) {}
+  Recorder(panmap::Mapper* mapper, int outputs_every, bool mesh_change)
+      : mapper_(mapper), outputs_every_(outputs_every), mesh_change_(mesh_change) {}
 
   void add(const panmap::FrameStats& s) {
     for (const auto& [stage, ms] : s.stageTimes()) times_[stage].push_back(ms);
@@ -44,6 +54,7 @@ class Recorder {
       const panmap::MeshUpdate update = mapper_->updateMesh();
       times_["mesh_update"].push_back(msSince(start));
       blocks_remeshed_.push_back(static_cast<double>(update.blocks.size()));
+      if (mesh_change_) compareWithPrevious(update);
       start = Clock::now();
       mapper_->extractMesh();
       times_["whole_mesh"].push_back(msSince(start));
@@ -64,15 +75,62 @@ class Recorder {
     out["voxels_updated_median"] = panmap::summariseTimes(voxels_updated_).median_ms;
     out["blocks_in_view_median"] = panmap::summariseTimes(blocks_in_view_).median_ms;
     out["blocks_remeshed_median"] = panmap::summariseTimes(blocks_remeshed_).median_ms;
+    if (mesh_change_) {
+      // Shares of all re-meshed blocks over every update after the first.
+      double total = 0.0;
+      for (const auto& [kind, n] : change_counts_) total += n;
+      for (const auto& [kind, n] : change_counts_) {
+        out["mesh_change"][kind] = total > 0.0 ? n / total : 0.0;
+      }
+      out["mesh_change"]["blocks"] = total;
+    }
     return out;
   }
 
  private:
+  // Sorts each re-meshed block that had a mesh before by how far its new mesh moved: the
+  // same faces with every vertex within 0.5, 1 or 2 mm (same labels or not), farther, or other
+  // faces.
+  void compareWithPrevious(const panmap::MeshUpdate& update) {
+    for (size_t i = 0; i < update.blocks.size(); ++i) {
+      const panmap::LabelledMesh& now = update.meshes[i];
+      auto it = previous_.find(update.blocks[i]);
+      if (it != previous_.end()) {
+        const panmap::LabelledMesh& before = it->second;
+        std::string kind = "faces_changed";
+        if (before.faces == now.faces && before.vertices.size() == now.vertices.size()) {
+          kind = "moved_over_2mm";
+          float moved_m = 0.0f;
+          for (size_t v = 0; v < now.vertices.size(); ++v) {
+            moved_m = std::max(moved_m, (now.vertices[v] - before.vertices[v]).norm());
+          }
+          const bool same_labels = before.semantic == now.semantic &&
+                                   before.instance == now.instance &&
+                                   before.superpoint == now.superpoint;
+          if (moved_m < 0.0005f) {
+            kind = same_labels ? "within_0.5mm" : "within_0.5mm_labels_changed";
+          } else if (moved_m < 0.001f) {
+            kind = same_labels ? "within_1mm" : "within_1mm_labels_changed";
+          } else if (moved_m < 0.002f) {
+            kind = same_labels ? "within_2mm" : "within_2mm_labels_changed";
+          }
+        }
+        change_counts_[kind] += 1.0;
+        it->second = now;
+      } else {
+        previous_.emplace(update.blocks[i], now);
+      }
+    }
+  }
+
   panmap::Mapper* mapper_;
   int outputs_every_;
   int frames_ = 0;
   std::map<std::string, std::vector<double>> times_;
   std::vector<double> voxels_updated_, blocks_in_view_, blocks_remeshed_;
+  bool mesh_change_ = false;
+  std::map<panmap::BlockIndex, panmap::LabelledMesh, BlockLess> previous_;
+  std::map<std::string, double> change_counts_;
 };
 
 }  // namespace
@@ -82,7 +140,7 @@ int main(int argc, char** argv) {
   std::string data = "../shared/data/7scenes-200", json_path, log_path, config_path;
   panmap::MapperConfig config;
   int frames = 0, outputs_every = 30;
-  bool markdown = false, slam = false;
+  bool markdown = false, slam = false, mesh_change = false;
   app.add_option("--data", data, "dataset folder (7-Scenes, ScanNet export or TUM)")
       ->capture_default_str();
   app.add_option("--config", config_path,
@@ -99,6 +157,9 @@ int main(int argc, char** argv) {
   app.add_flag("--slam-poses", slam,
                "flag the dataset's poses as SLAM poses, so that tracking (auto) refines each "
                "against the map and its stage is timed");
+  app.add_flag("--mesh-change", mesh_change,
+               "report how far the blocks each mesh update re-meshes moved since their previous "
+               "mesh (slower: keeps every block's mesh)");
   app.add_option("--json", json_path, "write the figures as JSON");
   app.add_flag("--markdown-row", markdown, "print one Markdown table row instead of JSON");
   CLI11_PARSE(app, argc, argv);
@@ -111,7 +172,7 @@ int main(int argc, char** argv) {
       if (app.count("--threads")) config.num_threads = threads;
     }
     panmap::Mapper mapper(config);
-    Recorder recorder(&mapper, outputs_every);
+    Recorder recorder(&mapper, outputs_every, mesh_change);
     if (!log_path.empty()) {
       // Messages are decoded between frames; only the mapper's own stages are timed.
       panmap::SessionOptions options;
