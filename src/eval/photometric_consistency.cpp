@@ -30,35 +30,6 @@ float medianOf(std::vector<float> values) {
   return values[mid];
 }
 
-}  // namespace
-
-void PhotometricConfig::check() const {
-  if (frame_gaps.empty()) throw Error("frame_gaps: give at least one gap");
-  for (int gap : frame_gaps) {
-    if (gap < 1)
-      throw Error("frame_gaps: a gap must be at least 1 frame, got " + std::to_string(gap));
-  }
-  if (pixel_stride < 1) throw Error("pixel_stride must be at least 1");
-  if (!(min_gradient >= 0.0)) throw Error("min_gradient must be >= 0");
-  if (!(max_depth_m > 0.0)) throw Error("max_depth_m must be > 0");
-  if (!(occlusion_tolerance_m >= 0.0) || !(occlusion_tolerance_rel >= 0.0)) {
-    throw Error("occlusion tolerances must be >= 0");
-  }
-}
-
-Image<float> toGrey(const ColorImage& color) {
-  Image<float> grey(color.width(), color.height());
-  for (int v = 0; v < color.height(); ++v) {
-    for (int u = 0; u < color.width(); ++u) {
-      const Rgb8& p = color(u, v);
-      grey(u, v) = 0.299f * p.r + 0.587f * p.g + 0.114f * p.b;
-    }
-  }
-  return grey;
-}
-
-namespace {
-
 /// Per candidate pixel of a (valid depth, strong gradient; a fixed order), I_a - I_b at the
 /// pixel carried into b, or NaN where it leaves b, lands on invalid depth or is occluded.
 std::vector<float> pairDifferences(const PhotometricFrame& a, const Eigen::Isometry3d& T_W_A,
@@ -103,17 +74,29 @@ std::vector<float> pairDifferences(const PhotometricFrame& a, const Eigen::Isome
 
 }  // namespace
 
-std::vector<float> pairResiduals(const PhotometricFrame& a, const Eigen::Isometry3d& T_W_A,
-                                 const PhotometricFrame& b, const Eigen::Isometry3d& T_W_B,
-                                 const PhotometricConfig& config) {
-  std::vector<float> differences = pairDifferences(a, T_W_A, b, T_W_B, config);
-  differences.erase(
-      std::remove_if(differences.begin(), differences.end(), [](float d) { return std::isnan(d); }),
-      differences.end());
-  if (differences.size() < config.min_samples) return {};
-  const float offset = medianOf(differences);
-  for (float& d : differences) d -= offset;
-  return differences;
+void PhotometricConfig::check() const {
+  if (frame_gaps.empty()) throw Error("frame_gaps: give at least one gap");
+  for (int gap : frame_gaps) {
+    if (gap < 1)
+      throw Error("frame_gaps: a gap must be at least 1 frame, got " + std::to_string(gap));
+  }
+  if (pixel_stride < 1) throw Error("pixel_stride must be at least 1");
+  if (!(min_gradient >= 0.0)) throw Error("min_gradient must be >= 0");
+  if (!(max_depth_m > 0.0)) throw Error("max_depth_m must be > 0");
+  if (!(occlusion_tolerance_m >= 0.0) || !(occlusion_tolerance_rel >= 0.0)) {
+    throw Error("occlusion tolerances must be >= 0");
+  }
+}
+
+Image<float> toGrey(const ColorImage& color) {
+  Image<float> grey(color.width(), color.height());
+  for (int v = 0; v < color.height(); ++v) {
+    for (int u = 0; u < color.width(); ++u) {
+      const Rgb8& p = color(u, v);
+      grey(u, v) = 0.299f * p.r + 0.587f * p.g + 0.114f * p.b;
+    }
+  }
+  return grey;
 }
 
 std::vector<PhotometricResult> photometricConsistency(

@@ -46,15 +46,9 @@ struct PhotometricFrame {
 /// Grey levels of a colour image (ITU-R BT.601 luma).
 Image<float> toGrey(const ColorImage& color);
 
-/// The photometric residuals of one pair: for each sampled pixel of `a` with valid depth and
-/// strong gradient that lands unoccluded inside `b`, I_a - I_b(carried) minus the pair's median
-/// of that difference (an exposure change between the frames shifts every pixel alike).
-/// Empty when fewer than config.min_samples survive. Throws Error when the sizes disagree.
-std::vector<float> pairResiduals(const PhotometricFrame& a, const Eigen::Isometry3d& T_W_A,
-                                 const PhotometricFrame& b, const Eigen::Isometry3d& T_W_B,
-                                 const PhotometricConfig& config);
-
-/// The check of one trajectory over a sequence.
+/// The check of one trajectory over a sequence. Residuals are I_a - I_b at each sampled pixel
+/// of frame a carried into frame b, minus the pair's median of that difference (an exposure
+/// change between the frames shifts every pixel alike).
 struct PhotometricResult {
   size_t frames_posed = 0;        ///< frames the trajectory has a pose for
   size_t pairs = 0;               ///< pairs scored (the same for every trajectory)
