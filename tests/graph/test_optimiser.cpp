@@ -270,8 +270,8 @@ TEST(AlphaBetaSwap, SurfaceWeightingKeepsAnObjectAmongOneVoxelFragments) {
   }
 }
 
-/// The mechanism behind LinkScale::kGeometric (scene0470, seed 1: a chair of 41 small
-/// super-points turned floor): a chair part of 40 voxels, well observed and 0.8 chair, is
+/// The mechanism behind LinkScale::kGeometric (scene0470, seed 1: two chairs, 41 small
+/// super-points, turned floor): a chair part of 40 voxels, well observed and 0.8 chair, is
 /// ringed by 30 fragments of 6 voxels that were observed once, as floor, and once under the
 /// chair's mask where it bled onto them (0.7), and that lie on the floor (linked to it). Over
 /// the smaller score sum each fragment's link to the chair is 0.7 / 1: as strong as a part

@@ -33,8 +33,8 @@ struct OptimiserConfig {
   /// mask is as strongly linked to the chair as a part seen under it in every frame. kGeometric:
   /// their geometric mean (the cosine of the two super-points' observations), so a link is
   /// strong only when the co-observation is a large share of both vertices' observations
-  /// (docs/MAPPING.md: a chair of 41 small super-points turned floor through 920 links to
-  /// barely observed fragments around it).
+  /// (docs/MAPPING.md: two chairs, 41 small super-points, turned floor through 920 links to
+  /// barely observed fragments around them).
   enum class LinkScale : int8_t { kSmaller = 0, kGeometric = 1 };
   LinkScale link_scale = LinkScale::kSmaller;
   /// How much a link is trusted, by how often its less observed end was seen: the normalised
