@@ -95,6 +95,27 @@ void GraphAccumulator::applyMerges(const SuperpointTracker& tracker) {
   edges_.applyMerges(merges, first_merge, merges.size());
 }
 
+void GraphAccumulator::applySplits(const std::vector<SuperpointSplit>& splits,
+                                   const SuperpointTracker& tracker) {
+  applyMerges(tracker);
+  for (const SuperpointSplit& split : splits) {
+    const int32_t from = tracker.labels().resolve(split.from);
+    const int32_t to = tracker.labels().resolve(split.to);
+    const auto it = scores_.find(from);
+    if (from == to || it == scores_.end()) continue;
+    const double share = std::clamp(split.share, 0.0, 1.0);
+    auto& target = scores_[to];  // std::map: `it` stays valid
+    for (auto& [cls, score] : it->second) {
+      const double moved = share * score;
+      target[cls] += moved;
+      if (cls > 0)
+        edges_.add(std::min(from, to), std::max(from, to), cls,
+                   std::min(share, 1.0 - share) * score);
+      score -= moved;
+    }
+  }
+}
+
 void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
                               const PanopticFrame& panoptic, const TsdfMap& map,
                               const SuperpointTracker& tracker, float stuff_confidence) {

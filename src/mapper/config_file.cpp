@@ -181,6 +181,7 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("semantic_consistency", &m.superpoints.semantic_consistency);
     s.read("sample_stride_px", &m.superpoints.sample_stride_px);
     s.read("instance_min_overlap", &m.superpoints.instance_min_overlap);
+    s.read("mask_verdicts", &m.superpoints.mask_verdicts);
     s.finish();
   }
   {
@@ -386,7 +387,9 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   semantic_consistency: " << m.superpoints.semantic_consistency
     << "   # 0: spatial-only merging\n"
     << "   sample_stride_px: " << m.superpoints.sample_stride_px << "\n"
-    << "   instance_min_overlap: " << m.superpoints.instance_min_overlap << "\n";
+    << "   instance_min_overlap: " << m.superpoints.instance_min_overlap << "\n"
+    << "   mask_verdicts: " << m.superpoints.mask_verdicts
+    << "   # 1: only masks of their class merge or split super-points\n";
   y << "graph:\n"
     << "   spatial_scale_m: " << m.graph.spatial_scale_m << "   # P_s = 1 / (1 + d / scale)\n"
     << "   sample_stride_px: " << m.graph.sample_stride_px << "\n"

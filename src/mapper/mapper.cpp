@@ -11,6 +11,7 @@
 #include "panmap/core/error.h"
 #include "panmap/core/pose.h"
 #include "panmap/mapper/final_labels.h"
+#include "panmap/superpoint/vote_split.h"
 
 namespace panmap {
 
@@ -267,10 +268,12 @@ FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_
   for (const std::exception_ptr& failure : failures) {
     if (failure) std::rethrow_exception(failure);
   }
+  applySplits(association, segmentation, frame, T_W_C, tracker_->labels(), map_.get());
   const auto t2 = Clock::now();
   stats.integration = integrator_->integrate(frame, T_W_C, &association.pixel_labels, map_.get());
   const auto t3 = Clock::now();
   if (panoptic && !config_.fusion.geometry_only) {
+    graph_->applySplits(association.splits, *tracker_);
     graph_->update(frame, T_W_C, *panoptic, *map_, *tracker_, config_.fusion.stuff_confidence);
   }
   if ((frames_ + 1) % kForgetEveryFrames == 0) forgetUnvotedSuperpoints();

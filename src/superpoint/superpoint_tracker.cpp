@@ -75,6 +75,23 @@ bool SuperpointTracker::consistent(int32_t a, int32_t b) const {
   return ca == cb;
 }
 
+bool SuperpointTracker::showsAsOne(const Surface& surface, int32_t a, int32_t b) const {
+  if (!config_.semantic_consistency || !config_.mask_verdicts) return true;
+  // A mask of another class that spills over two super-points (a floor mask over the feet of
+  // two cabinets, its outline a few pixels off) says nothing about whether they are one
+  // object; counted, it merged a row of three cabinets (issue 19).
+  const auto ia = states_.find(a), ib = states_.find(b);
+  const int32_t ca = ia == states_.end() ? 0 : ia->second.labelledClass();
+  const int32_t cb = ib == states_.end() ? 0 : ib->second.labelledClass();
+  return surface.category == ca && surface.category == cb;
+}
+
+bool SuperpointTracker::splitsFrom(const Surface& s, const Surface& t) const {
+  return config_.semantic_consistency && config_.mask_verdicts && s.is_thing && t.is_thing &&
+         s.category > 0 && s.category == t.category && s.panoptic_segment > 0 &&
+         t.panoptic_segment > 0 && s.panoptic_segment != t.panoptic_segment;
+}
+
 bool SuperpointTracker::seenApart(const std::pair<int32_t, int32_t>& key, int m) const {
   if (!config_.semantic_consistency) return false;
   const auto it = apart_.find(key);
@@ -114,8 +131,7 @@ void SuperpointTracker::mergeLabels(int32_t a, int32_t b, FrameAssociation* out)
 
 size_t SuperpointTracker::memoryBytes() const {
   size_t bytes = mapNodesBytes(states_) + mapNodesBytes(co_observed_) + mapNodesBytes(apart_) +
-                 vectorBytes(merge_log_) +
-                 vectorBytes(labels_.parents());
+                 vectorBytes(merge_log_) + vectorBytes(labels_.parents());
   for (const auto& [label, state] : states_) {
     bytes += mapNodesBytes(state.class_counts) + mapNodesBytes(state.instance_counts);
   }
@@ -217,18 +233,38 @@ void SuperpointTracker::associate(const FrameSegmentation& segmentation, const R
     for (const auto& [label, count] : overlap[s]) pairs.emplace_back(-count, s, label);
   }
   std::sort(pairs.begin(), pairs.end());
-  std::map<int32_t, bool> taken;
+  std::map<int32_t, size_t> holder;  // super-point -> the surface that took it
+  std::vector<int32_t> lost(n, 0);   // the first super-point a surface lost to another
   for (const auto& [neg_count, s, label] : pairs) {
-    if (out.surface_labels[s] != 0 || taken[label]) continue;
+    if (out.surface_labels[s] != 0) continue;
     if (-neg_count < config_.association_min_overlap * samples[s]) continue;
+    const auto it = holder.find(label);
+    if (it != holder.end()) {
+      if (lost[s] == 0 && splitsFrom(surfaces[s], surfaces[it->second])) lost[s] = label;
+      continue;
+    }
     out.surface_labels[s] = label;
-    taken[label] = true;
+    holder[label] = s;
   }
+  out.splits.clear();
   for (size_t s = 0; s < n; ++s) {
     if (out.surface_labels[s] == 0) {
       out.surface_labels[s] = labels_.create();
       states_[out.surface_labels[s]];
       ++out.new_labels;
+      // The network shows what the super-point covers as two objects here. Without the split
+      // the new super-point's votes never outweigh the old one's in those voxels (they were
+      // labelled under a mask that merged both objects, 15 frames of it), and every later
+      // frame starts yet another super-point there: one super-point kept a row of cabinets.
+      if (lost[s] != 0) {
+        int seen = 0;  // samples of the super-point in the frame, over all surfaces
+        for (size_t t = 0; t < n; ++t) {
+          const auto it = overlap[t].find(lost[s]);
+          if (it != overlap[t].end()) seen += it->second;
+        }
+        out.splits.push_back({surfaces[s].id, lost[s], out.surface_labels[s],
+                              static_cast<double>(overlap[s].at(lost[s])) / seen});
+      }
     }
     // Semantic frame count (background surfaces count for class 0).
     states_[out.surface_labels[s]].class_counts[surfaces[s].category] += 1.0;
@@ -271,6 +307,7 @@ void SuperpointTracker::associate(const FrameSegmentation& segmentation, const R
         const int32_t a = labels_.resolve(significant[s][i]);
         const int32_t b = labels_.resolve(significant[s][j]);
         if (a == b) continue;
+        if (!showsAsOne(surfaces[s], a, b)) continue;
         const auto key = std::minmax(a, b);
         int& m = co_observed_[key];
         ++m;

@@ -40,7 +40,8 @@ class WallGraph : public ::testing::Test {
     }
     const int32_t cats[3] = {c1, c2, c3};
     for (int k = 0; k < 3; ++k) {
-      if (count[k]) seg.surface_list.push_back(Surface{k + 1, 1, k + 1, cats[k], true, 0.9f, count[k]});
+      if (count[k])
+        seg.surface_list.push_back(Surface{k + 1, 1, k + 1, cats[k], true, 0.9f, count[k]});
     }
     return seg;
   }
@@ -127,6 +128,31 @@ TEST_F(WallGraph, MergedSuperpointsAddTheirScoresAndEdges) {
   EXPECT_EQ(g.edges[0].a, 1);
   EXPECT_EQ(g.edges[0].b, 3);
   for (const GraphVertex& v : g.vertices) EXPECT_NE(v.id, 2);
+}
+
+// A super-point formed under one mask, then shown as two masks of its class: the tracker
+// splits it (mask_verdicts), and the graph gives the new super-point its share of the scores
+// and the pair the one-mask history as P_eps (min(share, 1 - share) of the scores).
+TEST_F(WallGraph, SplitSuperpointsShareTheirScoresAndKeepTheirHistory) {
+  TsdfMap map(TsdfMap::Config{0.05f});
+  SuperpointConfig config;
+  config.mask_verdicts = true;
+  SuperpointTracker tracker(config);
+  GraphAccumulator graph(GraphConfig{});
+  for (int k = 0; k < 2; ++k) {
+    step(&tracker, &map, columns(640, 640, 5, 0, 0));  // one surface, one mask
+    graph.update(frame_, T_W_C_, wholeMask(), map, tracker);
+  }
+  const double before = graph.scores(1).at(5);
+  const FrameAssociation a = tracker.associate(columns(384, 640, 5, 5, 0), frame_, T_W_C_, map);
+  ASSERT_EQ(a.splits.size(), 1u);
+  const double share = a.splits[0].share;
+  EXPECT_NEAR(share, 0.4, 0.01);  // the right 256 of 640 columns
+  graph.applySplits(a.splits, tracker);
+  EXPECT_DOUBLE_EQ(graph.scores(2).at(5), share * before);
+  EXPECT_DOUBLE_EQ(graph.scores(1).at(5), before - share * before);
+  EXPECT_DOUBLE_EQ(graph.confidences(1, 2).at(5), share * before);
+  EXPECT_TRUE(graph.separations(1, 2).empty());
 }
 
 // Two chair masks side by side over super-points 1 and 2: the network saw two objects. Each

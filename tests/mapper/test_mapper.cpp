@@ -239,13 +239,18 @@ TEST_F(BoxScene, BadInputIsRefusedAndTheMapIsUnharmed) {
 namespace panmap {
 namespace {
 
-// The bytes of a map file rewritten as version 5 wrote them: without the three graph pruning
-// fields, which start one byte before the double at `share_offset`.
-std::vector<uint8_t> asVersionFive(std::vector<uint8_t> file, size_t share_offset) {
+// The bytes of a map file rewritten as an older version wrote them: version 6 without III-B's
+// mask_verdicts byte (right after the pruning fields), version 5 also without the three graph
+// pruning fields, which start one byte before the double at `share_offset`.
+std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, uint32_t version) {
   constexpr size_t kHeader = 20;  // magic, version, payload size
-  file.erase(file.begin() + static_cast<std::ptrdiff_t>(share_offset - 1),
-             file.begin() + static_cast<std::ptrdiff_t>(share_offset + 8 + 4));
-  const uint32_t version = 5;
+  const size_t flag = share_offset + 8 + 4;
+  file.erase(file.begin() + static_cast<std::ptrdiff_t>(flag),
+             file.begin() + static_cast<std::ptrdiff_t>(flag + 1));
+  if (version == 5) {
+    file.erase(file.begin() + static_cast<std::ptrdiff_t>(share_offset - 1),
+               file.begin() + static_cast<std::ptrdiff_t>(share_offset + 8 + 4));
+  }
   std::memcpy(&file[8], &version, sizeof(version));
   const uint64_t size = file.size() - kHeader - sizeof(uint32_t);
   std::memcpy(&file[12], &size, sizeof(size));
@@ -260,7 +265,9 @@ TEST(MapFile, KeepsThePruningSettingsAndReadsVersionFive) {
   a.graph.prune_edges = false;
   a.graph.edge_min_share = 0.3;
   a.graph.surface_band_voxels = 1.5f;
+  a.superpoints.mask_verdicts = true;
   const auto back = Mapper::deserialize(Mapper(a).serialize(), "a.panmap");
+  EXPECT_TRUE(back->config().superpoints.mask_verdicts);
   EXPECT_FALSE(back->config().graph.prune_edges);
   EXPECT_EQ(back->config().graph.edge_min_share, 0.3);
   EXPECT_EQ(back->config().graph.surface_band_voxels, 1.5f);
@@ -277,16 +284,23 @@ TEST(MapFile, KeepsThePruningSettingsAndReadsVersionFive) {
   size_t offset = 0;
   while (offset < bytes_b.size() && bytes_b[offset] == bytes_c[offset]) ++offset;
   ASSERT_LT(offset, bytes_b.size());
-  const auto old = Mapper::deserialize(asVersionFive(bytes_b, offset), "old.panmap");
+  const auto old = Mapper::deserialize(asVersion(bytes_b, offset, 5), "old.panmap");
   EXPECT_FALSE(old->config().graph.prune_edges);
+  EXPECT_FALSE(old->config().superpoints.mask_verdicts);
   EXPECT_EQ(old->config().map.voxel_size_m, 0.05f);
   EXPECT_EQ(Mapper(old->config()).serialize().size(), bytes_b.size());
 
-  // Versions outside 5-6 are refused by name.
+  // A version 6 file keeps its pruning and was built without III-B's mask verdicts.
+  const auto six = Mapper::deserialize(asVersion(bytes_b, offset, 6), "six.panmap");
+  EXPECT_TRUE(six->config().graph.prune_edges);
+  EXPECT_EQ(six->config().graph.edge_min_share, 0.3);
+  EXPECT_FALSE(six->config().superpoints.mask_verdicts);
+
+  // Versions outside 5-7 are refused by name.
   std::vector<uint8_t> future = bytes_b;
-  future[8] = 7;
+  future[8] = 8;
   test::expectError([&] { Mapper::deserialize(future, "future.panmap"); },
-                    {"future.panmap", "version 7", "reads 5 to 6"});
+                    {"future.panmap", "version 8", "reads 5 to 7"});
 }
 
 }  // namespace

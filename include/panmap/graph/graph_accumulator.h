@@ -67,6 +67,14 @@ class GraphAccumulator {
   void update(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const PanopticFrame& panoptic,
               const TsdfMap& map, const SuperpointTracker& tracker, float stuff_confidence = 0.5f);
 
+  /// Splits the evidence of super-points as the tracker split them this frame (call before
+  /// update() with FrameAssociation::splits). The new super-point takes its share of the old
+  /// one's scores P_nu^C, and the two get P_eps^C = min(share, 1 - share) P_nu^C: until this
+  /// frame every mask that saw the old super-point saw both parts under one mask, and that
+  /// history stays evidence for III-D (a fridge the network split in two for a few frames at
+  /// the end of a sequence is one object by its earlier frames).
+  void applySplits(const std::vector<SuperpointSplit>& splits, const SuperpointTracker& tracker);
+
   /// Drops the scores and edges of super-points no voxel votes for any more (see
   /// SuperpointTracker::forgetUnvoted; has_votes is indexed by root label).
   void forgetUnvoted(const std::vector<uint8_t>& has_votes, const LabelRegistry& registry);

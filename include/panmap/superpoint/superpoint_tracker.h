@@ -28,6 +28,12 @@ struct SuperpointConfig {
   /// (SuperpointState::labelledClass), unlabelled ones only with unlabelled ones. false:
   /// spatial-only merging as in Voxblox++ (ablation "w/o III-B").
   bool semantic_consistency = true;
+  /// Only the network's verdicts on their own class decide (with semantic_consistency;
+  /// docs/MAPPING.md): a co-observation counts towards a merge only in a surface of the two
+  /// super-points' class (a floor mask spilling over two cabinets says nothing about them),
+  /// and a surface that loses its super-point to a surface of another mask of its class
+  /// splits from it (the super-point was formed under a mask that merged two objects).
+  bool mask_verdicts = true;
   /// Pixels between overlap samples (1 = every pixel).
   int sample_stride_px = 2;
   /// A 2D instance joins the global instance covering at least this share of its pixels.
@@ -49,11 +55,23 @@ struct SuperpointState {
   int32_t instance() const;
 };
 
+/// A surface that split from a super-point: the network showed the super-point's surface as
+/// two objects of one class (two masks), and another surface took the super-point, so this
+/// one's voxels move to a new one (applySplits()).
+struct SuperpointSplit {
+  int32_t surface_id = 0;  ///< the surface (pixel value in FrameSegmentation::surfaces)
+  int32_t from = 0;        ///< the super-point it split from (a root label at association)
+  int32_t to = 0;          ///< its new super-point
+  /// The surface's share of the samples of `from` in the frame: how much of it splits off.
+  double share = 0.0;
+};
+
 /// The result of associating one frame's surfaces with super-points.
 struct FrameAssociation {
   LabelImage pixel_labels;                 ///< super-point label per pixel, 0 = none
   std::vector<int32_t> surface_labels;     ///< per surface (index = id - 1)
   std::vector<int32_t> surface_instances;  ///< global instance per surface, 0 = none
+  std::vector<SuperpointSplit> splits;     ///< to apply before integrating (applySplits())
   int new_labels = 0;
   int merges = 0;
 };
@@ -128,6 +146,12 @@ class SuperpointTracker {
 
  private:
   bool consistent(int32_t a, int32_t b) const;
+  /// Whether a surface in which both super-points are significant says they are one object:
+  /// it is a segment of their own class (semantic consistency only).
+  bool showsAsOne(const Surface& surface, int32_t a, int32_t b) const;
+  /// Whether surface s, which lost a super-point to surface t this frame, splits from it:
+  /// both are thing surfaces of one class under two different masks.
+  bool splitsFrom(const Surface& s, const Surface& t) const;
   /// The network showed the pair (a < b) as two objects in at least as many frames as it
   /// co-observed them in one surface (m): no merge (semantic consistency only).
   bool seenApart(const std::pair<int32_t, int32_t>& key, int m) const;
