@@ -79,11 +79,13 @@ bool SuperpointTracker::showsAsOne(const Surface& surface, int32_t a, int32_t b)
   if (!config_.semantic_consistency || !config_.mask_verdicts) return true;
   // A mask of another class that spills over two super-points (a floor mask over the feet of
   // two cabinets, its outline a few pixels off) says nothing about whether they are one
-  // object; counted, it merged a row of three cabinets (issue 19).
+  // object; counted, it merged a row of three cabinets (issue 19). A surface without a mask
+  // still counts: geometry alone joins them, and no verdict contradicts it (not counting it
+  // left a chair's pieces small enough for an unlabelled neighbour to outvote).
   const auto ia = states_.find(a), ib = states_.find(b);
   const int32_t ca = ia == states_.end() ? 0 : ia->second.labelledClass();
   const int32_t cb = ib == states_.end() ? 0 : ib->second.labelledClass();
-  return surface.category == ca && surface.category == cb;
+  return surface.category == 0 || (surface.category == ca && surface.category == cb);
 }
 
 bool SuperpointTracker::splitsFrom(const Surface& s, const Surface& t) const {

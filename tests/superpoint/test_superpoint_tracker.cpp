@@ -155,9 +155,8 @@ TEST_F(WallScene, UnlabelledSuperpointsDoNotChainClasses) {
   }
   EXPECT_EQ(merges, 0);
   EXPECT_EQ(tracker.states().size(), 3u);
-  // Spatially connected, but an unlabelled surface is no verdict on a wall or a floor.
-  EXPECT_EQ(tracker.coObservations().count({1, 2}), 0u);
-  EXPECT_EQ(tracker.coObservations().count({2, 3}), 0u);
+  EXPECT_GT(tracker.coObservations().at({1, 2}), 3);  // spatially connected, kept apart
+  EXPECT_GT(tracker.coObservations().at({2, 3}), 3);
   EXPECT_EQ(tracker.state(1)->labelledClass(), 1);
   EXPECT_EQ(tracker.state(2)->labelledClass(), 0);
   EXPECT_EQ(tracker.state(3)->labelledClass(), 2);
@@ -189,7 +188,7 @@ TEST_F(WallScene, UnlabelledPiecesMergeOnlyAmongThemselves) {
     merges += step(&labelled, &map2, stripes({{640, 0}})).merges;
   }
   EXPECT_EQ(merges, 0);
-  EXPECT_EQ(labelled.coObservations().count({1, 2}), 0u);
+  EXPECT_GT(labelled.coObservations().at({1, 2}), 3);
   EXPECT_EQ(labelled.state(1)->semanticClass(), 0);  // mostly seen unlabelled
   EXPECT_EQ(labelled.state(1)->labelledClass(), 5);  // but the network called it a chair
 }

@@ -30,7 +30,8 @@ struct SuperpointConfig {
   bool semantic_consistency = true;
   /// Only the network's verdicts on their own class decide (with semantic_consistency;
   /// docs/MAPPING.md): a co-observation counts towards a merge only in a surface of the two
-  /// super-points' class (a floor mask spilling over two cabinets says nothing about them),
+  /// super-points' class or without a mask (a floor mask spilling over two cabinets says
+  /// nothing about them),
   /// and a surface that loses its super-point to a surface of another mask of its class
   /// splits from it (the super-point was formed under a mask that merged two objects).
   bool mask_verdicts = true;
@@ -146,8 +147,8 @@ class SuperpointTracker {
 
  private:
   bool consistent(int32_t a, int32_t b) const;
-  /// Whether a surface in which both super-points are significant says they are one object:
-  /// it is a segment of their own class (semantic consistency only).
+  /// Whether a surface in which both super-points are significant may join them: it has no
+  /// mask, or a mask of their own class (with mask_verdicts).
   bool showsAsOne(const Surface& surface, int32_t a, int32_t b) const;
   /// Whether surface s, which lost a super-point to surface t this frame, splits from it:
   /// both are thing surfaces of one class under two different masks.
