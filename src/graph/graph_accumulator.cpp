@@ -104,13 +104,16 @@ void GraphAccumulator::applySplits(const std::vector<SuperpointSplit>& splits,
     const auto it = scores_.find(from);
     if (from == to || it == scores_.end()) continue;
     const double share = std::clamp(split.share, 0.0, 1.0);
+    // Eq. 6's P_s, as update() computes it from the two parts' centroids.
+    const double p_s =
+        split.distance_m >= 0.0 ? 1.0 / (1.0 + split.distance_m / config_.spatial_scale_m) : 0.0;
     auto& target = scores_[to];  // std::map: `it` stays valid
     for (auto& [cls, score] : it->second) {
       const double moved = share * score;
       target[cls] += moved;
       if (cls > 0)
         edges_.add(std::min(from, to), std::max(from, to), cls,
-                   std::min(share, 1.0 - share) * score);
+                   p_s * std::min(share, 1.0 - share) * score);
       score -= moved;
     }
   }

@@ -268,7 +268,7 @@ FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_
   for (const std::exception_ptr& failure : failures) {
     if (failure) std::rethrow_exception(failure);
   }
-  applySplits(association, segmentation, frame, T_W_C, tracker_->labels(), map_.get());
+  applySplits(&association, segmentation, frame, T_W_C, tracker_->labels(), map_.get());
   const auto t2 = Clock::now();
   stats.integration = integrator_->integrate(frame, T_W_C, &association.pixel_labels, map_.get());
   const auto t3 = Clock::now();

@@ -5,6 +5,7 @@
 #include "panmap/map/projective_integrator.h"
 #include "panmap/sim/depth_noise.h"
 #include "panmap/sim/renderer.h"
+#include "panmap/superpoint/vote_split.h"
 #include "test_meshes.h"
 
 namespace panmap {
@@ -132,7 +133,7 @@ TEST_F(WallGraph, MergedSuperpointsAddTheirScoresAndEdges) {
 
 // A super-point formed under one mask, then shown as two masks of its class: the tracker
 // splits it (mask_verdicts), and the graph gives the new super-point its share of the scores
-// and the pair the one-mask history as P_eps (min(share, 1 - share) of the scores).
+// and the pair the one-mask history as P_eps (P_s min(share, 1 - share) of the scores).
 TEST_F(WallGraph, SplitSuperpointsShareTheirScoresAndKeepTheirHistory) {
   TsdfMap map(TsdfMap::Config{0.05f});
   SuperpointConfig config;
@@ -144,14 +145,19 @@ TEST_F(WallGraph, SplitSuperpointsShareTheirScoresAndKeepTheirHistory) {
     graph.update(frame_, T_W_C_, wholeMask(), map, tracker);
   }
   const double before = graph.scores(1).at(5);
-  const FrameAssociation a = tracker.associate(columns(384, 640, 5, 5, 0), frame_, T_W_C_, map);
+  const FrameSegmentation two = columns(384, 640, 5, 5, 0);
+  FrameAssociation a = tracker.associate(two, frame_, T_W_C_, map);
   ASSERT_EQ(a.splits.size(), 1u);
+  EXPECT_GT(applySplits(&a, two, frame_, T_W_C_, tracker.labels(), &map), 0u);
   const double share = a.splits[0].share;
   EXPECT_NEAR(share, 0.4, 0.01);  // the right 256 of 640 columns
+  // The parts' centroids are 1.217 m apart (ScoresFollowEquationFiveAndEdgesEquationSix).
+  EXPECT_NEAR(a.splits[0].distance_m, 1.217, 0.01);
+  const double p_s = 1.0 / (1.0 + a.splits[0].distance_m / 0.5);
   graph.applySplits(a.splits, tracker);
   EXPECT_DOUBLE_EQ(graph.scores(2).at(5), share * before);
   EXPECT_DOUBLE_EQ(graph.scores(1).at(5), before - share * before);
-  EXPECT_DOUBLE_EQ(graph.confidences(1, 2).at(5), share * before);
+  EXPECT_DOUBLE_EQ(graph.confidences(1, 2).at(5), p_s * share * before);
   EXPECT_TRUE(graph.separations(1, 2).empty());
 }
 

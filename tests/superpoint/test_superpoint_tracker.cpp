@@ -68,7 +68,7 @@ class WallScene : public ::testing::Test {
   // One frame as the mapper runs it: association, splits, integration.
   FrameAssociation step(SuperpointTracker* tracker, TsdfMap* map, const FrameSegmentation& seg) {
     FrameAssociation a = tracker->associate(seg, frame_, T_W_C_, *map);
-    applySplits(a, seg, frame_, T_W_C_, tracker->labels(), map);
+    applySplits(&a, seg, frame_, T_W_C_, tracker->labels(), map);
     integrator_.integrate(frame_, T_W_C_, &a.pixel_labels, map);
     return a;
   }

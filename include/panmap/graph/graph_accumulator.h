@@ -69,7 +69,8 @@ class GraphAccumulator {
 
   /// Splits the evidence of super-points as the tracker split them this frame (call before
   /// update() with FrameAssociation::splits). The new super-point takes its share of the old
-  /// one's scores P_nu^C, and the two get P_eps^C = min(share, 1 - share) P_nu^C: until this
+  /// one's scores P_nu^C, and the two get P_eps^C = P_s min(share, 1 - share) P_nu^C (Eq. 6
+  /// with P_s from the split's distance_m; a split without one is left without): until this
   /// frame every mask that saw the old super-point saw both parts under one mask, and that
   /// history stays evidence for III-D (a fridge the network split in two for a few frames at
   /// the end of a sequence is one object by its earlier frames).

@@ -65,6 +65,9 @@ struct SuperpointSplit {
   int32_t to = 0;          ///< its new super-point
   /// The surface's share of the samples of `from` in the frame: how much of it splits off.
   double share = 0.0;
+  /// Distance between the centroids of the surface's points and of the points of the surface
+  /// that kept `from`, metres (applySplits() fills it in; -1 until then).
+  double distance_m = -1.0;
 };
 
 /// The result of associating one frame's surfaces with super-points.

@@ -15,9 +15,10 @@ namespace panmap {
 /// Carries out a frame's super-point splits (FrameAssociation::splits): in every voxel a
 /// split surface's pixels fall in, the votes for the super-point it split from (any label
 /// resolving to it) become votes for its new one, so the voxels change super-point at once.
-/// Call after SuperpointTracker::associate() and before integrating the frame.
+/// Also measures each split's SuperpointSplit::distance_m. Call after
+/// SuperpointTracker::associate() and before integrating the frame.
 /// @return the number of voxels whose votes moved
-size_t applySplits(const FrameAssociation& association, const FrameSegmentation& segmentation,
+size_t applySplits(FrameAssociation* association, const FrameSegmentation& segmentation,
                    const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
                    const LabelRegistry& labels, TsdfMap* map);
 
