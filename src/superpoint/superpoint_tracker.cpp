@@ -60,11 +60,13 @@ const SuperpointState* SuperpointTracker::state(int32_t label) const {
   return it == states_.end() ? nullptr : &it->second;
 }
 
+int32_t SuperpointTracker::labelledClassOf(int32_t label) const {
+  const auto it = states_.find(label);
+  return it == states_.end() ? 0 : it->second.labelledClass();
+}
+
 bool SuperpointTracker::consistent(int32_t a, int32_t b) const {
   if (!config_.semantic_consistency) return true;
-  const auto ia = states_.find(a), ib = states_.find(b);
-  const int32_t ca = ia == states_.end() ? 0 : ia->second.labelledClass();
-  const int32_t cb = ib == states_.end() ? 0 : ib->second.labelledClass();
   // The paper's III-B also lets any super-point merge with a background one. Unlabelled
   // surface is not "any class": with it as a joker, a wall, an unlabelled chair and the floor
   // chain into one super-point, merge after merge (issue 19: one super-point held floor,
@@ -72,7 +74,7 @@ bool SuperpointTracker::consistent(int32_t a, int32_t b) const {
   // themselves; labelled surfaces claim their voxels by votes when the network labels them.
   // Background counts do not dilute a labelled class either, or a chair seen mostly without a
   // mask would count as background and chain the same way.
-  return ca == cb;
+  return labelledClassOf(a) == labelledClassOf(b);
 }
 
 bool SuperpointTracker::showsAsOne(const Surface& surface, int32_t a, int32_t b) const {
@@ -82,10 +84,8 @@ bool SuperpointTracker::showsAsOne(const Surface& surface, int32_t a, int32_t b)
   // object; counted, it merged a row of three cabinets (issue 19). A surface without a mask
   // still counts: geometry alone joins them, and no verdict contradicts it (not counting it
   // left a chair's pieces small enough for an unlabelled neighbour to outvote).
-  const auto ia = states_.find(a), ib = states_.find(b);
-  const int32_t ca = ia == states_.end() ? 0 : ia->second.labelledClass();
-  const int32_t cb = ib == states_.end() ? 0 : ib->second.labelledClass();
-  return surface.category == 0 || (surface.category == ca && surface.category == cb);
+  return surface.category == 0 ||
+         (surface.category == labelledClassOf(a) && surface.category == labelledClassOf(b));
 }
 
 bool SuperpointTracker::splitsFrom(const Surface& s, const Surface& t) const {

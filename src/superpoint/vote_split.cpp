@@ -1,5 +1,6 @@
 #include "panmap/superpoint/vote_split.h"
 
+#include <string>
 #include <vector>
 
 #include "panmap/core/error.h"

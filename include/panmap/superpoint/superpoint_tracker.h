@@ -149,6 +149,8 @@ class SuperpointTracker {
   void restore(const Snapshot& snapshot);
 
  private:
+  /// SuperpointState::labelledClass() of a live super-point, 0 when it has no state.
+  int32_t labelledClassOf(int32_t label) const;
   bool consistent(int32_t a, int32_t b) const;
   /// Whether a surface in which both super-points are significant may join them: it has no
   /// mask, or a mask of their own class (with mask_verdicts).
