@@ -42,27 +42,37 @@ size_t applySplits(FrameAssociation* association, const FrameSegmentation& segme
   if (association->surface_labels.size() != n) {
     throw Error("super-point splits: association and segmentation disagree on the surfaces");
   }
-  // Per surface id: the split it starts (index + 1), and the split whose super-point it kept.
+  // Per surface id: the split it starts (index + 1), and the super-point it kept when another
+  // surface split from it (index + 1 into `kept`; several surfaces may split from one).
   std::vector<size_t> split_of(n + 1, 0), kept_of(n + 1, 0);
+  std::vector<int32_t> from(splits.size()), kept;
+  std::vector<size_t> kept_index(splits.size());
   for (size_t i = 0; i < splits.size(); ++i) {
     const int32_t id = splits[i].surface_id;
     if (id <= 0 || static_cast<size_t>(id) > n) {
       throw Error("super-point splits: unknown surface " + std::to_string(id));
     }
     split_of[id] = i + 1;
-    const int32_t from = labels.resolve(splits[i].from);
-    for (size_t s = 0; s < n; ++s) {
-      if (labels.resolve(association->surface_labels[s]) == from) kept_of[s + 1] = i + 1;
+    from[i] = labels.resolve(splits[i].from);
+    size_t k = 0;
+    while (k < kept.size() && kept[k] != from[i]) ++k;
+    if (k == kept.size()) kept.push_back(from[i]);
+    kept_index[i] = k;
+  }
+  for (size_t s = 0; s < n; ++s) {
+    const int32_t label = labels.resolve(association->surface_labels[s]);
+    for (size_t k = 0; k < kept.size(); ++k) {
+      if (kept[k] == label) kept_of[s + 1] = k + 1;
     }
   }
   const Eigen::Isometry3f T = T_W_C.cast<float>();
   const float scale = static_cast<float>(frame.depth_scale_m);
   const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
   const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
-  // Point sums and counts of each split's two sides: [2 i] the split surface, [2 i + 1] the
-  // surface that kept the super-point.
-  std::vector<Eigen::Vector3d> sums(2 * splits.size(), Eigen::Vector3d::Zero());
-  std::vector<size_t> counts(2 * splits.size(), 0);
+  // Point sums and counts of each split surface, and of each surface that kept a super-point.
+  std::vector<Eigen::Vector3d> split_sum(splits.size(), Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3d> kept_sum(kept.size(), Eigen::Vector3d::Zero());
+  std::vector<size_t> split_count(splits.size(), 0), kept_count(kept.size(), 0);
   MutableVoxelLookup lookup(*map);
   size_t changed = 0;
   for (int v = 0; v < h; ++v) {
@@ -74,21 +84,22 @@ size_t applySplits(FrameAssociation* association, const FrameSegmentation& segme
       if (!(d > 0.0f)) continue;
       const Eigen::Vector3f p_W = T * Eigen::Vector3f((u - cx) * d / fx, (v - cy) * d / fy, d);
       if (kept_of[sid] != 0) {
-        sums[2 * (kept_of[sid] - 1) + 1] += p_W.cast<double>();
-        ++counts[2 * (kept_of[sid] - 1) + 1];
+        kept_sum[kept_of[sid] - 1] += p_W.cast<double>();
+        ++kept_count[kept_of[sid] - 1];
       }
       if (split_of[sid] == 0) continue;
       const size_t i = split_of[sid] - 1;
-      sums[2 * i] += p_W.cast<double>();
-      ++counts[2 * i];
+      split_sum[i] += p_W.cast<double>();
+      ++split_count[i];
       Voxel* voxel = lookup.find(p_W);
-      if (voxel) changed += moveVotes(voxel, labels.resolve(splits[i].from), splits[i].to, labels);
+      if (voxel) changed += moveVotes(voxel, from[i], splits[i].to, labels);
     }
   }
   for (size_t i = 0; i < splits.size(); ++i) {
-    splits[i].distance_m = counts[2 * i] > 0 && counts[2 * i + 1] > 0
-                               ? (sums[2 * i] / static_cast<double>(counts[2 * i]) -
-                                  sums[2 * i + 1] / static_cast<double>(counts[2 * i + 1]))
+    const size_t k = kept_index[i];
+    splits[i].distance_m = split_count[i] > 0 && kept_count[k] > 0
+                               ? (split_sum[i] / static_cast<double>(split_count[i]) -
+                                  kept_sum[k] / static_cast<double>(kept_count[k]))
                                      .norm()
                                : -1.0;
   }

@@ -274,6 +274,22 @@ TEST_F(WallScene, SuperpointUnderOneMaskSplitsWhenShownAsTwoObjects) {
   }
 }
 
+// Three objects first seen under one mask, then as three masks: two surfaces split from the
+// same super-point in one frame, and each split measures its distance to the surface that
+// kept it (the middle stripe's centroid is nearer to the left one than the right stripe's).
+TEST_F(WallScene, TwoSurfacesSplittingFromOneSuperpointBothMeasureTheirDistance) {
+  TsdfMap map(TsdfMap::Config{0.05f});
+  SuperpointTracker tracker(SuperpointConfig{});
+  for (int k = 0; k < 4; ++k) step(&tracker, &map, stripes({{640, 5}}));
+  const FrameAssociation a = step(&tracker, &map, stripes({{216, 5}, {428, 5}, {640, 5}}));
+  ASSERT_EQ(a.splits.size(), 2u);
+  EXPECT_EQ(a.splits[0].from, 1);
+  EXPECT_EQ(a.splits[1].from, 1);
+  EXPECT_GT(a.splits[0].distance_m, 0.0);
+  EXPECT_GT(a.splits[1].distance_m, 1.5 * a.splits[0].distance_m);
+  EXPECT_EQ(tracker.states().size(), 3u);
+}
+
 // A surface of another class over two super-points is no verdict on them. Two objects of one
 // class, seen apart once; then the network misses the second and a floor mask spills over the
 // border between them. Counted, those floor surfaces would merge the two (co-observed four
