@@ -20,28 +20,35 @@ from suite import Spec  # noqa: E402
 
 # III-D clustering (join_affinity, min_coverage), III-C's pairwise weight K_C (0: no pairwise
 # term, the argmax labels of w/o III-C, as the grid's own reference), what its links are
-# scaled by (optimiser.link_scale) and how they are trusted by their less observed end
-# (optimiser.link_half_observations). The grid of 2026-11-26 found min_coverage 0.05-0.2
-# and K_C 15-120 tied on mAP50 and join_affinity 0.6 best.
-GRID = {"join_affinity": [0.6, 0.7],
+# scaled by (optimiser.link_scale), how they are trusted by their less observed end
+# (optimiser.link_half_observations) and how its terms are weighted (optimiser.weighting:
+# `shared` bounds the pairwise terms around a super-point by its own surface, against the
+# chairs turned floor by their many small boundary neighbours, docs/MAPPING.md). The grids of
+# 2026-11-26/27 found min_coverage 0.05-0.2 tied and join_affinity 0.6 best or tied.
+GRID = {"join_affinity": [0.6],
         "min_coverage": [0.05],
-        "K_C": [0.0, 30.0, 60.0, 120.0],
+        "K_C": [0.0, 60.0, 120.0, 240.0],
         "link_scale": ["smaller", "geometric"],
-        "link_half_observations": [0.0, 1.0, 3.0]}
-HEADER = ("| join_affinity | min_coverage | K_C | link_scale | link_half_observations | mAP50 | "
-          "mAP75 | PQ50 | mIoU |")
-RULE = "|---:|---:|---:|---|---:|---:|---:|---:|---:|"
+        "link_half_observations": [0.0, 1.0],
+        "weighting": ["surface", "shared"]}
+# The parameters the "best point of each" table varies (the rest take their best value).
+VARIED = ("K_C", "link_scale", "link_half_observations", "weighting")
+HEADER = "| " + " | ".join(GRID) + " | mAP50 | mAP75 | PQ50 | mIoU |"
+RULE = "|" + "|".join("---" if isinstance(v[0], str) else "---:" for v in GRID.values()) + \
+    "|---:|---:|---:|---:|"
 # The defaults before this grid: ties go to the point nearest them.
 START = {"join_affinity": 0.6, "min_coverage": 0.05, "K_C": 120.0, "link_scale": "smaller",
-         "link_half_observations": 0.0}
+         "link_half_observations": 0.0, "weighting": "surface"}
+
+
+def yaml_value(v):
+    return "\"%s\"" % v if isinstance(v, str) else "%g" % v
 
 
 def config_yaml(path, t):
     with open(path, "w") as f:
-        f.write("%%YAML:1.0\n---\noptimiser:\n   join_affinity: %g\n   min_coverage: %g\n"
-                "   K_C: %g\n   link_scale: \"%s\"\n   link_half_observations: %g\n" % (
-                    t["join_affinity"], t["min_coverage"], t["K_C"], t["link_scale"],
-                    t["link_half_observations"]))
+        f.write("%YAML:1.0\n---\noptimiser:\n" +
+                "".join("   %s: %s\n" % (k, yaml_value(v)) for k, v in t.items()))
 
 
 def main():
@@ -104,8 +111,9 @@ def main():
           "method; the final optimisation is re-run for each of the %d points of the grid %s "
           "and the result scored with panmap-eval. Chosen: the best mean mAP50 (ties: PQ50, "
           "then mIoU, then the point nearest the starting values %s). III-C's terms are "
-          "weighted per voxel (`optimiser.weighting: surface`), so K_C is a cost per voxel of "
-          "the smaller super-point of an edge." % (
+          "weighted per voxel (`optimiser.weighting`): with `surface`, K_C is a cost per voxel "
+          "of the smaller super-point of an edge; with `shared`, per voxel of the smaller of "
+          "the two shares of their surface the edge gets." % (
               ", ".join(os.path.basename(d) for d in dirs) or "no real scene",
               ", ".join(map(str, suite.TUNING_SCANNET_SEEDS)),
               ", ".join(map(str, suite.TUNING_SCANNET_LIKE)), 100 * args.voxel_size, len(grid),
@@ -115,20 +123,21 @@ def main():
 
     def row(i):
         t = grid[i]
-        return "| %g | %g | %g | %s | %g | %.1f | %.1f | %.1f | %.1f |" % (
-            t["join_affinity"], t["min_coverage"], t["K_C"], t["link_scale"],
-            t["link_half_observations"],
-            100 * overall(scores[i], "map50"), 100 * overall(scores[i], "map75"),
-            100 * overall(scores[i], "pq50"), 100 * overall(scores[i], "miou"))
+        return "| " + " | ".join(v if isinstance(v, str) else "%g" % v for v in t.values()) + \
+            " | %.1f | %.1f | %.1f | %.1f |" % (
+                100 * overall(scores[i], "map50"), 100 * overall(scores[i], "map75"),
+                100 * overall(scores[i], "pq50"), 100 * overall(scores[i], "miou"))
     md += [row(i) for i in ranked[:12]]
-    md += ["", "Best point of each K_C, link scale and link trust (K_C 0: no pairwise term, as "
-           "without III-C):", "", HEADER, RULE]
-    for k_c in GRID["K_C"]:
-        for scale in GRID["link_scale"]:
-            for half in GRID["link_half_observations"]:
-                md.append(row(next(i for i in ranked if grid[i]["K_C"] == k_c and
-                                   grid[i]["link_scale"] == scale and
-                                   grid[i]["link_half_observations"] == half)))
+    md += ["", "Best point of each %s (K_C 0: no pairwise term, as without III-C):" %
+           ", ".join(VARIED), "", HEADER, RULE]
+    seen = set()
+    for i in sorted(range(len(grid)), key=lambda i: [GRID[k].index(grid[i][k]) for k in VARIED]):
+        key = tuple(grid[i][k] for k in VARIED)
+        if key in seen:
+            continue
+        seen.add(key)
+        md.append(row(next(j for j in ranked
+                           if tuple(grid[j][k] for k in VARIED) == key)))
     worst = ranked[-1]
     start_index = grid.index(START) if START in grid else None
     md += ["", "Worst point: %s, mAP50 %.1f.%s" % (
@@ -136,10 +145,7 @@ def main():
         " Starting values: mAP50 %.1f." % (100 * overall(scores[start_index], "map50"))
         if start_index is not None else ""), "", "## Chosen", "",
         "As YAML (`optimiser` section):", "", "```yaml",
-        "   join_affinity: %g\n   min_coverage: %g\n   K_C: %g\n   link_scale: \"%s\"\n"
-        "   link_half_observations: %g" % (
-            best["join_affinity"], best["min_coverage"], best["K_C"], best["link_scale"],
-            best["link_half_observations"]),
+        "\n".join("   %s: %s" % (k, yaml_value(v)) for k, v in best.items()),
         "```", "",
         "The paper's instance-refinement rules (theta_D, theta_O, theta_L; "
         "`optimiser.refinement: paper`) were tuned on box rooms before issue 19 (theta_D 0, "

@@ -22,6 +22,7 @@ OptimiserConfig handConfig() {
   OptimiserConfig config;  // the paper's weights, which the hand computations below use
   config.K_C = 15.0;
   config.weighting = OptimiserConfig::Weighting::kNone;
+  config.link_half_observations = 0.0;  // the paper trusts every link fully
   config.refinement = OptimiserConfig::Refinement::kPaperRules;
   config.default_thresholds = {0.1, 0.1, 0.5};
   return config;

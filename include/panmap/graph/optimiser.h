@@ -11,7 +11,7 @@ namespace panmap {
 struct OptimiserConfig {
   bool regularise = true;  ///< III-C semantic regularisation (off: argmax of the scores)
   bool refine = true;      ///< III-D instance refinement (off: initial instances)
-  double K_C = 120.0;      ///< pairwise weight per voxel (Eq. 9, weighting; docs/TUNING.md)
+  double K_C = 60.0;       ///< pairwise weight per voxel (Eq. 9, weighting; docs/TUNING.md)
   double theta = 0.5;      ///< pairwise bandwidth (Eq. 9)
   /// Discount Eq. 9's co-observation sum_C P_eps^C by P_eps / (P_eps + P_apart): how often the
   /// two super-points were under one mask rather than two (not in the paper).
@@ -42,7 +42,7 @@ struct OptimiserConfig {
   /// two vertices' score sums per voxel (confidence-weighted observations per voxel). A
   /// fragment seen once or twice then pulls on its neighbours weakly, a surface seen in many
   /// frames as before. 0: every link fully trusted (docs/MAPPING.md).
-  double link_half_observations = 0.0;
+  double link_half_observations = 1.0;
   /// Floor of the normalised score P_nu^C / sum_C' P_nu^C' in the unary (Eq. 8): a class
   /// without score costs -log(score_floor) (13.8 for 1e-6) instead of infinity.
   double score_floor = 1e-6;
