@@ -36,9 +36,10 @@ VARIED = ("K_C", "link_scale", "link_half_observations", "weighting")
 HEADER = "| " + " | ".join(GRID) + " | mAP50 | mAP75 | PQ50 | mIoU |"
 RULE = "|" + "|".join("---" if isinstance(v[0], str) else "---:" for v in GRID.values()) + \
     "|---:|---:|---:|---:|"
-# The defaults before this grid: ties go to the point nearest them.
-START = {"join_affinity": 0.6, "min_coverage": 0.05, "K_C": 120.0, "link_scale": "smaller",
-         "link_half_observations": 0.0, "weighting": "surface"}
+# The current defaults (include/panmap/graph/optimiser.h): ties go to the point nearest them.
+# docs/TUNING.md of 2026-11-27 ran from K_C 120, link_half_observations 0 and chose these.
+START = {"join_affinity": 0.6, "min_coverage": 0.05, "K_C": 60.0, "link_scale": "smaller",
+         "link_half_observations": 1.0, "weighting": "surface"}
 
 
 def yaml_value(v):
