@@ -153,7 +153,7 @@ TEST_F(WallGraph, SplitSuperpointsShareTheirScoresAndKeepTheirHistory) {
   EXPECT_NEAR(share, 0.4, 0.01);  // the right 256 of 640 columns
   // The parts' centroids are 1.217 m apart (ScoresFollowEquationFiveAndEdgesEquationSix).
   EXPECT_NEAR(a.splits[0].distance_m, 1.217, 0.01);
-  const double p_s = 1.0 / (1.0 + a.splits[0].distance_m / 0.5);
+  const double p_s = 1.0 / (1.0 + a.splits[0].distance_m / GraphConfig{}.spatial_scale_m);
   graph.applySplits(a.splits, tracker);
   EXPECT_DOUBLE_EQ(graph.scores(2).at(5), share * before);
   EXPECT_DOUBLE_EQ(graph.scores(1).at(5), before - share * before);
