@@ -395,6 +395,7 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
     }
     vertex.instance = state.instance();
     vertex.semantic = state.semanticClass();
+    vertex.void_share = state.voidShare();
     const auto s = scores_.find(label);
     if (s != scores_.end()) vertex.scores = s->second;
     g.vertices.push_back(vertex);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "panmap/core/error.h"
 
@@ -45,6 +46,9 @@ void checkGraph(const SuperpointGraph& graph) {
     // initial instance of INT32_MAX overflowed, found by fuzz/fuzz_lcm_messages).
     if (v.instance < 0 || v.instance >= kMaxInitialInstance) {
       throw Error(field + ".instance: " + std::to_string(v.instance) + " (must be in [0, 2^30))");
+    }
+    if (!(v.void_share >= 0.0 && v.void_share <= 1.0)) {
+      throw Error(field + ".void_share: " + std::to_string(v.void_share) + " (must be in [0, 1])");
     }
     checkValues(v.scores, field + ".scores");
   }
@@ -107,6 +111,12 @@ ClassSet::ClassSet(std::vector<int32_t> classes) : sorted_(std::move(classes)) {
 
 bool ClassSet::containsSorted(const std::vector<int32_t>& sorted, int32_t value) {
   return std::binary_search(sorted.begin(), sorted.end(), value);
+}
+
+ClassSet noInstanceClasses(const SuperpointGraph& graph) {
+  std::vector<int32_t> classes = graph.background;
+  classes.push_back(0);
+  return ClassSet(std::move(classes));
 }
 
 }  // namespace internal

@@ -22,8 +22,8 @@ struct Between {
 struct Candidate {
   double affinity;
   double same;
-  int a, b;         // cluster ids (first member's vertex index), a < b
-  uint64_t stamp;   // versions of both clusters when pushed
+  int a, b;        // cluster ids (first member's vertex index), a < b
+  uint64_t stamp;  // versions of both clusters when pushed
   bool operator<(const Candidate& o) const {
     return std::tie(affinity, same, o.a, o.b) < std::tie(o.affinity, o.same, a, b);
   }
@@ -34,7 +34,7 @@ struct Candidate {
 InstanceLabels clusterInstances(const SuperpointGraph& graph, const std::vector<int32_t>& classes,
                                 const OptimiserConfig& config) {
   const int n = static_cast<int>(graph.vertices.size());
-  const ClassSet background(graph.background);
+  const ClassSet background = noInstanceClasses(graph);
   const VertexIndex index(graph);
   // Clusters start as single super-points; cluster k is keyed by its smallest vertex index.
   std::vector<int> parent(n);
@@ -109,7 +109,7 @@ InstanceLabels clusterInstances(const SuperpointGraph& graph, const std::vector<
     root[i] = r;
   }
   std::map<int, std::map<int32_t, int64_t>> initial;  // root -> initial id -> voxels
-  std::map<int, int64_t> size;                          // root -> voxels
+  std::map<int, int64_t> size;                        // root -> voxels
   for (int i = 0; i < n; ++i) {
     if (background.contains(classes[i])) continue;
     size[root[i]] += graph.vertices[i].num_voxels;

@@ -154,7 +154,7 @@ class Refiner {
   }
 
  private:
-  ClassSet backgroundSet() const { return ClassSet(graph_.background); }
+  ClassSet backgroundSet() const { return noInstanceClasses(graph_); }
 
   static float normalise(double p, double max_p) {
     return max_p > 0.0 ? static_cast<float>(p / max_p) : 0.0f;

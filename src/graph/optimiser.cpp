@@ -36,6 +36,10 @@ void OptimiserConfig::check() const {
     throw Error("OptimiserConfig.link_half_observations: " +
                 std::to_string(link_half_observations) + " (must be finite, >= 0)");
   }
+  if (!(max_void_share >= 0.0 && max_void_share <= 1.0)) {
+    throw Error("OptimiserConfig.max_void_share: " + std::to_string(max_void_share) +
+                " (must be in [0, 1])");
+  }
   if (!(std::isfinite(K_C) && K_C >= 0.0)) {
     throw Error("OptimiserConfig.K_C: " + std::to_string(K_C) + " (must be finite, >= 0)");
   }
@@ -87,7 +91,10 @@ GraphLabels optimise(const SuperpointGraph& graph, const OptimiserConfig& config
   std::vector<int> labels = problem.initial;
   if (config.regularise) internal::alphaBetaSwap(problem, labels, config.max_sweeps);
   std::vector<int32_t> classes(labels.size());
-  for (size_t i = 0; i < labels.size(); ++i) classes[i] = problem.labels[labels[i]];
+  for (size_t i = 0; i < labels.size(); ++i) {
+    classes[i] =
+        internal::leftUnlabelled(graph.vertices[i], config) ? 0 : problem.labels[labels[i]];
+  }
 
   // III-D: instances.
   const internal::InstanceLabels instances =

@@ -56,6 +56,10 @@ EdgeTerms edgeTerms(const SuperpointGraph& graph, const ClassSet& classes, const
     const GraphEdge& e = graph.edges[k];
     const int a = index(e.a);
     const int b = index(e.b);
+    // An unlabelled vertex's class is not the swap's to choose: it neither pulls nor is pulled.
+    if (leftUnlabelled(graph.vertices[a], config) || leftUnlabelled(graph.vertices[b], config)) {
+      continue;
+    }
     const double c = normalisedConfidence(edgeEvidence(e, classes, config), score_sum[a],
                                           score_sum[b], config.link_scale) *
                      linkTrust(std::min(observationsPerVoxel(graph.vertices[a], score_sum[a]),
@@ -217,7 +221,10 @@ double semanticEnergy(const SuperpointGraph& graph, const std::map<int32_t, int3
     const double score = internal::valueOf(v.scores, classes, label[i]);
     normalised[i] = sum > 0.0 ? score / sum : 0.0;
     weight[i] = internal::vertexWeight(v, config.weighting);
-    energy += weight[i] * internal::unaryPotential(score, sum, config.score_floor);
+    // An unlabelled vertex's class is fixed (class 0): its unary is no part of the choice.
+    if (!internal::leftUnlabelled(v, config)) {
+      energy += weight[i] * internal::unaryPotential(score, sum, config.score_floor);
+    }
   }
   const internal::EdgeTerms terms =
       internal::edgeTerms(graph, classes, index, config, sums, weight);

@@ -48,6 +48,7 @@ superpoint_graph_t toMessage(const SuperpointGraph& graph, int64_t utime, int64_
     for (int k = 0; k < 3; ++k) m.centroid[k] = v.centroid[k];
     m.instance = v.instance;
     m.semantic = v.semantic;
+    m.void_share = v.void_share;
     putClassMap(v.scores, &m.num_scores, &m.score_classes, &m.scores);
     msg.vertices.push_back(m);
   }
@@ -86,6 +87,7 @@ SuperpointGraph fromMessage(const superpoint_graph_t& msg) {
     v.centroid = Eigen::Vector3d(m.centroid[0], m.centroid[1], m.centroid[2]);
     v.instance = m.instance;
     v.semantic = m.semantic;
+    v.void_share = m.void_share;
     v.scores = getClassMap(m.num_scores, m.score_classes, m.scores,
                            "graph message vertex " + std::to_string(m.id));
     ids.insert(v.id);
@@ -123,7 +125,8 @@ graph_labels_t toMessage(const GraphLabels& labels, int64_t utime, int64_t reque
     msg.instance_ids.push_back(id);
     msg.instance_confidence.push_back(conf);
     const auto e = labels.instance_evidence.find(id);
-    const ObjectEvidence evidence = e == labels.instance_evidence.end() ? ObjectEvidence() : e->second;
+    const ObjectEvidence evidence =
+        e == labels.instance_evidence.end() ? ObjectEvidence() : e->second;
     msg.instance_area_m2.push_back(evidence.area_m2);
     msg.instance_support.push_back(evidence.support);
     msg.instance_class_share.push_back(evidence.class_share);

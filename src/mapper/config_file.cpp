@@ -296,6 +296,7 @@ PanmapConfig loadConfig(const std::string& path) {
     o.link_scale = link_scale == "geometric" ? OptimiserConfig::LinkScale::kGeometric
                                              : OptimiserConfig::LinkScale::kSmaller;
     s.read("link_half_observations", &o.link_half_observations);
+    s.read("max_void_share", &o.max_void_share);
     std::string refinement =
         o.refinement == OptimiserConfig::Refinement::kPaperRules ? "paper" : "clustering";
     s.readString("refinement", &refinement);
@@ -472,6 +473,8 @@ std::string configToYaml(const PanmapConfig& c) {
        " the two score sums\n"
     << "   link_half_observations: " << o.link_half_observations
     << "   # a link counts n / (n + this), n its less observed end's observations per voxel\n"
+    << "   max_void_share: " << o.max_void_share
+    << "   # super-points no mask covered in more of their frames stay unlabelled (1: off)\n"
     << "   refinement: \""
     << (o.refinement == OptimiserConfig::Refinement::kPaperRules ? "paper" : "clustering")
     << "\"   # III-D: clustering by one-mask / two-mask evidence, or the paper's rules\n"

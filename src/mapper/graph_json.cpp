@@ -31,6 +31,7 @@ void writeGraphJson(const std::string& path, const SuperpointGraph& graph,
                         {"voxels", v.num_voxels},
                         {"centroid", {v.centroid.x(), v.centroid.y(), v.centroid.z()}},
                         {"initial_class", v.semantic},
+                        {"void_share", v.void_share},
                         {"initial_instance", v.instance},
                         {"class", lookup(labels.semantic, v.id)},
                         {"instance", lookup(labels.instance, v.id)},
@@ -44,9 +45,8 @@ void writeGraphJson(const std::string& path, const SuperpointGraph& graph,
                      {"separations", classMap(e.separations)},
                      {"apart", e.apart}});
   }
-  const nlohmann::json root = {{"voxel_size_m", graph.voxel_size_m},
-                               {"vertices", vertices},
-                               {"edges", edges}};
+  const nlohmann::json root = {
+      {"voxel_size_m", graph.voxel_size_m}, {"vertices", vertices}, {"edges", edges}};
   std::ofstream out(path);
   out << root.dump() << "\n";
   if (!out) throw Error(path + ": cannot write");

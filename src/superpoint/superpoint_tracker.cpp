@@ -43,6 +43,15 @@ int32_t SuperpointState::labelledClass() const {
   return best;
 }
 
+double SuperpointState::voidShare() const {
+  double total = 0.0, none = 0.0;
+  for (const auto& [cls, count] : class_counts) {
+    total += count;
+    if (cls <= 0) none += count;
+  }
+  return total > 0.0 ? none / total : 0.0;
+}
+
 int32_t SuperpointState::instance() const {
   int32_t best = 0, best_count = 0;
   for (const auto& [id, count] : instance_counts) {

@@ -17,6 +17,7 @@ SuperpointGraph sampleGraph() {
   a.centroid = Eigen::Vector3d(0.1, -2.5, 1.0 / 3.0);
   a.instance = 7;
   a.semantic = 5;
+  a.void_share = 2.0 / 3.0;
   a.scores = {{5, 12.75}, {1, 0.1 + 0.2}};
   GraphVertex b;
   b.id = 9;
@@ -42,6 +43,7 @@ TEST(GraphConversions, GraphRoundTripIsExact) {
   EXPECT_EQ(back.vertices[0].scores, g.vertices[0].scores);
   EXPECT_EQ(back.vertices[0].centroid, g.vertices[0].centroid);
   EXPECT_EQ(back.vertices[0].instance, 7);
+  EXPECT_EQ(back.vertices[0].void_share, 2.0 / 3.0);
   EXPECT_EQ(back.vertices[1].scores, g.vertices[1].scores);
   ASSERT_EQ(back.edges.size(), 1u);
   EXPECT_EQ(back.edges[0].confidences, g.edges[0].confidences);

@@ -151,10 +151,12 @@ TEST(ConfigFile, LinkScaleRoundTripsAndABadValueIsNamed) {
   EXPECT_EQ(geometric.optimiser.link_scale, OptimiserConfig::LinkScale::kGeometric);
   EXPECT_EQ(loadConfig(write(dir, configToYaml(geometric))).optimiser.link_scale,
             OptimiserConfig::LinkScale::kGeometric);
-  const PanmapConfig smaller = loadConfig(write(
-      dir,
-      "%YAML:1.0\n---\noptimiser:\n   link_scale: \"smaller\"\n   link_half_observations: 2\n"));
+  const PanmapConfig smaller = loadConfig(
+      write(dir,
+            "%YAML:1.0\n---\noptimiser:\n   link_scale: \"smaller\"\n   link_half_observations: 2\n"
+            "   max_void_share: 0.875\n"));
   EXPECT_EQ(loadConfig(write(dir, configToYaml(smaller))).optimiser.link_half_observations, 2.0);
+  EXPECT_EQ(loadConfig(write(dir, configToYaml(smaller))).optimiser.max_void_share, 0.875);
   EXPECT_EQ(loadConfig(write(dir, configToYaml(smaller))).optimiser.link_scale,
             OptimiserConfig::LinkScale::kSmaller);
   try {

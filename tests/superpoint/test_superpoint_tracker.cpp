@@ -80,6 +80,17 @@ class WallScene : public ::testing::Test {
   RgbdFrame frame_;
 };
 
+TEST(SuperpointState, VoidShareIsTheShareOfFramesWithoutAMask) {
+  SuperpointState state;
+  EXPECT_EQ(state.voidShare(), 0.0);  // never seen
+  state.class_counts = {{0, 3.0}, {5, 1.0}};
+  EXPECT_EQ(state.voidShare(), 0.75);
+  EXPECT_EQ(state.semanticClass(), 0);
+  EXPECT_EQ(state.labelledClass(), 5);
+  state.class_counts = {{1, 2.0}, {5, 2.0}};
+  EXPECT_EQ(state.voidShare(), 0.0);
+}
+
 TEST_F(WallScene, SurfacesKeepTheirSuperpointAcrossFrames) {
   TsdfMap map(TsdfMap::Config{0.05f});
   SuperpointTracker tracker(SuperpointConfig{});

@@ -43,6 +43,13 @@ struct OptimiserConfig {
   /// fragment seen once or twice then pulls on its neighbours weakly, a surface seen in many
   /// frames as before. 0: every link fully trusted (docs/MAPPING.md).
   double link_half_observations = 1.0;
+  /// A super-point that no mask of a known class covered in more than this share of the
+  /// frames that showed it (GraphVertex::void_share) is left unlabelled: class 0, no instance,
+  /// outside III-C's labelling. Its class scores are then the bleed of its neighbours' mask
+  /// outlines, and labelling it by them grows those objects by surface the network never
+  /// called theirs (docs/MAPPING.md). 1: off. 0.8 was chosen by
+  /// scripts/bench/tune_refinement.py (docs/TUNING.md; 0.6-0.8 tied).
+  double max_void_share = 0.8;
   /// Floor of the normalised score P_nu^C / sum_C' P_nu^C' in the unary (Eq. 8): a class
   /// without score costs -log(score_floor) (13.8 for 1e-6) instead of infinity.
   double score_floor = 1e-6;

@@ -10,11 +10,14 @@ namespace panmap {
 
 /// A vertex of the super-point graph (paper III-C): one live super-point.
 struct GraphVertex {
-  int32_t id = 0;              ///< super-point label L_S (> 0)
-  int32_t num_voxels = 0;      ///< voxels whose argmax label it is
+  int32_t id = 0;                                      ///< super-point label L_S (> 0)
+  int32_t num_voxels = 0;                              ///< voxels whose argmax label it is
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< world frame, metres
-  int32_t instance = 0;        ///< initial instance (frame counting), 0 = none
-  int32_t semantic = 0;        ///< initial class (frame counting), 0 = none
+  int32_t instance = 0;  ///< initial instance (frame counting), 0 = none
+  int32_t semantic = 0;  ///< initial class (frame counting), 0 = none
+  /// Share of the frames that showed it in which no mask of a known class covered it (the
+  /// frame counts' class 0): what the network left void.
+  double void_share = 0.0;
   std::map<int32_t, double> scores;  ///< P_nu^C(L_S) per class C (Eq. 5); absent = 0
 };
 

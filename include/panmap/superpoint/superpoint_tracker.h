@@ -52,6 +52,8 @@ struct SuperpointState {
   /// The most frequent class other than background (0 when no surface of it was labelled):
   /// what the network said the super-point is, whenever it said anything.
   int32_t labelledClass() const;
+  /// Share of its frame counts that are class 0 (no mask of a known class); 0 when never seen.
+  double voidShare() const;
   /// Its global instance from frame counting (0 = none).
   int32_t instance() const;
 };

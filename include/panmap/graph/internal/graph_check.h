@@ -48,5 +48,9 @@ class ClassSet {
   bool flags_complete_ = true;  ///< all classes are in [0, kTableSize)
 };
 
+/// The classes whose super-points get no instance: the graph's background C_0 (stuff) and
+/// class 0, the super-points left unlabelled (OptimiserConfig::max_void_share).
+ClassSet noInstanceClasses(const SuperpointGraph& graph);
+
 }  // namespace internal
 }  // namespace panmap

@@ -47,6 +47,12 @@ inline double linkTrust(double n, double half) {
   return n > 0.0 ? n / (n + half) : 0.0;
 }
 
+/// Whether the vertex is left unlabelled (OptimiserConfig::max_void_share): class 0 and no
+/// instance, and its edges carry no pairwise term.
+inline bool leftUnlabelled(const GraphVertex& vertex, const OptimiserConfig& config) {
+  return config.max_void_share < 1.0 && vertex.void_share > config.max_void_share;
+}
+
 /// The edge factor of Eq. 9, 1 / (2 theta^2 c) with c the normalised confidence
 /// (normalisedConfidence); 0 for an edge without confidence, which then costs nothing.
 inline double edgeFactor(double confidence_sum, double theta) {
