@@ -9,6 +9,10 @@ the neighbours' size and observations per voxel: the mechanism docs/MAPPING.md d
 
   python3 scripts/bench/energy_breakdown.py graph.json --class 5 [--K-C 120] [--theta 0.5]
       [--link-scale smaller|geometric] [--link-half-observations 0] [--no-discount-apart]
+      [--max-void-share 1]
+
+Super-points left unlabelled (void share above --max-void-share; 1: none) are not III-C's
+choice: they are left out of the group and their links cost nothing.
 """
 import argparse
 import json
@@ -27,6 +31,7 @@ def main():
     parser.add_argument("--link-scale", choices=("smaller", "geometric"), default="smaller")
     parser.add_argument("--link-half-observations", type=float, default=0.0)
     parser.add_argument("--no-discount-apart", action="store_true")
+    parser.add_argument("--max-void-share", type=float, default=1.0)
     args = parser.parse_args()
     try:
         with open(args.graph) as f:
@@ -54,8 +59,11 @@ def main():
     def observations(v):
         return score_sum(v) / weight(v)
 
+    def unlabelled(v):
+        return args.max_void_share < 1.0 and v.get("void_share", 0.0) > args.max_void_share
+
     def pairwise(a, b, e, ca, cb):
-        if ca == cb:
+        if ca == cb or unlabelled(a) or unlabelled(b):
             return 0.0
         same = sum(e["confidences"].values())
         if same <= 0:
@@ -80,7 +88,8 @@ def main():
         scored = [(s, int(c)) for c, s in v["scores"].items() if s > 0]
         return max(scored)[1] if scored else None
 
-    group = {i for i, v in vertices.items() if argmax(v) == args.cls and v["class"] != args.cls}
+    group = {i for i, v in vertices.items()
+             if argmax(v) == args.cls and v["class"] != args.cls and not unlabelled(v)}
     if not group:
         print("no super-point with argmax class %d ends with another class" % args.cls)
         return
