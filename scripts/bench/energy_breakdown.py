@@ -60,7 +60,7 @@ def main():
         return score_sum(v) / weight(v)
 
     def unlabelled(v):
-        return args.max_void_share < 1.0 and v.get("void_share", 0.0) > args.max_void_share
+        return v.get("void_share", 0.0) > args.max_void_share
 
     def pairwise(a, b, e, ca, cb):
         if ca == cb or unlabelled(a) or unlabelled(b):

@@ -50,7 +50,7 @@ inline double linkTrust(double n, double half) {
 /// Whether the vertex is left unlabelled (OptimiserConfig::max_void_share): class 0 and no
 /// instance, and its edges carry no pairwise term.
 inline bool leftUnlabelled(const GraphVertex& vertex, const OptimiserConfig& config) {
-  return config.max_void_share < 1.0 && vertex.void_share > config.max_void_share;
+  return vertex.void_share > config.max_void_share;  // never above 1: 1 turns it off
 }
 
 /// The edge factor of Eq. 9, 1 / (2 theta^2 c) with c the normalised confidence
