@@ -4,7 +4,7 @@
 // association, label-TSDF integration; geometry only, 7-Scenes has no masks), and the store
 // gets the per-pixel super-point labels association gave the integrator.
 //   panmap-bench-frame-store [--data DIR] [--frames N] [--color] [--color-quality Q]
-//                            [--png-compression L] [--voxel-size M] [--threads N] [--store DIR]
+//                            [--compression-level L] [--voxel-size M] [--threads N] [--store DIR]
 
 #include <algorithm>
 #include <chrono>
@@ -22,6 +22,7 @@
 #include "panmap/core/thread_pool.h"
 #include "panmap/io/dataset_reader.h"
 #include "panmap/io/image_codec.h"
+#include "panmap/io/plane_codec.h"
 #include "panmap/loop/frame_store.h"
 #include "panmap/map/projective_integrator.h"
 #include "panmap/map/tsdf_map.h"
@@ -84,7 +85,8 @@ int main(int argc, char** argv) {
   app.add_option("--frames", frames, "frames to store (0 = all)");
   app.add_flag("--color", config.store_color, "store colour as JPEG too");
   app.add_option("--color-quality", config.color_quality, "JPEG quality")->capture_default_str();
-  app.add_option("--png-compression", config.png_compression, "zlib level of the PNGs (0..9)")
+  app.add_option("--compression-level", config.compression_level,
+                 "zstd level of the depth and label planes (1..19)")
       ->capture_default_str();
   app.add_option("--voxel-size", voxel_size_m, "voxel size of the mapping run, metres")
       ->capture_default_str();
@@ -131,7 +133,9 @@ int main(int argc, char** argv) {
         distinct;
     std::vector<int64_t> utimes;
     std::vector<std::pair<uint64_t, uint64_t>> prints;  // depth, labels of each stored frame
-    size_t high_planes = 0, no_pose = 0;
+    // The same images as version 1 stores kept them (PNG, zlib level 6), for comparison.
+    std::vector<double> png_kb, png_encode_ms, png_decode_ms, plane_decode_ms;
+    size_t no_pose = 0;
     panmap::ProgressLine progress("frame store", "frames");
     for (size_t i = 0; i < n; ++i) {
       const panmap::DatasetFrame f = reader->read(i);
@@ -147,8 +151,8 @@ int main(int argc, char** argv) {
       // The encoding alone (what add() costs before its file writes and fsyncs), timed on
       // the same images; a frame whose labels need the high plane encodes a little more.
       auto start = Clock::now();
-      panmap::encodeDepthPng(f.rgbd.depth, config.png_compression);
-      panmap::encodeLabelPng(labels, config.png_compression);
+      panmap::encodePlane(f.rgbd.depth, config.compression_level);
+      panmap::encodePlane(labels, config.compression_level);
       if (config.store_color && !f.rgbd.color.empty()) {
         panmap::encodeJpeg(f.rgbd.color, config.color_quality);
       }
@@ -161,8 +165,24 @@ int main(int argc, char** argv) {
       labels_kb.push_back(b.labels / 1000.0);
       color_kb.push_back(b.color / 1000.0);
       total_kb.push_back(b.total() / 1000.0);
-      if (fs::exists(store_dir + "/frames/" + std::to_string(f.rgbd.utime) + ".labels-hi.png")) {
-        ++high_planes;
+      {
+        const std::vector<uint8_t> d_plane =
+            panmap::encodePlane(f.rgbd.depth, config.compression_level);
+        const std::vector<uint8_t> l_plane = panmap::encodePlane(labels, config.compression_level);
+        auto t = Clock::now();
+        panmap::decodeDepthPlane(d_plane.data(), d_plane.size(), "depth");
+        panmap::decodeLabelPlane(l_plane.data(), l_plane.size(), "labels");
+        plane_decode_ms.push_back(msSince(t));
+        // Association's labels stay below 2^24 here: one label PNG holds them.
+        t = Clock::now();
+        const std::vector<uint8_t> d_png = panmap::encodeDepthPng(f.rgbd.depth, 6);
+        const std::vector<uint8_t> l_png = panmap::encodeLabelPng(labels, 6);
+        png_encode_ms.push_back(msSince(t));
+        png_kb.push_back((d_png.size() + l_png.size()) / 1000.0);
+        t = Clock::now();
+        panmap::decodeDepthPng(d_png.data(), d_png.size(), "depth");
+        panmap::decodeLabelPng(l_png.data(), l_png.size(), "labels");
+        png_decode_ms.push_back(msSince(t));
       }
       distinct.push_back(static_cast<double>(
           std::set<int32_t>(labels.data(), labels.data() + labels.size()).size()));
@@ -196,27 +216,31 @@ int main(int argc, char** argv) {
 
     std::printf(
         "frame store: %zu frames of %s%s, labels of a geometry-only run at %.0f cm, "
-        "PNG level %d, colour %s\n",
+        "zstd level %d, colour %s\n",
         utimes.size(), data.c_str(),
         no_pose ? (" (" + std::to_string(no_pose) + " without a pose skipped)").c_str() : "",
-        voxel_size_m * 100.0, config.png_compression,
+        voxel_size_m * 100.0, config.compression_level,
         config.store_color ? ("JPEG q" + std::to_string(config.color_quality)).c_str() : "off");
     const auto row = [](const char* what, const std::vector<double>& v, const char* unit) {
       const Summary s = summarise(v);
       std::printf("  %-18s median %7.1f  p95 %7.1f  max %7.1f %s\n", what, s.median, s.p95, s.max,
                   unit);
     };
-    row("depth PNG", depth_kb, "kB");
-    row("label PNG", labels_kb, "kB");
+    row("depth plane", depth_kb, "kB");
+    row("label plane", labels_kb, "kB");
     if (config.store_color) row("colour JPEG", color_kb, "kB");
     row("total", total_kb, "kB");
     row("labels per frame", distinct, "");
-    std::printf("  label high plane   %zu of %zu frames\n", high_planes, utimes.size());
     std::printf("  on disk            %.1f MB (%.1f kB per frame, index included)\n",
                 bytes_on_disk / 1e6, bytes_on_disk / 1e3 / utimes.size());
     row("add()", add_ms, "ms");
     row("  of it encoding", encode_ms, "ms");
     row("load()", load_ms, "ms");
+    row("  decoding planes", plane_decode_ms, "ms");
+    std::printf("  the same images as PNGs at zlib level 6 (store version 1):\n");
+    row("  depth + labels", png_kb, "kB");
+    row("  encoding", png_encode_ms, "ms");
+    row("  decoding", png_decode_ms, "ms");
     std::printf("  open()             %.1f ms for %zu frames (CRC-32 of every file)\n", open_ms,
                 utimes.size());
     const Summary total = summarise(total_kb);

@@ -1,12 +1,14 @@
-// Feeds image file bytes (JPEG / PNG) to the colour, depth and label decoders, in memory.
+// Feeds image file bytes (JPEG / PNG / zstd planes) to the colour, depth and label decoders,
+// in memory.
 #include <cstddef>
 #include <cstdint>
 #include <exception>
 
 #include "panmap/io/image_codec.h"
+#include "panmap/io/plane_codec.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  // The same bytes go to all three decoders: each refuses other kinds with an Error, and a
+  // The same bytes go to all five decoders: each refuses other kinds with an Error, and a
   // file that one decoder accepts is exactly what the others must refuse cleanly.
   try {
     panmap::isCompleteJpeg(data, size);
@@ -19,6 +21,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   try {
     panmap::decodeLabelPng(data, size, "fuzz");
+  } catch (const std::exception&) {
+  }
+  try {
+    panmap::decodeDepthPlane(data, size, "fuzz");
+  } catch (const std::exception&) {
+  }
+  try {
+    panmap::decodeLabelPlane(data, size, "fuzz");
   } catch (const std::exception&) {
   }
   return 0;

@@ -17,6 +17,7 @@
 #include "panmap/command_t.hpp"
 #include "panmap/core/error.h"
 #include "panmap/io/image_codec.h"
+#include "panmap/io/plane_codec.h"
 #include "panmap/io/ply.h"
 #include "panmap/lcm/conversions.h"
 #include "panmap/lcm/correction_conversions.h"
@@ -134,6 +135,8 @@ void imageSeeds() {
   seed("image_codec", "color.jpg", panmap::encodeJpeg(f.color, 80));
   panmap::LabelImage grey(kW, kH, 7);
   seed("image_codec", "labels_rgb.png", panmap::encodeLabelPng(tinyPanoptic(0, 0).segment_ids));
+  seed("image_codec", "depth.zst", panmap::encodePlane(f.depth));
+  seed("image_codec", "labels.zst", panmap::encodePlane(tinyPanoptic(0, 0).segment_ids));
 }
 
 void plySeeds() {

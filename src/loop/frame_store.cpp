@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cinttypes>
 #include <cmath>
@@ -19,19 +20,44 @@
 #include "panmap/core/error.h"
 #include "panmap/io/atomic_file.h"
 #include "panmap/io/image_codec.h"
+#include "panmap/io/plane_codec.h"
 
 namespace panmap {
 
 namespace {
 
 constexpr char kIndexName[] = "index.txt";
-constexpr char kVersionLine[] = "panmap-frame-store 1";
+// Version 2 keeps depth and labels as zstd planes (io/plane_codec.h); version 1 kept PNGs
+// (decoding them was most of a repair's time). Stores of either version are read and grow
+// in their own format.
+constexpr char kVersionPrefix[] = "panmap-frame-store ";
+constexpr int kVersion = 2;
+// The zlib level version 1 stores were written with.
+constexpr int kVersion1PngLevel = 6;
 // Poses the mapper accepts (Mapper::validate uses the same tolerance) must be storable.
 constexpr double kRigidTolerance = 1e-4;
 // Tokens of an index line, its CRC included.
 constexpr size_t kFrameTokens = 30;
 constexpr size_t kPoseTokens = 15;
 constexpr size_t kMaskTokens = 9;
+
+// File names of a frame's images, by store version: version 1 split labels above 2^24 into a
+// second PNG, a plane holds every int32 in one file.
+struct Suffixes {
+  const char* depth;
+  const char* labels;
+  const char* labels_hi;
+  const char* masks;
+  const char* masks_hi;
+};
+
+const Suffixes& suffixesOf(int version) {
+  static const Suffixes kPng{".depth.png", ".labels.png", ".labels-hi.png", ".masks.png",
+                             ".masks-hi.png"};
+  static const Suffixes kPlanes{".depth.zst", ".labels.zst", ".labels-hi.png", ".masks.zst",
+                                ".masks-hi.png"};
+  return version == 1 ? kPng : kPlanes;
+}
 
 uint32_t crcOf(const uint8_t* data, size_t size) {
   uLong crc = crc32(0L, Z_NULL, 0);
@@ -168,9 +194,9 @@ void FrameStoreConfig::check() const {
     throw Error("frame_store color_quality must be in [1, 100] (is " +
                 std::to_string(color_quality) + ")");
   }
-  if (png_compression < 0 || png_compression > 9) {
-    throw Error("frame_store png_compression must be in [0, 9] (is " +
-                std::to_string(png_compression) + ")");
+  if (compression_level < 1 || compression_level > 19) {
+    throw Error("frame_store compression_level must be in [1, 19] (is " +
+                std::to_string(compression_level) + ")");
   }
   if (folder.find('\n') != std::string::npos) {
     throw Error("frame_store folder must not contain a line break");
@@ -193,7 +219,8 @@ FrameStore::FrameStore(const FrameStoreConfig& config, bool create, Check check)
       throw Error("frame store: cannot create " + config_.folder + "/frames: " + ec.message());
     }
     // The version line goes in atomically: an index either exists whole or not at all.
-    const std::string header = std::string(kVersionLine) + "\n";
+    version_ = kVersion;
+    const std::string header = kVersionPrefix + std::to_string(kVersion) + "\n";
     writeAtomically(index_path_, std::vector<uint8_t>(header.begin(), header.end()));
   } else {
     fs::create_directories(config_.folder + "/frames", ec);
@@ -228,10 +255,13 @@ void FrameStore::readIndex(Check check) {
   const std::vector<uint8_t> bytes = readFileBytes(index_path_);
   const std::string text(bytes.begin(), bytes.end());
   const size_t first_end = text.find('\n');
-  if (first_end == std::string::npos || text.substr(0, first_end) != kVersionLine) {
+  const std::string first = text.substr(0, std::min(first_end, text.size()));
+  if (first_end == std::string::npos || (first != kVersionPrefix + std::string("1") &&
+                                         first != kVersionPrefix + std::to_string(kVersion))) {
     throw Error("frame store " + config_.folder + ": " + kIndexName + " does not start with '" +
-                kVersionLine + "'");
+                kVersionPrefix + "1' or '" + kVersionPrefix + std::to_string(kVersion) + "'");
   }
+  version_ = first.back() - '0';
   // A line without its line break was being appended when the process died: the frame's files
   // may be whole, but its line is not, so it is dropped (and cut off, so that the next line
   // appended starts on a line of its own).
@@ -346,10 +376,11 @@ void FrameStore::readIndex(Check check) {
 }
 
 std::string FrameStore::checkFiles(int64_t utime, const Entry& entry, Check check) const {
+  const Suffixes& sfx = suffixesOf(version_);
   const std::pair<const FileRecord*, const char*> files[7] = {
-      {&entry.depth, ".depth.png"},         {&entry.labels, ".labels.png"},
-      {&entry.labels_hi, ".labels-hi.png"}, {&entry.color, ".color.jpg"},
-      {&entry.masks, ".masks.png"},         {&entry.masks_hi, ".masks-hi.png"},
+      {&entry.depth, sfx.depth},         {&entry.labels, sfx.labels},
+      {&entry.labels_hi, sfx.labels_hi}, {&entry.color, ".color.jpg"},
+      {&entry.masks, sfx.masks},         {&entry.masks_hi, sfx.masks_hi},
       {&entry.segments, ".segments.txt"}};
   const std::string what = "frame " + std::to_string(utime) + ": ";
   for (const auto& [record, suffix] : files) {
@@ -450,13 +481,22 @@ void FrameStore::add(int64_t utime, const Eigen::Isometry3d& T_W_C, const Pinhol
     rec->size = bytes.size();
     rec->crc = crcOf(bytes.data(), bytes.size());
   };
-  store(encodeDepthPng(depth, config_.png_compression), ".depth.png", &entry.depth);
-  // A label PNG holds 24 bits per pixel (COCO panoptic RGB); super-point and segment ids stay
-  // far below 2^24 in practice, but an int32 has 8 more bits: they go to a second plane
-  // written only when some id uses them, so every int32 (negative ones too) round-trips.
-  // Returns whether the second plane was written.
+  const Suffixes& sfx = suffixesOf(version_);
+  if (version_ == 1) {
+    store(encodeDepthPng(depth, kVersion1PngLevel), sfx.depth, &entry.depth);
+  } else {
+    store(encodePlane(depth, config_.compression_level), sfx.depth, &entry.depth);
+  }
+  // A plane holds every int32. A label PNG (version 1) holds 24 bits per pixel (COCO panoptic
+  // RGB); super-point and segment ids stay far below 2^24 in practice, but an int32 has 8 more
+  // bits: they go to a second PNG written only when some id uses them, so every int32
+  // (negative ones too) round-trips. Returns whether the second file was written.
   const auto storePlanes = [&](const LabelImage& ids, const char* suffix, const char* hi_suffix,
                                FileRecord* rec, FileRecord* hi_rec) {
+    if (version_ != 1) {
+      store(encodePlane(ids, config_.compression_level), suffix, rec);
+      return false;
+    }
     LabelImage low(ids.width(), ids.height());
     LabelImage high(ids.width(), ids.height());
     bool any_high = false;
@@ -466,17 +506,17 @@ void FrameStore::add(int64_t utime, const Eigen::Isometry3d& T_W_C, const Pinhol
       high.data()[i] = static_cast<int32_t>(bits >> 24);
       any_high = any_high || (bits >> 24) != 0;
     }
-    store(encodeLabelPng(low, config_.png_compression), suffix, rec);
-    if (any_high) store(encodeLabelPng(high, config_.png_compression), hi_suffix, hi_rec);
+    store(encodeLabelPng(low, kVersion1PngLevel), suffix, rec);
+    if (any_high) store(encodeLabelPng(high, kVersion1PngLevel), hi_suffix, hi_rec);
     return any_high;
   };
   const bool labels_high =
-      storePlanes(labels, ".labels.png", ".labels-hi.png", &entry.labels, &entry.labels_hi);
+      storePlanes(labels, sfx.labels, sfx.labels_hi, &entry.labels, &entry.labels_hi);
   if (with_color) store(encodeJpeg(*color, config_.color_quality), ".color.jpg", &entry.color);
   bool masks_high = false;
   if (panoptic) {
-    masks_high = storePlanes(panoptic->segment_ids, ".masks.png", ".masks-hi.png", &entry.masks,
-                             &entry.masks_hi);
+    masks_high =
+        storePlanes(panoptic->segment_ids, sfx.masks, sfx.masks_hi, &entry.masks, &entry.masks_hi);
     std::string text;
     char row[128];
     for (const PanopticSegment& seg : panoptic->segments) {
@@ -489,11 +529,11 @@ void FrameStore::add(int64_t utime, const Eigen::Isometry3d& T_W_C, const Pinhol
     store(std::vector<uint8_t>(text.begin(), text.end()), ".segments.txt", &entry.segments);
   }
   // Files an earlier, interrupted add() of this utime may have left (never in the index).
-  if (!labels_high) std::remove(framePath(utime, ".labels-hi.png").c_str());
+  if (!labels_high) std::remove(framePath(utime, sfx.labels_hi).c_str());
   if (!with_color) std::remove(framePath(utime, ".color.jpg").c_str());
-  if (!masks_high) std::remove(framePath(utime, ".masks-hi.png").c_str());
+  if (!masks_high) std::remove(framePath(utime, sfx.masks_hi).c_str());
   if (!panoptic) {
-    std::remove(framePath(utime, ".masks.png").c_str());
+    std::remove(framePath(utime, sfx.masks).c_str());
     std::remove(framePath(utime, ".segments.txt").c_str());
   }
 
@@ -552,8 +592,8 @@ StoredFrame FrameStore::load(int64_t utime) const {
     }
     entry = it->second;
   }
-  // Checked against the index before decoding: a PNG whose chunks are intact can still be
-  // another frame's file.
+  // Checked against the index before decoding: a file that decodes can still be another
+  // frame's.
   const auto read = [&](const char* suffix, const FileRecord& rec) {
     const std::string path = framePath(utime, suffix);
     std::vector<uint8_t> bytes = readFileBytes(path);
@@ -570,13 +610,19 @@ StoredFrame FrameStore::load(int64_t utime) const {
   out.rgbd.camera = entry.camera;
   out.rgbd.depth_scale_m = entry.depth_scale_m;
   const std::string name = "frame store: frame " + std::to_string(utime) + ": ";
+  const Suffixes& sfx = suffixesOf(version_);
   {
-    const std::vector<uint8_t> bytes = read(".depth.png", entry.depth);
-    out.rgbd.depth = decodeDepthPng(bytes.data(), bytes.size(), name + "depth");
+    const std::vector<uint8_t> bytes = read(sfx.depth, entry.depth);
+    out.rgbd.depth = version_ == 1 ? decodeDepthPng(bytes.data(), bytes.size(), name + "depth")
+                                   : decodeDepthPlane(bytes.data(), bytes.size(), name + "depth");
   }
   const auto readPlanes = [&](const char* suffix, const FileRecord& rec, const char* hi_suffix,
                               const FileRecord& hi_rec, const std::string& what) {
     const std::vector<uint8_t> bytes = read(suffix, rec);
+    if (version_ != 1) {
+      if (hi_rec.size > 0) throw Error(name + what + ": a second plane in a version 2 store");
+      return decodeLabelPlane(bytes.data(), bytes.size(), name + what);
+    }
     LabelImage ids = decodeLabelPng(bytes.data(), bytes.size(), name + what);
     if (hi_rec.size > 0) {
       const std::vector<uint8_t> hi_bytes = read(hi_suffix, hi_rec);
@@ -592,12 +638,12 @@ StoredFrame FrameStore::load(int64_t utime) const {
     }
     return ids;
   };
-  out.labels = readPlanes(".labels.png", entry.labels, ".labels-hi.png", entry.labels_hi, "labels");
+  out.labels = readPlanes(sfx.labels, entry.labels, sfx.labels_hi, entry.labels_hi, "labels");
   if (entry.masks.size > 0) {
     out.has_panoptic = true;
     out.panoptic.utime = utime;
     out.panoptic.segment_ids =
-        readPlanes(".masks.png", entry.masks, ".masks-hi.png", entry.masks_hi, "masks");
+        readPlanes(sfx.masks, entry.masks, sfx.masks_hi, entry.masks_hi, "masks");
     const std::vector<uint8_t> bytes = read(".segments.txt", entry.segments);
     std::istringstream in(std::string(bytes.begin(), bytes.end()));
     std::string row;

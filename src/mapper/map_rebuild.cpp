@@ -1,6 +1,7 @@
 // MapRebuild: the maps of a repair, built aside from the live ones.
 #include "panmap/mapper/map_rebuild.h"
 
+#include <future>
 #include <string>
 
 #include "panmap/core/error.h"
@@ -55,10 +56,22 @@ void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
                 std::to_string(labels->height()) + ", depth " + std::to_string(frame.camera.width) +
                 "x" + std::to_string(frame.camera.height));
   }
-  const IntegrationStats integration =
-      integrator_->integrate(frame, T_W_C, labelled ? labels : nullptr, map_.get());
+  // The occupancy update needs only the frame and its pose. On a thread of its own it fills
+  // the gaps the integrator's parallel loops leave on the two cores (its serial parts, the
+  // ends of loops): a 1,000-frame repair went from 7.9 to 6.0 s (docs/LOOP_CLOSURE.md).
+  std::future<void> occupancy;
+  if (occupancy_) {
+    occupancy = std::async(std::launch::async, [&] { occupancy_->integrate(frame, T_W_C); });
+  }
+  IntegrationStats integration;
+  try {
+    integration = integrator_->integrate(frame, T_W_C, labelled ? labels : nullptr, map_.get());
+  } catch (...) {
+    if (occupancy.valid()) occupancy.wait();  // it reads the frame
+    throw;
+  }
   votes_evicted_ += integration.votes_evicted;
-  if (occupancy_) occupancy_->integrate(frame, T_W_C);
+  if (occupancy.valid()) occupancy.get();  // rethrows its error, if any
   poses_.push_back(pose);
 }
 

@@ -140,8 +140,11 @@ TEST(FrameStore, RoundTripIsExact) {
   EXPECT_EQ(store.utimes(), std::vector<int64_t>{1000});
   const StoredFrame f = store.load(1000);
   expectFrame(f, 0);
-  // The labels above 2^24 (and -1) need the second plane; frames without them do not write it.
-  EXPECT_TRUE(fs::exists(dir.path("store/frames/1000.labels-hi.png")));
+  // A new store writes version 2: one zstd plane per image, whatever its labels.
+  EXPECT_EQ(store.version(), 2);
+  EXPECT_TRUE(fs::exists(dir.path("store/frames/1000.depth.zst")));
+  EXPECT_TRUE(fs::exists(dir.path("store/frames/1000.labels.zst")));
+  EXPECT_FALSE(fs::exists(dir.path("store/frames/1000.labels-hi.png")));
   EXPECT_TRUE(f.rgbd.color.empty());  // colour is off by default
   // Bytes on disk are the files plus the index.
   uint64_t files = 0;
@@ -152,17 +155,79 @@ TEST(FrameStore, RoundTripIsExact) {
   EXPECT_EQ(store.frameBytes(1000).total(), files);
 }
 
-TEST(FrameStore, LabelsBelow2To24WriteOnePlane) {
+TEST(FrameStore, EveryCompressionLevelRoundTrips) {
   TempDir dir;
-  FrameStore store(configIn(dir));
-  LabelImage l(kWidth, kHeight, 70000);
-  l(3, 4) = 0;
-  l(5, 6) = (1 << 24) - 1;
-  store.add(7, pose(0.0), camera(), 0.00025, depth(0), l);
-  EXPECT_FALSE(fs::exists(dir.path("store/frames/7.labels-hi.png")));
-  const StoredFrame f = store.load(7);
-  EXPECT_TRUE(f.labels == l);
-  EXPECT_EQ(f.rgbd.depth_scale_m, 0.00025);
+  for (int level : {1, 19}) {
+    FrameStoreConfig config = configIn(dir);
+    config.folder = dir.path("store" + std::to_string(level));
+    config.compression_level = level;
+    FrameStore store(config);
+    store.add(7, pose(0.0), camera(), 0.00025, depth(0), labels(2));
+    const StoredFrame f = store.load(7);
+    EXPECT_TRUE(f.labels == labels(2));
+    EXPECT_TRUE(f.rgbd.depth == depth(0));
+    EXPECT_EQ(f.rgbd.depth_scale_m, 0.00025);
+  }
+}
+
+// tests/fixtures/frame_store_v1 was written by panmap at commit 4b7e4d0 (PNG frames, a second
+// PNG for ids above 2^24), two 8x6 frames, the second with a segmentation, then a pose update.
+TEST(FrameStore, Version1StoresAreReadAndGrowInTheirOwnFormat) {
+  TempDir dir;
+  fs::copy(test::fixtureDir("frame_store_v1"), dir.path("store"), fs::copy_options::recursive);
+  auto expected_depth = [](int f) {
+    DepthImage d(8, 6);
+    for (int i = 0; i < 48; ++i) d.data()[i] = static_cast<uint16_t>(1000 + 37 * i + f);
+    d.data()[0] = 0;
+    d.data()[1] = 65535;
+    return d;
+  };
+  auto expected_labels = [](int f) {
+    LabelImage l(8, 6);
+    for (int i = 0; i < 48; ++i) l.data()[i] = 1 + f + i / 12;
+    l.data()[0] = 0;
+    l.data()[1] = (1 << 24) + 5;
+    l.data()[2] = std::numeric_limits<int32_t>::max();
+    l.data()[3] = -1;
+    return l;
+  };
+  {
+    const auto store = FrameStore::open(dir.path("store"));
+    EXPECT_TRUE(store->problems().empty());
+    EXPECT_EQ(store->version(), 1);
+    ASSERT_EQ(store->utimes(), (std::vector<int64_t>{1000000, 1200000}));
+    const StoredFrame a = store->load(1000000);
+    EXPECT_TRUE(a.rgbd.depth == expected_depth(0));
+    EXPECT_TRUE(a.labels == expected_labels(0));
+    EXPECT_FALSE(a.has_panoptic);
+    EXPECT_EQ(a.T_W_C.translation(), Eigen::Vector3d(0.0, -0.5, 1.125));  // the pose update
+    const StoredFrame b = store->load(1200000);
+    EXPECT_TRUE(b.labels == expected_labels(1));
+    ASSERT_TRUE(b.has_panoptic);
+    EXPECT_EQ(b.panoptic.segment_ids(0, 0), 1);
+    EXPECT_EQ(b.panoptic.segment_ids(7, 5), (1 << 24) + 2);
+    ASSERT_EQ(b.panoptic.segments.size(), 2u);
+    EXPECT_EQ(b.panoptic.segments[0].score, 0.75f);
+  }
+  // Continuing the store adds PNG frames to it, which read back like the old ones.
+  FrameStore again(configIn(dir));
+  EXPECT_EQ(again.version(), 1);
+  LabelImage l = expected_labels(5);
+  again.add(1400000, pose(0.2), again.load(1000000).rgbd.camera, 0.001, expected_depth(5), l);
+  EXPECT_TRUE(fs::exists(dir.path("store/frames/1400000.depth.png")));
+  EXPECT_TRUE(fs::exists(dir.path("store/frames/1400000.labels-hi.png")));
+  const auto reopened = FrameStore::open(dir.path("store"));
+  EXPECT_TRUE(reopened->problems().empty());
+  EXPECT_EQ(reopened->size(), 3u);
+  EXPECT_TRUE(reopened->load(1400000).labels == l);
+}
+
+TEST(FrameStore, AnIndexOfAnotherVersionIsRefusedByName) {
+  TempDir dir;
+  fs::create_directories(dir.path("store"));
+  std::ofstream(dir.path("store/index.txt")) << "panmap-frame-store 3\n";
+  expectError([&] { FrameStore::open(dir.path("store")); },
+              {"index.txt", "panmap-frame-store 1", "panmap-frame-store 2"});
 }
 
 TEST(FrameStore, ColourIsStoredAsJpegWhenAsked) {
@@ -229,10 +294,12 @@ TEST(FrameStore, MissingCutOrCorruptFilesAreNamedAndSkipped) {
     for (int i = 0; i < 5; ++i) addFrame(&store, i);
   }
   const std::string frames = dir.path("store/frames/");
-  fs::remove(frames + "1001.depth.png");
-  fs::resize_file(frames + "1002.labels.png", fs::file_size(frames + "1002.labels.png") / 2);
-  flipByte(frames + "1003.depth.png", 100);  // same size, other bytes
-  fs::remove(frames + "1004.labels-hi.png");
+  fs::remove(frames + "1001.depth.zst");
+  fs::resize_file(frames + "1002.labels.zst", fs::file_size(frames + "1002.labels.zst") / 2);
+  flipByte(frames + "1003.depth.zst", 100);  // same size, other bytes
+  // A file of the wrong frame: same name pattern, another frame's bytes.
+  fs::copy_file(frames + "1000.labels.zst", frames + "1004.labels.zst",
+                fs::copy_options::overwrite_existing);
 
   const auto store = FrameStore::open(dir.path("store"));
   EXPECT_EQ(store->utimes(), std::vector<int64_t>{1000});
@@ -246,17 +313,17 @@ TEST(FrameStore, MissingCutOrCorruptFilesAreNamedAndSkipped) {
     }
     return false;
   };
-  EXPECT_TRUE(named("frame 1001", "1001.depth.png is missing"));
-  EXPECT_TRUE(named("frame 1002", "1002.labels.png has"));
-  EXPECT_TRUE(named("frame 1003", "1003.depth.png is corrupt"));
-  EXPECT_TRUE(named("frame 1004", "1004.labels-hi.png is missing"));
+  EXPECT_TRUE(named("frame 1001", "1001.depth.zst is missing"));
+  EXPECT_TRUE(named("frame 1002", "1002.labels.zst has"));
+  EXPECT_TRUE(named("frame 1003", "1003.depth.zst is corrupt"));
+  EXPECT_TRUE(named("frame 1004", "1004.labels.zst"));
   expectFrame(store->load(1000), 0);
   expectError([&] { store->load(1003); }, {"1003"});
 
   // Checking sizes only lets the same-size corruption through to load(), which names the file.
   const auto quick = FrameStore::open(dir.path("store"), FrameStore::Check::kSizes);
   EXPECT_EQ(quick->utimes(), (std::vector<int64_t>{1000, 1003}));
-  expectError([&] { quick->load(1003); }, {"frame 1003", "1003.depth.png", "differs"});
+  expectError([&] { quick->load(1003); }, {"frame 1003", "1003.depth.zst", "differs"});
 }
 
 TEST(FrameStore, CutLastIndexLineIsDroppedAndTheStoreContinues) {
@@ -367,7 +434,7 @@ TEST(FrameStore, AddRefusesDuplicatesAndBadInputStoringNothing) {
               {"frame 1", "intrinsics"});
   EXPECT_EQ(store.size(), 1u);
   EXPECT_EQ(store.bytesOnDisk(), bytes);
-  EXPECT_FALSE(fs::exists(dir.path("store/frames/1.depth.png")));
+  EXPECT_FALSE(fs::exists(dir.path("store/frames/1.depth.zst")));
 }
 
 TEST(FrameStore, ConfigCheckRejectsBadValues) {
@@ -378,11 +445,11 @@ TEST(FrameStore, ConfigCheckRejectsBadValues) {
   config.color_quality = 101;
   expectError([&] { config.check(); }, {"color_quality"});
   config.color_quality = 50;
-  config.png_compression = 10;
-  expectError([&] { config.check(); }, {"png_compression"});
-  config.png_compression = -1;
-  expectError([&] { config.check(); }, {"png_compression"});
-  config.png_compression = 0;  // stored, not compressed: still valid
+  config.compression_level = 20;
+  expectError([&] { config.check(); }, {"compression_level"});
+  config.compression_level = 0;
+  expectError([&] { config.check(); }, {"compression_level"});
+  config.compression_level = 1;
   EXPECT_NO_THROW(config.check());
   config.folder = "a\nb";
   expectError([&] { config.check(); }, {"folder"});
@@ -431,7 +498,8 @@ TEST(FrameStore, PanopticSegmentationsRoundTripExactly) {
   EXPECT_EQ(f.panoptic.utime, 2000);
   EXPECT_TRUE(f.panoptic.segment_ids == p.segment_ids);
   EXPECT_EQ(f.panoptic.segments, p.segments);
-  EXPECT_TRUE(fs::exists(dir.path("store/frames/2000.masks-hi.png")));
+  EXPECT_TRUE(fs::exists(dir.path("store/frames/2000.masks.zst")));
+  EXPECT_FALSE(fs::exists(dir.path("store/frames/2000.masks-hi.png")));
   const StoredFrame g = store->load(1000);
   EXPECT_FALSE(g.has_panoptic);
   expectFrame(g, 0);

@@ -27,10 +27,10 @@ struct FrameStoreConfig {
   bool store_color = false;
   /// JPEG quality of the stored colour, 1..100 (only with store_color).
   int color_quality = 50;
-  /// zlib level of the depth and label PNGs, 0..9 (lossless at every level): 6 keeps a
-  /// 7-Scenes frame within the 150 kB budget, 1 encodes twice as fast but does not
+  /// zstd level of the depth and label planes, 1..19 (lossless at every level; decoding speed
+  /// does not depend on it). 5 keeps a 7-Scenes frame within the 150 kB budget
   /// (docs/LOOP_CLOSURE.md, panmap-bench-frame-store).
-  int png_compression = 6;
+  int compression_level = 5;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -60,12 +60,14 @@ struct StoredFrame {
 ///
 /// Layout of the folder: `index.txt` (a version line, then one line per added frame and per
 /// pose update, each ending in its CRC-32; a frame stored with its panoptic segmentation has a
-/// `masks` line right after its frame line, appended with it) and `frames/<utime>.depth.png`
-/// (16-bit, as integrated), `.labels.png` (label bits 0-23, COCO panoptic RGB),
-/// `.labels-hi.png` (bits 24-31, only when some label needs them), `.color.jpg` (store_color
-/// only), and with a segmentation `.masks.png` / `.masks-hi.png` (segment ids, as the labels)
-/// and `.segments.txt` (one segment per line: id, category, source category, thing 0/1,
-/// score). Each file is
+/// `masks` line right after its frame line, appended with it) and `frames/<utime>.depth.zst`
+/// (16-bit depth as integrated, a zstd plane of io/plane_codec.h), `.labels.zst` (int32
+/// labels, a plane), `.color.jpg` (store_color only), and with a segmentation `.masks.zst`
+/// (segment ids, a plane) and `.segments.txt` (one segment per line: id, category, source
+/// category, thing 0/1, score). Stores of version 1 (`panmap-frame-store 1`) keep depth as a
+/// 16-bit PNG and labels and masks as COCO panoptic RGB PNGs (bits 0-23) with a second PNG
+/// for bits 24-31 when some id needs them (`.labels-hi.png`, `.masks-hi.png`); they are read
+/// and grow in their own format. Each file is
 /// written atomically (AtomicFileWriter) before the frame's index line is appended and synced,
 /// so a crash at any moment leaves whole frames, a frame missing from the index, or a cut last
 /// index line, which reopening names and drops.
@@ -149,6 +151,9 @@ class FrameStore {
   size_t skipped() const;
   /// The config in use.
   const FrameStoreConfig& config() const { return config_; }
+  /// Format version of the store's files: 2 (zstd planes) for a new store, 1 (PNGs) for a
+  /// store written before.
+  int version() const { return version_; }
 
   /// Bytes of one frame's files, as add() wrote them (for measurements).
   struct FrameBytes {
@@ -188,6 +193,7 @@ class FrameStore {
 
   FrameStoreConfig config_;
   std::string index_path_;
+  int version_ = 2;           ///< format of the frames' files (index version line); set on opening
   mutable std::mutex mutex_;  ///< guards everything below
   int index_fd_ = -1;
   std::map<int64_t, Entry> entries_;
