@@ -89,9 +89,9 @@ struct OptimiserConfig {
     /// (docs/CALIBRATION.md) so that about a share c of the objects reported with confidence
     /// c match a real object. The class share did not help on scene kinds left out of the
     /// fit: held at 0.
-    double bias = 0.4745;
-    double area = 2.5046;
-    double support = 0.8669;
+    double bias = 0.2772;
+    double area = 2.5930;
+    double support = 0.9467;
     double share = 0.0;
   };
   Objects objects;
