@@ -34,14 +34,10 @@ bool littleEndianHost() {
   return first == 1;
 }
 
-// Pixels in little-endian byte order: a copy on this machine, byte by byte elsewhere, so a
-// store written on one host decodes on any.
+// Pixels in little-endian byte order, so a store written on one host decodes on any (on a
+// little-endian host the pixels are coded in place, without these).
 template <typename T>
 void toLittleEndian(const T* pixels, size_t count, uint8_t* out) {
-  if (littleEndianHost()) {
-    std::memcpy(out, pixels, count * sizeof(T));
-    return;
-  }
   for (size_t i = 0; i < count; ++i) {
     const auto bits = static_cast<std::make_unsigned_t<T>>(pixels[i]);
     for (size_t b = 0; b < sizeof(T); ++b)
@@ -51,10 +47,6 @@ void toLittleEndian(const T* pixels, size_t count, uint8_t* out) {
 
 template <typename T>
 void fromLittleEndian(const uint8_t* in, size_t count, T* pixels) {
-  if (littleEndianHost()) {
-    std::memcpy(pixels, in, count * sizeof(T));
-    return;
-  }
   for (size_t i = 0; i < count; ++i) {
     std::make_unsigned_t<T> bits = 0;
     for (size_t b = 0; b < sizeof(T); ++b) {
@@ -72,8 +64,13 @@ std::vector<uint8_t> encode(const Image& image, uint8_t type, int level) {
                 std::to_string(ZSTD_maxCLevel()));
   }
   const size_t raw_bytes = image.size() * sizeof(Pixel);
-  std::vector<uint8_t> raw(raw_bytes);
-  toLittleEndian(image.data(), image.size(), raw.data());
+  std::vector<uint8_t> swapped;
+  const void* raw = image.data();
+  if (!littleEndianHost()) {
+    swapped.resize(raw_bytes);
+    toLittleEndian(image.data(), image.size(), swapped.data());
+    raw = swapped.data();
+  }
   std::vector<uint8_t> out(kHeaderBytes + ZSTD_compressBound(raw_bytes));
   std::memcpy(out.data(), kMagic, 4);
   out[4] = type;
@@ -87,7 +84,7 @@ std::vector<uint8_t> encode(const Image& image, uint8_t type, int level) {
   ZSTD_CCtx_setParameter(context.get(), ZSTD_c_compressionLevel, level);
   ZSTD_CCtx_setParameter(context.get(), ZSTD_c_checksumFlag, 1);
   const size_t n = ZSTD_compress2(context.get(), out.data() + kHeaderBytes,
-                                  out.size() - kHeaderBytes, raw.data(), raw_bytes);
+                                  out.size() - kHeaderBytes, raw, raw_bytes);
   if (ZSTD_isError(n)) throw Error(std::string("plane codec: zstd: ") + ZSTD_getErrorName(n));
   out.resize(kHeaderBytes + n);
   return out;
@@ -121,14 +118,15 @@ Image decode(const uint8_t* data, size_t size, uint8_t type, const char* kind,
     throw Error(what + ": the zstd frame does not hold " + std::to_string(width) + "x" +
                 std::to_string(height) + " " + kind + " pixels");
   }
-  std::vector<uint8_t> raw(raw_bytes);
-  const size_t n = ZSTD_decompress(raw.data(), raw.size(), frame, frame_bytes);
+  Image image(static_cast<int>(width), static_cast<int>(height));
+  std::vector<uint8_t> swapped(littleEndianHost() ? 0 : raw_bytes);
+  void* raw = littleEndianHost() ? static_cast<void*>(image.data()) : swapped.data();
+  const size_t n = ZSTD_decompress(raw, raw_bytes, frame, frame_bytes);
   if (ZSTD_isError(n) || n != raw_bytes) {
     throw Error(what + ": corrupt zstd frame" +
                 (ZSTD_isError(n) ? std::string(" (") + ZSTD_getErrorName(n) + ")" : ""));
   }
-  Image image(static_cast<int>(width), static_cast<int>(height));
-  fromLittleEndian(raw.data(), image.size(), image.data());
+  if (!littleEndianHost()) fromLittleEndian(swapped.data(), image.size(), image.data());
   return image;
 }
 
