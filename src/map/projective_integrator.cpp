@@ -17,7 +17,15 @@ void IntegratorConfig::check() const {
   if (!(min_depth_m >= 0.0f && max_depth_m > min_depth_m)) {
     throw Error("integrator needs 0 <= min_depth_m < max_depth_m");
   }
-  if (vote_stride_px < 1) throw Error("integrator vote_stride_px must be >= 1");
+  if (vote_stride_px < 0) throw Error("integrator vote_stride_px must be >= 0 (0 = automatic)");
+}
+
+int voteStride(const IntegratorConfig& config, float voxel_size_m, double fx_px) {
+  if (config.vote_stride_px > 0) return config.vote_stride_px;
+  const double spacing = voxel_size_m * fx_px / (2.0 * config.max_depth_m);
+  // Clamped before the conversion (a huge focal length would overflow int); beyond 64 pixels a
+  // frame would vote in too few places to label small segments at all.
+  return static_cast<int>(std::clamp(std::floor(spacing), 1.0, 64.0));
 }
 
 ProjectiveIntegrator::ProjectiveIntegrator(const IntegratorConfig& config, ThreadPool* pool)
@@ -62,7 +70,7 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
   const PinholeCamera& cam = frame.camera;
   const internal::RowCamera row_cam{static_cast<float>(cam.fx), static_cast<float>(cam.fy),
                                     static_cast<float>(cam.cx), static_cast<float>(cam.cy)};
-  const int stride = config_.vote_stride_px;
+  const int stride = voteStride(config_, map->voxelSize(), cam.fx);
   const size_t cols = (cam.width + stride - 1) / stride, rows = (cam.height + stride - 1) / stride;
   const size_t owners = static_cast<size_t>(pool_->size());
   vote_runs_.resize(cols * rows);

@@ -369,7 +369,8 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   # weight falls behind the surface (0/1)\n"
     << "   space_carving: " << m.integrator.space_carving
     << "   # record free space up to the camera (0/1)\n"
-    << "   vote_stride_px: " << m.integrator.vote_stride_px << "   # pixels between label votes\n";
+    << "   vote_stride_px: " << m.integrator.vote_stride_px
+    << "   # pixels between label votes (0 = automatic by voxel size)\n";
   y << "depth_segmentation:\n"
     << "   normals_window_px: " << m.depth_segmentation.normals_window_px << "\n"
     << "   min_convexity_window_px: " << m.depth_segmentation.min_convexity_window_px << "\n"

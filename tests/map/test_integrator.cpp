@@ -27,6 +27,22 @@ RgbdFrame renderFrame(const MeshRenderer& renderer, const Eigen::Isometry3d& T_W
   return frame;
 }
 
+// A wall filling the view 2 m ahead of a camera at the origin looking along +x, its left half
+// (u < 320) labelled 7, its right half 9.
+struct LabelledWall {
+  LabelledWall() : labels(640, 480, 0) {
+    LabelledMesh mesh;
+    test::addQuad(&mesh, {2, -3, -3}, {2, 3, -3}, {2, 3, 3}, {2, -3, 3}, 1, 1, 10);
+    frame = renderFrame(MeshRenderer(mesh), T_W_C);
+    for (int v = 0; v < 480; ++v) {
+      for (int u = 0; u < 640; ++u) labels(u, v) = u < 320 ? 7 : 9;
+    }
+  }
+  Eigen::Isometry3d T_W_C = test::lookAt({0, 0, 0}, {1, 0, 0});
+  RgbdFrame frame;
+  LabelImage labels;
+};
+
 class AnalyticScene : public ::testing::TestWithParam<float> {};
 
 // Floor plane, a sphere and a box, integrated from four poses around them.
@@ -106,15 +122,10 @@ TEST(Integrator, FreeSpaceIsPositiveAndBehindIsNegative) {
 }
 
 TEST(Integrator, VotesGoToSurfaceVoxelsAndSameInputGivesSameMap) {
-  LabelledMesh mesh;
-  test::addQuad(&mesh, {2, -3, -3}, {2, 3, -3}, {2, 3, 3}, {2, -3, 3}, 1, 1, 10);
-  const MeshRenderer renderer(mesh);
-  const Eigen::Isometry3d T = test::lookAt({0, 0, 0}, {1, 0, 0});
-  const RgbdFrame frame = renderFrame(renderer, T);
-  LabelImage labels(640, 480, 0);
-  for (int v = 0; v < 480; ++v) {
-    for (int u = 0; u < 640; ++u) labels(u, v) = u < 320 ? 7 : 9;
-  }
+  const LabelledWall wall;
+  const Eigen::Isometry3d& T = wall.T_W_C;
+  const RgbdFrame& frame = wall.frame;
+  const LabelImage& labels = wall.labels;
   auto run = [&](int threads) {
     auto map = std::make_unique<TsdfMap>(TsdfMap::Config{0.02f});
     ThreadPool pool(threads);
@@ -148,6 +159,71 @@ TEST(Integrator, VotesGoToSurfaceVoxelsAndSameInputGivesSameMap) {
   const Voxel* free_space = one->findVoxel({1.95f, 0.5f, 0.1f});  // 5 cm in front: no vote
   ASSERT_TRUE(free_space);
   EXPECT_EQ(argmaxLabel(*free_space, identity), 0);
+}
+
+TEST(VoteStride, AutomaticIsTheLargestStrideHalfAVoxelApartAtMaxDepth) {
+  ASSERT_EQ(IntegratorConfig{}.vote_stride_px, 1);  // every pixel by default
+  IntegratorConfig automatic;                       // max_depth_m = 3.5
+  automatic.vote_stride_px = 0;
+  // floor(voxel * fx / (2 * 3.5 m)), at least 1.
+  EXPECT_EQ(voteStride(automatic, 0.01f, 525.0), 1);  // 0.75
+  EXPECT_EQ(voteStride(automatic, 0.02f, 525.0), 1);  // 1.5
+  EXPECT_EQ(voteStride(automatic, 0.02f, 585.0), 1);  // 1.67
+  EXPECT_EQ(voteStride(automatic, 0.05f, 525.0), 3);  // 3.75
+  EXPECT_EQ(voteStride(automatic, 0.05f, 585.0), 4);  // 4.18
+  EXPECT_EQ(voteStride(automatic, 0.10f, 525.0), 7);  // 7.5
+  EXPECT_EQ(voteStride(automatic, 10.0f, 1e9), 64);   // clamped
+  automatic.max_depth_m = 2.0f;
+  EXPECT_EQ(voteStride(automatic, 0.05f, 525.0), 6);  // 6.56: a shorter range allows more
+  IntegratorConfig fixed;
+  fixed.vote_stride_px = 2;
+  EXPECT_EQ(voteStride(fixed, 0.05f, 525.0), 2);
+  EXPECT_EQ(voteStride(fixed, 0.01f, 525.0), 2);
+  IntegratorConfig negative;
+  negative.vote_stride_px = -1;
+  EXPECT_THROW(negative.check(), Error);
+}
+
+// At 5 cm voxels a frame's pixels cast ~100 identical votes per voxel: the automatic stride
+// keeps one in 9 and labels the same voxels the same way.
+TEST(Integrator, AutomaticVoteStrideAtCoarseVoxelsLabelsTheSameVoxels) {
+  const LabelledWall wall;
+  const Eigen::Isometry3d& T = wall.T_W_C;
+  const RgbdFrame& frame = wall.frame;
+  const LabelImage& labels = wall.labels;
+  ThreadPool pool(2);
+  auto run = [&](int stride, IntegrationStats* stats) {
+    auto map = std::make_unique<TsdfMap>(TsdfMap::Config{0.05f});
+    IntegratorConfig config;
+    config.vote_stride_px = stride;
+    ProjectiveIntegrator integrator(config, &pool);
+    *stats = integrator.integrate(frame, T, &labels, map.get());
+    return map;
+  };
+  IntegrationStats every_stats, automatic_stats;
+  const auto every = run(1, &every_stats);
+  const auto automatic = run(0, &automatic_stats);
+  // The wall fills the image: every pixel votes at stride 1, pixels (3i, 3j) at stride 3.
+  EXPECT_EQ(every_stats.votes_added, 640u * 480u);
+  EXPECT_EQ(automatic_stats.votes_added, 214u * 160u);
+  auto identity = [](int32_t l) { return l; };
+  size_t voted = 0, kept = 0;
+  for (size_t b = 0; b < every->numBlocks(); ++b) {
+    const Block& one = *every->blocks()[b];
+    const Block& other = *automatic->blocks()[b];
+    ASSERT_EQ(one.index, other.index);
+    for (int i = 0; i < kBlockVoxels; ++i) {
+      const int32_t label = argmaxLabel(one.voxels[i], identity);
+      if (label == 0) continue;
+      ++voted;
+      const int32_t sampled = argmaxLabel(other.voxels[i], identity);
+      if (sampled == 0) continue;
+      ++kept;
+      EXPECT_EQ(sampled, label);
+    }
+  }
+  ASSERT_GT(voted, 1000u);
+  EXPECT_GE(kept, voted * 95 / 100) << kept << " of " << voted;
 }
 
 TEST(Votes, EvictionIsWeakestFirstAndCounted) {

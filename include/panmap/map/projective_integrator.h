@@ -24,11 +24,21 @@ struct IntegratorConfig {
   /// Also allocate blocks between camera and surface and record free space there (voxels
   /// farther than the truncation in front of the surface); off: only the truncation band.
   bool space_carving = false;
-  /// Pixels between label votes (1 = every labelled pixel votes in its point's voxel).
+  /// Pixels between label votes (1 = every labelled pixel votes in its point's voxel); 0 =
+  /// automatic: the largest stride whose samples, at max_depth_m, still fall at most half a
+  /// voxel apart (1 at 1-2 cm voxels and a 525-585 px focal length, 3-4 at 5 cm; see
+  /// voteStride()). Not the default: at 5 cm it changes which objects merge or take a wrong
+  /// class, beyond issue 23's bar of 0.5 mAP50 per scene (docs/VOTE_STRIDE.md).
   int vote_stride_px = 1;
   /// Throws Error naming the bad field.
   void check() const;
 };
+
+/// The vote stride `config` gives for voxels of `voxel_size_m` seen by a camera of focal length
+/// `fx_px`: config.vote_stride_px when set, else max(1, floor(voxel * fx / (2 max_depth))).
+/// Neighbouring votes then land at most half a voxel apart at every depth used, so each surface
+/// voxel a frame sees still gets votes; coarse voxels stop paying for hundreds of equal votes.
+int voteStride(const IntegratorConfig& config, float voxel_size_m, double fx_px);
 
 /// What one integration did.
 struct IntegrationStats {
