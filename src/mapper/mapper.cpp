@@ -5,6 +5,7 @@
 #include <cmath>
 #include <exception>
 #include <iterator>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -81,9 +82,13 @@ MeshUpdate Mapper::updateMesh(const GraphLabels* labels) {
   std::vector<absl::flat_hash_map<int32_t, SuperpointLabels>> caches(threads);
   std::vector<MeshLabeller> labellers;
   for (auto& cache : caches) labellers.push_back(meshLabeller(labels, &cache));
+  std::vector<std::unique_ptr<BlockMeshLabeller>> block_labellers;
+  for (const MeshLabeller& labeller : labellers) {
+    block_labellers.push_back(std::make_unique<BlockMeshLabeller>(*map_, labeller));
+  }
   std::vector<std::vector<std::pair<BlockIndex, LabelledMesh>>> labelled(threads);
   mesher_->update(map_.get(), [&](const BlockMesh& mesh, int thread) {
-    labelled[thread].emplace_back(mesh.index, labelBlockMesh(*map_, mesh, labellers[thread]));
+    labelled[thread].emplace_back(mesh.index, block_labellers[thread]->label(mesh));
   });
   std::vector<std::pair<BlockIndex, LabelledMesh>> all;
   for (auto& list : labelled) std::move(list.begin(), list.end(), std::back_inserter(all));
@@ -100,7 +105,7 @@ MeshUpdate Mapper::updateMesh(const GraphLabels* labels) {
     } else {
       // A block dropped by a rebuild and not meshed since has no surface any more.
       const BlockMesh* mesh = mesher_->find(update.blocks[i]);
-      if (mesh) update.meshes[i] = labelBlockMesh(*map_, *mesh, labellers[0]);
+      if (mesh) update.meshes[i] = block_labellers[0]->label(*mesh);
     }
   }
   return update;

@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <utility>
 
 #include <absl/container/flat_hash_map.h>
 
 #include "panmap/core/error.h"
-#include "panmap/map/voxel_lookup.h"
 #include "panmap/mesh/internal/marching_cubes_tables.h"
 
 namespace panmap {
@@ -100,24 +100,52 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
     neighbours[slot] = map.findBlock(block.index + slotOffset(slot));
   }
 
+  // Per grid row (y, z): the sdf of its 9 voxels, and bit x set when voxel x is inside
+  // (sdf < 0) or observed. Missing blocks read as unobserved with sdf 0.
   float sdf[kGridVoxels];
-  bool observed[kGridVoxels];
-  bool any_inside = false, any_outside = false;
+  uint16_t inside[kGrid * kGrid], observed[kGrid * kGrid];
+  uint32_t any_inside = 0, any_outside = 0;
+  const float min_weight = config.min_weight;
+  // The rows are 352 bytes apart in their blocks and the upper neighbour's voxel of each row
+  // in another block: asking for the next rows' memory early overlaps the cache misses.
+  constexpr int kPrefetchRows = 2;
+  auto prefetchRow = [&neighbours](int y, int z) {
+    const int slot = ((y >> 3) << 1) | ((z >> 3) << 2);
+    if (const Block* b = neighbours[slot]) {
+      const char* p = reinterpret_cast<const char*>(&b->at(0, y & 7, z & 7));
+      for (int offset = 0; offset < kBlockSide * static_cast<int>(sizeof(Voxel)); offset += 64) {
+        __builtin_prefetch(p + offset);
+      }
+    }
+    if (const Block* b = neighbours[slot | 1]) __builtin_prefetch(&b->at(0, y & 7, z & 7));
+  };
+  for (int r = 0; r < kPrefetchRows; ++r) prefetchRow(r, 0);
   for (int z = 0; z < kGrid; ++z) {
     for (int y = 0; y < kGrid; ++y) {
-      for (int x = 0; x < kGrid; ++x) {
-        const int g = gridIndex(x, y, z);
-        const Block* b = neighbours[(x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2)];
+      const int row = y + kGrid * z;
+      const int ahead = row + kPrefetchRows;
+      if (ahead < kGrid * kGrid) prefetchRow(ahead % kGrid, ahead / kGrid);
+      const int slot = ((y >> 3) << 1) | ((z >> 3) << 2);
+      float* row_sdf = sdf + kGrid * row;
+      uint32_t in = 0, obs = 0;
+      for (int part = 0; part < 2; ++part) {
+        const int begin = part * kBlockSide, count = part == 0 ? kBlockSide : 1;
+        const Block* b = neighbours[slot | part];
         if (!b) {
-          sdf[g] = 0.0f;
-          observed[g] = false;
+          std::fill(row_sdf + begin, row_sdf + begin + count, 0.0f);
           continue;
         }
-        const Voxel& v = b->at(x & 7, y & 7, z & 7);
-        sdf[g] = v.sdf_m;
-        observed[g] = v.weight > config.min_weight;
-        if (observed[g]) (v.sdf_m < 0.0f ? any_inside : any_outside) = true;
+        const Voxel* v = &b->at(0, y & 7, z & 7);
+        for (int i = 0; i < count; ++i) {
+          row_sdf[begin + i] = v[i].sdf_m;
+          in |= static_cast<uint32_t>(v[i].sdf_m < 0.0f) << (begin + i);
+          obs |= static_cast<uint32_t>(v[i].weight > min_weight) << (begin + i);
+        }
       }
+      inside[row] = static_cast<uint16_t>(in);
+      observed[row] = static_cast<uint16_t>(obs);
+      any_inside |= in & obs;
+      any_outside |= ~in & obs;
     }
   }
   if (!any_inside || !any_outside) return;  // no observed sign change: nothing to mesh
@@ -140,14 +168,31 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
 
   for (int z = 0; z < kBlockSide; ++z) {
     for (int y = 0; y < kBlockSide; ++y) {
-      for (int x = 0; x < kBlockSide; ++x) {
+      // The four rows holding this row of cubes' corners, by corner offset (dy, dz).
+      const int rows[2][2] = {{y + kGrid * z, y + kGrid * (z + 1)},
+                              {y + 1 + kGrid * z, y + 1 + kGrid * (z + 1)}};
+      uint32_t all_observed =
+          observed[rows[0][0]] & observed[rows[1][0]] & observed[rows[0][1]] & observed[rows[1][1]];
+      uint32_t some_inside =
+          inside[rows[0][0]] | inside[rows[1][0]] | inside[rows[0][1]] | inside[rows[1][1]];
+      uint32_t all_inside =
+          inside[rows[0][0]] & inside[rows[1][0]] & inside[rows[0][1]] & inside[rows[1][1]];
+      // Cube x joins voxels x and x + 1 of each row: it is meshed when its 8 corners are
+      // observed and not all on one side.
+      all_observed &= all_observed >> 1;
+      some_inside |= some_inside >> 1;
+      all_inside &= all_inside >> 1;
+      uint32_t cubes = all_observed & some_inside & ~all_inside & 0xFFu;
+      while (cubes) {
+        const int x = __builtin_ctz(cubes);
+        cubes &= cubes - 1;
         const int g = gridIndex(x, y, z);
         int cube = 0;
-        for (int i = 0; i < 8; ++i) cube |= (sdf[g + corner_offset[i]] < 0.0f) << i;
-        if (cube == 0 || cube == 255) continue;
+        for (int i = 0; i < 8; ++i) {
+          const int row = rows[kMcCornerOffset[i][1]][kMcCornerOffset[i][2]];
+          cube |= ((inside[row] >> (x + kMcCornerOffset[i][0])) & 1) << i;
+        }
         bool ok = true;
-        for (int i = 0; i < 8 && ok; ++i) ok = observed[g + corner_offset[i]];
-        if (!ok) continue;
         const uint16_t crossed = edge_masks[cube];
         for (int e = 0; e < 12 && ok; ++e) {
           if (!(crossed >> e & 1)) continue;
@@ -182,8 +227,11 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
             const Rgb8 cb = neighbours[(ax >> 3) | ((ay >> 3) << 1) | ((az >> 3) << 2)]
                                 ->at(ax & 7, ay & 7, az & 7)
                                 .color;
+            // Rounds half away from zero, as std::lround, without its library call: the
+            // value is >= 0 and the sum exact in double.
             auto mix = [t](uint8_t a, uint8_t b) {
-              return static_cast<uint8_t>(std::lround(a + t * (static_cast<float>(b) - a)));
+              const float v = a + t * (static_cast<float>(b) - a);
+              return static_cast<uint8_t>(static_cast<int>(static_cast<double>(v) + 0.5));
             };
             // The label comes from the voxel whose cell holds the vertex (the nearer one).
             const bool upper = t >= 0.5f;
@@ -219,33 +267,49 @@ struct VertexLabels {
   int32_t superpoint = 0, semantic = 0, instance = 0;
 };
 
-// Labels vertices from their source voxels through a MeshLabeller. Neighbouring vertices
-// mostly share their voxel, and neighbouring voxels their super-point, so the last of each is
-// remembered (the map must not change while it is in use).
+}  // namespace
+
+namespace internal {
+
+// Labels vertices from their source voxels through a MeshLabeller, one block's vertices at a
+// time (setBlock). The labels of the voxels around the block are computed once each and kept
+// (a vertex without a label reads its 26 neighbours, which the next vertices mostly share),
+// and so are the last vertex's labels: neighbouring vertices mostly share their voxel, and
+// neighbouring voxels their super-point. The map must not change while it is in use.
 class VertexLabeller {
  public:
   VertexLabeller(const TsdfMap& map, const MeshLabeller& labeller)
-      : lookup_(map), labeller_(labeller) {}
+      : map_(map), labeller_(labeller), region_(kRegionVoxels) {}
 
-  /// @param neighbours the 8 block slots of the block whose cubes made the vertex
-  VertexLabels operator()(const Block* const* neighbours, uint16_t source) {
-    const Block* owner = neighbours[source >> 9];
+  /// Makes `index` the block whose cubes made the next vertices.
+  void setBlock(const BlockIndex& index) {
+    index_ = index;
+    fetched_ = 0;
+    if (++stamp_ == 0) {  // wrapped: forget every entry explicitly once
+      for (Entry& e : region_) e.stamp = 0;
+      stamp_ = 1;
+    }
+    last_voxel_ = nullptr;
+  }
+
+  /// @param source a BlockMesh source of the block last given to setBlock()
+  VertexLabels operator()(uint16_t source) {
+    const int slot = source >> 9, local = source & 511;
+    const int x = (slot & 1) * kBlockSide + (local & 7);
+    const int y = ((slot >> 1) & 1) * kBlockSide + ((local >> 3) & 7);
+    const int z = (slot >> 2) * kBlockSide + (local >> 6);
+    const Block* owner = blockAt(x, y, z);
     if (!owner) return VertexLabels{};
-    const Voxel* voxel = &owner->voxels[source & 511];
+    const Voxel* voxel = &owner->voxels[local];
     if (voxel == last_voxel_) return last_;
     last_voxel_ = voxel;
-    const int32_t superpoint = labeller_.superpoint(*voxel);
+    const int r = regionIndex(x, y, z);
+    const int32_t superpoint = entry(r, x, y, z).label;
     // A filled vertex takes its class and instance from the neighbours' super-point but keeps
     // super-point 0: it belongs to none (super-point diagnostics measure them as voted).
     int32_t source_label = superpoint;
-    if (superpoint == 0 && labeller_.fill_from_neighbours) {
-      const int local = source & 511;
-      const Eigen::Vector3i global =
-          (owner->index * kBlockSide) + Eigen::Vector3i(local % kBlockSide,
-                                                        (local / kBlockSide) % kBlockSide,
-                                                        local / (kBlockSide * kBlockSide));
-      source_label = neighbourhoodLabel(global);
-    }
+    if (superpoint == 0 && labeller_.fill_from_neighbours)
+      source_label = neighbourhoodLabel(x, y, z);
     if (have_last_ && superpoint == last_.superpoint && source_label == last_source_) {
       return last_;
     }
@@ -258,9 +322,51 @@ class VertexLabeller {
   }
 
  private:
-  // The label most of the 26 neighbours of voxel `global` carry (ties: more votes, then the
-  // smaller label); 0 when none carries one.
-  int32_t neighbourhoodLabel(const Eigen::Vector3i& global) {
+  // The region holds the voxels at block-local coordinates -1 .. 9: sources lie in 0 .. 8.
+  static constexpr int kRegionSide = kBlockSide + 3;
+  static constexpr int kRegionVoxels = kRegionSide * kRegionSide * kRegionSide;
+
+  struct Entry {
+    uint32_t stamp = 0;  // valid when equal to stamp_
+    int32_t label = 0;   // super-point, 0 for none or no block
+    uint64_t votes = 0;  // all votes of the voxel
+  };
+
+  static int regionIndex(int x, int y, int z) {
+    return (x + 1) + kRegionSide * ((y + 1) + kRegionSide * (z + 1));
+  }
+
+  // The block holding block-local (x, y, z), looked up once per setBlock() (most vertices
+  // need only a few of the 27). Arithmetic shifts: -1 >> 3 is -1, so -1 .. 9 map to -1 .. 1.
+  const Block* blockAt(int x, int y, int z) {
+    const int dx = x >> 3, dy = y >> 3, dz = z >> 3;
+    const int slot = (dx + 1) + 3 * ((dy + 1) + 3 * (dz + 1));
+    if (!(fetched_ >> slot & 1u)) {
+      blocks_[slot] = map_.findBlock(index_ + BlockIndex(dx, dy, dz));
+      fetched_ |= 1u << slot;
+    }
+    return blocks_[slot];
+  }
+
+  // The labels of the voxel at block-local (x, y, z), region index r.
+  const Entry& entry(int r, int x, int y, int z) {
+    Entry& e = region_[r];
+    if (e.stamp == stamp_) return e;
+    e.stamp = stamp_;
+    e.label = 0;
+    e.votes = 0;
+    const Block* b = blockAt(x, y, z);
+    if (!b) return e;
+    const Voxel& v = b->at(x & 7, y & 7, z & 7);
+    for (const LabelVote& vote : v.votes) e.votes += vote.count;
+    // Most voxels around a surface hold no vote: their label is 0 without asking.
+    if (e.votes > 0) e.label = labeller_.superpoint(v);
+    return e;
+  }
+
+  // The label most of the 26 neighbours of the voxel at block-local (x, y, z) carry (ties:
+  // more votes, then the smaller label); 0 when none carries one.
+  int32_t neighbourhoodLabel(int x, int y, int z) {
     struct Tally {
       int32_t label;
       int voxels;
@@ -272,17 +378,14 @@ class VertexLabeller {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           if (dx == 0 && dy == 0 && dz == 0) continue;
-          const Voxel* v = lookup_.findGrid(global.x() + dx, global.y() + dy, global.z() + dz);
-          if (!v) continue;
-          const int32_t label = labeller_.superpoint(*v);
-          if (label == 0) continue;
-          uint64_t votes = 0;
-          for (const LabelVote& vote : v->votes) votes += vote.count;
+          const int nx = x + dx, ny = y + dy, nz = z + dz;
+          const Entry& e = entry(regionIndex(nx, ny, nz), nx, ny, nz);
+          if (e.label == 0) continue;
           int k = 0;
-          while (k < n && tally[k].label != label) ++k;
-          if (k == n) tally[n++] = Tally{label, 0, 0};
+          while (k < n && tally[k].label != e.label) ++k;
+          if (k == n) tally[n++] = Tally{e.label, 0, 0};
           ++tally[k].voxels;
-          tally[k].votes += votes;
+          tally[k].votes += e.votes;
         }
       }
     }
@@ -299,15 +402,22 @@ class VertexLabeller {
     return best;
   }
 
-  VoxelLookup lookup_;  // remembers the last block: neighbours mostly share it
+  const TsdfMap& map_;
   const MeshLabeller& labeller_;
+  BlockIndex index_ = BlockIndex::Zero();  // the block of setBlock()
+  const Block* blocks_[27] = {};           // it and its 26 neighbours, where fetched_ says
+  uint32_t fetched_ = 0;
+  std::vector<Entry> region_;
+  uint32_t stamp_ = 0;
   const Voxel* last_voxel_ = nullptr;
   bool have_last_ = false;
   int32_t last_source_ = 0;  // the label last_'s class and instance come from
   VertexLabels last_;
 };
 
-}  // namespace
+}  // namespace internal
+
+using internal::VertexLabeller;
 
 LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const BlockMesh*>& blocks,
                                  const MeshLabeller& labeller) {
@@ -325,17 +435,15 @@ LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const Blo
   out.faces.reserve(num_faces);
 
   VertexLabeller label_vertex(map, labeller);
-  const Block* neighbours[8];
   auto findNeighbours = [&](const BlockIndex& index) {
-    if (!labelled) return;
-    for (int slot = 0; slot < 8; ++slot) neighbours[slot] = map.findBlock(index + slotOffset(slot));
+    if (labelled) label_vertex.setBlock(index);
   };
   auto emit = [&](const BlockMesh& mesh, size_t i) {
     const int32_t index = static_cast<int32_t>(out.vertices.size());
     out.vertices.push_back(mesh.vertices[i]);
     out.colors.push_back(mesh.colors[i]);
     if (labelled) {
-      const VertexLabels labels = label_vertex(neighbours, mesh.sources[i]);
+      const VertexLabels labels = label_vertex(mesh.sources[i]);
       out.superpoint.push_back(labels.superpoint);
       out.semantic.push_back(labels.semantic);
       out.instance.push_back(labels.instance);
@@ -405,28 +513,35 @@ LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const Blo
   return out;
 }
 
-LabelledMesh labelBlockMesh(const TsdfMap& map, const BlockMesh& mesh,
-                            const MeshLabeller& labeller) {
+BlockMeshLabeller::BlockMeshLabeller(const TsdfMap& map, const MeshLabeller& labeller)
+    : labeller_(labeller),
+      vertex_(labeller.superpoint ? std::make_unique<VertexLabeller>(map, labeller_) : nullptr) {}
+
+BlockMeshLabeller::~BlockMeshLabeller() = default;
+
+LabelledMesh BlockMeshLabeller::label(const BlockMesh& mesh) {
   LabelledMesh out;
   out.vertices = mesh.vertices;
   out.colors = mesh.colors;
   out.faces = mesh.faces;
-  if (!labeller.superpoint) return out;
-  const Block* neighbours[8];
-  for (int slot = 0; slot < 8; ++slot)
-    neighbours[slot] = map.findBlock(mesh.index + slotOffset(slot));
+  if (!vertex_) return out;
+  vertex_->setBlock(mesh.index);
   const size_t n = mesh.vertices.size();
   out.superpoint.resize(n);
   out.semantic.resize(n);
   out.instance.resize(n);
-  VertexLabeller label_vertex(map, labeller);
   for (size_t i = 0; i < n; ++i) {
-    const VertexLabels labels = label_vertex(neighbours, mesh.sources[i]);
+    const VertexLabels labels = (*vertex_)(mesh.sources[i]);
     out.superpoint[i] = labels.superpoint;
     out.semantic[i] = labels.semantic;
     out.instance[i] = labels.instance;
   }
   return out;
+}
+
+LabelledMesh labelBlockMesh(const TsdfMap& map, const BlockMesh& mesh,
+                            const MeshLabeller& labeller) {
+  return BlockMeshLabeller(map, labeller).label(mesh);
 }
 
 LabelledMesh marchingCubes(const TsdfMap& map, const MarchingCubesConfig& config,

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,7 +36,8 @@ struct MarchingCubesConfig {
 /// change (super-points merge, the optimiser relabels) without the surface changing.
 struct MeshLabeller {
   /// Super-point label of a voxel (e.g. argmaxLabel with the current merges). Empty: the mesh
-  /// gets no label arrays. A vertex takes the label of the nearer voxel of its edge.
+  /// gets no label arrays. A vertex takes the label of the nearer voxel of its edge. Called
+  /// only for voxels with votes: a voxel without any has label 0.
   std::function<int32_t(const Voxel&)> superpoint;
   /// NYU40 class of a super-point label; empty: 0 (unlabelled).
   std::function<int32_t(int32_t)> semantic;
@@ -91,6 +93,30 @@ LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const Blo
 /// blocks side by side and replaces a block when it changes).
 LabelledMesh labelBlockMesh(const TsdfMap& map, const BlockMesh& mesh,
                             const MeshLabeller& labeller = {});
+
+namespace internal {
+class VertexLabeller;
+}  // namespace internal
+
+/// labelBlockMesh for one block after another, keeping its scratch memory (the labels of the
+/// voxels around a block) between blocks: one per thread. The map must not change while it
+/// is in use.
+class BlockMeshLabeller {
+ public:
+  /// @param map the map whose voxels label the vertices; must outlive this
+  /// @param labeller how voxels are labelled; must outlive this
+  BlockMeshLabeller(const TsdfMap& map, const MeshLabeller& labeller);
+  ~BlockMeshLabeller();
+  BlockMeshLabeller(const BlockMeshLabeller&) = delete;
+  BlockMeshLabeller& operator=(const BlockMeshLabeller&) = delete;
+
+  /// The same as labelBlockMesh(map, mesh, labeller).
+  LabelledMesh label(const BlockMesh& mesh);
+
+ private:
+  const MeshLabeller& labeller_;
+  std::unique_ptr<internal::VertexLabeller> vertex_;  // null when nothing is labelled
+};
 
 /// Orders block indices by x, then y, then z: the order of every assembled mesh.
 inline bool blockIndexLess(const BlockIndex& a, const BlockIndex& b) {
