@@ -182,6 +182,7 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("sample_stride_px", &m.superpoints.sample_stride_px);
     s.read("instance_min_overlap", &m.superpoints.instance_min_overlap);
     s.read("mask_verdicts", &m.superpoints.mask_verdicts);
+    s.read("apart_weight", &m.superpoints.apart_weight);
     s.finish();
   }
   {
@@ -391,7 +392,9 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   sample_stride_px: " << m.superpoints.sample_stride_px << "\n"
     << "   instance_min_overlap: " << m.superpoints.instance_min_overlap << "\n"
     << "   mask_verdicts: " << m.superpoints.mask_verdicts
-    << "   # 1: only masks of their class merge or split super-points\n";
+    << "   # 1: only masks of their class merge or split super-points\n"
+    << "   apart_weight: " << m.superpoints.apart_weight
+    << "   # merge only when co-observed in more than this x the frames showing two objects\n";
   y << "graph:\n"
     << "   spatial_scale_m: " << m.graph.spatial_scale_m << "   # P_s = 1 / (1 + d / scale)\n"
     << "   sample_stride_px: " << m.graph.sample_stride_px << "\n"

@@ -22,7 +22,8 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 // 6: graph edge pruning (prune_edges, edge_min_share, surface_band_voxels); version 5 files
 //    still load, with pruning off as they were built.
 // 7: III-B's mask_verdicts; version 5 and 6 files load with it off, as they were built.
-constexpr uint32_t kVersion = 7;
+// 8: III-B's apart_weight; older files load with 1, the rule they were built with.
+constexpr uint32_t kVersion = 8;
 constexpr uint32_t kOldestVersion = 5;
 // Magic, version, payload size.
 constexpr size_t kHeaderBytes = sizeof(kMagic) + sizeof(uint32_t) + sizeof(uint64_t);
@@ -80,6 +81,7 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put(c.graph.edge_min_share);
   w->put(c.graph.surface_band_voxels);
   w->put<uint8_t>(c.superpoints.mask_verdicts);
+  w->put(c.superpoints.apart_weight);
   w->put<uint8_t>(c.occupancy_enabled);
   const OccupancyMap::Config& o = c.occupancy;
   for (double v : {o.resolution_m, o.min_depth_m, o.max_depth_m, o.prob_hit, o.prob_miss,
@@ -147,6 +149,7 @@ MapperConfig getConfig(BinaryReader* r, uint32_t version) {
     c.graph.prune_edges = false;
   }
   c.superpoints.mask_verdicts = version >= 7 && r->get<uint8_t>() != 0;
+  c.superpoints.apart_weight = version >= 8 ? r->get<float>() : 1.0f;
   c.occupancy_enabled = r->get<uint8_t>() != 0;
   OccupancyMap::Config& o = c.occupancy;
   for (double* v : {&o.resolution_m, &o.min_depth_m, &o.max_depth_m, &o.prob_hit, &o.prob_miss,

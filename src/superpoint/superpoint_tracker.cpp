@@ -19,6 +19,9 @@ void SuperpointConfig::check() const {
     throw Error("superpoint significant_overlap must be in (0, 1]");
   }
   if (merge_threshold < 0) throw Error("superpoint merge_threshold must be >= 0");
+  if (!(apart_weight >= 0.0f && apart_weight <= 1e6f)) {
+    throw Error("superpoint apart_weight must be in [0, 1e6]");
+  }
   if (sample_stride_px < 1) throw Error("superpoint sample_stride_px must be >= 1");
   if (!(instance_min_overlap >= 0.0f && instance_min_overlap <= 1.0f)) {
     throw Error("superpoint instance_min_overlap must be in [0, 1]");
@@ -106,7 +109,7 @@ bool SuperpointTracker::splitsFrom(const Surface& s, const Surface& t) const {
 bool SuperpointTracker::seenApart(const std::pair<int32_t, int32_t>& key, int m) const {
   if (!config_.semantic_consistency) return false;
   const auto it = apart_.find(key);
-  return it != apart_.end() && it->second >= m;
+  return it != apart_.end() && config_.apart_weight * static_cast<float>(it->second) >= m;
 }
 
 void SuperpointTracker::mergeLabels(int32_t a, int32_t b, FrameAssociation* out) {
@@ -312,6 +315,10 @@ void SuperpointTracker::associate(const FrameSegmentation& segmentation, const R
   // merging of spatially connected, semantically consistent ones that the network did not
   // see as two objects as often as it saw them as one surface (two touching cabinets of a
   // row, one mask over both now and then).
+  // With semantic consistency both count once per frame and pair: the network's verdict is
+  // per frame, and two surfaces of one mask (a plane cut by a depth edge) are not two
+  // verdicts. Spatial-only merging (Voxblox++) counts every surface, as it does.
+  std::set<std::pair<int32_t, int32_t>> counted;
   for (size_t s = 0; s < n; ++s) {
     for (size_t i = 0; i < significant[s].size(); ++i) {
       for (size_t j = i + 1; j < significant[s].size(); ++j) {
@@ -320,6 +327,7 @@ void SuperpointTracker::associate(const FrameSegmentation& segmentation, const R
         if (a == b) continue;
         if (!showsAsOne(surfaces[s], a, b)) continue;
         const auto key = std::minmax(a, b);
+        if (config_.semantic_consistency && !counted.insert(key).second) continue;
         int& m = co_observed_[key];
         ++m;
         if (m > config_.merge_threshold && consistent(a, b) && !seenApart(key, m)) {

@@ -239,14 +239,19 @@ TEST_F(BoxScene, BadInputIsRefusedAndTheMapIsUnharmed) {
 namespace panmap {
 namespace {
 
-// The bytes of a map file rewritten as an older version wrote them: version 6 without III-B's
+// The bytes of a map file rewritten as an older version wrote them: version 7 without III-B's
+// apart_weight (the float after the mask_verdicts byte), version 6 also without the
 // mask_verdicts byte (right after the pruning fields), version 5 also without the three graph
 // pruning fields, which start one byte before the double at `share_offset`.
 std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, uint32_t version) {
   constexpr size_t kHeader = 20;  // magic, version, payload size
   const size_t flag = share_offset + 8 + 4;
-  file.erase(file.begin() + static_cast<std::ptrdiff_t>(flag),
-             file.begin() + static_cast<std::ptrdiff_t>(flag + 1));
+  file.erase(file.begin() + static_cast<std::ptrdiff_t>(flag + 1),
+             file.begin() + static_cast<std::ptrdiff_t>(flag + 1 + sizeof(float)));
+  if (version <= 6) {
+    file.erase(file.begin() + static_cast<std::ptrdiff_t>(flag),
+               file.begin() + static_cast<std::ptrdiff_t>(flag + 1));
+  }
   if (version == 5) {
     file.erase(file.begin() + static_cast<std::ptrdiff_t>(share_offset - 1),
                file.begin() + static_cast<std::ptrdiff_t>(share_offset + 8 + 4));
@@ -259,15 +264,17 @@ std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, u
   return file;
 }
 
-TEST(MapFile, KeepsThePruningSettingsAndReadsVersionFive) {
+TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToSeven) {
   MapperConfig a;
   a.map.voxel_size_m = 0.05f;
   a.graph.prune_edges = false;
   a.graph.edge_min_share = 0.3;
   a.graph.surface_band_voxels = 1.5f;
   a.superpoints.mask_verdicts = true;
+  a.superpoints.apart_weight = 2.5f;
   const auto back = Mapper::deserialize(Mapper(a).serialize(), "a.panmap");
   EXPECT_TRUE(back->config().superpoints.mask_verdicts);
+  EXPECT_EQ(back->config().superpoints.apart_weight, 2.5f);
   EXPECT_FALSE(back->config().graph.prune_edges);
   EXPECT_EQ(back->config().graph.edge_min_share, 0.3);
   EXPECT_EQ(back->config().graph.surface_band_voxels, 1.5f);
@@ -295,12 +302,19 @@ TEST(MapFile, KeepsThePruningSettingsAndReadsVersionFive) {
   EXPECT_TRUE(six->config().graph.prune_edges);
   EXPECT_EQ(six->config().graph.edge_min_share, 0.3);
   EXPECT_FALSE(six->config().superpoints.mask_verdicts);
+  EXPECT_EQ(six->config().superpoints.apart_weight, 1.0f);
 
-  // Versions outside 5-7 are refused by name.
+  // A version 7 file keeps its mask verdicts and was built with the plain majority rule.
+  const auto seven = Mapper::deserialize(asVersion(bytes_b, offset, 7), "seven.panmap");
+  EXPECT_TRUE(seven->config().superpoints.mask_verdicts);
+  EXPECT_EQ(seven->config().superpoints.apart_weight, 1.0f);
+  EXPECT_EQ(seven->config().graph.edge_min_share, 0.3);
+
+  // Versions outside 5-8 are refused by name.
   std::vector<uint8_t> future = bytes_b;
-  future[8] = 8;
+  future[8] = 9;
   test::expectError([&] { Mapper::deserialize(future, "future.panmap"); },
-                    {"future.panmap", "version 8", "reads 5 to 7"});
+                    {"future.panmap", "version 9", "reads 5 to 8"});
 }
 
 }  // namespace

@@ -206,12 +206,14 @@ TEST_F(WallScene, UnlabelledPiecesMergeOnlyAmongThemselves) {
 
 // Two touching objects of one class, one plane (geometry cannot tell them apart): the network
 // shows them as two masks, and now and then as one. Co-observed in one surface more than
-// theta_merge times, they still do not merge while the frames showing them as two objects
-// are at least as many; the same pair seen as one object far more often merges.
+// theta_merge times, they still do not merge while the frames showing them as two objects,
+// times apart_weight, are at least as many; the same pair seen as one object far more often
+// merges.
 TEST_F(WallScene, SuperpointsSeenAsTwoObjectsDoNotMerge) {
   for (bool mostly_one : {false, true}) {
     TsdfMap map(TsdfMap::Config{0.05f});
     SuperpointTracker tracker(SuperpointConfig{});
+    ASSERT_EQ(tracker.config().apart_weight, 1.5f);
     const auto two = stripes({{320, 5}, {640, 5}});  // two masks (ids 1 and 2) of a thing class
     const auto one = stripes({{640, 5}});            // one mask over both
     step(&tracker, &map, two);
@@ -225,18 +227,81 @@ TEST_F(WallScene, SuperpointsSeenAsTwoObjectsDoNotMerge) {
       if (mostly_one) merges += step(&tracker, &map, one).merges;
     }
     if (mostly_one) {
-      // Merged once the one-mask frames outnumber the two-mask ones; each two-mask frame
-      // after that splits the pair again (mask_verdicts) and the one-mask frames that follow
-      // merge it back: it ends as one super-point.
-      EXPECT_EQ(merges, 4);
+      // The pair itself stops at 4 co-observations against 3 apart (1.5 x 3 >= 4): the
+      // one-mask frames' votes hand the whole plane to super-point 1 first. From then on
+      // each two-mask frame splits the right half off (mask_verdicts) and the next round's
+      // one-mask frames, outnumbering the new pair's single two-mask frame, merge it back.
+      EXPECT_EQ(merges, 3);
       EXPECT_EQ(splits, 3);
-      EXPECT_EQ(tracker.states().size(), 1u);
+      EXPECT_EQ(tracker.labels().resolve(2), 2);
+      EXPECT_EQ(tracker.coObservations().at({1, 2}), 4);
+      EXPECT_EQ(tracker.apartCounts().at({1, 2}), 3);
     } else {
       EXPECT_EQ(merges, 0);
       EXPECT_EQ(splits, 0);
       // Every two-mask frame but the first (its super-points were only just created).
       EXPECT_EQ(tracker.apartCounts().at({1, 2}), 9);
       EXPECT_EQ(tracker.coObservations().at({1, 2}), 8);
+    }
+  }
+}
+
+// With apart_weight 1, the plain majority (the rule of map files before version 8): the pair
+// merges as soon as its one-mask frames outnumber the two-mask ones.
+TEST_F(WallScene, ApartWeightOneMergesOnAPlainMajority) {
+  TsdfMap map(TsdfMap::Config{0.05f});
+  SuperpointConfig config;
+  config.apart_weight = 1.0f;
+  SuperpointTracker tracker(config);
+  const auto two = stripes({{320, 5}, {640, 5}});
+  const auto one = stripes({{640, 5}});
+  step(&tracker, &map, two);
+  step(&tracker, &map, two);
+  int merges = 0, splits = 0;
+  for (int k = 0; k < 8; ++k) {
+    const FrameAssociation a = step(&tracker, &map, two);
+    merges += a.merges;
+    splits += static_cast<int>(a.splits.size());
+    merges += step(&tracker, &map, one).merges;
+    merges += step(&tracker, &map, one).merges;
+  }
+  EXPECT_EQ(merges, 4);
+  EXPECT_EQ(splits, 3);
+  EXPECT_EQ(tracker.states().size(), 1u);
+}
+
+// A frame is one verdict: two surfaces that both show the same pair (one mask cut in two by
+// the frame's geometry) count once towards theta_merge, as the frames showing the pair apart
+// do. Spatial-only merging (the Voxblox++-like baseline) counts each surface.
+TEST_F(WallScene, CoObservationsCountOncePerFrame) {
+  for (bool consistency : {true, false}) {
+    TsdfMap map(TsdfMap::Config{0.05f});
+    SuperpointConfig config;
+    config.semantic_consistency = consistency;
+    SuperpointTracker tracker(config);
+    const auto sides = stripes({{320, 0}, {640, 0}});  // super-points 1 (left) and 2 (right)
+    // Upper and lower halves: each surface covers half of both super-points.
+    FrameSegmentation halves;
+    halves.geometric = LabelImage(640, 480, 1);
+    halves.surfaces = LabelImage(640, 480, 0);
+    for (int v = 0; v < 480; ++v) {
+      for (int u = 0; u < 640; ++u) halves.surfaces(u, v) = v < 240 ? 1 : 2;
+    }
+    halves.surface_list.push_back(Surface{1, 1, 0, 0, false, 0.9f, 640 * 240});
+    halves.surface_list.push_back(Surface{2, 1, 0, 0, false, 0.9f, 640 * 240});
+    step(&tracker, &map, sides);
+    step(&tracker, &map, sides);
+    if (!consistency) {
+      step(&tracker, &map, halves);
+      EXPECT_EQ(tracker.coObservations().at({1, 2}), 2);
+      EXPECT_EQ(step(&tracker, &map, halves).merges, 1);  // M = 4 > theta_merge
+      continue;
+    }
+    for (int k = 1; k <= 3; ++k) {
+      EXPECT_EQ(step(&tracker, &map, halves).merges, 0);
+      // Both surfaces show the pair in every frame, counted once: with a count per surface,
+      // M would reach 4 > theta_merge in the second frame and merge them.
+      EXPECT_EQ(tracker.coObservations().at({1, 2}), k);
     }
   }
 }

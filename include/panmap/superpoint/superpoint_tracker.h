@@ -22,7 +22,8 @@ struct SuperpointConfig {
   float association_min_overlap = 0.2f;
   /// Super-points holding at least this share of a surface are its L_N(s_i) (Eq. 3).
   float significant_overlap = 0.2f;
-  /// theta_merge: super-points merge once co-observed in more than this many surfaces.
+  /// theta_merge: super-points merge once co-observed in more than this many surfaces (with
+  /// semantic_consistency: frames, each counting once however many of its surfaces show them).
   int merge_threshold = 3;
   /// Merge only semantically consistent super-points: the same labelled class
   /// (SuperpointState::labelledClass), unlabelled ones only with unlabelled ones. false:
@@ -35,6 +36,13 @@ struct SuperpointConfig {
   /// and a surface that loses its super-point to a surface of another mask of its class
   /// splits from it (the super-point was formed under a mask that merged two objects).
   bool mask_verdicts = true;
+  /// With semantic_consistency: two super-points merge only when they were co-observed in
+  /// more than apart_weight times as many frames as the network showed them as two objects
+  /// (two masks of one class). A merge cannot be undone, while III-D can still group pieces
+  /// left apart, so a merge needs clearly more evidence than a split: 1.5 is the geometric
+  /// mean of the one-to-two odds of a network's errors on two touching objects (merged into
+  /// one mask 20 % of the time: 0.25) and on one long object (split 10 %: 9), docs/MAPPING.md.
+  float apart_weight = 1.5f;
   /// Pixels between overlap samples (1 = every pixel).
   int sample_stride_px = 2;
   /// A 2D instance joins the global instance covering at least this share of its pixels.
