@@ -1,3 +1,5 @@
+#include <utility>
+
 #include <gtest/gtest.h>
 
 #include "panmap/core/error.h"
@@ -64,6 +66,23 @@ class WallScene : public ::testing::Test {
       start = end;
     }
     return seg;
+  }
+  // Two objects of one thing class on the wall's halves: two frames with a mask each, then
+  // 8 rounds of such a frame and `ones` frames of one mask over both. Returns the merges and
+  // splits of the rounds.
+  std::pair<int, int> twoMasksThenOne(SuperpointTracker* tracker, TsdfMap* map, int ones) {
+    const auto two = stripes({{320, 5}, {640, 5}});  // two masks (ids 1 and 2)
+    const auto one = stripes({{640, 5}});            // one mask over both
+    step(tracker, map, two);
+    step(tracker, map, two);
+    int merges = 0, splits = 0;
+    for (int k = 0; k < 8; ++k) {
+      const FrameAssociation a = step(tracker, map, two);
+      merges += a.merges;
+      splits += static_cast<int>(a.splits.size());
+      for (int i = 0; i < ones; ++i) merges += step(tracker, map, one).merges;
+    }
+    return {merges, splits};
   }
   // One frame as the mapper runs it: association, splits, integration.
   FrameAssociation step(SuperpointTracker* tracker, TsdfMap* map, const FrameSegmentation& seg) {
@@ -214,18 +233,7 @@ TEST_F(WallScene, SuperpointsSeenAsTwoObjectsDoNotMerge) {
     TsdfMap map(TsdfMap::Config{0.05f});
     SuperpointTracker tracker(SuperpointConfig{});
     ASSERT_EQ(tracker.config().apart_weight, 1.5f);
-    const auto two = stripes({{320, 5}, {640, 5}});  // two masks (ids 1 and 2) of a thing class
-    const auto one = stripes({{640, 5}});            // one mask over both
-    step(&tracker, &map, two);
-    step(&tracker, &map, two);
-    int merges = 0, splits = 0;
-    for (int k = 0; k < 8; ++k) {
-      const FrameAssociation a = step(&tracker, &map, two);
-      merges += a.merges;
-      splits += static_cast<int>(a.splits.size());
-      merges += step(&tracker, &map, one).merges;
-      if (mostly_one) merges += step(&tracker, &map, one).merges;
-    }
+    const auto [merges, splits] = twoMasksThenOne(&tracker, &map, mostly_one ? 2 : 1);
     if (mostly_one) {
       // The pair itself stops at 4 co-observations against 3 apart (1.5 x 3 >= 4): the
       // one-mask frames' votes hand the whole plane to super-point 1 first. From then on
@@ -253,18 +261,7 @@ TEST_F(WallScene, ApartWeightOneMergesOnAPlainMajority) {
   SuperpointConfig config;
   config.apart_weight = 1.0f;
   SuperpointTracker tracker(config);
-  const auto two = stripes({{320, 5}, {640, 5}});
-  const auto one = stripes({{640, 5}});
-  step(&tracker, &map, two);
-  step(&tracker, &map, two);
-  int merges = 0, splits = 0;
-  for (int k = 0; k < 8; ++k) {
-    const FrameAssociation a = step(&tracker, &map, two);
-    merges += a.merges;
-    splits += static_cast<int>(a.splits.size());
-    merges += step(&tracker, &map, one).merges;
-    merges += step(&tracker, &map, one).merges;
-  }
+  const auto [merges, splits] = twoMasksThenOne(&tracker, &map, 2);
   EXPECT_EQ(merges, 4);
   EXPECT_EQ(splits, 3);
   EXPECT_EQ(tracker.states().size(), 1u);
