@@ -100,8 +100,9 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
     neighbours[slot] = map.findBlock(block.index + slotOffset(slot));
   }
 
-  // Per grid row (y, z): the sdf of its 9 voxels, and bit x set when voxel x is inside
-  // (sdf < 0) or observed. Missing blocks read as unobserved with sdf 0.
+  // Per grid row (y, z): the sdf of its 9 voxels; bit x of inside[row] set when voxel x has
+  // sdf < 0, of observed[row] when its weight is above min_weight. Missing blocks read as
+  // unobserved with sdf 0.
   float sdf[kGridVoxels];
   uint16_t inside[kGrid * kGrid], observed[kGrid * kGrid];
   uint32_t any_inside = 0, any_outside = 0;
