@@ -515,8 +515,7 @@ LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const Blo
 }
 
 BlockMeshLabeller::BlockMeshLabeller(const TsdfMap& map, const MeshLabeller& labeller)
-    : labeller_(labeller),
-      vertex_(labeller.superpoint ? std::make_unique<VertexLabeller>(map, labeller_) : nullptr) {}
+    : vertex_(labeller.superpoint ? std::make_unique<VertexLabeller>(map, labeller) : nullptr) {}
 
 BlockMeshLabeller::~BlockMeshLabeller() = default;
 

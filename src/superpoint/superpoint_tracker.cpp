@@ -312,9 +312,9 @@ void SuperpointTracker::associate(const FrameSegmentation& segmentation, const R
   }
   for (const auto& key : apart) ++apart_[key];
   // Co-observation M (Eq. 3) of the super-points significantly overlapping each surface, and
-  // merging of spatially connected, semantically consistent ones that the network did not
-  // see as two objects as often as it saw them as one surface (two touching cabinets of a
-  // row, one mask over both now and then).
+  // merging of spatially connected, semantically consistent ones that the network saw as one
+  // more than apart_weight times as often as it saw them as two objects (two touching cabinets
+  // of a row, one mask over both now and then).
   // With semantic consistency both count once per frame and pair: the network's verdict is
   // per frame, and two surfaces of one mask (a plane cut by a depth edge) are not two
   // verdicts. Spatial-only merging (Voxblox++) counts every surface, as it does.

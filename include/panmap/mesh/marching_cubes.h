@@ -114,7 +114,6 @@ class BlockMeshLabeller {
   LabelledMesh label(const BlockMesh& mesh);
 
  private:
-  const MeshLabeller& labeller_;
   std::unique_ptr<internal::VertexLabeller> vertex_;  // null when nothing is labelled
 };
 
