@@ -345,6 +345,9 @@ PanmapConfig loadConfig(const std::string& path) {
     if (!root["threads"].isInt()) throw Error(path + ": threads must be an integer");
     m.num_threads = static_cast<int>(root["threads"]);
   }
+  // One key for both: III-B must not merge into a super-point the final labelling leaves
+  // unlabelled (SuperpointConfig::unlabelled_void_share).
+  c.mapper.superpoints.unlabelled_void_share = c.optimiser.max_void_share;
   try {
     c.mapper.check();
     c.optimiser.check();

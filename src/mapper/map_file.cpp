@@ -23,7 +23,8 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 //    still load, with pruning off as they were built.
 // 7: III-B's mask_verdicts; version 5 and 6 files load with it off, as they were built.
 // 8: III-B's apart_weight; older files load with 1, the rule they were built with.
-constexpr uint32_t kVersion = 8;
+// 9: III-B's unlabelled_void_share; older files load with 1 (off), as they were built.
+constexpr uint32_t kVersion = 9;
 constexpr uint32_t kOldestVersion = 5;
 // Magic, version, payload size.
 constexpr size_t kHeaderBytes = sizeof(kMagic) + sizeof(uint32_t) + sizeof(uint64_t);
@@ -82,6 +83,7 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put(c.graph.surface_band_voxels);
   w->put<uint8_t>(c.superpoints.mask_verdicts);
   w->put(c.superpoints.apart_weight);
+  w->put(c.superpoints.unlabelled_void_share);
   w->put<uint8_t>(c.occupancy_enabled);
   const OccupancyMap::Config& o = c.occupancy;
   for (double v : {o.resolution_m, o.min_depth_m, o.max_depth_m, o.prob_hit, o.prob_miss,
@@ -150,6 +152,7 @@ MapperConfig getConfig(BinaryReader* r, uint32_t version) {
   }
   c.superpoints.mask_verdicts = version >= 7 && r->get<uint8_t>() != 0;
   c.superpoints.apart_weight = version >= 8 ? r->get<float>() : 1.0f;
+  c.superpoints.unlabelled_void_share = version >= 9 ? r->get<double>() : 1.0;
   c.occupancy_enabled = r->get<uint8_t>() != 0;
   OccupancyMap::Config& o = c.occupancy;
   for (double* v : {&o.resolution_m, &o.min_depth_m, &o.max_depth_m, &o.prob_hit, &o.prob_miss,

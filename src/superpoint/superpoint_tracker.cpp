@@ -22,6 +22,9 @@ void SuperpointConfig::check() const {
   if (!(apart_weight >= 0.0f && apart_weight <= 1e6f)) {
     throw Error("superpoint apart_weight must be in [0, 1e6]");
   }
+  if (!(unlabelled_void_share >= 0.0 && unlabelled_void_share <= 1.0)) {
+    throw Error("superpoint unlabelled_void_share must be in [0, 1]");
+  }
   if (sample_stride_px < 1) throw Error("superpoint sample_stride_px must be >= 1");
   if (!(instance_min_overlap >= 0.0f && instance_min_overlap <= 1.0f)) {
     throw Error("superpoint instance_min_overlap must be in [0, 1]");
@@ -46,12 +49,17 @@ int32_t SuperpointState::labelledClass() const {
   return best;
 }
 
-double SuperpointState::voidShare() const {
+std::pair<double, double> SuperpointState::voidFrames() const {
   double total = 0.0, none = 0.0;
   for (const auto& [cls, count] : class_counts) {
     total += count;
     if (cls <= 0) none += count;
   }
+  return {none, total};
+}
+
+double SuperpointState::voidShare() const {
+  const auto [none, total] = voidFrames();
   return total > 0.0 ? none / total : 0.0;
 }
 
@@ -86,7 +94,17 @@ bool SuperpointTracker::consistent(int32_t a, int32_t b) const {
   // themselves; labelled surfaces claim their voxels by votes when the network labels them.
   // Background counts do not dilute a labelled class either, or a chair seen mostly without a
   // mask would count as background and chain the same way.
-  return labelledClassOf(a) == labelledClassOf(b);
+  if (labelledClassOf(a) != labelledClassOf(b)) return false;
+  // The class that decides the merge ignores void frames, the final labelling does not: a
+  // merge that leaves the pooled counts unlabelled would take a labelled part's class away.
+  const auto sa = states_.find(a), sb = states_.find(b);
+  if (sa == states_.end() || sb == states_.end()) return true;
+  const auto [none_a, total_a] = sa->second.voidFrames();
+  const auto [none_b, total_b] = sb->second.voidFrames();
+  const double limit = config_.unlabelled_void_share;
+  const bool unlabelled_a = none_a > limit * total_a, unlabelled_b = none_b > limit * total_b;
+  const bool unlabelled = none_a + none_b > limit * (total_a + total_b);
+  return !unlabelled || (unlabelled_a && unlabelled_b);
 }
 
 bool SuperpointTracker::showsAsOne(const Surface& surface, int32_t a, int32_t b) const {

@@ -157,6 +157,8 @@ TEST(ConfigFile, LinkScaleRoundTripsAndABadValueIsNamed) {
             "   max_void_share: 0.875\n"));
   EXPECT_EQ(loadConfig(write(dir, configToYaml(smaller))).optimiser.link_half_observations, 2.0);
   EXPECT_EQ(loadConfig(write(dir, configToYaml(smaller))).optimiser.max_void_share, 0.875);
+  // III-B refuses merges into super-points the optimiser leaves unlabelled: one key for both.
+  EXPECT_EQ(smaller.mapper.superpoints.unlabelled_void_share, 0.875);
   EXPECT_EQ(loadConfig(write(dir, configToYaml(smaller))).optimiser.link_scale,
             OptimiserConfig::LinkScale::kSmaller);
   try {

@@ -239,15 +239,21 @@ TEST_F(BoxScene, BadInputIsRefusedAndTheMapIsUnharmed) {
 namespace panmap {
 namespace {
 
-// The bytes of a map file rewritten as an older version wrote them: version 7 without III-B's
-// apart_weight (the float after the mask_verdicts byte), version 6 also without the
+// The bytes of a map file rewritten as an older version wrote them: version 8 without III-B's
+// unlabelled_void_share (the double after apart_weight), version 7 also without apart_weight
+// (the float after the mask_verdicts byte), version 6 also without the
 // mask_verdicts byte (right after the pruning fields), version 5 also without the three graph
 // pruning fields, which start one byte before the double at `share_offset`.
 std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, uint32_t version) {
   constexpr size_t kHeader = 20;  // magic, version, payload size
   const size_t flag = share_offset + 8 + 4;
-  file.erase(file.begin() + static_cast<std::ptrdiff_t>(flag + 1),
-             file.begin() + static_cast<std::ptrdiff_t>(flag + 1 + sizeof(float)));
+  const size_t apart = flag + 1;
+  file.erase(file.begin() + static_cast<std::ptrdiff_t>(apart + sizeof(float)),
+             file.begin() + static_cast<std::ptrdiff_t>(apart + sizeof(float) + sizeof(double)));
+  if (version <= 7) {
+    file.erase(file.begin() + static_cast<std::ptrdiff_t>(apart),
+               file.begin() + static_cast<std::ptrdiff_t>(apart + sizeof(float)));
+  }
   if (version <= 6) {
     file.erase(file.begin() + static_cast<std::ptrdiff_t>(flag),
                file.begin() + static_cast<std::ptrdiff_t>(flag + 1));
@@ -264,7 +270,7 @@ std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, u
   return file;
 }
 
-TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToSeven) {
+TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToEight) {
   MapperConfig a;
   a.map.voxel_size_m = 0.05f;
   a.graph.prune_edges = false;
@@ -272,9 +278,11 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToSeven) {
   a.graph.surface_band_voxels = 1.5f;
   a.superpoints.mask_verdicts = true;
   a.superpoints.apart_weight = 2.5f;
+  a.superpoints.unlabelled_void_share = 0.75;
   const auto back = Mapper::deserialize(Mapper(a).serialize(), "a.panmap");
   EXPECT_TRUE(back->config().superpoints.mask_verdicts);
   EXPECT_EQ(back->config().superpoints.apart_weight, 2.5f);
+  EXPECT_EQ(back->config().superpoints.unlabelled_void_share, 0.75);
   EXPECT_FALSE(back->config().graph.prune_edges);
   EXPECT_EQ(back->config().graph.edge_min_share, 0.3);
   EXPECT_EQ(back->config().graph.surface_band_voxels, 1.5f);
@@ -309,12 +317,19 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToSeven) {
   EXPECT_TRUE(seven->config().superpoints.mask_verdicts);
   EXPECT_EQ(seven->config().superpoints.apart_weight, 1.0f);
   EXPECT_EQ(seven->config().graph.edge_min_share, 0.3);
+  EXPECT_EQ(seven->config().superpoints.unlabelled_void_share, 1.0);
 
-  // Versions outside 5-8 are refused by name.
+  // A version 8 file keeps its apart_weight and was built without the unlabelled-merge rule.
+  const auto eight = Mapper::deserialize(asVersion(bytes_b, offset, 8), "eight.panmap");
+  EXPECT_EQ(eight->config().superpoints.apart_weight, 2.5f);
+  EXPECT_EQ(eight->config().superpoints.unlabelled_void_share, 1.0);
+  EXPECT_EQ(eight->config().graph.edge_min_share, 0.3);
+
+  // Versions outside 5-9 are refused by name.
   std::vector<uint8_t> future = bytes_b;
-  future[8] = 9;
+  future[8] = 10;
   test::expectError([&] { Mapper::deserialize(future, "future.panmap"); },
-                    {"future.panmap", "version 9", "reads 5 to 8"});
+                    {"future.panmap", "version 10", "reads 5 to 9"});
 }
 
 }  // namespace

@@ -43,6 +43,13 @@ struct SuperpointConfig {
   /// mean of the one-to-two odds of a network's errors on two touching objects (merged into
   /// one mask 20 % of the time: 0.25) and on one long object (split 10 %: 9), docs/MAPPING.md.
   float apart_weight = 1.5f;
+  /// With semantic_consistency: the void share (SuperpointState::voidShare) above which the
+  /// final labelling leaves a super-point unlabelled (OptimiserConfig::max_void_share; the
+  /// config file sets both from that key). A merge whose result would be left unlabelled is
+  /// refused unless both parts already are: a mostly unmasked super-point that the network
+  /// labelled a few times must not bury a labelled piece of an object (issue 19: half of a
+  /// chair went unlabelled in a wall-and-clutter super-point). 1 turns the rule off.
+  double unlabelled_void_share = 0.8;
   /// Pixels between overlap samples (1 = every pixel).
   int sample_stride_px = 2;
   /// A 2D instance joins the global instance covering at least this share of its pixels.
@@ -62,6 +69,8 @@ struct SuperpointState {
   int32_t labelledClass() const;
   /// Share of its frame counts that are class 0 (no mask of a known class); 0 when never seen.
   double voidShare() const;
+  /// Its frame counts of class 0 (first) and of every class (second): voidShare's terms.
+  std::pair<double, double> voidFrames() const;
   /// Its global instance from frame counting (0 = none).
   int32_t instance() const;
 };
