@@ -94,6 +94,9 @@ void checkDecodedSize(const Image<T>& image, const image_t& msg, const char* wha
 
 image_t colorToMessage(const ColorImage& image, const ImageEncoding& encoding,
                        const std::vector<uint8_t>* jpeg_bytes) {
+  // A depth-only source (or a frame store kept without colour) sends no colour: an empty raw
+  // image, which fromMessage reads back as a frame without colour. The codecs refuse 0x0.
+  if (image.empty()) return rawImage(image, image_t::PIXEL_FORMAT_RGB8);
   switch (encoding.color) {
     case image_t::COMPRESSION_JPEG:
       return compressedImage(

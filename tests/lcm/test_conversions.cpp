@@ -64,6 +64,23 @@ TEST(Conversions, RgbdRoundTripRawAndPngIsExact) {
   }
 }
 
+TEST(Conversions, AFrameWithoutColourRoundTripsWithEveryEncoding) {
+  RgbdFrame f = makeFrame();
+  f.color = ColorImage();
+  ImageEncoding raw;
+  raw.color = raw.depth = image_t::COMPRESSION_NONE;
+  ImageEncoding png;
+  png.color = image_t::COMPRESSION_PNG;
+  for (const ImageEncoding& enc : {raw, png, ImageEncoding{}}) {  // the last: JPEG colour
+    const rgbd_frame_t msg = toMessage(f, enc);
+    EXPECT_EQ(msg.color.width, 0);
+    EXPECT_EQ(msg.color.size, 0);
+    const RgbdFrame back = fromMessage(decode<rgbd_frame_t>(encode(msg)));
+    EXPECT_TRUE(back.color.empty());
+    EXPECT_EQ(back.depth, f.depth);
+  }
+}
+
 TEST(Conversions, JpegBytesTravelUnchanged) {
   const RgbdFrame f = makeFrame();
   const std::vector<uint8_t> jpeg = encodeJpeg(f.color, 70);
