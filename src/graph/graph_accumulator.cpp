@@ -382,7 +382,7 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
   auto resolve = [&tracker](int32_t l) { return tracker.labels().resolve(l); };
   tracker.labels().flatten();  // every label points at its root: resolving is a table lookup
   const SurfaceAdjacency adjacency = SurfaceAdjacency::compute(
-      map, tracker.labels().parents(), config_.surface_band_voxels, &totals);
+      map, tracker.labels().parents(), config_.surface_band_voxels, &totals, pool_);
   // Without pruning the adjacency is not used (its scan still counts the voxels).
   const SurfaceAdjacency* surface = config_.prune_edges ? &adjacency : nullptr;
   for (const auto& [label, state] : tracker.states()) {

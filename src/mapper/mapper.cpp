@@ -206,7 +206,7 @@ void Mapper::forgetUnvotedSuperpoints() {
   if (config_.graph.prune_edges) {
     const SurfaceAdjacency surface = SurfaceAdjacency::compute(
         *map_, [&registry](int32_t label) { return registry.resolve(label); },
-        config_.graph.surface_band_voxels);
+        config_.graph.surface_band_voxels, pool_.get());
     edges_pruned_ += graph_->pruneEdges(surface, registry);
   }
 }

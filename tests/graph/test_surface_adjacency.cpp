@@ -128,6 +128,48 @@ TEST(SurfaceAdjacency, LabelsResolveToTheirRoots) {
   EXPECT_THROW(SurfaceAdjacency::compute(m.map(), identity, 0.0f), Error);
 }
 
+// Scanned by two threads or one, the map gives the same owners, pairs and totals: each
+// thread's counts and voxel index sums are exact, so how the blocks were shared out does not
+// show. 300 blocks of random labels, some off the band.
+TEST(SurfaceAdjacency, TwoThreadsFindWhatOneFinds) {
+  HandMap m;
+  uint32_t state = 12345;
+  auto next = [&state] { return state = state * 1664525u + 1013904223u; };
+  for (int i = 0; i < 20000; ++i) {
+    const int x = static_cast<int>(next() >> 20) % 80 - 40;
+    const int y = static_cast<int>(next() >> 20) % 40 - 20;
+    const int z = static_cast<int>(next() >> 20) % 30;
+    m.set(x, y, z, 1 + static_cast<int32_t>(next() >> 24) % 50, (next() >> 31) ? 0.0f : 3.0f);
+  }
+  ASSERT_GT(m.map().numBlocks(), 200u);
+  auto totalsFor = [] {
+    SurfaceAdjacency::OwnerTotals t;
+    t.voxels.assign(52, 0);
+    t.centre_sum.assign(52, Eigen::Vector3d::Zero());
+    return t;
+  };
+  SurfaceAdjacency::OwnerTotals one = totalsFor(), two = totalsFor();
+  const SurfaceAdjacency a = SurfaceAdjacency::compute(m.map(), identity, 2.0f, &one);
+  ThreadPool pool(2);
+  const SurfaceAdjacency b = SurfaceAdjacency::compute(m.map(), identity, 2.0f, &two, &pool);
+  EXPECT_EQ(a.numOwners(), b.numOwners());
+  EXPECT_EQ(a.numPairs(), b.numPairs());
+  EXPECT_GT(a.numPairs(), 1000u);
+  for (int32_t l = 1; l <= 50; ++l) {
+    EXPECT_EQ(a.surfaceVoxels(l), b.surfaceVoxels(l));
+    for (int32_t k = 1; k <= 50; ++k) EXPECT_EQ(a.touching(l, k), b.touching(l, k));
+  }
+  EXPECT_EQ(one.voxels, two.voxels);
+  EXPECT_EQ(one.centre_sum, two.centre_sum);  // exactly
+  int voxels = 0;
+  for (int v : one.voxels) voxels += v;
+  int distinct = 0;  // every set voxel counts once, however often it was drawn
+  for (const auto& block : m.map().blocks()) {
+    for (const Voxel& v : block->voxels) distinct += v.votes[0].count > 0;
+  }
+  EXPECT_EQ(voxels, distinct);
+}
+
 // Pruning keeps touching pairs and strong pairs between surface owners, drops the rest.
 TEST(GraphPruning, KeepsTouchingAndStrongPairsOfSurfaceOwners) {
   HandMap m;
