@@ -349,8 +349,8 @@ PanmapConfig loadConfig(const std::string& path) {
   // unlabelled (SuperpointConfig::unlabelled_void_share).
   c.mapper.superpoints.unlabelled_void_share = c.optimiser.max_void_share;
   try {
+    c.optimiser.check();  // first: a bad max_void_share is named by its own key
     c.mapper.check();
-    c.optimiser.check();
   } catch (const Error& e) {
     throw Error(path + ": " + e.what());
   }

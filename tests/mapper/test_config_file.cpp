@@ -159,6 +159,10 @@ TEST(ConfigFile, LinkScaleRoundTripsAndABadValueIsNamed) {
   EXPECT_EQ(loadConfig(write(dir, configToYaml(smaller))).optimiser.max_void_share, 0.875);
   // III-B refuses merges into super-points the optimiser leaves unlabelled: one key for both.
   EXPECT_EQ(smaller.mapper.superpoints.unlabelled_void_share, 0.875);
+  // A bad value is named by the key the file holds, not by the setting derived from it.
+  test::expectError(
+      [&] { loadConfig(write(dir, "%YAML:1.0\n---\noptimiser:\n   max_void_share: 1.5\n")); },
+      {"OptimiserConfig.max_void_share"});
   EXPECT_EQ(loadConfig(write(dir, configToYaml(smaller))).optimiser.link_scale,
             OptimiserConfig::LinkScale::kSmaller);
   try {
