@@ -37,6 +37,17 @@ inline float sampleDepth(const Image<float>& depth, float uf, float vf, int u, i
   return (1 - b) * ((1 - a) * d00 + a * d10) + b * ((1 - a) * d01 + a * d11);
 }
 
+// The lower neighbours (Block::lower_changed bits) whose cubes read a voxel of row (y, z) whose
+// bit is set in `fused` (bit x for voxel x).
+inline uint8_t lowerNeighboursReading(uint32_t fused, int y, int z) {
+  if (fused == 0) return 0;
+  uint8_t slots = 0xFE;
+  if (!(fused & 1u)) slots &= static_cast<uint8_t>(~0xAAu);  // 1, 3, 5, 7 read x = 0 only
+  if (y != 0) slots &= static_cast<uint8_t>(~0xCCu);         // 2, 3, 6, 7 read y = 0 only
+  if (z != 0) slots &= static_cast<uint8_t>(~0xF0u);         // 4, 5, 6, 7 read z = 0 only
+  return slots;
+}
+
 // Fuses measured depth d (> 0) seen through pixel (u, v) into a voxel at depth z. Returns
 // whether the voxel changed. Both paths call this, so they agree bit for bit.
 inline bool fuseVoxel(const BlockUpdateParams& p, float z, float d, int u, int v, Voxel* vox) {
@@ -203,10 +214,13 @@ __attribute__((target("avx2"))) size_t updateBlockAvx2(const BlockUpdateParams& 
       _mm256_store_si256(reinterpret_cast<__m256i*>(us), u);
       _mm256_store_si256(reinterpret_cast<__m256i*>(vs), v);
       Voxel* row = &block->at(0, y, z);
+      uint32_t fused = 0;
       for (; lanes != 0; lanes &= lanes - 1) {
         const int x = __builtin_ctz(static_cast<unsigned>(lanes));
-        updated += fuseVoxel(p, zs[x], ds[x], us[x], vs[x], &row[x]);
+        fused |= static_cast<uint32_t>(fuseVoxel(p, zs[x], ds[x], us[x], vs[x], &row[x])) << x;
       }
+      updated += __builtin_popcount(fused);
+      block->lower_changed |= lowerNeighboursReading(fused, y, z);
     }
   }
   return updated;
@@ -228,6 +242,7 @@ size_t updateBlockScalar(const BlockUpdateParams& p, const Eigen::Vector3f& orig
     for (int y = 0; y < kBlockSide; ++y) {
       rowCentres(origin_C, dx, dy, dz, y, z, xs, ys, zs);
       Voxel* row = &block->at(0, y, z);
+      uint32_t fused = 0;
       for (int x = 0; x < kBlockSide; ++x) {
         if (zs[x] < p.min_depth_m) continue;
         const float inv_z = 1.0f / zs[x];
@@ -237,8 +252,10 @@ size_t updateBlockScalar(const BlockUpdateParams& p, const Eigen::Vector3f& orig
         const int u = roundPositive(uf), v = roundPositive(vf);
         const float d = sampleDepth(depth, uf, vf, u, v);
         if (d <= 0.0f) continue;
-        updated += fuseVoxel(p, zs[x], d, u, v, &row[x]);
+        fused |= static_cast<uint32_t>(fuseVoxel(p, zs[x], d, u, v, &row[x])) << x;
       }
+      updated += __builtin_popcount(fused);
+      block->lower_changed |= lowerNeighboursReading(fused, y, z);
     }
   }
   return updated;

@@ -438,6 +438,8 @@ std::unique_ptr<Mapper> Mapper::deserialize(const std::vector<uint8_t>& bytes,
     }
     Block* block = mapper->map_->allocateBlock(index);
     block->updated = r.get<uint8_t>() != 0;
+    // The file does not say which faces changed: a changed block may have changed them all.
+    block->lower_changed = block->updated ? 0xFE : 0;
     r.getBytes(block->voxels, sizeof(block->voxels));
   }
   mapper->tracker_->restore(getSnapshot(&r));

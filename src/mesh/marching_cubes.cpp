@@ -287,7 +287,7 @@ class VertexLabeller {
     index_ = index;
     fetched_ = 0;
     if (++stamp_ == 0) {  // wrapped: forget every entry explicitly once
-      for (Entry& e : region_) e.stamp = 0;
+      for (Entry& e : region_) e.stamp = e.fill_stamp = 0;
       stamp_ = 1;
     }
     last_voxel_ = nullptr;
@@ -309,8 +309,7 @@ class VertexLabeller {
     // A filled vertex takes its class and instance from the neighbours' super-point but keeps
     // super-point 0: it belongs to none (super-point diagnostics measure them as voted).
     int32_t source_label = superpoint;
-    if (superpoint == 0 && labeller_.fill_from_neighbours)
-      source_label = neighbourhoodLabel(x, y, z);
+    if (superpoint == 0 && labeller_.fill_from_neighbours) source_label = filledLabel(r, x, y, z);
     if (have_last_ && superpoint == last_.superpoint && source_label == last_source_) {
       return last_;
     }
@@ -328,9 +327,11 @@ class VertexLabeller {
   static constexpr int kRegionVoxels = kRegionSide * kRegionSide * kRegionSide;
 
   struct Entry {
-    uint32_t stamp = 0;  // valid when equal to stamp_
-    int32_t label = 0;   // super-point, 0 for none or no block
-    uint64_t votes = 0;  // all votes of the voxel
+    uint32_t stamp = 0;       // valid when equal to stamp_
+    int32_t label = 0;        // super-point, 0 for none or no block
+    uint64_t votes = 0;       // all votes of the voxel
+    uint32_t fill_stamp = 0;  // `fill` valid when equal to stamp_
+    int32_t fill = 0;         // neighbourhoodLabel() of the voxel
   };
 
   static int regionIndex(int x, int y, int z) {
@@ -363,6 +364,18 @@ class VertexLabeller {
     // Most voxels around a surface hold no vote: their label is 0 without asking.
     if (e.votes > 0) e.label = labeller_.superpoint(v);
     return e;
+  }
+
+  // neighbourhoodLabel() of the voxel at block-local (x, y, z), region index r, computed once
+  // per block: the up to 6 vertices (one per grid edge at the voxel) that take their label from
+  // a voxel rarely come one after another.
+  int32_t filledLabel(int r, int x, int y, int z) {
+    Entry& e = region_[r];
+    if (e.fill_stamp != stamp_) {
+      e.fill = neighbourhoodLabel(x, y, z);
+      e.fill_stamp = stamp_;
+    }
+    return e.fill;
   }
 
   // The label most of the 26 neighbours of the voxel at block-local (x, y, z) carry (ties:

@@ -52,6 +52,25 @@ void seedBlock(Block* block, uint32_t seed) {
   }
 }
 
+// Block::lower_changed as it must be after an update that changed the voxels differing
+// between `before` and `after`: bit s for each lower neighbour whose cubes read one of them.
+uint8_t expectedLowerChanged(const Block& before, const Block& after) {
+  uint8_t mask = 0;
+  for (int z = 0; z < kBlockSide; ++z) {
+    for (int y = 0; y < kBlockSide; ++y) {
+      for (int x = 0; x < kBlockSide; ++x) {
+        if (std::memcmp(&before.at(x, y, z), &after.at(x, y, z), sizeof(Voxel)) == 0) continue;
+        for (int slot = 1; slot < 8; ++slot) {
+          const bool reads =
+              (!(slot & 1) || x == 0) && (!(slot & 2) || y == 0) && (!(slot & 4) || z == 0);
+          if (reads) mask |= 1 << slot;
+        }
+      }
+    }
+  }
+  return mask;
+}
+
 // The 8-wide path must give the portable path's voxels bit for bit, over blocks straddling
 // the image border, the minimum depth and the truncation band, with and without colour,
 // carving and weight drop-off.
@@ -69,7 +88,7 @@ TEST(BlockUpdate, VectorPathMatchesScalarBitForBit) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> angle(-0.4f, 0.4f), lateral(-0.6f, 0.6f),
       range(0.05f, 1.2f);
-  size_t total_updated = 0;
+  size_t total_updated = 0, partial_masks = 0;
   for (int trial = 0; trial < 400; ++trial) {
     p.color = trial % 2 ? &color : nullptr;
     p.space_carving = trial % 3 == 0;
@@ -78,18 +97,25 @@ TEST(BlockUpdate, VectorPathMatchesScalarBitForBit) {
                Eigen::AngleAxisf(angle(rng), Eigen::Vector3f::UnitY()))
                   .toRotationMatrix();
     const Eigen::Vector3f origin_C(lateral(rng), lateral(rng), range(rng));
-    Block scalar, vector;
+    Block scalar, vector, before;
     seedBlock(&scalar, trial);
     std::memcpy(static_cast<void*>(&vector), &scalar, sizeof(Block));
+    std::memcpy(static_cast<void*>(&before), &scalar, sizeof(Block));
     const size_t n_scalar = updateBlockScalar(p, origin_C, &scalar);
     const size_t n_vector = updateBlock(p, origin_C, &vector);
     ASSERT_EQ(n_scalar, n_vector) << "trial " << trial;
     ASSERT_EQ(0, std::memcmp(scalar.voxels, vector.voxels, sizeof(scalar.voxels)))
         << "trial " << trial;
+    // Every fused voxel changes here (weights stay far below the cap), so the mask is exact.
+    ASSERT_EQ(scalar.lower_changed, expectedLowerChanged(before, scalar)) << "trial " << trial;
+    ASSERT_EQ(vector.lower_changed, scalar.lower_changed) << "trial " << trial;
+    partial_masks += scalar.lower_changed != 0 && scalar.lower_changed != 0xFE;
     total_updated += n_scalar;
   }
-  // The trials must actually reach the surface, or the comparison proves nothing.
+  // The trials must actually reach the surface, or the comparison proves nothing; and some
+  // must change some of the lower faces but not all.
   EXPECT_GT(total_updated, 10000u);
+  EXPECT_GT(partial_masks, 20u);
   if (!blockUpdateUsesAvx2()) GTEST_SKIP() << "no AVX2 on this CPU: only the scalar path ran";
 }
 

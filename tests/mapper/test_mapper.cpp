@@ -14,6 +14,7 @@
 #include "panmap/graph/optimiser.h"
 #include "panmap/io/image_codec.h"
 #include "panmap/mapper/mapper.h"
+#include "panmap/mesh/marching_cubes.h"
 #include "panmap/sim/depth_noise.h"
 #include "panmap/sim/renderer.h"
 #include "panmap/sim/segmenter_noise.h"
@@ -152,6 +153,13 @@ TEST_F(BoxScene, LiveMeshUpdatesAddUpToTheExportedMesh) {
   }
   EXPECT_EQ(held.size(), exported.size());
   for (const auto& p : held) ASSERT_TRUE(exported.count(p)) << "a vertex the export lacks";
+  // Re-meshing only what integration changed (a block, and a lower neighbour only when a face
+  // they share changed) loses nothing: the same geometry as meshing the map from scratch.
+  MarchingCubesConfig scratch_config;
+  scratch_config.max_sdf_jump_voxels = config().integrator.truncation_voxels;
+  const LabelledMesh scratch = marchingCubes(mapper.map(), scratch_config);
+  EXPECT_EQ(scratch.vertices, whole.vertices);
+  EXPECT_EQ(scratch.faces, whole.faces);
   size_t checked = 0;
   for (const LabelledMesh& mesh : last.meshes) {
     for (size_t i = 0; i < mesh.numVertices(); ++i, ++checked) {

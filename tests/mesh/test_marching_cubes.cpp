@@ -511,6 +511,7 @@ TEST(IncrementalMesher, RemeshesOnlyChangedBlocksAndMatchesFromScratch) {
   ASSERT_NE(block, nullptr);
   for (Voxel& v : block->voxels) v.sdf_m += v.weight > 0.0f ? 0.004f : 0.0f;
   block->updated = true;
+  block->lower_changed = 0xFE;  // every face changed
   size_t expected = 0;
   for (int slot = 0; slot < 8; ++slot) {
     expected +=
@@ -526,6 +527,31 @@ TEST(IncrementalMesher, RemeshesOnlyChangedBlocksAndMatchesFromScratch) {
   size_t moved = 0;
   for (const Eigen::Vector3f& p : after.vertices) moved += std::abs(sphereSdf(p) + 0.004f) < 1e-3f;
   EXPECT_GT(moved, 10u);
+
+  // A change inside the block, off the faces its lower neighbours read, re-meshes it alone.
+  for (int z = 1; z < kBlockSide; ++z) {
+    for (int y = 1; y < kBlockSide; ++y) {
+      for (int x = 1; x < kBlockSide; ++x) {
+        Voxel& v = block->at(x, y, z);
+        v.sdf_m += v.weight > 0.0f ? 0.002f : 0.0f;
+      }
+    }
+  }
+  block->updated = true;
+  EXPECT_EQ(mesher.update(&map), 1u);
+  expectSameMesh(mesher.assemble(map), marchingCubes(map));
+  // A change on its lower x face alone re-meshes it and its lower x neighbour.
+  for (int z = 0; z < kBlockSide; ++z) {
+    for (int y = 0; y < kBlockSide; ++y) {
+      Voxel& v = block->at(0, y, z);
+      v.sdf_m += v.weight > 0.0f ? 0.002f : 0.0f;
+    }
+  }
+  block->updated = true;
+  block->lower_changed = 1 << 1;
+  ASSERT_NE(map.findBlock(changed - BlockIndex(1, 0, 0)), nullptr);
+  EXPECT_EQ(mesher.update(&map), 2u);
+  expectSameMesh(mesher.assemble(map), marchingCubes(map));
 
   // A block the mesher has never seen is meshed even without its flag, with its lower
   // neighbours (whose border cubes now reach observed voxels).
@@ -634,9 +660,11 @@ TEST(IncrementalMesher, ReportsChangedBlocksOnceAndTheirMeshesMatchTheWholeMesh)
   EXPECT_EQ(faces, whole.numFaces());
   EXPECT_EQ(mesher.find(BlockIndex(99, 99, 99)), nullptr);
 
-  // One changed block: it and its existing lower neighbours are reported, whoever updated.
+  // One block changed on all its faces: it and its existing lower neighbours are reported,
+  // whoever updated.
   const BlockIndex changed = map.blockIndexOf(kCentre + Eigen::Vector3f(0.15f, 0.0f, 0.0f));
   map.findBlock(changed)->updated = true;
+  map.findBlock(changed)->lower_changed = 0xFE;
   std::vector<BlockIndex> expected_changed;
   for (int slot = 0; slot < 8; ++slot) {
     const BlockIndex lower = changed - BlockIndex(slot & 1, (slot >> 1) & 1, slot >> 2);

@@ -23,6 +23,10 @@ using BlockIndex = Eigen::Vector3i;
 struct Block {
   BlockIndex index = BlockIndex::Zero();
   bool updated = false;  ///< changed since the mesher last looked (cleared by the mesher)
+  /// Bit s (1..7) set when voxels this block shares with its lower neighbour at
+  /// -(s & 1, s >> 1 & 1, s >> 2) changed since the mesher last looked: that neighbour's cubes
+  /// read them (the x = 0 face for bit 0 of s, y = 0 for bit 1, z = 0 for bit 2; all named).
+  uint8_t lower_changed = 0;
   Voxel voxels[kBlockVoxels];
 
   /// Voxel at local coordinates (x, y, z), each in [0, kBlockSide).

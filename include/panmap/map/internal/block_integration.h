@@ -27,7 +27,8 @@ struct BlockUpdateParams {
 /// Fuses the frame into every voxel of `block` whose projection sees a surface within the
 /// truncation band. origin_C is the centre of the block's voxel (0, 0, 0) in the camera frame.
 /// Uses 8-wide AVX2 projection and depth sampling when the CPU has it; the result is bitwise
-/// the same as updateBlockScalar's. Returns the number of voxels updated.
+/// the same as updateBlockScalar's. Returns the number of voxels updated; marks in
+/// block->lower_changed the lower neighbours whose cubes read an updated voxel.
 size_t updateBlock(const BlockUpdateParams& params, const Eigen::Vector3f& origin_C, Block* block);
 
 /// The reference: one voxel at a time, portable.
