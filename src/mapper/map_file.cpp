@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 
 #include "panmap/core/binary_io.h"
 #include "panmap/io/atomic_file.h"
@@ -24,7 +25,32 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 // 7: III-B's mask_verdicts; version 5 and 6 files load with it off, as they were built.
 // 8: III-B's apart_weight; older files load with 1, the rule they were built with.
 // 9: III-B's unlabelled_void_share; older files load with 1 (off), as they were built.
-constexpr uint32_t kVersion = 9;
+// 10: 36-byte voxels (6-byte vote slots, counts saturating at 65,535); older files' 44-byte
+//     voxels are converted on loading.
+constexpr uint32_t kVersion = 10;
+// Before version 10 a voxel was 44 bytes: sdf, weight (float), colour, flags, then four vote
+// slots of a 4-byte label and a 4-byte count.
+constexpr size_t kVoxelBytesBefore10 = 44;
+
+// Reads a block's voxels as files before version 10 stored them.
+void getVoxelsBefore10(BinaryReader* r, Block* block) {
+  for (Voxel& v : block->voxels) {
+    uint8_t bytes[kVoxelBytesBefore10];
+    r->getBytes(bytes, sizeof(bytes));
+    std::memcpy(&v.sdf_m, bytes, 4);
+    std::memcpy(&v.weight, bytes + 4, 4);
+    v.color = Rgb8{bytes[8], bytes[9], bytes[10]};
+    v.flags = bytes[11];
+    for (int k = 0; k < kVoteSlots; ++k) {
+      int32_t label;
+      uint32_t count;
+      std::memcpy(&label, bytes + 12 + 8 * k, 4);
+      std::memcpy(&count, bytes + 16 + 8 * k, 4);
+      v.votes[k].label = label;
+      v.votes[k].count = static_cast<uint16_t>(count < kMaxVoteCount ? count : kMaxVoteCount);
+    }
+  }
+}
 constexpr uint32_t kOldestVersion = 5;
 // Magic, version, payload size.
 constexpr size_t kHeaderBytes = sizeof(kMagic) + sizeof(uint32_t) + sizeof(uint64_t);
@@ -422,7 +448,8 @@ std::unique_ptr<Mapper> Mapper::deserialize(const std::vector<uint8_t>& bytes,
   auto mapper = std::make_unique<Mapper>(getConfig(&r, version));
   mapper->frames_ = r.get<int64_t>();
   mapper->vote_evictions_ = r.get<uint64_t>();
-  const uint64_t blocks = r.getCount(13 + sizeof(Block::voxels));
+  const size_t voxel_bytes = version >= 10 ? sizeof(Voxel) : kVoxelBytesBefore10;
+  const uint64_t blocks = r.getCount(13 + kBlockVoxels * voxel_bytes);
   // Block keys hold 21 bits per axis: an index beyond them would alias another block, and its
   // voxel coordinates (index * 8) overflow int (fuzz/fuzz_map_file).
   constexpr int32_t kMaxBlockIndex = 1 << 20;
@@ -440,7 +467,11 @@ std::unique_ptr<Mapper> Mapper::deserialize(const std::vector<uint8_t>& bytes,
     block->updated = r.get<uint8_t>() != 0;
     // The file does not say which faces changed: a changed block may have changed them all.
     block->lower_changed = block->updated ? 0xFE : 0;
-    r.getBytes(block->voxels, sizeof(block->voxels));
+    if (version >= 10) {
+      r.getBytes(block->voxels, sizeof(block->voxels));
+    } else {
+      getVoxelsBefore10(&r, block);
+    }
   }
   mapper->tracker_->restore(getSnapshot(&r));
   mapper->graph_->restore(getGraph(&r));

@@ -21,7 +21,7 @@ bool moveVotes(Voxel* voxel, int32_t from, int32_t to, const LabelRegistry& labe
   }
   if (moved == 0) return false;
   // The slot just emptied takes the new label, so nothing is evicted.
-  addVotes(voxel, to, moved > UINT32_MAX ? UINT32_MAX : static_cast<uint32_t>(moved));
+  addVotes(voxel, to, moved > kMaxVoteCount ? kMaxVoteCount : static_cast<uint32_t>(moved));
   return true;
 }
 

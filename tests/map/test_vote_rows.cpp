@@ -158,9 +158,13 @@ TEST(VoteRows, AddVotesEqualsRepeatedAddVote) {
     EXPECT_EQ(evicted_bulk, evicted_single);
   }
   Voxel full;
-  full.votes[0] = LabelVote{3, UINT32_MAX - 2};
+  full.votes[0] = LabelVote{3, kMaxVoteCount - 2};
   addVotes(&full, 3, 10);
-  EXPECT_EQ(full.votes[0].count, UINT32_MAX);
+  EXPECT_EQ(full.votes[0].count, kMaxVoteCount);
+  // A new slot takes at most the cap too, however many votes arrive at once.
+  addVotes(&full, 4, 100000);
+  EXPECT_EQ(full.votes[1].label, 4);
+  EXPECT_EQ(full.votes[1].count, kMaxVoteCount);
 }
 
 // The lookups' floor must agree with std::floor everywhere a voxel index can be.

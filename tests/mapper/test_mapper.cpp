@@ -252,12 +252,25 @@ namespace {
 // (the float after the mask_verdicts byte), version 6 also without the
 // mask_verdicts byte (right after the pruning fields), version 5 also without the three graph
 // pruning fields, which start one byte before the double at `share_offset`.
+constexpr size_t kMapFileHeader = 20;  // magic, version, payload size
+
+// Gives `file` another version number, payload size and checksum.
+std::vector<uint8_t> reseal(std::vector<uint8_t> file, uint32_t version) {
+  std::memcpy(&file[8], &version, sizeof(version));
+  const uint64_t size = file.size() - kMapFileHeader - sizeof(uint32_t);
+  std::memcpy(&file[12], &size, sizeof(size));
+  const auto crc = static_cast<uint32_t>(crc32(0L, &file[kMapFileHeader], static_cast<uInt>(size)));
+  std::memcpy(&file[kMapFileHeader + size], &crc, sizeof(crc));
+  return file;
+}
+
 std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, uint32_t version) {
-  constexpr size_t kHeader = 20;  // magic, version, payload size
   const size_t flag = share_offset + 8 + 4;
   const size_t apart = flag + 1;
-  file.erase(file.begin() + static_cast<std::ptrdiff_t>(apart + sizeof(float)),
-             file.begin() + static_cast<std::ptrdiff_t>(apart + sizeof(float) + sizeof(double)));
+  if (version <= 8) {
+    file.erase(file.begin() + static_cast<std::ptrdiff_t>(apart + sizeof(float)),
+               file.begin() + static_cast<std::ptrdiff_t>(apart + sizeof(float) + sizeof(double)));
+  }
   if (version <= 7) {
     file.erase(file.begin() + static_cast<std::ptrdiff_t>(apart),
                file.begin() + static_cast<std::ptrdiff_t>(apart + sizeof(float)));
@@ -270,15 +283,10 @@ std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, u
     file.erase(file.begin() + static_cast<std::ptrdiff_t>(share_offset - 1),
                file.begin() + static_cast<std::ptrdiff_t>(share_offset + 8 + 4));
   }
-  std::memcpy(&file[8], &version, sizeof(version));
-  const uint64_t size = file.size() - kHeader - sizeof(uint32_t);
-  std::memcpy(&file[12], &size, sizeof(size));
-  const auto crc = static_cast<uint32_t>(crc32(0L, &file[kHeader], static_cast<uInt>(size)));
-  std::memcpy(&file[kHeader + size], &crc, sizeof(crc));
-  return file;
+  return reseal(std::move(file), version);
 }
 
-TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToEight) {
+TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToNine) {
   MapperConfig a;
   a.map.voxel_size_m = 0.05f;
   a.graph.prune_edges = false;
@@ -333,11 +341,81 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToEight) {
   EXPECT_EQ(eight->config().superpoints.unlabelled_void_share, 1.0);
   EXPECT_EQ(eight->config().graph.edge_min_share, 0.3);
 
-  // Versions outside 5-9 are refused by name.
+  // A version 9 file keeps its unlabelled-merge rule.
+  const auto nine = Mapper::deserialize(asVersion(bytes_b, offset, 9), "nine.panmap");
+  EXPECT_EQ(nine->config().superpoints.unlabelled_void_share, 0.75);
+
+  // Versions outside 5-10 are refused by name.
   std::vector<uint8_t> future = bytes_b;
-  future[8] = 10;
+  future[8] = 11;
   test::expectError([&] { Mapper::deserialize(future, "future.panmap"); },
-                    {"future.panmap", "version 10", "reads 5 to 9"});
+                    {"future.panmap", "version 11", "reads 5 to 10"});
+}
+
+// Files before version 10 hold 44-byte voxels (4-byte vote counts): they load into today's
+// 36-byte voxels with every value kept, counts above 65,535 saturated.
+TEST_F(BoxScene, MapFilesBeforeVersionTenLoadTheirVoxels) {
+  const auto mapper = run(config(), 3);
+  const std::vector<uint8_t> file = mapper->serialize();
+  const TsdfMap& map = mapper->map();
+  ASSERT_GT(map.numBlocks(), 10u);
+  // Blocks are stored in allocation order, each as index, updated flag and voxels: the first
+  // block's record is found by its bytes.
+  const Block& first = *map.blocks()[0];
+  constexpr size_t kRecordHead = 3 * sizeof(int32_t) + 1;
+  std::vector<uint8_t> pattern(kRecordHead + sizeof(Voxel));
+  const int32_t index[3] = {first.index.x(), first.index.y(), first.index.z()};
+  std::memcpy(pattern.data(), index, sizeof(index));
+  pattern[12] = first.updated;
+  std::memcpy(pattern.data() + kRecordHead, &first.voxels[0], sizeof(Voxel));
+  const auto found = std::search(file.begin(), file.end(), pattern.begin(), pattern.end());
+  ASSERT_NE(found, file.end());
+  const size_t begin = static_cast<size_t>(found - file.begin());
+  const size_t record = kRecordHead + sizeof(Block::voxels);
+  std::vector<uint8_t> old(file.begin(), found);
+  for (size_t b = 0; b < map.numBlocks(); ++b) {
+    const uint8_t* head = file.data() + begin + b * record;
+    old.insert(old.end(), head, head + kRecordHead);
+    for (int i = 0; i < kBlockVoxels; ++i) {
+      Voxel v;
+      std::memcpy(&v, head + kRecordHead + i * sizeof(Voxel), sizeof(Voxel));
+      uint8_t bytes[44] = {};
+      std::memcpy(bytes, &v.sdf_m, 4);
+      std::memcpy(bytes + 4, &v.weight, 4);
+      bytes[8] = v.color.r;
+      bytes[9] = v.color.g;
+      bytes[10] = v.color.b;
+      bytes[11] = v.flags;
+      for (int k = 0; k < kVoteSlots; ++k) {
+        int32_t label = v.votes[k].label;
+        uint32_t count = v.votes[k].count;
+        if (b == 0 && i == 0 && k == 0) label = 77, count = 70000;  // beyond today's slots
+        std::memcpy(bytes + 12 + 8 * k, &label, 4);
+        std::memcpy(bytes + 16 + 8 * k, &count, 4);
+      }
+      old.insert(old.end(), bytes, bytes + sizeof(bytes));
+    }
+  }
+  old.insert(old.end(),
+             file.begin() + static_cast<std::ptrdiff_t>(begin + map.numBlocks() * record),
+             file.end());
+  const auto loaded = Mapper::deserialize(reseal(old, 9), "nine.panmap");
+  const TsdfMap& back = loaded->map();
+  ASSERT_EQ(back.numBlocks(), map.numBlocks());
+  size_t voted = 0;
+  for (size_t b = 0; b < map.numBlocks(); ++b) {
+    const Block& want = *map.blocks()[b];
+    const Block& got = *back.blocks()[b];
+    ASSERT_EQ(got.index, want.index);
+    for (int i = b == 0 ? 1 : 0; i < kBlockVoxels; ++i) {
+      ASSERT_EQ(0, std::memcmp(&got.voxels[i], &want.voxels[i], sizeof(Voxel))) << b << " " << i;
+      voted += want.voxels[i].votes[0].count > 0;
+    }
+  }
+  EXPECT_GT(voted, 100u);  // the votes were carried, not only empty slots
+  EXPECT_EQ(back.blocks()[0]->voxels[0].votes[0].label, 77);
+  EXPECT_EQ(back.blocks()[0]->voxels[0].votes[0].count, kMaxVoteCount);
+  EXPECT_EQ(back.blocks()[0]->voxels[0].sdf_m, first.voxels[0].sdf_m);
 }
 
 }  // namespace

@@ -10,13 +10,19 @@ namespace panmap {
 /// a 4th label; panmap keeps 4 and evicts the weakest, counting every eviction.
 constexpr int kVoteSlots = 4;
 
-/// One super-point label and how often it was observed in a voxel: Pi_V(L_S, V).
-struct LabelVote {
-  int32_t label = 0;   ///< super-point label L_S (0 = empty slot)
-  uint32_t count = 0;  ///< observations
-};
+/// Votes a slot counts at most: counts saturate here. A voxel seen by 65,535 pixels of one
+/// label (at 30 Hz, minutes of staring at it) holds its label as firmly as one seen more.
+constexpr uint32_t kMaxVoteCount = UINT16_MAX;
 
-/// A voxel of the label-TSDF: 44 bytes.
+/// One super-point label and how often it was observed in a voxel: Pi_V(L_S, V). Packed to 6
+/// bytes: the map is mostly voxels, and a building at 2 cm outgrew 4 GB with 8-byte slots.
+struct __attribute__((packed)) LabelVote {
+  int32_t label = 0;   ///< super-point label L_S (0 = empty slot)
+  uint16_t count = 0;  ///< observations, at most kMaxVoteCount
+};
+static_assert(sizeof(LabelVote) == 6, "vote slots are packed");
+
+/// A voxel of the label-TSDF: 36 bytes.
 struct Voxel {
   float sdf_m = 0.0f;   ///< truncated signed distance to the surface, metres (+ in front)
   float weight = 0.0f;  ///< integration weight, 0 = never observed
@@ -24,17 +30,19 @@ struct Voxel {
   uint8_t flags = 0;    ///< reserved
   LabelVote votes[kVoteSlots];
 };
-static_assert(sizeof(Voxel) == 44, "keep voxels lean (<= 64 bytes with votes)");
+static_assert(sizeof(Voxel) == 36, "keep voxels lean");
 
 /// Adds `n` votes for `label` (n >= 1), exactly as n calls adding one vote each would:
-/// increments its slot (saturating), or fills an empty one, or evicts the weakest slot (lowest
-/// count, first on ties). Returns true when a vote was evicted.
+/// increments its slot (saturating at kMaxVoteCount), or fills an empty one, or evicts the
+/// weakest slot (lowest count, first on ties). Returns true when a vote was evicted.
 inline bool addVotes(Voxel* voxel, int32_t label, uint32_t n) {
+  const uint16_t capped = static_cast<uint16_t>(n < kMaxVoteCount ? n : kMaxVoteCount);
   int empty = -1, weakest = 0;
   for (int i = 0; i < kVoteSlots; ++i) {
     LabelVote& v = voxel->votes[i];
     if (v.label == label && v.count > 0) {
-      v.count = v.count > UINT32_MAX - n ? UINT32_MAX : v.count + n;
+      v.count = static_cast<uint16_t>(v.count > kMaxVoteCount - capped ? kMaxVoteCount
+                                                                       : v.count + capped);
       return false;
     }
     if (v.count == 0) {
@@ -44,10 +52,10 @@ inline bool addVotes(Voxel* voxel, int32_t label, uint32_t n) {
     }
   }
   if (empty >= 0) {
-    voxel->votes[empty] = LabelVote{label, n};
+    voxel->votes[empty] = LabelVote{label, capped};
     return false;
   }
-  voxel->votes[weakest] = LabelVote{label, n};
+  voxel->votes[weakest] = LabelVote{label, capped};
   return true;
 }
 
