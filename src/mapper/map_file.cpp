@@ -25,8 +25,8 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 // 7: III-B's mask_verdicts; version 5 and 6 files load with it off, as they were built.
 // 8: III-B's apart_weight; older files load with 1, the rule they were built with.
 // 9: III-B's unlabelled_void_share; older files load with 1 (off), as they were built.
-// 10: 36-byte voxels (6-byte vote slots, counts saturating at 65,535); older files' 44-byte
-//     voxels are converted on loading.
+// 10: 36-byte voxels (6-byte vote slots, counts at most 65,535); older files' 44-byte voxels
+//     are converted on loading (a voxel's counts scaled together where one exceeds that).
 constexpr uint32_t kVersion = 10;
 // Before version 10 a voxel was 44 bytes: sdf, weight (float), colour, flags, then four vote
 // slots of a 4-byte label and a 4-byte count.
@@ -41,13 +41,18 @@ void getVoxelsBefore10(BinaryReader* r, Block* block) {
     std::memcpy(&v.weight, bytes + 4, 4);
     v.color = Rgb8{bytes[8], bytes[9], bytes[10]};
     v.flags = bytes[11];
+    uint32_t counts[kVoteSlots], most = 0;
     for (int k = 0; k < kVoteSlots; ++k) {
-      int32_t label;
-      uint32_t count;
-      std::memcpy(&label, bytes + 12 + 8 * k, 4);
-      std::memcpy(&count, bytes + 16 + 8 * k, 4);
-      v.votes[k].label = label;
-      v.votes[k].count = static_cast<uint16_t>(count < kMaxVoteCount ? count : kMaxVoteCount);
+      std::memcpy(&v.votes[k].label, bytes + 12 + 8 * k, 4);
+      std::memcpy(&counts[k], bytes + 16 + 8 * k, 4);
+      most = std::max(most, counts[k]);
+    }
+    // Counts beyond today's slots are scaled down together, as addVotes halves them: the
+    // ratios survive and no slot empties.
+    for (int k = 0; k < kVoteSlots; ++k) {
+      const uint64_t c = counts[k];
+      v.votes[k].count =
+          static_cast<uint16_t>(most <= kMaxVoteCount ? c : (c * kMaxVoteCount + most - 1) / most);
     }
   }
 }

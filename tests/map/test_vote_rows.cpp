@@ -157,14 +157,21 @@ TEST(VoteRows, AddVotesEqualsRepeatedAddVote) {
     }
     EXPECT_EQ(evicted_bulk, evicted_single);
   }
+  // A slot about to overflow halves the voxel's counts (rounding up) and then takes the votes:
+  // the ratios Eq. 2 reads survive, and no slot empties.
   Voxel full;
   full.votes[0] = LabelVote{3, kMaxVoteCount - 2};
+  full.votes[1] = LabelVote{5, 40001};
+  full.votes[2] = LabelVote{6, 1};
   addVotes(&full, 3, 10);
-  EXPECT_EQ(full.votes[0].count, kMaxVoteCount);
-  // A new slot takes at most the cap too, however many votes arrive at once.
+  EXPECT_EQ(full.votes[0].count, 32767u + 10u);
+  EXPECT_EQ(full.votes[1].count, 20001u);
+  EXPECT_EQ(full.votes[2].count, 1u);
+  EXPECT_EQ(argmaxLabel(full, [](int32_t l) { return l; }), 3);
+  // A new slot takes at most the cap, however many votes arrive at once.
   addVotes(&full, 4, 100000);
-  EXPECT_EQ(full.votes[1].label, 4);
-  EXPECT_EQ(full.votes[1].count, kMaxVoteCount);
+  EXPECT_EQ(full.votes[3].label, 4);
+  EXPECT_EQ(full.votes[3].count, kMaxVoteCount);
 }
 
 // The lookups' floor must agree with std::floor everywhere a voxel index can be.

@@ -353,7 +353,7 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToNine) {
 }
 
 // Files before version 10 hold 44-byte voxels (4-byte vote counts): they load into today's
-// 36-byte voxels with every value kept, counts above 65,535 saturated.
+// 36-byte voxels with every value kept; a voxel whose counts exceed 65,535 is scaled down.
 TEST_F(BoxScene, MapFilesBeforeVersionTenLoadTheirVoxels) {
   const auto mapper = run(config(), 3);
   const std::vector<uint8_t> file = mapper->serialize();
@@ -389,7 +389,10 @@ TEST_F(BoxScene, MapFilesBeforeVersionTenLoadTheirVoxels) {
       for (int k = 0; k < kVoteSlots; ++k) {
         int32_t label = v.votes[k].label;
         uint32_t count = v.votes[k].count;
-        if (b == 0 && i == 0 && k == 0) label = 77, count = 70000;  // beyond today's slots
+        if (b == 0 && i == 0) {  // counts beyond today's slots: scaled together
+          label = 77 + k;
+          count = k == 0 ? 140000 : k == 1 ? 70000 : k == 2 ? 1 : 0;
+        }
         std::memcpy(bytes + 12 + 8 * k, &label, 4);
         std::memcpy(bytes + 16 + 8 * k, &count, 4);
       }
@@ -413,8 +416,13 @@ TEST_F(BoxScene, MapFilesBeforeVersionTenLoadTheirVoxels) {
     }
   }
   EXPECT_GT(voted, 100u);  // the votes were carried, not only empty slots
-  EXPECT_EQ(back.blocks()[0]->voxels[0].votes[0].label, 77);
-  EXPECT_EQ(back.blocks()[0]->voxels[0].votes[0].count, kMaxVoteCount);
+  const Voxel& scaled = back.blocks()[0]->voxels[0];
+  EXPECT_EQ(scaled.votes[0].label, 77);
+  EXPECT_EQ(scaled.votes[0].count, kMaxVoteCount);
+  EXPECT_EQ(scaled.votes[1].label, 78);
+  EXPECT_EQ(scaled.votes[1].count, 32768u);  // half of 65,535, rounded up
+  EXPECT_EQ(scaled.votes[2].count, 1u);      // a vote stays a vote
+  EXPECT_EQ(scaled.votes[3].count, 0u);
   EXPECT_EQ(back.blocks()[0]->voxels[0].sdf_m, first.voxels[0].sdf_m);
 }
 

@@ -10,8 +10,10 @@ namespace panmap {
 /// a 4th label; panmap keeps 4 and evicts the weakest, counting every eviction.
 constexpr int kVoteSlots = 4;
 
-/// Votes a slot counts at most: counts saturate here. A voxel seen by 65,535 pixels of one
-/// label (at 30 Hz, minutes of staring at it) holds its label as firmly as one seen more.
+/// Votes a slot counts at most. Every pixel votes, so a slot fills fast at coarse voxels (a
+/// 5 cm voxel at 1 m covers ~700 pixels of a 525 px focal length: 95 frames) and on long runs;
+/// addVotes then halves the voxel's counts rather than saturating, keeping their ratios, which
+/// are what Eq. 2's argmax and the eviction read.
 constexpr uint32_t kMaxVoteCount = UINT16_MAX;
 
 /// One super-point label and how often it was observed in a voxel: Pi_V(L_S, V). Packed to 6
@@ -32,15 +34,22 @@ struct Voxel {
 };
 static_assert(sizeof(Voxel) == 36, "keep voxels lean");
 
-/// Adds `n` votes for `label` (n >= 1), exactly as n calls adding one vote each would:
-/// increments its slot (saturating at kMaxVoteCount), or fills an empty one, or evicts the
-/// weakest slot (lowest count, first on ties). Returns true when a vote was evicted.
+/// Adds `n` votes for `label` (n >= 1), as n calls adding one vote each would (up to rounding
+/// where counts are halved): increments its slot, or fills an empty one, or evicts the weakest
+/// slot (lowest count, first on ties). A slot that would exceed kMaxVoteCount first halves
+/// every count of the voxel (rounding up, so no slot empties); what still does not fit
+/// saturates. Returns true when a vote was evicted.
 inline bool addVotes(Voxel* voxel, int32_t label, uint32_t n) {
   const uint16_t capped = static_cast<uint16_t>(n < kMaxVoteCount ? n : kMaxVoteCount);
   int empty = -1, weakest = 0;
   for (int i = 0; i < kVoteSlots; ++i) {
     LabelVote& v = voxel->votes[i];
     if (v.label == label && v.count > 0) {
+      if (v.count > kMaxVoteCount - capped) {
+        for (LabelVote& other : voxel->votes) {
+          other.count = static_cast<uint16_t>((other.count + 1u) / 2u);
+        }
+      }
       v.count = static_cast<uint16_t>(v.count > kMaxVoteCount - capped ? kMaxVoteCount
                                                                        : v.count + capped);
       return false;
