@@ -48,9 +48,13 @@ inline uint8_t lowerNeighboursReading(uint32_t fused, int y, int z) {
   return slots;
 }
 
-// Fuses measured depth d (> 0) seen through pixel (u, v) into a voxel at depth z. Returns
-// whether the voxel changed. Both paths call this, so they agree bit for bit.
-inline bool fuseVoxel(const BlockUpdateParams& p, float z, float d, int u, int v, Voxel* vox) {
+// Fuses measured depth d (> 0) seen through pixel (u, v) into a voxel at depth z whose distance
+// and weight are given as floats (updated in place) and whose colour is `color`. Returns
+// whether the voxel changed. Both paths call this, so they agree bit for bit; they differ only
+// in how they convert the voxel's 2-byte floats, which is exact one way and rounds to nearest
+// even the other, in both.
+inline bool fuseValues(const BlockUpdateParams& p, float z, float d, int u, int v, float* sdf_m,
+                       float* weight_sum, Rgb8* color) {
   const float trunc = p.truncation_m;
   // Projective distance along the optical axis.
   const float sdf = d - z;
@@ -63,16 +67,25 @@ inline bool fuseVoxel(const BlockUpdateParams& p, float z, float d, int u, int v
   if (p.weight_dropoff && sdf < -p.voxel_m) weight = (trunc + sdf) / (trunc - p.voxel_m);
   if (weight <= 0.0f) return false;
   const float s = std::min(sdf, trunc);
-  const float total = vox->weight + weight;
-  vox->sdf_m = (vox->sdf_m * vox->weight + s * weight) / total;
+  const float total = *weight_sum + weight;
+  *sdf_m = (*sdf_m * *weight_sum + s * weight) / total;
   if (p.color && sdf < trunc) {
     const Rgb8 c = (*p.color)(u, v);
     const float a = weight / total;
-    vox->color.r = static_cast<uint8_t>(vox->color.r + a * (c.r - vox->color.r) + 0.5f);
-    vox->color.g = static_cast<uint8_t>(vox->color.g + a * (c.g - vox->color.g) + 0.5f);
-    vox->color.b = static_cast<uint8_t>(vox->color.b + a * (c.b - vox->color.b) + 0.5f);
+    color->r = static_cast<uint8_t>(color->r + a * (c.r - color->r) + 0.5f);
+    color->g = static_cast<uint8_t>(color->g + a * (c.g - color->g) + 0.5f);
+    color->b = static_cast<uint8_t>(color->b + a * (c.b - color->b) + 0.5f);
   }
-  vox->weight = std::min(total, p.max_weight);
+  *weight_sum = std::min(total, p.max_weight);
+  return true;
+}
+
+// fuseValues on a voxel, converting its 2-byte floats in software (Float16).
+inline bool fuseVoxel(const BlockUpdateParams& p, float z, float d, int u, int v, Voxel* vox) {
+  float sdf_m = vox->sdf_m, weight = vox->weight;
+  if (!fuseValues(p, z, d, u, v, &sdf_m, &weight, &vox->color)) return false;
+  vox->sdf_m = sdf_m;
+  vox->weight = weight;
   return true;
 }
 
@@ -100,9 +113,10 @@ inline void prefetchRow(const Voxel* row) {
 }
 
 // One x-row per 8-wide vector: projection, bounds, rounding and the bilinear depth sample are
-// the scalar path's IEEE operations in the same order (no FMA: the target is avx2 only), so
-// results are identical; only voxels left in the band go through the scalar update.
-__attribute__((target("avx2"))) size_t updateBlockAvx2(const BlockUpdateParams& p,
+// the scalar path's IEEE operations in the same order (no FMA: the target is avx2 and f16c),
+// so results are identical; only voxels left in the band go through the scalar update, whose
+// 2-byte floats F16C converts (exactly to float, to nearest even back, as Float16 does).
+__attribute__((target("avx2,f16c"))) size_t updateBlockAvx2(const BlockUpdateParams& p,
                                                        const Eigen::Vector3f& origin_C,
                                                        Block* block) {
   const Eigen::Vector3f dx = p.R_C_W.col(0) * p.voxel_m, dy = p.R_C_W.col(1) * p.voxel_m,
@@ -217,7 +231,13 @@ __attribute__((target("avx2"))) size_t updateBlockAvx2(const BlockUpdateParams& 
       uint32_t fused = 0;
       for (; lanes != 0; lanes &= lanes - 1) {
         const int x = __builtin_ctz(static_cast<unsigned>(lanes));
-        fused |= static_cast<uint32_t>(fuseVoxel(p, zs[x], ds[x], us[x], vs[x], &row[x])) << x;
+        // fuseVoxel with the 2-byte floats converted by F16C instructions.
+        Voxel& vox = row[x];
+        float sdf_m = _cvtsh_ss(vox.sdf_m.bits()), weight = _cvtsh_ss(vox.weight.bits());
+        if (!fuseValues(p, zs[x], ds[x], us[x], vs[x], &sdf_m, &weight, &vox.color)) continue;
+        vox.sdf_m = Float16::fromBits(_cvtss_sh(sdf_m, _MM_FROUND_TO_NEAREST_INT));
+        vox.weight = Float16::fromBits(_cvtss_sh(weight, _MM_FROUND_TO_NEAREST_INT));
+        fused |= 1u << x;
       }
       updated += __builtin_popcount(fused);
       block->lower_changed |= lowerNeighboursReading(fused, y, z);
@@ -261,7 +281,7 @@ size_t updateBlockScalar(const BlockUpdateParams& p, const Eigen::Vector3f& orig
   return updated;
 }
 
-bool blockUpdateUsesAvx2() { return cpuHasAvx2(); }
+bool blockUpdateUsesAvx2() { return cpuHasAvx2F16c(); }
 
 size_t updateBlock(const BlockUpdateParams& p, const Eigen::Vector3f& origin_C, Block* block) {
 #ifdef PANMAP_HAVE_AVX2_PATH

@@ -14,6 +14,8 @@ namespace panmap {
 void IntegratorConfig::check() const {
   if (!(truncation_voxels >= 1.0f)) throw Error("integrator truncation_voxels must be >= 1");
   if (!(max_weight > 0.0f)) throw Error("integrator max_weight must be > 0");
+  // Voxel weights are 2-byte floats (Voxel::weight): at 1,024 their step is 1 already.
+  if (max_weight > 1000.0f) throw Error("integrator max_weight must be <= 1000");
   if (!(min_depth_m >= 0.0f && max_depth_m > min_depth_m)) {
     throw Error("integrator needs 0 <= min_depth_m < max_depth_m");
   }

@@ -27,24 +27,37 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 // 9: III-B's unlabelled_void_share; older files load with 1 (off), as they were built.
 // 10: 36-byte voxels (6-byte vote slots, counts at most 65,535); older files' 44-byte voxels
 //     are converted on loading (a voxel's counts scaled together where one exceeds that).
-constexpr uint32_t kVersion = 10;
-// Before version 10 a voxel was 44 bytes: sdf, weight (float), colour, flags, then four vote
-// slots of a 4-byte label and a 4-byte count.
-constexpr size_t kVoxelBytesBefore10 = 44;
+// 11: 32-byte voxels (distance and weight as 2-byte floats); older files' voxels are rounded
+//     to them on loading.
+constexpr uint32_t kVersion = 11;
 
-// Reads a block's voxels as files before version 10 stored them.
-void getVoxelsBefore10(BinaryReader* r, Block* block) {
+// Reads a block's voxels as files before version 11 stored them: a 4-byte float distance and
+// weight, colour, flags, then four vote slots of a 4-byte label and a count of 4 bytes (before
+// version 10) or 2 (version 10).
+void getVoxelsBefore11(BinaryReader* r, uint32_t version, Block* block) {
+  const size_t count_bytes = version >= 10 ? 2 : 4;
+  const size_t slot_bytes = 4 + count_bytes;
   for (Voxel& v : block->voxels) {
-    uint8_t bytes[kVoxelBytesBefore10];
-    r->getBytes(bytes, sizeof(bytes));
-    std::memcpy(&v.sdf_m, bytes, 4);
-    std::memcpy(&v.weight, bytes + 4, 4);
+    uint8_t bytes[12 + kVoteSlots * 8];
+    r->getBytes(bytes, 12 + kVoteSlots * slot_bytes);
+    float sdf_m, weight;
+    std::memcpy(&sdf_m, bytes, 4);
+    std::memcpy(&weight, bytes + 4, 4);
+    v.sdf_m = sdf_m;
+    v.weight = weight;
     v.color = Rgb8{bytes[8], bytes[9], bytes[10]};
     v.flags = bytes[11];
     uint32_t counts[kVoteSlots], most = 0;
     for (int k = 0; k < kVoteSlots; ++k) {
-      std::memcpy(&v.votes[k].label, bytes + 12 + 8 * k, 4);
-      std::memcpy(&counts[k], bytes + 16 + 8 * k, 4);
+      const uint8_t* slot = bytes + 12 + slot_bytes * k;
+      std::memcpy(&v.votes[k].label, slot, 4);
+      uint16_t short_count = 0;
+      if (count_bytes == 2) {
+        std::memcpy(&short_count, slot + 4, 2);
+        counts[k] = short_count;
+      } else {
+        std::memcpy(&counts[k], slot + 4, 4);
+      }
       most = std::max(most, counts[k]);
     }
     // Counts beyond today's slots are scaled down together, as addVotes halves them: the
@@ -55,6 +68,10 @@ void getVoxelsBefore10(BinaryReader* r, Block* block) {
           static_cast<uint16_t>(most <= kMaxVoteCount ? c : (c * kMaxVoteCount + most - 1) / most);
     }
   }
+}
+// Bytes of a voxel in files of `version`.
+size_t voxelBytes(uint32_t version) {
+  return version >= 11 ? sizeof(Voxel) : 12 + kVoteSlots * (version >= 10 ? 6 : 8);
 }
 constexpr uint32_t kOldestVersion = 5;
 // Magic, version, payload size.
@@ -453,8 +470,7 @@ std::unique_ptr<Mapper> Mapper::deserialize(const std::vector<uint8_t>& bytes,
   auto mapper = std::make_unique<Mapper>(getConfig(&r, version));
   mapper->frames_ = r.get<int64_t>();
   mapper->vote_evictions_ = r.get<uint64_t>();
-  const size_t voxel_bytes = version >= 10 ? sizeof(Voxel) : kVoxelBytesBefore10;
-  const uint64_t blocks = r.getCount(13 + kBlockVoxels * voxel_bytes);
+  const uint64_t blocks = r.getCount(13 + kBlockVoxels * voxelBytes(version));
   // Block keys hold 21 bits per axis: an index beyond them would alias another block, and its
   // voxel coordinates (index * 8) overflow int (fuzz/fuzz_map_file).
   constexpr int32_t kMaxBlockIndex = 1 << 20;
@@ -472,10 +488,10 @@ std::unique_ptr<Mapper> Mapper::deserialize(const std::vector<uint8_t>& bytes,
     block->updated = r.get<uint8_t>() != 0;
     // The file does not say which faces changed: a changed block may have changed them all.
     block->lower_changed = block->updated ? 0xFE : 0;
-    if (version >= 10) {
+    if (version >= 11) {
       r.getBytes(block->voxels, sizeof(block->voxels));
     } else {
-      getVoxelsBefore10(&r, block);
+      getVoxelsBefore11(&r, version, block);
     }
   }
   mapper->tracker_->restore(getSnapshot(&r));

@@ -103,10 +103,18 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
   // Per grid row (y, z): the sdf of its 9 voxels; bit x of inside[row] set when voxel x has
   // sdf < 0, of observed[row] when its weight is above min_weight. Missing blocks read as
   // unobserved with sdf 0.
-  float sdf[kGridVoxels];
+  // Distances stay 2-byte floats (Voxel::sdf_m) here: classifying reads their bits, and only
+  // the corners of crossed edges are converted.
+  uint16_t sdf[kGridVoxels];
   uint16_t inside[kGrid * kGrid], observed[kGrid * kGrid];
   uint32_t any_inside = 0, any_outside = 0;
-  const float min_weight = config.min_weight;
+  // weight > min_weight (>= 0) as bits: non-negative binary16 values order as their bits, so
+  // the observed weights are those from the smallest one above min_weight up to infinity.
+  const Float16 rounded_min(config.min_weight);
+  const uint16_t observed_from = static_cast<float>(rounded_min) > config.min_weight
+                                     ? rounded_min.bits()
+                                     : static_cast<uint16_t>(rounded_min.bits() + 1u);
+  constexpr uint16_t kInfinityBits = 0x7C00u;
   // The rows are 352 bytes apart in their blocks and the upper neighbour's voxel of each row
   // in another block: asking for the next rows' memory early overlaps the cache misses.
   constexpr int kPrefetchRows = 2;
@@ -127,20 +135,22 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
       const int ahead = row + kPrefetchRows;
       if (ahead < kGrid * kGrid) prefetchRow(ahead % kGrid, ahead / kGrid);
       const int slot = ((y >> 3) << 1) | ((z >> 3) << 2);
-      float* row_sdf = sdf + kGrid * row;
+      uint16_t* row_sdf = sdf + kGrid * row;
       uint32_t in = 0, obs = 0;
       for (int part = 0; part < 2; ++part) {
         const int begin = part * kBlockSide, count = part == 0 ? kBlockSide : 1;
         const Block* b = neighbours[slot | part];
         if (!b) {
-          std::fill(row_sdf + begin, row_sdf + begin + count, 0.0f);
+          std::fill(row_sdf + begin, row_sdf + begin + count, uint16_t{0});
           continue;
         }
         const Voxel* v = &b->at(0, y & 7, z & 7);
         for (int i = 0; i < count; ++i) {
-          row_sdf[begin + i] = v[i].sdf_m;
-          in |= static_cast<uint32_t>(v[i].sdf_m < 0.0f) << (begin + i);
-          obs |= static_cast<uint32_t>(v[i].weight > min_weight) << (begin + i);
+          const uint16_t bits = v[i].sdf_m.bits(), weight = v[i].weight.bits();
+          row_sdf[begin + i] = bits;
+          in |= static_cast<uint32_t>(Float16::bitsBelowZero(bits)) << (begin + i);
+          obs |= static_cast<uint32_t>(weight >= observed_from && weight <= kInfinityBits)
+                 << (begin + i);
         }
       }
       inside[row] = static_cast<uint16_t>(in);
@@ -151,6 +161,7 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
   }
   if (!any_inside || !any_outside) return;  // no observed sign change: nothing to mesh
 
+  auto valueOf = [](uint16_t bits) { return static_cast<float>(Float16::fromBits(bits)); };
   const float voxel_m = map.voxelSize();
   const float max_jump_m = config.max_sdf_jump_voxels * voxel_m;
   const std::array<CubeEdge, 12>& cube_edges = cubeEdges();
@@ -198,8 +209,8 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
         for (int e = 0; e < 12 && ok; ++e) {
           if (!(crossed >> e & 1)) continue;
           const CubeEdge& ce = cube_edges[e];
-          ok = std::abs(sdf[g + corner_offset[ce.lower_corner]] -
-                        sdf[g + corner_offset[ce.upper_corner]]) < max_jump_m;
+          ok = std::abs(valueOf(sdf[g + corner_offset[ce.lower_corner]]) -
+                        valueOf(sdf[g + corner_offset[ce.upper_corner]])) < max_jump_m;
         }
         if (!ok) continue;
 
@@ -211,7 +222,7 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
           const uint16_t id = blockEdgeId(lx, ly, lz, ce.axis);
           if (edge_vertex[id] < 0) {
             const int ga = gridIndex(lx, ly, lz), gb = ga + kAxisStride[ce.axis];
-            const float sa = sdf[ga], sb = sdf[gb];
+            const float sa = valueOf(sdf[ga]), sb = valueOf(sdf[gb]);
             const float t = sa / (sa - sb);  // signs differ, so no division by zero
             // Computed from global integers only, so neighbour blocks that mesh the same
             // edge produce bit-identical vertices.

@@ -345,20 +345,18 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToNine) {
   const auto nine = Mapper::deserialize(asVersion(bytes_b, offset, 9), "nine.panmap");
   EXPECT_EQ(nine->config().superpoints.unlabelled_void_share, 0.75);
 
-  // Versions outside 5-10 are refused by name.
+  // Versions outside 5-11 are refused by name.
   std::vector<uint8_t> future = bytes_b;
-  future[8] = 11;
+  future[8] = 12;
   test::expectError([&] { Mapper::deserialize(future, "future.panmap"); },
-                    {"future.panmap", "version 11", "reads 5 to 10"});
+                    {"future.panmap", "version 12", "reads 5 to 11"});
 }
 
-// Files before version 10 hold 44-byte voxels (4-byte vote counts): they load into today's
-// 36-byte voxels with every value kept; a voxel whose counts exceed 65,535 is scaled down.
-TEST_F(BoxScene, MapFilesBeforeVersionTenLoadTheirVoxels) {
-  const auto mapper = run(config(), 3);
-  const std::vector<uint8_t> file = mapper->serialize();
-  const TsdfMap& map = mapper->map();
-  ASSERT_GT(map.numBlocks(), 10u);
+// `file` (written by `mapper`) with its voxels as versions before 11 stored them: 4-byte
+// distance and weight, then vote counts of 4 bytes (version 9) or 2 (version 10). Voxel 0 of
+// block 0 gets the labels 77-80 with `first_counts`.
+std::vector<uint8_t> withLegacyVoxels(const std::vector<uint8_t>& file, const TsdfMap& map,
+                                      uint32_t version, const uint32_t first_counts[kVoteSlots]) {
   // Blocks are stored in allocation order, each as index, updated flag and voxels: the first
   // block's record is found by its bytes.
   const Block& first = *map.blocks()[0];
@@ -369,9 +367,11 @@ TEST_F(BoxScene, MapFilesBeforeVersionTenLoadTheirVoxels) {
   pattern[12] = first.updated;
   std::memcpy(pattern.data() + kRecordHead, &first.voxels[0], sizeof(Voxel));
   const auto found = std::search(file.begin(), file.end(), pattern.begin(), pattern.end());
-  ASSERT_NE(found, file.end());
+  EXPECT_NE(found, file.end());
+  if (found == file.end()) return {};
   const size_t begin = static_cast<size_t>(found - file.begin());
   const size_t record = kRecordHead + sizeof(Block::voxels);
+  const size_t count_bytes = version >= 10 ? 2 : 4;
   std::vector<uint8_t> old(file.begin(), found);
   for (size_t b = 0; b < map.numBlocks(); ++b) {
     const uint8_t* head = file.data() + begin + b * record;
@@ -379,9 +379,10 @@ TEST_F(BoxScene, MapFilesBeforeVersionTenLoadTheirVoxels) {
     for (int i = 0; i < kBlockVoxels; ++i) {
       Voxel v;
       std::memcpy(&v, head + kRecordHead + i * sizeof(Voxel), sizeof(Voxel));
-      uint8_t bytes[44] = {};
-      std::memcpy(bytes, &v.sdf_m, 4);
-      std::memcpy(bytes + 4, &v.weight, 4);
+      std::vector<uint8_t> bytes(12 + kVoteSlots * (4 + count_bytes));
+      const float sdf_m = v.sdf_m, weight = v.weight;
+      std::memcpy(bytes.data(), &sdf_m, 4);
+      std::memcpy(bytes.data() + 4, &weight, 4);
       bytes[8] = v.color.r;
       bytes[9] = v.color.g;
       bytes[10] = v.color.b;
@@ -389,41 +390,65 @@ TEST_F(BoxScene, MapFilesBeforeVersionTenLoadTheirVoxels) {
       for (int k = 0; k < kVoteSlots; ++k) {
         int32_t label = v.votes[k].label;
         uint32_t count = v.votes[k].count;
-        if (b == 0 && i == 0) {  // counts beyond today's slots: scaled together
+        if (b == 0 && i == 0) {
           label = 77 + k;
-          count = k == 0 ? 140000 : k == 1 ? 70000 : k == 2 ? 1 : 0;
+          count = first_counts[k];
         }
-        std::memcpy(bytes + 12 + 8 * k, &label, 4);
-        std::memcpy(bytes + 16 + 8 * k, &count, 4);
+        uint8_t* slot = bytes.data() + 12 + (4 + count_bytes) * k;
+        std::memcpy(slot, &label, 4);
+        const uint16_t short_count = static_cast<uint16_t>(count);
+        std::memcpy(slot + 4, count_bytes == 2 ? static_cast<const void*>(&short_count) : &count,
+                    count_bytes);
       }
-      old.insert(old.end(), bytes, bytes + sizeof(bytes));
+      old.insert(old.end(), bytes.begin(), bytes.end());
     }
   }
   old.insert(old.end(),
              file.begin() + static_cast<std::ptrdiff_t>(begin + map.numBlocks() * record),
              file.end());
-  const auto loaded = Mapper::deserialize(reseal(old, 9), "nine.panmap");
-  const TsdfMap& back = loaded->map();
-  ASSERT_EQ(back.numBlocks(), map.numBlocks());
-  size_t voted = 0;
-  for (size_t b = 0; b < map.numBlocks(); ++b) {
-    const Block& want = *map.blocks()[b];
-    const Block& got = *back.blocks()[b];
-    ASSERT_EQ(got.index, want.index);
-    for (int i = b == 0 ? 1 : 0; i < kBlockVoxels; ++i) {
-      ASSERT_EQ(0, std::memcmp(&got.voxels[i], &want.voxels[i], sizeof(Voxel))) << b << " " << i;
-      voted += want.voxels[i].votes[0].count > 0;
+  return reseal(old, version);
+}
+
+// Files before version 11 hold 44-byte (version 9) or 36-byte (version 10) voxels with 4-byte
+// distances and weights: they load into today's 32-byte voxels with every value kept (the
+// 2-byte floats round-trip through 4-byte ones exactly); counts beyond 65,535 are scaled down.
+TEST_F(BoxScene, MapFilesBeforeVersionElevenLoadTheirVoxels) {
+  const auto mapper = run(config(), 3);
+  const std::vector<uint8_t> file = mapper->serialize();
+  const TsdfMap& map = mapper->map();
+  ASSERT_GT(map.numBlocks(), 10u);
+  const uint32_t nine_counts[kVoteSlots] = {140000, 70000, 1, 0};
+  const uint32_t ten_counts[kVoteSlots] = {65535, 1000, 1, 0};
+  for (const uint32_t version : {9u, 10u}) {
+    SCOPED_TRACE(version);
+    const std::vector<uint8_t> old =
+        withLegacyVoxels(file, map, version, version == 9 ? nine_counts : ten_counts);
+    ASSERT_FALSE(old.empty());
+    const auto loaded = Mapper::deserialize(old, "old.panmap");
+    const TsdfMap& back = loaded->map();
+    ASSERT_EQ(back.numBlocks(), map.numBlocks());
+    size_t voted = 0;
+    for (size_t b = 0; b < map.numBlocks(); ++b) {
+      const Block& want = *map.blocks()[b];
+      const Block& got = *back.blocks()[b];
+      ASSERT_EQ(got.index, want.index);
+      for (int i = b == 0 ? 1 : 0; i < kBlockVoxels; ++i) {
+        ASSERT_EQ(0, std::memcmp(&got.voxels[i], &want.voxels[i], sizeof(Voxel))) << b << " " << i;
+        voted += want.voxels[i].votes[0].count > 0;
+      }
     }
+    EXPECT_GT(voted, 100u);  // the votes were carried, not only empty slots
+    const Voxel& first = back.blocks()[0]->voxels[0];
+    EXPECT_EQ(first.votes[0].label, 77);
+    EXPECT_EQ(first.votes[0].count, kMaxVoteCount);
+    EXPECT_EQ(first.votes[1].label, 78);
+    // Version 9: half of 65,535, rounded up; version 10 kept its count.
+    EXPECT_EQ(first.votes[1].count, version == 9 ? 32768u : 1000u);
+    EXPECT_EQ(first.votes[2].count, 1u);  // a vote stays a vote
+    EXPECT_EQ(first.votes[3].count, 0u);
+    EXPECT_EQ(first.sdf_m.bits(), map.blocks()[0]->voxels[0].sdf_m.bits());
+    EXPECT_EQ(first.weight.bits(), map.blocks()[0]->voxels[0].weight.bits());
   }
-  EXPECT_GT(voted, 100u);  // the votes were carried, not only empty slots
-  const Voxel& scaled = back.blocks()[0]->voxels[0];
-  EXPECT_EQ(scaled.votes[0].label, 77);
-  EXPECT_EQ(scaled.votes[0].count, kMaxVoteCount);
-  EXPECT_EQ(scaled.votes[1].label, 78);
-  EXPECT_EQ(scaled.votes[1].count, 32768u);  // half of 65,535, rounded up
-  EXPECT_EQ(scaled.votes[2].count, 1u);      // a vote stays a vote
-  EXPECT_EQ(scaled.votes[3].count, 0u);
-  EXPECT_EQ(back.blocks()[0]->voxels[0].sdf_m, first.voxels[0].sdf_m);
 }
 
 }  // namespace

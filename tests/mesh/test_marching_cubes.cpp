@@ -307,6 +307,16 @@ TEST(MarchingCubes, SignChangeOnlyWhenTheJumpIsBelowTheLimit) {
   // Weights at or under min_weight count as unobserved.
   EXPECT_EQ(meshStep(0.5f * v, -0.5f * v, 1.0f, 1.0f).numFaces(), 0u);
   EXPECT_EQ(meshStep(0.5f * v, -0.5f * v, 1.5f, 1.0f).numFaces(), 450u);
+  // Weights are 2-byte floats, compared by their bits: 0.3 is stored as 0.30004883, above 0.3
+  // and not above itself or 0.3001. Likewise a distance of -0 is not inside.
+  const float stored = Float16(0.3f);
+  ASSERT_GT(stored, 0.3f);
+  EXPECT_EQ(meshStep(0.5f * v, -0.5f * v, 0.3f, 0.3f).numFaces(), 450u);
+  EXPECT_EQ(meshStep(0.5f * v, -0.5f * v, 0.3f, stored).numFaces(), 0u);
+  EXPECT_EQ(meshStep(0.5f * v, -0.5f * v, 0.3f, 0.3001f).numFaces(), 0u);
+  EXPECT_EQ(meshStep(0.5f * v, -0.5f * v, 0.3f, 0.2999f).numFaces(), 450u);
+  EXPECT_EQ(meshStep(0.5f * v, -0.0f, 1.0f, 0.0f).numFaces(), 0u);
+  EXPECT_EQ(meshStep(0.5f * v, -1e-6f, 1.0f, 0.0f).numFaces(), 450u);  // a subnormal
 }
 
 TEST(MarchingCubes, RandomFieldGivesAClosedConsistentSurface) {

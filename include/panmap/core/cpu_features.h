@@ -2,7 +2,8 @@
 
 // PANMAP_HAVE_AVX2_PATH: this compiler can build functions for AVX2 next to the baseline
 // x86-64 ones (with __attribute__((target("avx2"))) and <immintrin.h>); cpuHasAvx2() tells at
-// run time whether this CPU may call them.
+// run time whether this CPU may call them, cpuHasAvx2F16c() whether it may call those that
+// also convert 2-byte floats (target("avx2,f16c"); every AVX2 CPU so far has F16C).
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 #define PANMAP_HAVE_AVX2_PATH 1
@@ -15,6 +16,16 @@ inline bool cpuHasAvx2() {
 #ifdef PANMAP_HAVE_AVX2_PATH
   static const bool avx2 = __builtin_cpu_supports("avx2");
   return avx2;
+#else
+  return false;
+#endif
+}
+
+/// True when the CPU running this has AVX2 and F16C (checked once).
+inline bool cpuHasAvx2F16c() {
+#ifdef PANMAP_HAVE_AVX2_PATH
+  static const bool f16c = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("f16c");
+  return f16c;
 #else
   return false;
 #endif

@@ -35,7 +35,7 @@ size_t updateBlock(const BlockUpdateParams& params, const Eigen::Vector3f& origi
 size_t updateBlockScalar(const BlockUpdateParams& params, const Eigen::Vector3f& origin_C,
                          Block* block);
 
-/// True when updateBlock runs the AVX2 path on this CPU.
+/// True when updateBlock runs the AVX2 path on this CPU (AVX2 and F16C).
 bool blockUpdateUsesAvx2();
 
 }  // namespace internal
