@@ -108,8 +108,8 @@ static_assert(kBlockSide == 8, "the AVX2 path handles one 8-voxel row per vector
 inline void prefetchRow(const Voxel* row) {
   const char* bytes = reinterpret_cast<const char*>(row);
   constexpr size_t kBytes = kBlockSide * sizeof(Voxel);
+  static_assert(kBytes % 64 == 0, "rows start on a cache line (Block::voxels)");
   for (size_t k = 0; k < kBytes; k += 64) _mm_prefetch(bytes + k, _MM_HINT_T0);
-  _mm_prefetch(bytes + kBytes - 1, _MM_HINT_T0);  // rows need not start on a line
 }
 
 // One x-row per 8-wide vector: projection, bounds, rounding and the bilinear depth sample are
@@ -117,8 +117,8 @@ inline void prefetchRow(const Voxel* row) {
 // so results are identical; only voxels left in the band go through the scalar update, whose
 // 2-byte floats F16C converts (exactly to float, to nearest even back, as Float16 does).
 __attribute__((target("avx2,f16c"))) size_t updateBlockAvx2(const BlockUpdateParams& p,
-                                                       const Eigen::Vector3f& origin_C,
-                                                       Block* block) {
+                                                            const Eigen::Vector3f& origin_C,
+                                                            Block* block) {
   const Eigen::Vector3f dx = p.R_C_W.col(0) * p.voxel_m, dy = p.R_C_W.col(1) * p.voxel_m,
                         dz = p.R_C_W.col(2) * p.voxel_m;
   const Image<float>& depth = *p.depth_m;

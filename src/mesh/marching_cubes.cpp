@@ -115,7 +115,7 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
                                      ? rounded_min.bits()
                                      : static_cast<uint16_t>(rounded_min.bits() + 1u);
   constexpr uint16_t kInfinityBits = 0x7C00u;
-  // The rows are 352 bytes apart in their blocks and the upper neighbour's voxel of each row
+  // The rows are 256 bytes apart in their blocks and the upper neighbour's voxel of each row
   // in another block: asking for the next rows' memory early overlaps the cache misses.
   constexpr int kPrefetchRows = 2;
   auto prefetchRow = [&neighbours](int y, int z) {

@@ -1,4 +1,5 @@
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <random>
 
@@ -149,6 +150,19 @@ TEST(BlockUpdate, WallAtOneMetre) {
       EXPECT_NEAR(v.sdf_m, sdf, 1e-6f + std::ldexp(std::abs(sdf), -11)) << "z " << z;
     }
   }
+}
+
+// Voxels are half a cache line and blocks keep them on line boundaries, wherever the block
+// lives: a voxel never straddles two lines.
+TEST(BlockLayout, VoxelsStartOnACacheLine) {
+  TsdfMap map(TsdfMap::Config{0.02f});
+  for (int i = 0; i < 20; ++i) {
+    const Block* block = map.allocateBlock(BlockIndex(i, -i, 2 * i));
+    EXPECT_EQ(reinterpret_cast<uintptr_t>(&block->voxels[0]) % 64, 0u) << i;
+  }
+  Block on_stack;
+  EXPECT_EQ(reinterpret_cast<uintptr_t>(&on_stack.voxels[0]) % 64, 0u);
+  EXPECT_EQ(64 % sizeof(Voxel), 0u);
 }
 
 }  // namespace

@@ -13,7 +13,7 @@ TEST(Float16, HoldsExactValuesBitForBit) {
   EXPECT_EQ(Float16(0.0f).bits(), 0x0000u);
   EXPECT_EQ(Float16(1.0f).bits(), 0x3C00u);
   EXPECT_EQ(Float16(-2.0f).bits(), 0xC000u);
-  EXPECT_EQ(Float16(100.0f).bits(), 0x5640u);  // the default maximum weight
+  EXPECT_EQ(Float16(100.0f).bits(), 0x5640u);    // the default maximum weight
   EXPECT_EQ(Float16(65504.0f).bits(), 0x7BFFu);  // the largest finite value
   for (const float v : {0.0f, 1.0f, -2.0f, 0.5f, 100.0f, 0.0009765625f}) {
     EXPECT_EQ(static_cast<float>(Float16(v)), v);

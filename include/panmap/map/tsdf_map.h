@@ -27,7 +27,9 @@ struct Block {
   /// -(s & 1, s >> 1 & 1, s >> 2) changed since the mesher last looked: that neighbour's cubes
   /// read them (the x = 0 face for bit 0 of s, y = 0 for bit 1, z = 0 for bit 2; all named).
   uint8_t lower_changed = 0;
-  Voxel voxels[kBlockVoxels];
+  /// On a cache line boundary: a voxel is half a line, so none straddles two and a row of 8
+  /// is exactly 4 lines.
+  alignas(64) Voxel voxels[kBlockVoxels];
 
   /// Voxel at local coordinates (x, y, z), each in [0, kBlockSide).
   Voxel& at(int x, int y, int z) { return voxels[x + kBlockSide * (y + kBlockSide * z)]; }

@@ -61,9 +61,9 @@ static_assert(sizeof(Float16) == 2, "two bytes");
 /// A voxel of the label-TSDF: 32 bytes, two to a cache line. Distance and weight are 2-byte
 /// floats: the map is mostly voxels, and a building at 2 cm outgrew 4 GB with 4-byte ones.
 struct Voxel {
-  Float16 sdf_m;   ///< truncated signed distance to the surface, metres (+ in front)
-  Float16 weight;  ///< integration weight, 0 = never observed
-  Rgb8 color;      ///< running mean colour
+  Float16 sdf_m;      ///< truncated signed distance to the surface, metres (+ in front)
+  Float16 weight;     ///< integration weight, 0 = never observed
+  Rgb8 color;         ///< running mean colour
   uint8_t flags = 0;  ///< reserved
   LabelVote votes[kVoteSlots];
 };
