@@ -5,6 +5,7 @@
 // run time whether this CPU may call them, cpuHasAvx2F16c() whether it may call those that
 // also convert 2-byte floats (target("avx2,f16c"); every AVX2 CPU so far has F16C).
 #if defined(__x86_64__) && defined(__GNUC__)
+#include <cpuid.h>
 #include <immintrin.h>
 #define PANMAP_HAVE_AVX2_PATH 1
 #endif
@@ -24,7 +25,11 @@ inline bool cpuHasAvx2() {
 /// True when the CPU running this has AVX2 and F16C (checked once).
 inline bool cpuHasAvx2F16c() {
 #ifdef PANMAP_HAVE_AVX2_PATH
-  static const bool f16c = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("f16c");
+  // CPUID leaf 1 directly: clang's __builtin_cpu_supports does not know "f16c".
+  static const bool f16c = [] {
+    unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+    return cpuHasAvx2() && __get_cpuid(1, &eax, &ebx, &ecx, &edx) != 0 && (ecx & bit_F16C) != 0;
+  }();
   return f16c;
 #else
   return false;
