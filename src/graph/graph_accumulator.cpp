@@ -313,7 +313,7 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
 }
 
 size_t GraphAccumulator::memoryBytes() const {
-  size_t bytes = mapNodesBytes(scores_) + edges_.memoryBytes();
+  size_t bytes = mapNodesBytes(scores_) + edges_.memoryBytes() + surface_scan_.memoryBytes();
   for (const auto& [label, by_class] : scores_) bytes += mapNodesBytes(by_class);
   for (const ThreadScratch& scratch : thread_scratch_) {
     bytes += vectorBytes(scratch.hits) + vectorBytes(scratch.samples) + vectorBytes(scratch.masks) +
@@ -365,6 +365,12 @@ size_t GraphAccumulator::pruneEdges(const SurfaceAdjacency& surface,
   });
 }
 
+const SurfaceScan& GraphAccumulator::surfaceScan(const TsdfMap& map,
+                                                 const LabelRegistry& registry) const {
+  surface_scan_.refresh(map, registry, config_.surface_band_voxels, pool_);
+  return surface_scan_;
+}
+
 SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
                                         const SuperpointTracker& tracker) const {
   SuperpointGraph g;
@@ -379,10 +385,10 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
   SurfaceAdjacency::OwnerTotals totals;
   totals.voxels.assign(num_labels, 0);
   totals.centre_sum.assign(num_labels, Eigen::Vector3d::Zero());
+  const SurfaceScan& scan = surfaceScan(map, tracker.labels());  // flattens the registry
   auto resolve = [&tracker](int32_t l) { return tracker.labels().resolve(l); };
-  tracker.labels().flatten();  // every label points at its root: resolving is a table lookup
-  const SurfaceAdjacency adjacency = SurfaceAdjacency::compute(
-      map, tracker.labels().parents(), config_.surface_band_voxels, &totals, pool_);
+  scan.addTotals(&totals);
+  const SurfaceAdjacency adjacency = scan.adjacency();
   // Without pruning the adjacency is not used (its scan still counts the voxels).
   const SurfaceAdjacency* surface = config_.prune_edges ? &adjacency : nullptr;
   for (const auto& [label, state] : tracker.states()) {

@@ -4,18 +4,10 @@
 #include <cmath>
 
 #include "panmap/core/error.h"
+#include "panmap/graph/internal/touching_voxels.h"
 #include "panmap/map/voxel.h"
 
 namespace panmap {
-
-namespace {
-
-// The 13 "forward" offsets of the 26-neighbourhood: each touching voxel pair is visited once.
-constexpr int kForward[13][3] = {{1, 0, 0},  {0, 1, 0},  {0, 0, 1},  {1, 1, 0},  {1, -1, 0},
-                                 {1, 0, 1},  {1, 0, -1}, {0, 1, 1},  {0, 1, -1}, {1, 1, 1},
-                                 {1, 1, -1}, {1, -1, 1}, {1, -1, -1}};
-
-}  // namespace
 
 uint64_t SurfaceAdjacency::key(int32_t a, int32_t b) {
   const auto [lo, hi] = std::minmax(a, b);
@@ -121,9 +113,8 @@ SurfaceAdjacency SurfaceAdjacency::computeWith(const TsdfMap& map, const Resolve
       if (owners[b].empty()) continue;
       const BlockIndex index = blocks[b]->index;
       // The owner arrays of the block and its 26 neighbours, looked up once per block rather
-      // than per voxel on its border: near[dx + 1][dy + 1][dz + 1], null where nothing owns
-      // surface.
-      const std::vector<int32_t>* near[3][3][3];
+      // than per voxel on its border.
+      internal::NearOwners near;
       for (int dz = -1; dz <= 1; ++dz) {
         for (int dy = -1; dy <= 1; ++dy) {
           for (int dx = -1; dx <= 1; ++dx) {
@@ -132,31 +123,8 @@ SurfaceAdjacency SurfaceAdjacency::computeWith(const TsdfMap& map, const Resolve
           }
         }
       }
-      const std::vector<int32_t>& labels = owners[b];
-      for (int z = 0; z < kBlockSide; ++z) {
-        for (int y = 0; y < kBlockSide; ++y) {
-          for (int x = 0; x < kBlockSide; ++x) {
-            const int32_t label =
-                labels[static_cast<size_t>(x + kBlockSide * (y + kBlockSide * z))];
-            if (label <= 0) continue;
-            for (const auto& d : kForward) {
-              int nx = x + d[0], ny = y + d[1], nz = z + d[2];
-              // Which neighbour block (-1, 0, 1 per axis) and the voxel inside it.
-              const int bx = nx < 0 ? -1 : (nx >= kBlockSide ? 1 : 0);
-              const int by = ny < 0 ? -1 : (ny >= kBlockSide ? 1 : 0);
-              const int bz = nz < 0 ? -1 : (nz >= kBlockSide ? 1 : 0);
-              const std::vector<int32_t>* other = near[bx + 1][by + 1][bz + 1];
-              if (!other) continue;
-              nx -= bx * kBlockSide;
-              ny -= by * kBlockSide;
-              nz -= bz * kBlockSide;
-              const int32_t neighbour =
-                  (*other)[static_cast<size_t>(nx + kBlockSide * (ny + kBlockSide * nz))];
-              if (neighbour > 0 && neighbour != label) scan.pairs.insert(key(label, neighbour));
-            }
-          }
-        }
-      }
+      internal::forEachTouchingPair(
+          near, [&scan](int32_t a, int32_t b) { scan.pairs.insert(key(a, b)); });
     }
   });
   SurfaceAdjacency out;

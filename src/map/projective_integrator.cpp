@@ -226,6 +226,7 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
   params.weight_dropoff = config_.weight_dropoff;
   params.space_carving = config_.space_carving;
   std::atomic<size_t> voxels_updated{0};
+  const uint64_t stamp = map->nextChangeStamp();
   // Blocks differ a lot in how many of their voxels lie in the band: hand them out in small
   // chunks. Each block is updated by one thread from its own data only, so the result does
   // not depend on which thread takes it.
@@ -235,7 +236,10 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
       Block& block = *blocks_[b];
       const size_t n =
           internal::updateBlock(params, T_C_W * map->voxelCentre(block.index, 0, 0, 0), &block);
-      if (n > 0) block.updated = true;
+      if (n > 0) {
+        block.updated = true;
+        block.changed.store(stamp, std::memory_order_relaxed);
+      }
       updated += n;
     }
     voxels_updated += updated;

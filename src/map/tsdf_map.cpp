@@ -12,7 +12,40 @@ void TsdfMap::Config::check() const {
   }
 }
 
-TsdfMap::TsdfMap(const Config& config) : config_(config) { config_.check(); }
+namespace {
+
+uint64_t newMapId() {
+  static std::atomic<uint64_t> next_id{0};
+  return ++next_id;
+}
+
+}  // namespace
+
+TsdfMap::TsdfMap(const Config& config) : config_(config), id_(newMapId()) { config_.check(); }
+
+TsdfMap::TsdfMap(TsdfMap&& other) noexcept
+    : config_(other.config_),
+      id_(other.id_),
+      change_stamp_(other.change_stamp_.load()),
+      index_(std::move(other.index_)),
+      blocks_(std::move(other.blocks_)) {
+  other.id_ = newMapId();
+  other.index_.clear();
+  other.blocks_.clear();
+}
+
+TsdfMap& TsdfMap::operator=(TsdfMap&& other) noexcept {
+  if (this == &other) return *this;
+  config_ = other.config_;
+  id_ = other.id_;
+  change_stamp_ = other.change_stamp_.load();
+  index_ = std::move(other.index_);
+  blocks_ = std::move(other.blocks_);
+  other.id_ = newMapId();
+  other.index_.clear();
+  other.blocks_.clear();
+  return *this;
+}
 
 BlockIndex TsdfMap::blockIndexOf(const Eigen::Vector3f& p_W) const {
   const float inv = 1.0f / blockSize();

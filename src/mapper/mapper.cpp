@@ -182,33 +182,13 @@ void checkFrame(const MapperConfig& config, const RgbdFrame& frame, const Eigen:
 
 void Mapper::forgetUnvotedSuperpoints() {
   const LabelRegistry& registry = tracker_->labels();
-  registry.flatten();  // resolve() only reads from here on: safe on every thread
-  const int threads = pool_->size();
-  std::vector<std::vector<uint8_t>> flags(static_cast<size_t>(threads));
-  const auto& blocks = map_->blocks();
-  pool_->parallelFor(blocks.size(), [&](size_t begin, size_t end, int t) {
-    std::vector<uint8_t>& has_votes = flags[static_cast<size_t>(t)];
-    has_votes.assign(static_cast<size_t>(registry.size()) + 1, 0);
-    for (size_t b = begin; b < end; ++b) {
-      for (const Voxel& voxel : blocks[b]->voxels) {
-        for (const LabelVote& vote : voxel.votes) {
-          if (vote.count > 0) has_votes[static_cast<size_t>(registry.resolve(vote.label))] = 1;
-        }
-      }
-    }
-  });
-  std::vector<uint8_t> has_votes(static_cast<size_t>(registry.size()) + 1, 0);
-  for (const std::vector<uint8_t>& part : flags) {
-    for (size_t i = 0; i < part.size(); ++i) has_votes[i] |= part[i];
-  }
+  // Reads only the blocks changed since the last look: at building scale a whole-map read took
+  // over a second every kForgetEveryFrames frames.
+  const SurfaceScan& scan = graph_->surfaceScan(*map_, registry);
+  const std::vector<uint8_t> has_votes = scan.hasVotes();
   superpoints_forgotten_ += tracker_->forgetUnvoted(has_votes);
   graph_->forgetUnvoted(has_votes, registry);
-  if (config_.graph.prune_edges) {
-    const SurfaceAdjacency surface = SurfaceAdjacency::compute(
-        *map_, [&registry](int32_t label) { return registry.resolve(label); },
-        config_.graph.surface_band_voxels, pool_.get());
-    edges_pruned_ += graph_->pruneEdges(surface, registry);
-  }
+  if (config_.graph.prune_edges) edges_pruned_ += graph_->pruneEdges(scan.adjacency(), registry);
 }
 
 FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C_given,

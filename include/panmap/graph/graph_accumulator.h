@@ -13,6 +13,7 @@
 #include "panmap/graph/internal/edge_table.h"
 #include "panmap/graph/superpoint_graph.h"
 #include "panmap/graph/surface_adjacency.h"
+#include "panmap/graph/surface_scan.h"
 #include "panmap/map/tsdf_map.h"
 #include "panmap/map/voxel_label_sampler.h"
 #include "panmap/superpoint/superpoint_tracker.h"
@@ -96,6 +97,11 @@ class GraphAccumulator {
   /// output (meshes and objects are made of surface voxels) and would only slow the solver.
   SuperpointGraph graph(const TsdfMap& map, const SuperpointTracker& tracker) const;
 
+  /// The map's surface owners, touching pairs, owner totals and voted labels, brought up to
+  /// date by reading only the blocks that changed since the last call (SurfaceScan). Kept
+  /// here, beside the graph it serves; like update(), call from one thread at a time.
+  const SurfaceScan& surfaceScan(const TsdfMap& map, const LabelRegistry& registry) const;
+
   /// P_nu^C of a super-point (merges resolved by the caller), empty if never seen.
   const std::map<int32_t, double>& scores(int32_t label) const;
   /// P_eps^C of a pair (either order), empty if never co-observed.
@@ -106,7 +112,8 @@ class GraphAccumulator {
   double apart(int32_t a, int32_t b) const;
   /// Number of edges.
   size_t numEdges() const { return edges_.size(); }
-  /// Estimated heap bytes of the scores (std::map nodes), the edge table and the scratch.
+  /// Estimated heap bytes of the scores (std::map nodes), the edge table, the surface scan's
+  /// per-block results and the scratch.
   size_t memoryBytes() const;
 
   /// Full state for saving and restoring a map.
@@ -126,6 +133,8 @@ class GraphAccumulator {
 
  private:
   void applyMerges(const SuperpointTracker& tracker);
+
+  mutable SurfaceScan surface_scan_;
 
   /// A sampled pixel's mask, the voxel its ray reaches and that voxel's super-point.
   struct Hit {

@@ -62,6 +62,7 @@ class SurfaceAdjacency {
   size_t numPairs() const { return pairs_.size(); }
 
  private:
+  friend class SurfaceScan;  // builds one from its per-block results
   static uint64_t key(int32_t a, int32_t b);
   template <typename Resolve>
   static SurfaceAdjacency computeWith(const TsdfMap& map, const Resolve& resolve, float band_voxels,

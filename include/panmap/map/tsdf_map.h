@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -27,6 +28,10 @@ struct Block {
   /// -(s & 1, s >> 1 & 1, s >> 2) changed since the mesher last looked: that neighbour's cubes
   /// read them (the x = 0 face for bit 0 of s, y = 0 for bit 1, z = 0 for bit 2; all named).
   uint8_t lower_changed = 0;
+  /// The TsdfMap::nextChangeStamp() of the last pass that wrote its voxels (0: none since it
+  /// was allocated or loaded). Scans that keep results per block (graph/surface_scan.h) redo
+  /// the blocks whose stamp moved. Atomic: the threads of one pass may stamp the same block.
+  std::atomic<uint64_t> changed{0};
   /// On a cache line boundary: a voxel is half a line, so none straddles two and a row of 8
   /// is exactly 4 lines.
   alignas(64) Voxel voxels[kBlockVoxels];
@@ -52,6 +57,10 @@ class TsdfMap {
 
   /// Throws Error when the config is invalid.
   explicit TsdfMap(const Config& config);
+  /// Takes the blocks and the id of `other`, which is left empty with an id of its own.
+  TsdfMap(TsdfMap&& other) noexcept;
+  /// @copydoc TsdfMap(TsdfMap&&)
+  TsdfMap& operator=(TsdfMap&& other) noexcept;
 
   /// The config the map was built with.
   const Config& config() const { return config_; }
@@ -82,6 +91,17 @@ class TsdfMap {
   /// Bytes used by voxel storage and the index.
   size_t memoryBytes() const;
 
+  /// Unique among the maps of this process: results kept per block (graph/surface_scan.h)
+  /// belong to one map, and a map built in its place may reuse the old one's address.
+  uint64_t id() const { return id_; }
+  /// A stamp larger than every one handed out before, for a pass that writes voxels to store
+  /// in Block::changed of each block it writes (MutableVoxelLookup and the integrator do).
+  uint64_t nextChangeStamp() { return ++change_stamp_; }
+  /// Stamps a block as written by a pass of its own (for writers that use neither).
+  void markChanged(Block* block) {
+    block->changed.store(nextChangeStamp(), std::memory_order_relaxed);
+  }
+
   /// Hash key of a block index (21 bits per axis, two's complement).
   static uint64_t key(const BlockIndex& index) {
     return (static_cast<uint64_t>(index.x() & 0x1FFFFF) << 42) |
@@ -91,6 +111,8 @@ class TsdfMap {
 
  private:
   Config config_;
+  uint64_t id_;
+  std::atomic<uint64_t> change_stamp_{0};
   absl::flat_hash_map<uint64_t, Block*> index_;
   std::vector<std::unique_ptr<Block>> blocks_;
 };

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <cmath>
 #include <type_traits>
 
@@ -11,7 +12,8 @@ namespace panmap {
 
 /// Finds the voxel containing a world point, remembering the last block: neighbouring pixels
 /// of an image mostly fall in the same block, so most lookups skip the hash map. One per
-/// thread and per pass (it caches a block pointer).
+/// thread and per pass (it caches a block pointer). A mutable lookup is for writing: it stamps
+/// every block it finds with one TsdfMap::nextChangeStamp() of its own (Block::changed).
 template <typename Map>
 class VoxelLookupT {
   using BlockPtr = std::conditional_t<std::is_const<Map>::value, const Block*, Block*>;
@@ -19,7 +21,9 @@ class VoxelLookupT {
 
  public:
   /// @param map the TsdfMap (const or not) looked up
-  explicit VoxelLookupT(Map& map) : map_(map), inv_voxel_(1.0f / map.voxelSize()) {}
+  explicit VoxelLookupT(Map& map) : map_(map), inv_voxel_(1.0f / map.voxelSize()) {
+    if constexpr (!std::is_const<Map>::value) stamp_ = map.nextChangeStamp();
+  }
 
   /// The voxel containing p_W, or null when its block is not allocated.
   VoxelPtr find(const Eigen::Vector3f& p_W) {
@@ -49,6 +53,9 @@ class VoxelLookupT {
       last_index_ = BlockIndex(bx, by, bz);
       last_ = map_.findBlock(last_index_);
       valid_ = true;
+      if constexpr (!std::is_const<Map>::value) {
+        if (last_) last_->changed.store(stamp_, std::memory_order_relaxed);
+      }
     }
     return last_;
   }
@@ -66,6 +73,7 @@ class VoxelLookupT {
   BlockIndex last_index_ = BlockIndex::Zero();
   Eigen::Vector3i last_voxel_ = Eigen::Vector3i::Zero();
   bool valid_ = false;
+  uint64_t stamp_ = 0;  // mutable lookups: Block::changed of the blocks found
 };
 
 /// Read-only lookups.

@@ -1,0 +1,269 @@
+#include "panmap/graph/surface_scan.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+#include "panmap/core/container_memory.h"
+#include "panmap/core/error.h"
+#include "panmap/graph/internal/touching_voxels.h"
+#include "panmap/map/voxel.h"
+
+namespace panmap {
+
+namespace {
+
+/// Runs fn(begin, end, thread) over [0, n) on the pool (blocks cost unevenly), or inline.
+void forRange(ThreadPool* pool, size_t n, const std::function<void(size_t, size_t, int)>& fn) {
+  if (pool && pool->size() > 1) {
+    pool->parallelForDynamic(n, 64, fn);
+  } else {
+    fn(0, n, 0);
+  }
+}
+
+/// A block read again: its summary and its surface owners (empty when it owns none).
+struct Reading {
+  SurfaceScan::Summary summary;
+  std::vector<int32_t> owners;
+};
+
+}  // namespace
+
+void SurfaceScan::reset(const TsdfMap& map, float band_voxels) {
+  map_id_ = map.id();
+  band_voxels_ = band_voxels;
+  registry_size_ = -1;
+  summaries_.clear();
+  position_.clear();
+  voxels_.clear();
+  surface_.clear();
+  vote_blocks_.clear();
+  index_sum_.clear();
+  pair_blocks_.clear();
+}
+
+void SurfaceScan::add(const Summary& s, const BlockIndex& index, int sign) {
+  const Eigen::Matrix<int64_t, 3, 1> origin = index.cast<int64_t>() * kBlockSide;
+  for (int32_t root : s.roots) vote_blocks_[static_cast<size_t>(root)] += sign;
+  for (const Owner& o : s.owners) {
+    const auto l = static_cast<size_t>(o.label);
+    voxels_[l] += sign * o.voxels;
+    surface_[l] += sign * o.surface;
+    const Eigen::Matrix<int64_t, 3, 1> sum(o.index_sum[0], o.index_sum[1], o.index_sum[2]);
+    index_sum_[l] += sign * (origin * o.voxels + sum);
+  }
+  for (uint64_t pair : s.pairs) {
+    const int count = pair_blocks_[pair] += sign;
+    if (count == 0) pair_blocks_.erase(pair);
+  }
+}
+
+void SurfaceScan::refresh(const TsdfMap& map, const LabelRegistry& registry, float band_voxels,
+                          ThreadPool* pool) {
+  if (!(band_voxels > 0.0f)) throw Error("surface scan band_voxels must be > 0");
+  const auto& blocks = map.blocks();
+  if (map.id() != map_id_ || band_voxels != band_voxels_ || registry.size() < registry_size_ ||
+      blocks.size() < summaries_.size()) {
+    reset(map, band_voxels);
+  }
+  voxel_m_ = map.voxelSize();
+  registry.flatten();
+  const std::vector<int32_t>& roots = registry.parents();
+  const auto num_labels = roots.size();
+  const bool registry_grew = registry.size() != registry_size_;
+  registry_size_ = registry.size();
+  voxels_.resize(num_labels, 0);
+  surface_.resize(num_labels, 0);
+  vote_blocks_.resize(num_labels, 0);
+  index_sum_.resize(num_labels, Eigen::Matrix<int64_t, 3, 1>::Zero());
+  for (size_t i = summaries_.size(); i < blocks.size(); ++i) {
+    position_.emplace(TsdfMap::key(blocks[i]->index), i);
+  }
+  summaries_.resize(blocks.size());
+
+  // Blocks whose voxels or votes' roots changed since they were read.
+  std::vector<uint8_t> dirty(blocks.size(), 0);
+  forRange(pool, blocks.size(), [&](size_t begin, size_t end, int) {
+    for (size_t b = begin; b < end; ++b) {
+      const Summary& s = summaries_[b];
+      bool stale = !s.read || s.changed != blocks[b]->changed.load(std::memory_order_relaxed);
+      for (size_t k = 0; k < s.roots.size() && !stale; ++k) {
+        // Root 0: a vote whose label the registry did not know then; it may know it now.
+        const int32_t r = s.roots[k];
+        stale = r == 0 ? registry_grew : roots[static_cast<size_t>(r)] != r;
+      }
+      dirty[b] = stale ? 1 : 0;
+    }
+  });
+  // Touching pairs cross block faces: a changed block's neighbours are read again too. Their
+  // own neighbours' owners are needed to find the pairs.
+  auto neighbours = [&](size_t b, auto&& fn) {
+    const BlockIndex index = blocks[b]->index;
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const auto it = position_.find(TsdfMap::key(index + BlockIndex(dx, dy, dz)));
+          if (it != position_.end()) fn(it->second);
+        }
+      }
+    }
+  };
+  std::vector<uint8_t> role(blocks.size(), 0);  // 2: read again, 1: owners only
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    if (dirty[b]) neighbours(b, [&role](size_t n) { role[n] = 2; });
+  }
+  std::vector<size_t> read, near_list;
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    if (role[b] == 2) read.push_back(b);
+  }
+  for (size_t b : read) {
+    neighbours(b, [&role](size_t n) {
+      if (role[n] == 0) role[n] = 1;
+    });
+  }
+  std::vector<int32_t> slot(blocks.size(), -1);  // position -> index into readings
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    if (role[b] != 0) {
+      slot[b] = static_cast<int32_t>(near_list.size());
+      near_list.push_back(b);
+    }
+  }
+  last_read_ = read.size();
+  if (read.empty()) return;
+
+  const float band_m = band_voxels * map.voxelSize();
+  const auto size = static_cast<int32_t>(num_labels);
+  auto resolve = [&roots, size](int32_t l) { return l > 0 && l < size ? roots[l] : 0; };
+  std::vector<Reading> readings(near_list.size());
+  forRange(pool, near_list.size(), [&](size_t begin, size_t end, int) {
+    for (size_t n = begin; n < end; ++n) {
+      const size_t b = near_list[n];
+      const Block& block = *blocks[b];
+      Reading& reading = readings[n];
+      const bool full = role[b] == 2;
+      Summary& s = reading.summary;
+      if (full) {
+        // Stamp first: a write racing this read stamps later, so it is read next time.
+        s.changed = block.changed.load(std::memory_order_relaxed);
+        s.read = true;
+      }
+      for (int i = 0; i < kBlockVoxels; ++i) {
+        const Voxel& voxel = block.voxels[i];
+        if (full) {
+          for (const LabelVote& vote : voxel.votes) {
+            if (vote.count > 0) s.roots.push_back(resolve(vote.label));
+          }
+        }
+        const bool on_surface = voxel.weight > 0.0f && std::fabs(voxel.sdf_m) <= band_m;
+        if (!on_surface && !full) continue;
+        const int32_t label = argmaxLabel(voxel, resolve);
+        if (label <= 0) continue;
+        if (full) {
+          auto it = std::lower_bound(s.owners.begin(), s.owners.end(), label,
+                                     [](const Owner& o, int32_t l) { return o.label < l; });
+          if (it == s.owners.end() || it->label != label) {
+            it = s.owners.insert(it, Owner{label, 0, 0, {0, 0, 0}});
+          }
+          ++it->voxels;
+          it->index_sum[0] += static_cast<uint16_t>(i % kBlockSide);
+          it->index_sum[1] += static_cast<uint16_t>((i / kBlockSide) % kBlockSide);
+          it->index_sum[2] += static_cast<uint16_t>(i / (kBlockSide * kBlockSide));
+          if (on_surface) ++it->surface;
+        }
+        if (!on_surface) continue;
+        if (reading.owners.empty()) reading.owners.assign(kBlockVoxels, 0);
+        reading.owners[static_cast<size_t>(i)] = label;
+      }
+      if (full) {
+        std::sort(s.roots.begin(), s.roots.end());
+        s.roots.erase(std::unique(s.roots.begin(), s.roots.end()), s.roots.end());
+        s.roots.shrink_to_fit();
+        s.owners.shrink_to_fit();
+      }
+    }
+  });
+  forRange(pool, read.size(), [&](size_t begin, size_t end, int) {
+    for (size_t k = begin; k < end; ++k) {
+      const size_t b = read[k];
+      Reading& reading = readings[static_cast<size_t>(slot[b])];
+      if (reading.owners.empty()) continue;
+      internal::NearOwners near;
+      const BlockIndex index = blocks[b]->index;
+      for (int dz = -1; dz <= 1; ++dz) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const auto it = position_.find(TsdfMap::key(index + BlockIndex(dx, dy, dz)));
+            const std::vector<int32_t>* owners = nullptr;
+            if (it != position_.end()) {
+              const std::vector<int32_t>& o =
+                  readings[static_cast<size_t>(slot[it->second])].owners;
+              if (!o.empty()) owners = &o;
+            }
+            near[dx + 1][dy + 1][dz + 1] = owners;
+          }
+        }
+      }
+      std::vector<uint64_t>& pairs = reading.summary.pairs;
+      internal::forEachTouchingPair(
+          near, [&pairs](int32_t a, int32_t c) { pairs.push_back(SurfaceAdjacency::key(a, c)); });
+      std::sort(pairs.begin(), pairs.end());
+      pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+      pairs.shrink_to_fit();
+    }
+  });
+  // In block order: the sums are integers, so the order only keeps the hash map's history
+  // the same on every run.
+  for (size_t b : read) {
+    Summary& old = summaries_[b];
+    if (old.read) add(old, blocks[b]->index, -1);
+    old = std::move(readings[static_cast<size_t>(slot[b])].summary);
+    add(old, blocks[b]->index, 1);
+  }
+}
+
+SurfaceAdjacency SurfaceScan::adjacency() const {
+  SurfaceAdjacency out;
+  for (size_t l = 1; l < surface_.size(); ++l) {
+    if (surface_[l] > 0) out.surface_voxels_.emplace(static_cast<int32_t>(l), surface_[l]);
+  }
+  out.pairs_.reserve(pair_blocks_.size());
+  for (const auto& [pair, count] : pair_blocks_) out.pairs_.insert(pair);
+  return out;
+}
+
+void SurfaceScan::addTotals(SurfaceAdjacency::OwnerTotals* totals) const {
+  if (totals->centre_sum.size() != totals->voxels.size()) {
+    throw Error("surface scan totals: voxels and centre_sum differ in size");
+  }
+  // Same arithmetic as SurfaceAdjacency::compute: (sum + count / 2) x voxel size.
+  const double voxel_m = voxel_m_;
+  const size_t n = std::min(totals->voxels.size(), voxels_.size());
+  for (size_t l = 1; l < n; ++l) {
+    const int64_t count = voxels_[l];
+    if (count == 0) continue;
+    totals->voxels[l] += static_cast<int>(count);
+    totals->centre_sum[l] += (index_sum_[l].cast<double>() +
+                              Eigen::Vector3d::Constant(0.5 * static_cast<double>(count))) *
+                             voxel_m;
+  }
+}
+
+std::vector<uint8_t> SurfaceScan::hasVotes() const {
+  std::vector<uint8_t> has(vote_blocks_.size(), 0);
+  for (size_t l = 0; l < vote_blocks_.size(); ++l) has[l] = vote_blocks_[l] > 0 ? 1 : 0;
+  return has;
+}
+
+size_t SurfaceScan::memoryBytes() const {
+  size_t bytes = vectorBytes(summaries_) + vectorBytes(voxels_) + vectorBytes(surface_) +
+                 vectorBytes(vote_blocks_) + vectorBytes(index_sum_) +
+                 position_.capacity() * (sizeof(std::pair<const uint64_t, size_t>) + 1) +
+                 pair_blocks_.capacity() * (sizeof(std::pair<const uint64_t, int>) + 1);
+  for (const Summary& s : summaries_) {
+    bytes += vectorBytes(s.roots) + vectorBytes(s.owners) + vectorBytes(s.pairs);
+  }
+  return bytes;
+}
+
+}  // namespace panmap
