@@ -91,12 +91,14 @@ size_t EdgeTable::keepPairsIf(const std::function<bool(int32_t, int32_t, const C
 
 void EdgeTable::forEachSorted(
     const std::function<void(int32_t, int32_t, const Classes&)>& f) const {
-  std::vector<const std::pair<const uint64_t, Classes>*> entries;
+  // Keys beside the pointers: comparing them does not reach into the table's scattered slots
+  // (a building's table holds 300k pairs, far more than the cache).
+  std::vector<std::pair<uint64_t, const Classes*>> entries;
   entries.reserve(table_.size());
-  for (const auto& entry : table_) entries.push_back(&entry);
+  for (const auto& [key, classes] : table_) entries.emplace_back(key, &classes);
   std::sort(entries.begin(), entries.end(),
-            [](const auto* x, const auto* y) { return x->first < y->first; });
-  for (const auto* entry : entries) f(first(entry->first), second(entry->first), entry->second);
+            [](const auto& x, const auto& y) { return x.first < y.first; });
+  for (const auto& [key, classes] : entries) f(first(key), second(key), *classes);
 }
 
 EdgeTable::OrderedEdges EdgeTable::toOrdered() const {
