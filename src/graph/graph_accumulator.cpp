@@ -336,32 +336,54 @@ void GraphAccumulator::forgetUnvoted(const std::vector<uint8_t>& has_votes,
   edges_.keepIf(voted);
 }
 
-bool GraphAccumulator::keepEdge(int32_t a, int32_t b, double strongest,
-                                const SurfaceAdjacency& surface) const {
+double GraphAccumulator::scoreTotal(int32_t label) const {
+  double sum = 0.0;
+  const auto it = scores_.find(label);
+  if (it != scores_.end()) {
+    for (const auto& [cls, value] : it->second) sum += value;
+  }
+  return sum;
+}
+
+std::vector<double> GraphAccumulator::scoreTotals(size_t size) const {
+  std::vector<double> totals(size, 0.0);
+  for (const auto& [label, by_class] : scores_) {
+    if (label < 0 || static_cast<size_t>(label) >= size) continue;
+    double sum = 0.0;  // in class order, as scoreTotal() adds them
+    for (const auto& [cls, value] : by_class) sum += value;
+    totals[static_cast<size_t>(label)] = sum;
+  }
+  return totals;
+}
+
+template <typename Total>
+bool GraphAccumulator::keepEdgeWith(int32_t a, int32_t b, double strongest,
+                                    const SurfaceAdjacency& surface, const Total& total) const {
   if (!config_.prune_edges) return true;
   if (a == b || surface.surfaceVoxels(a) == 0 || surface.surfaceVoxels(b) == 0) return false;
   if (surface.touching(a, b)) return true;
-  auto total = [this](int32_t label) {
-    double sum = 0.0;
-    const auto it = scores_.find(label);
-    if (it != scores_.end()) {
-      for (const auto& [cls, value] : it->second) sum += value;
-    }
-    return sum;
-  };
   return strongest > 0.0 && strongest >= config_.edge_min_share * std::min(total(a), total(b));
+}
+
+bool GraphAccumulator::keepEdge(int32_t a, int32_t b, double strongest,
+                                const SurfaceAdjacency& surface) const {
+  return keepEdgeWith(a, b, strongest, surface, [this](int32_t l) { return scoreTotal(l); });
 }
 
 size_t GraphAccumulator::pruneEdges(const SurfaceAdjacency& surface,
                                     const LabelRegistry& registry) {
   if (!config_.prune_edges) return 0;
+  const std::vector<double> totals = scoreTotals(static_cast<size_t>(registry.size()) + 1);
+  auto total = [&](int32_t l) {
+    return l >= 0 && static_cast<size_t>(l) < totals.size() ? totals[l] : scoreTotal(l);
+  };
   return edges_.keepPairsIf([&](int32_t a, int32_t b, const EdgeTable::Classes& classes) {
     // P_eps^C (C > 0) or P_sep^C (C < 0); P_apart (0) only weighs them.
     double strongest = 0.0;
     for (const auto& [cls, value] : classes) {
       if (cls != 0) strongest = std::max(strongest, value);
     }
-    return keepEdge(registry.resolve(a), registry.resolve(b), strongest, surface);
+    return keepEdgeWith(registry.resolve(a), registry.resolve(b), strongest, surface, total);
   });
 }
 
@@ -439,6 +461,10 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
     }
     return e;
   };
+  const std::vector<double> totals_by_label = scoreTotals(num_labels);
+  auto total = [&](int32_t l) {
+    return l >= 0 && static_cast<size_t>(l) < num_labels ? totals_by_label[l] : scoreTotal(l);
+  };
   g.edges.reserve(stored.size());
   for (size_t i = 0; i < stored.size();) {
     size_t j = i + 1;
@@ -450,7 +476,7 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
         if (cls != 0) strongest = std::max(strongest, value);
       }
       // After the sums: a pair's evidence is judged whole.
-      if (!surface || keepEdge(stored[i].a, stored[i].b, strongest, *surface)) {
+      if (!surface || keepEdgeWith(stored[i].a, stored[i].b, strongest, *surface, total)) {
         g.edges.push_back(toEdge(stored[i]));
       }
       i = j;
@@ -466,7 +492,9 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
     }
     for (const auto& [cls, c] : sum.confidences) strongest = std::max(strongest, c);
     for (const auto& [cls, c] : sum.separations) strongest = std::max(strongest, c);
-    if (!surface || keepEdge(sum.a, sum.b, strongest, *surface)) g.edges.push_back(std::move(sum));
+    if (!surface || keepEdgeWith(sum.a, sum.b, strongest, *surface, total)) {
+      g.edges.push_back(std::move(sum));
+    }
     i = j;
   }
   return g;

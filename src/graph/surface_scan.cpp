@@ -151,8 +151,13 @@ void SurfaceScan::refresh(const TsdfMap& map, const LabelRegistry& registry, flo
       for (int i = 0; i < kBlockVoxels; ++i) {
         const Voxel& voxel = block.voxels[i];
         if (full) {
+          // A block's votes name a handful of roots: a search beats sorting thousands.
           for (const LabelVote& vote : voxel.votes) {
-            if (vote.count > 0) s.roots.push_back(resolve(vote.label));
+            if (vote.count == 0) continue;
+            const int32_t root = resolve(vote.label);
+            if (std::find(s.roots.begin(), s.roots.end(), root) == s.roots.end()) {
+              s.roots.push_back(root);
+            }
           }
         }
         const bool on_surface = voxel.weight > 0.0f && std::fabs(voxel.sdf_m) <= band_m;
@@ -177,7 +182,6 @@ void SurfaceScan::refresh(const TsdfMap& map, const LabelRegistry& registry, flo
       }
       if (full) {
         std::sort(s.roots.begin(), s.roots.end());
-        s.roots.erase(std::unique(s.roots.begin(), s.roots.end()), s.roots.end());
         s.roots.shrink_to_fit();
         s.owners.shrink_to_fit();
       }

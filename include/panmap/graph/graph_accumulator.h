@@ -133,6 +133,14 @@ class GraphAccumulator {
 
  private:
   void applyMerges(const SuperpointTracker& tracker);
+  /// Sum of a super-point's P_nu^C over its classes (0 if never seen).
+  double scoreTotal(int32_t label) const;
+  /// Per label below `size`: scoreTotal(label), for the many lookups of a whole-table pass.
+  std::vector<double> scoreTotals(size_t size) const;
+  /// keepEdge() with the ends' score totals from `total(label)`.
+  template <typename Total>
+  bool keepEdgeWith(int32_t a, int32_t b, double strongest, const SurfaceAdjacency& surface,
+                    const Total& total) const;
 
   mutable SurfaceScan surface_scan_;
 
