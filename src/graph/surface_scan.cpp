@@ -144,7 +144,7 @@ void SurfaceScan::refresh(const TsdfMap& map, const LabelRegistry& registry, flo
       const bool full = role[b] == 2;
       Summary& s = reading.summary;
       if (full) {
-        // Stamp first: a write racing this read stamps later, so it is read next time.
+        // What the next refresh compares: a writer moving it sends the block back to be read.
         s.changed = block.changed.load(std::memory_order_relaxed);
         s.read = true;
       }
