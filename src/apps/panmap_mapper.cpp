@@ -357,10 +357,11 @@ int main(int argc, char** argv) {
       const panmap::SuperpointGraph graph = mapper->graph();
       const panmap::GraphLabels labels = panmap::optimise(graph, optimiser);
       const double optimise_ms = msSince(optimise_start);
-      if (!graph_json.empty()) panmap::writeGraphJson(graph_json, graph, labels);
       output_options.utime = report.last_frame_utime;
       const panmap::OutputSummary outputs =
           panmap::writeOutputs(out_dir, mapper.get(), &labels, optimiser, output_options);
+      // After the outputs, which create OUT: OUT/graph.json is the natural place for it.
+      if (!graph_json.empty()) panmap::writeGraphJson(graph_json, graph, labels);
       nlohmann::json json = sessionJson(report);
       json["mode"] = export_only ? "export-only" : "offline";
       json["log"] = log_path;

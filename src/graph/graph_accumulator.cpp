@@ -466,7 +466,14 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
     return l >= 0 && static_cast<size_t>(l) < num_labels ? totals_by_label[l] : scoreTotal(l);
   };
   g.edges.reserve(stored.size());
+  // The pairs' classes sit in the table's slots, in hash order: visited in pair order each is a
+  // cache miss, so they are asked for a few pairs ahead.
+  constexpr size_t kPrefetchAhead = 16;
+  for (size_t k = 0; k < std::min(kPrefetchAhead, stored.size()); ++k) {
+    __builtin_prefetch(stored[k].classes);
+  }
   for (size_t i = 0; i < stored.size();) {
+    if (i + kPrefetchAhead < stored.size()) __builtin_prefetch(stored[i + kPrefetchAhead].classes);
     size_t j = i + 1;
     while (j < stored.size() && stored[j].a == stored[i].a && stored[j].b == stored[i].b) ++j;
     // P_eps^C (C > 0) and P_sep^C (C < 0); P_apart (0) only weighs them.

@@ -22,6 +22,60 @@ void forRange(ThreadPool* pool, size_t n, const std::function<void(size_t, size_
   }
 }
 
+/// argmaxLabel(), and in `tie` whether another of the voxel's roots had the winner's count: a
+/// renaming of the roots can then change the winner, ties going to the smaller label.
+template <typename Resolve>
+int32_t argmaxWithTie(const Voxel& voxel, const Resolve& resolve, bool* tie) {
+  int32_t labels[kVoteSlots];
+  uint64_t counts[kVoteSlots];
+  int n = 0;
+  for (const LabelVote& v : voxel.votes) {
+    if (v.count == 0) continue;
+    const int32_t label = resolve(v.label);
+    int k = 0;
+    while (k < n && labels[k] != label) ++k;
+    if (k == n) {
+      labels[n] = label;
+      counts[n++] = 0;
+    }
+    counts[k] += v.count;
+  }
+  int32_t best = 0;
+  uint64_t best_count = 0;
+  int winners = 0;
+  for (int k = 0; k < n; ++k) {
+    if (counts[k] > best_count) {
+      winners = 1;
+    } else if (counts[k] == best_count) {
+      ++winners;
+    }
+    if (counts[k] > best_count || (counts[k] == best_count && labels[k] < best)) {
+      best = labels[k];
+      best_count = counts[k];
+    }
+  }
+  *tie = winners > 1;
+  return best;
+}
+
+/// Whether a label of the summary (a root, an owner or an end of a pair) is no root any more.
+bool namesMergedLabel(const SurfaceScan::Summary& s, const std::vector<int32_t>& roots) {
+  auto merged = [&roots](int32_t l) { return l > 0 && roots[static_cast<size_t>(l)] != l; };
+  for (int32_t r : s.roots) {
+    if (merged(r)) return true;
+  }
+  for (const SurfaceScan::Owner& o : s.owners) {
+    if (merged(o.label)) return true;
+  }
+  for (uint64_t pair : s.pairs) {
+    if (merged(static_cast<int32_t>(pair >> 32)) ||
+        merged(static_cast<int32_t>(pair & 0xFFFFFFFFu))) {
+      return true;
+    }
+  }
+  return false;
+}
+
 /// A block read again: its summary and its surface owners (empty when it owns none).
 struct Reading {
   SurfaceScan::Summary summary;
@@ -59,6 +113,32 @@ void SurfaceScan::add(const Summary& s, const BlockIndex& index, int sign) {
   }
 }
 
+SurfaceScan::Summary SurfaceScan::renamed(const Summary& s, const std::vector<int32_t>& roots) {
+  auto root = [&roots](int32_t l) { return l > 0 ? roots[static_cast<size_t>(l)] : l; };
+  Summary out;
+  out.changed = s.changed;
+  out.read = s.read;
+  out.tie = s.tie;
+  out.roots.reserve(s.roots.size());
+  for (int32_t r : s.roots) out.roots.push_back(root(r));
+  std::sort(out.roots.begin(), out.roots.end());
+  out.owners = s.owners;
+  for (Owner& o : out.owners) o.label = root(o.label);
+  // Distinct: a renamed block's roots stayed distinct (refresh checks), so its owners did.
+  std::sort(out.owners.begin(), out.owners.end(),
+            [](const Owner& a, const Owner& b) { return a.label < b.label; });
+  out.pairs.reserve(s.pairs.size());
+  for (uint64_t pair : s.pairs) {
+    const int32_t a = root(static_cast<int32_t>(pair >> 32));
+    const int32_t b = root(static_cast<int32_t>(pair & 0xFFFFFFFFu));
+    if (a != b) out.pairs.push_back(SurfaceAdjacency::key(a, b));
+  }
+  std::sort(out.pairs.begin(), out.pairs.end());
+  out.pairs.erase(std::unique(out.pairs.begin(), out.pairs.end()), out.pairs.end());
+  out.pairs.shrink_to_fit();
+  return out;
+}
+
 void SurfaceScan::refresh(const TsdfMap& map, const LabelRegistry& registry, float band_voxels,
                           ThreadPool* pool) {
   if (!(band_voxels > 0.0f)) throw Error("surface scan band_voxels must be > 0");
@@ -82,18 +162,37 @@ void SurfaceScan::refresh(const TsdfMap& map, const LabelRegistry& registry, flo
   }
   summaries_.resize(blocks.size());
 
-  // Blocks whose voxels or votes' roots changed since they were read.
-  std::vector<uint8_t> dirty(blocks.size(), 0);
+  // Blocks whose voxels changed since they were read, or whose votes' roots did in a way that
+  // can change an owner (kRead); blocks whose roots merged into distinct roots without a tie
+  // (kRename: every owner keeps its voxels under a new name).
+  enum : uint8_t { kClean = 0, kRead = 1, kRename = 2 };
+  std::vector<uint8_t> state(blocks.size(), kClean);
   forRange(pool, blocks.size(), [&](size_t begin, size_t end, int) {
     for (size_t b = begin; b < end; ++b) {
       const Summary& s = summaries_[b];
-      bool stale = !s.read || s.changed != blocks[b]->changed.load(std::memory_order_relaxed);
-      for (size_t k = 0; k < s.roots.size() && !stale; ++k) {
+      if (!s.read || s.changed != blocks[b]->changed.load(std::memory_order_relaxed)) {
+        state[b] = kRead;
+        continue;
+      }
+      bool merged = false, renamable = !s.tie;
+      for (size_t k = 0; k < s.roots.size(); ++k) {
         // Root 0: a vote whose label the registry did not know then; it may know it now.
         const int32_t r = s.roots[k];
-        stale = r == 0 ? registry_grew : roots[static_cast<size_t>(r)] != r;
+        if (r == 0) {
+          if (registry_grew) merged = true, renamable = false;
+          continue;
+        }
+        const int32_t now = roots[static_cast<size_t>(r)];
+        if (now == r) continue;
+        merged = true;
+        // Two roots of the block became one: a voxel voting for both now sums their counts.
+        for (size_t j = 0; j < s.roots.size() && renamable; ++j) {
+          if (j != k && s.roots[j] > 0 && roots[static_cast<size_t>(s.roots[j])] == now) {
+            renamable = false;
+          }
+        }
       }
-      dirty[b] = stale ? 1 : 0;
+      state[b] = !merged ? kClean : renamable ? kRename : kRead;
     }
   });
   // Touching pairs cross block faces: a changed block's neighbours are read again too. Their
@@ -111,7 +210,13 @@ void SurfaceScan::refresh(const TsdfMap& map, const LabelRegistry& registry, flo
   };
   std::vector<uint8_t> role(blocks.size(), 0);  // 2: read again, 1: owners only
   for (size_t b = 0; b < blocks.size(); ++b) {
-    if (dirty[b]) neighbours(b, [&role](size_t n) { role[n] = 2; });
+    if (state[b] == kRead) neighbours(b, [&role](size_t n) { role[n] = 2; });
+  }
+  // A renamed block's pairs and its neighbours' name its owners: all of them are renamed
+  // (those read again anyway are not).
+  std::vector<uint8_t> rename(blocks.size(), 0);
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    if (state[b] == kRename) neighbours(b, [&rename](size_t n) { rename[n] = 1; });
   }
   std::vector<size_t> read, near_list;
   for (size_t b = 0; b < blocks.size(); ++b) {
@@ -130,7 +235,39 @@ void SurfaceScan::refresh(const TsdfMap& map, const LabelRegistry& registry, flo
     }
   }
   last_read_ = read.size();
+  readBlocks(map, roots, band_voxels, read, near_list, slot, role, pool);
+  std::vector<size_t> renames;
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    if (rename[b] && role[b] != 2) renames.push_back(b);
+  }
+  std::vector<Summary> renamed_summaries(renames.size());
+  std::vector<uint8_t> renamed_any(renames.size(), 0);
+  forRange(pool, renames.size(), [&](size_t begin, size_t end, int) {
+    for (size_t k = begin; k < end; ++k) {
+      const Summary& s = summaries_[renames[k]];
+      if (!s.read || !namesMergedLabel(s, roots)) continue;
+      renamed_summaries[k] = renamed(s, roots);
+      renamed_any[k] = 1;
+    }
+  });
+  last_renamed_ = 0;
+  for (size_t k = 0; k < renames.size(); ++k) {  // in block order, as the blocks read
+    if (!renamed_any[k]) continue;
+    const size_t b = renames[k];
+    add(summaries_[b], blocks[b]->index, -1);
+    summaries_[b] = std::move(renamed_summaries[k]);
+    add(summaries_[b], blocks[b]->index, 1);
+    ++last_renamed_;
+  }
+}
+
+void SurfaceScan::readBlocks(const TsdfMap& map, const std::vector<int32_t>& roots,
+                             float band_voxels, const std::vector<size_t>& read,
+                             const std::vector<size_t>& near_list, const std::vector<int32_t>& slot,
+                             const std::vector<uint8_t>& role, ThreadPool* pool) {
   if (read.empty()) return;
+  const auto& blocks = map.blocks();
+  const auto num_labels = roots.size();
 
   const float band_m = band_voxels * map.voxelSize();
   const auto size = static_cast<int32_t>(num_labels);
@@ -162,8 +299,10 @@ void SurfaceScan::refresh(const TsdfMap& map, const LabelRegistry& registry, flo
         }
         const bool on_surface = voxel.weight > 0.0f && std::fabs(voxel.sdf_m) <= band_m;
         if (!on_surface && !full) continue;
-        const int32_t label = argmaxLabel(voxel, resolve);
+        bool tie = false;
+        const int32_t label = argmaxWithTie(voxel, resolve, &tie);
         if (label <= 0) continue;
+        if (full && tie) s.tie = true;
         if (full) {
           auto it = std::lower_bound(s.owners.begin(), s.owners.end(), label,
                                      [](const Owner& o, int32_t l) { return o.label < l; });

@@ -132,6 +132,91 @@ TEST(SurfaceScan, RefreshedAfterWritesAndMergesItEqualsAFullScan) {
   }
 }
 
+// Voxels of one label per 2 x 2 x 2 blocks (one vote each, so no voxel has a tie): a merge
+// only renames, and the refresh renames the summaries of the merged labels' blocks and their
+// neighbours without reading a block, with the results of a full scan. A voxel with two roots
+// tied for its argmax sends its block back to be read, and so do two roots of one block
+// becoming one.
+TEST(SurfaceScan, MergesThatOnlyRenameReadNoBlock) {
+  for (const int threads : {1, 2}) {
+    SCOPED_TRACE(testing::Message() << "threads " << threads);
+    TsdfMap map(config());
+    LabelRegistry registry;
+    for (int i = 0; i < kLabels; ++i) registry.create();
+    ThreadPool pool(threads);
+    RandomWriter rng(5);
+    auto regionLabel = [](int gx, int gy, int gz) {
+      const int rx = (gx >> 4) + 3, ry = (gy >> 4) + 3, rz = (gz >> 4) + 3;
+      return 1 + (rx + 6 * ry + 36 * rz) % kLabels;
+    };
+    for (int i = 0; i < 8000; ++i) {
+      const int gx = rng.below(81) - 40, gy = rng.below(81) - 40, gz = rng.below(81) - 40;
+      map.allocateBlock(BlockIndex(gx >> 3, gy >> 3, gz >> 3));
+      MutableVoxelLookup lookup(map);
+      Voxel* v = lookup.findGrid(gx, gy, gz);
+      v->weight = rng.below(5) == 0 ? 0.0f : 1.0f;
+      v->sdf_m = rng.below(3) == 0 ? 0.35f : 0.05f;
+      v->votes[0] = LabelVote{regionLabel(gx, gy, gz), static_cast<uint16_t>(1 + rng.below(4))};
+    }
+    SurfaceScan scan;
+    scan.refresh(map, registry, 2.0f, &pool);
+    expectSame(scan, map, registry);
+    // Neighbouring regions' labels (touching pairs become one super-point) and distant ones.
+    for (const auto& [a, b] : {std::make_pair(regionLabel(0, 0, 0), regionLabel(16, 0, 0)),
+                               std::make_pair(regionLabel(-40, -40, -40), regionLabel(0, 16, 0)),
+                               std::make_pair(regionLabel(0, 0, 16), regionLabel(16, 0, 0))}) {
+      registry.merge(a, b);
+      scan.refresh(map, registry, 2.0f, &pool);
+      SCOPED_TRACE(testing::Message() << "merged " << a << " and " << b);
+      expectSame(scan, map, registry);
+      EXPECT_EQ(scan.blocksRead(), 0u);
+      EXPECT_GT(scan.blocksRenamed(), 0u);
+    }
+    // A tie in one voxel of a block of region (1, 1, 1): its merge reads that block and its
+    // neighbours.
+    {
+      MutableVoxelLookup lookup(map);
+      Voxel* v = lookup.findGrid(20, 20, 20);
+      v->weight = 1.0f;
+      v->sdf_m = 0.0f;
+      v->votes[0] = LabelVote{regionLabel(20, 20, 20), 3};
+      v->votes[1] = LabelVote{regionLabel(-40, 0, 0), 3};
+    }
+    scan.refresh(map, registry, 2.0f, &pool);
+    expectSame(scan, map, registry);
+    registry.merge(regionLabel(20, 20, 20), regionLabel(40, 40, 40));
+    scan.refresh(map, registry, 2.0f, &pool);
+    expectSame(scan, map, registry);
+    EXPECT_GT(scan.blocksRead(), 0u);
+    // The two roots of that voxel become one: read again, their votes summed.
+    registry.merge(regionLabel(-40, 0, 0), regionLabel(20, 20, 20));
+    scan.refresh(map, registry, 2.0f, &pool);
+    expectSame(scan, map, registry);
+    EXPECT_GT(scan.blocksRead(), 0u);
+    // No tie, 3 against 2 and 2, until the two 2s become one super-point of 4 and win.
+    const int32_t own = regionLabel(-20, -20, -20);
+    const int32_t p = regionLabel(-40, 40, 0), q = regionLabel(40, -40, 0);
+    ASSERT_NE(registry.resolve(p), registry.resolve(q));
+    ASSERT_NE(registry.resolve(own), registry.resolve(p));
+    ASSERT_NE(registry.resolve(own), registry.resolve(q));
+    {
+      MutableVoxelLookup lookup(map);
+      Voxel* v = lookup.findGrid(-20, -20, -20);
+      v->weight = 1.0f;
+      v->sdf_m = 0.0f;
+      v->votes[0] = LabelVote{own, 3};
+      v->votes[1] = LabelVote{p, 2};
+      v->votes[2] = LabelVote{q, 2};
+    }
+    scan.refresh(map, registry, 2.0f, &pool);
+    expectSame(scan, map, registry);
+    registry.merge(p, q);
+    scan.refresh(map, registry, 2.0f, &pool);
+    expectSame(scan, map, registry);
+    EXPECT_GT(scan.blocksRead(), 0u);
+  }
+}
+
 // A write that bypasses the stamping writers is invisible until the block is marked; marked,
 // it is read again.
 TEST(SurfaceScan, AMarkedBlockIsReadAgain) {

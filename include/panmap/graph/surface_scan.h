@@ -19,10 +19,17 @@ namespace panmap {
 /// scan's exactly (tests/graph/test_surface_scan.cpp).
 ///
 /// A block is read again when its Block::changed stamp moved (every writer stamps: the
-/// integrator and MutableVoxelLookup), when a label of its votes merged into another since (a
-/// voxel's owner is the argmax over its votes' roots, so a merge can change it), or when a
-/// block within one block of it was read again (touching pairs cross block faces). Another
-/// map (TsdfMap::id), a registry that shrank or another band starts afresh.
+/// integrator and MutableVoxelLookup), when a label of its votes merged into another since in a
+/// way that can change an argmax (below), or when a block within one block of it was read again
+/// (touching pairs cross block faces). Another map (TsdfMap::id), a registry that shrank or
+/// another band starts afresh.
+///
+/// A merge alone only renames: when no two of a block's roots became one and no voxel of it had
+/// two roots tied for its argmax (ties go to the smaller label, which a renaming can change),
+/// every voxel keeps its owner under the new name, and the block's summary and its neighbours'
+/// touching pairs are renamed without reading a voxel. At the end of the 2 cm building, merges
+/// of corridor-long super-points left 20,859 of the 25,711 stale blocks stale by their roots
+/// alone.
 class SurfaceScan {
  public:
   /// Brings the results up to date with the map and the registry's merges.
@@ -45,6 +52,8 @@ class SurfaceScan {
 
   /// Blocks read by the last refresh (all of them the first time).
   size_t blocksRead() const { return last_read_; }
+  /// Blocks whose summary the last refresh renamed after merges instead of reading them.
+  size_t blocksRenamed() const { return last_renamed_; }
   /// Bytes held by the per-block results.
   size_t memoryBytes() const;
 
@@ -60,6 +69,7 @@ class SurfaceScan {
   struct Summary {
     uint64_t changed = 0;         ///< Block::changed when read
     bool read = false;            ///< false: not read yet
+    bool tie = false;             ///< a voxel had two roots tied for its argmax
     std::vector<int32_t> roots;   ///< distinct roots of its votes, ascending
     std::vector<Owner> owners;    ///< by label, ascending
     std::vector<uint64_t> pairs;  ///< touching pairs with a voxel here (forward offsets)
@@ -68,12 +78,21 @@ class SurfaceScan {
  private:
   void reset(const TsdfMap& map, float band_voxels);
   void add(const Summary& s, const BlockIndex& index, int sign);
+  /// Reads the blocks of `read` (role 2) and the owners of their neighbours (`near_list`,
+  /// role 1; `slot`: position -> index into it) and replaces the summaries of `read`.
+  void readBlocks(const TsdfMap& map, const std::vector<int32_t>& roots, float band_voxels,
+                  const std::vector<size_t>& read, const std::vector<size_t>& near_list,
+                  const std::vector<int32_t>& slot, const std::vector<uint8_t>& role,
+                  ThreadPool* pool);
+  /// The summary with every label replaced by its root (roots: the flattened registry).
+  static Summary renamed(const Summary& s, const std::vector<int32_t>& roots);
 
   uint64_t map_id_ = 0;
   float band_voxels_ = 0.0f;
   double voxel_m_ = 0.0;
   int32_t registry_size_ = -1;
   size_t last_read_ = 0;
+  size_t last_renamed_ = 0;
   std::vector<Summary> summaries_;                  // by position in TsdfMap::blocks()
   absl::flat_hash_map<uint64_t, size_t> position_;  // TsdfMap::key -> position
   // Sums over the summaries, by label.
