@@ -22,42 +22,6 @@ void forRange(ThreadPool* pool, size_t n, const std::function<void(size_t, size_
   }
 }
 
-/// argmaxLabel(), and in `tie` whether another of the voxel's roots had the winner's count: a
-/// renaming of the roots can then change the winner, ties going to the smaller label.
-template <typename Resolve>
-int32_t argmaxWithTie(const Voxel& voxel, const Resolve& resolve, bool* tie) {
-  int32_t labels[kVoteSlots];
-  uint64_t counts[kVoteSlots];
-  int n = 0;
-  for (const LabelVote& v : voxel.votes) {
-    if (v.count == 0) continue;
-    const int32_t label = resolve(v.label);
-    int k = 0;
-    while (k < n && labels[k] != label) ++k;
-    if (k == n) {
-      labels[n] = label;
-      counts[n++] = 0;
-    }
-    counts[k] += v.count;
-  }
-  int32_t best = 0;
-  uint64_t best_count = 0;
-  int winners = 0;
-  for (int k = 0; k < n; ++k) {
-    if (counts[k] > best_count) {
-      winners = 1;
-    } else if (counts[k] == best_count) {
-      ++winners;
-    }
-    if (counts[k] > best_count || (counts[k] == best_count && labels[k] < best)) {
-      best = labels[k];
-      best_count = counts[k];
-    }
-  }
-  *tie = winners > 1;
-  return best;
-}
-
 /// Whether a label of the summary (a root, an owner or an end of a pair) is no root any more.
 bool namesMergedLabel(const SurfaceScan::Summary& s, const std::vector<int32_t>& roots) {
   auto merged = [&roots](int32_t l) { return l > 0 && roots[static_cast<size_t>(l)] != l; };
@@ -300,7 +264,7 @@ void SurfaceScan::readBlocks(const TsdfMap& map, const std::vector<int32_t>& roo
         const bool on_surface = voxel.weight > 0.0f && std::fabs(voxel.sdf_m) <= band_m;
         if (!on_surface && !full) continue;
         bool tie = false;
-        const int32_t label = argmaxWithTie(voxel, resolve, &tie);
+        const int32_t label = argmaxLabel(voxel, resolve, &tie);
         if (label <= 0) continue;
         if (full && tie) s.tie = true;
         if (full) {

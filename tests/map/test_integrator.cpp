@@ -242,6 +242,16 @@ TEST(Votes, EvictionIsWeakestFirstAndCounted) {
   // Merging 2 and 4 into 1's rival: 2 + 4 pooled = 5 ties with 1 (5): smaller label wins.
   EXPECT_EQ(argmaxLabel(v, [](int32_t l) { return l == 4 ? 2 : l; }), 1);
   EXPECT_EQ(argmaxLabel(v, [](int32_t l) { return l == 1 ? 9 : (l == 4 || l == 5 ? 2 : l); }), 2);
+  // The tie is reported: counts 5 (label 1), 3 (2), 2 (4), 1 (5).
+  bool tie = true;
+  EXPECT_EQ(argmaxLabel(v, [](int32_t l) { return l; }, &tie), 1);
+  EXPECT_FALSE(tie);
+  EXPECT_EQ(argmaxLabel(v, [](int32_t l) { return l == 4 ? 2 : l; }, &tie), 1);
+  EXPECT_TRUE(tie);
+  EXPECT_EQ(argmaxLabel(v, [](int32_t l) { return l == 5 ? 4 : l; }, &tie), 1);
+  EXPECT_FALSE(tie);  // 4 and 5 pooled: 3 ties with 2, below the winner's 5
+  EXPECT_EQ(argmaxLabel(Voxel{}, [](int32_t l) { return l; }, &tie), 0);
+  EXPECT_FALSE(tie);
 }
 
 TEST(Integrator, RejectsMismatchedImages) {

@@ -109,8 +109,10 @@ inline bool addVote(Voxel* voxel, int32_t label) { return addVotes(voxel, label,
 /// Eq. 2: the voxel's super-point label, argmax of its votes after mapping every stored label
 /// through `resolve` (merged super-points pool their votes). 0 when the voxel has no vote.
 /// Ties go to the smaller resolved label, so the result does not depend on slot order.
+/// @param tie if given, set to whether another resolved label had the winner's count (a
+///        renaming of the labels could then change the winner)
 template <typename Resolve>
-int32_t argmaxLabel(const Voxel& voxel, const Resolve& resolve) {
+int32_t argmaxLabel(const Voxel& voxel, const Resolve& resolve, bool* tie = nullptr) {
   int32_t labels[kVoteSlots];
   uint64_t counts[kVoteSlots];
   int n = 0;
@@ -132,6 +134,11 @@ int32_t argmaxLabel(const Voxel& voxel, const Resolve& resolve) {
       best = labels[k];
       best_count = counts[k];
     }
+  }
+  if (tie) {
+    int winners = 0;
+    for (int k = 0; k < n; ++k) winners += counts[k] == best_count ? 1 : 0;
+    *tie = winners > 1;
   }
   return best;
 }
