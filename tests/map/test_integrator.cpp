@@ -243,14 +243,18 @@ TEST(Votes, EvictionIsWeakestFirstAndCounted) {
   EXPECT_EQ(argmaxLabel(v, [](int32_t l) { return l == 4 ? 2 : l; }), 1);
   EXPECT_EQ(argmaxLabel(v, [](int32_t l) { return l == 1 ? 9 : (l == 4 || l == 5 ? 2 : l); }), 2);
   // The tie is reported: counts 5 (label 1), 3 (2), 2 (4), 1 (5).
+  auto same = [](int32_t l) { return l; };
+  auto four_into_two = [](int32_t l) { return l == 4 ? 2 : l; };
+  auto five_into_four = [](int32_t l) { return l == 5 ? 4 : l; };
   bool tie = true;
-  EXPECT_EQ(argmaxLabel(v, [](int32_t l) { return l; }, &tie), 1);
+  EXPECT_EQ(argmaxLabel(v, same, &tie), 1);
   EXPECT_FALSE(tie);
-  EXPECT_EQ(argmaxLabel(v, [](int32_t l) { return l == 4 ? 2 : l; }, &tie), 1);
+  EXPECT_EQ(argmaxLabel(v, four_into_two, &tie), 1);
   EXPECT_TRUE(tie);
-  EXPECT_EQ(argmaxLabel(v, [](int32_t l) { return l == 5 ? 4 : l; }, &tie), 1);
+  EXPECT_EQ(argmaxLabel(v, five_into_four, &tie), 1);
   EXPECT_FALSE(tie);  // 4 and 5 pooled: 3 ties with 2, below the winner's 5
-  EXPECT_EQ(argmaxLabel(Voxel{}, [](int32_t l) { return l; }, &tie), 0);
+  tie = true;
+  EXPECT_EQ(argmaxLabel(Voxel{}, same, &tie), 0);
   EXPECT_FALSE(tie);
 }
 
