@@ -82,7 +82,7 @@ SurfaceScan::Summary SurfaceScan::renamed(const Summary& s, const std::vector<in
   Summary out;
   out.changed = s.changed;
   out.read = s.read;
-  out.tie = s.tie;
+  out.tied = s.tied;  // renamed blocks keep their tied roots (refresh checks)
   out.roots.reserve(s.roots.size());
   for (int32_t r : s.roots) out.roots.push_back(root(r));
   std::sort(out.roots.begin(), out.roots.end());
@@ -127,7 +127,7 @@ void SurfaceScan::refresh(const TsdfMap& map, const LabelRegistry& registry, flo
   summaries_.resize(blocks.size());
 
   // Blocks whose voxels changed since they were read, or whose votes' roots did in a way that
-  // can change an owner (kRead); blocks whose roots merged into distinct roots without a tie
+  // can change an owner (kRead); blocks whose roots merged into distinct roots, none of a tie
   // (kRename: every owner keeps its voxels under a new name).
   enum : uint8_t { kClean = 0, kRead = 1, kRename = 2 };
   std::vector<uint8_t> state(blocks.size(), kClean);
@@ -138,7 +138,7 @@ void SurfaceScan::refresh(const TsdfMap& map, const LabelRegistry& registry, flo
         state[b] = kRead;
         continue;
       }
-      bool merged = false, renamable = !s.tie;
+      bool merged = false, renamable = true;
       for (size_t k = 0; k < s.roots.size(); ++k) {
         // Root 0: a vote whose label the registry did not know then; it may know it now.
         const int32_t r = s.roots[k];
@@ -149,6 +149,8 @@ void SurfaceScan::refresh(const TsdfMap& map, const LabelRegistry& registry, flo
         const int32_t now = roots[static_cast<size_t>(r)];
         if (now == r) continue;
         merged = true;
+        // A voxel with a tie may now prefer the other label of it.
+        if (std::binary_search(s.tied.begin(), s.tied.end(), r)) renamable = false;
         // Two roots of the block became one: a voxel voting for both now sums their counts.
         for (size_t j = 0; j < s.roots.size() && renamable; ++j) {
           if (j != k && s.roots[j] > 0 && roots[static_cast<size_t>(s.roots[j])] == now) {
@@ -266,7 +268,14 @@ void SurfaceScan::readBlocks(const TsdfMap& map, const std::vector<int32_t>& roo
         bool tie = false;
         const int32_t label = argmaxLabel(voxel, resolve, &tie);
         if (label <= 0) continue;
-        if (full && tie) s.tie = true;
+        if (full && tie) {
+          for (const LabelVote& vote : voxel.votes) {
+            const int32_t root = resolve(vote.label);
+            if (vote.count > 0 && std::find(s.tied.begin(), s.tied.end(), root) == s.tied.end()) {
+              s.tied.push_back(root);
+            }
+          }
+        }
         if (full) {
           auto it = std::lower_bound(s.owners.begin(), s.owners.end(), label,
                                      [](const Owner& o, int32_t l) { return o.label < l; });
@@ -285,7 +294,9 @@ void SurfaceScan::readBlocks(const TsdfMap& map, const std::vector<int32_t>& roo
       }
       if (full) {
         std::sort(s.roots.begin(), s.roots.end());
+        std::sort(s.tied.begin(), s.tied.end());
         s.roots.shrink_to_fit();
+        s.tied.shrink_to_fit();
         s.owners.shrink_to_fit();
       }
     }
@@ -368,7 +379,8 @@ size_t SurfaceScan::memoryBytes() const {
                  position_.capacity() * (sizeof(std::pair<const uint64_t, size_t>) + 1) +
                  pair_blocks_.capacity() * (sizeof(std::pair<const uint64_t, int>) + 1);
   for (const Summary& s : summaries_) {
-    bytes += vectorBytes(s.roots) + vectorBytes(s.owners) + vectorBytes(s.pairs);
+    bytes +=
+        vectorBytes(s.roots) + vectorBytes(s.tied) + vectorBytes(s.owners) + vectorBytes(s.pairs);
   }
   return bytes;
 }

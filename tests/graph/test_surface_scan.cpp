@@ -172,24 +172,41 @@ TEST(SurfaceScan, MergesThatOnlyRenameReadNoBlock) {
       EXPECT_EQ(scan.blocksRead(), 0u);
       EXPECT_GT(scan.blocksRenamed(), 0u);
     }
-    // A tie in one voxel of a block of region (1, 1, 1): its merge reads that block and its
-    // neighbours.
+    // A tie in one voxel of a block of region (1, 1, 1), beside a voxel of a third label: a
+    // merge of the third label renames the block, a merge of a tied label reads it.
+    const int32_t tied = regionLabel(20, 20, 20), rival = regionLabel(-40, 0, 0);
+    const int32_t third = regionLabel(-40, -40, 0), survivor = regionLabel(-40, -40, -40);
+    ASSERT_LT(survivor, third);  // the smaller root survives a merge
+    // Merged into a label below its rival's, the tied label wins the tie it lost.
+    const int32_t below_rival = regionLabel(-20, -40, -40);
+    ASSERT_LT(below_rival, rival);
+    ASSERT_LT(rival, tied);
     {
       MutableVoxelLookup lookup(map);
       Voxel* v = lookup.findGrid(20, 20, 20);
       v->weight = 1.0f;
       v->sdf_m = 0.0f;
-      v->votes[0] = LabelVote{regionLabel(20, 20, 20), 3};
-      v->votes[1] = LabelVote{regionLabel(-40, 0, 0), 3};
+      v->votes[0] = LabelVote{tied, 3};
+      v->votes[1] = LabelVote{rival, 3};
+      Voxel* w = lookup.findGrid(21, 20, 20);
+      w->weight = 1.0f;
+      w->sdf_m = 0.0f;
+      w->votes[0] = LabelVote{third, 2};
+      for (int k = 1; k < kVoteSlots; ++k) w->votes[k] = LabelVote{};
     }
     scan.refresh(map, registry, 2.0f, &pool);
     expectSame(scan, map, registry);
-    registry.merge(regionLabel(20, 20, 20), regionLabel(40, 40, 40));
+    registry.merge(third, survivor);
+    scan.refresh(map, registry, 2.0f, &pool);
+    expectSame(scan, map, registry);
+    EXPECT_EQ(scan.blocksRead(), 0u);
+    EXPECT_GT(scan.blocksRenamed(), 0u);
+    registry.merge(tied, below_rival);
     scan.refresh(map, registry, 2.0f, &pool);
     expectSame(scan, map, registry);
     EXPECT_GT(scan.blocksRead(), 0u);
     // The two roots of that voxel become one: read again, their votes summed.
-    registry.merge(regionLabel(-40, 0, 0), regionLabel(20, 20, 20));
+    registry.merge(rival, tied);
     scan.refresh(map, registry, 2.0f, &pool);
     expectSame(scan, map, registry);
     EXPECT_GT(scan.blocksRead(), 0u);

@@ -24,12 +24,12 @@ namespace panmap {
 /// (touching pairs cross block faces). Another map (TsdfMap::id), a registry that shrank or
 /// another band starts afresh.
 ///
-/// A merge alone only renames: when no two of a block's roots became one and no voxel of it had
-/// two roots tied for its argmax (ties go to the smaller label, which a renaming can change),
-/// every voxel keeps its owner under the new name, and the block's summary and its neighbours'
-/// touching pairs are renamed without reading a voxel. At the end of the 2 cm building, merges
-/// of corridor-long super-points left 20,859 of the 25,711 stale blocks stale by their roots
-/// alone.
+/// A merge alone only renames: when no two of a block's roots became one and no root of a voxel
+/// that had two roots tied for its argmax was renamed (ties go to the smaller label, which a
+/// renaming can change), every voxel keeps its owner under the new name, and the block's
+/// summary and its neighbours' touching pairs are renamed without reading a voxel. At the end of
+/// the 2 cm building, merges of corridor-long super-points left 20,859 of the 25,711 stale blocks
+/// stale by their roots alone.
 class SurfaceScan {
  public:
   /// Brings the results up to date with the map and the registry's merges.
@@ -69,7 +69,7 @@ class SurfaceScan {
   struct Summary {
     uint64_t changed = 0;         ///< Block::changed when read
     bool read = false;            ///< false: not read yet
-    bool tie = false;             ///< a voxel had two roots tied for its argmax
+    std::vector<int32_t> tied;    ///< roots of the voxels with a tie for the argmax, ascending
     std::vector<int32_t> roots;   ///< distinct roots of its votes, ascending
     std::vector<Owner> owners;    ///< by label, ascending
     std::vector<uint64_t> pairs;  ///< touching pairs with a voxel here (forward offsets)
