@@ -159,16 +159,19 @@ TEST(SurfaceScan, MergesThatOnlyRenameReadNoBlock) {
       v->votes[0] = LabelVote{regionLabel(gx, gy, gz), static_cast<uint16_t>(1 + rng.below(4))};
     }
     SurfaceScan scan;
-    scan.refresh(map, registry, 2.0f, &pool);
-    expectSame(scan, map, registry);
+    // Brings the scan up to date and compares it with a full scan.
+    auto refreshAndCompare = [&] {
+      scan.refresh(map, registry, 2.0f, &pool);
+      expectSame(scan, map, registry);
+    };
+    refreshAndCompare();
     // Neighbouring regions' labels (touching pairs become one super-point) and distant ones.
     for (const auto& [a, b] : {std::make_pair(regionLabel(0, 0, 0), regionLabel(16, 0, 0)),
                                std::make_pair(regionLabel(-40, -40, -40), regionLabel(0, 16, 0)),
                                std::make_pair(regionLabel(0, 0, 16), regionLabel(16, 0, 0))}) {
       registry.merge(a, b);
-      scan.refresh(map, registry, 2.0f, &pool);
       SCOPED_TRACE(testing::Message() << "merged " << a << " and " << b);
-      expectSame(scan, map, registry);
+      refreshAndCompare();
       EXPECT_EQ(scan.blocksRead(), 0u);
       EXPECT_GT(scan.blocksRenamed(), 0u);
     }
@@ -194,21 +197,17 @@ TEST(SurfaceScan, MergesThatOnlyRenameReadNoBlock) {
       w->votes[0] = LabelVote{third, 2};
       for (int k = 1; k < kVoteSlots; ++k) w->votes[k] = LabelVote{};
     }
-    scan.refresh(map, registry, 2.0f, &pool);
-    expectSame(scan, map, registry);
+    refreshAndCompare();
     registry.merge(third, survivor);
-    scan.refresh(map, registry, 2.0f, &pool);
-    expectSame(scan, map, registry);
+    refreshAndCompare();
     EXPECT_EQ(scan.blocksRead(), 0u);
     EXPECT_GT(scan.blocksRenamed(), 0u);
     registry.merge(tied, below_rival);
-    scan.refresh(map, registry, 2.0f, &pool);
-    expectSame(scan, map, registry);
+    refreshAndCompare();
     EXPECT_GT(scan.blocksRead(), 0u);
     // The two roots of that voxel become one: read again, their votes summed.
     registry.merge(rival, tied);
-    scan.refresh(map, registry, 2.0f, &pool);
-    expectSame(scan, map, registry);
+    refreshAndCompare();
     EXPECT_GT(scan.blocksRead(), 0u);
     // No tie, 3 against 2 and 2, until the two 2s become one super-point of 4 and win.
     const int32_t own = regionLabel(-20, -20, -20);
@@ -225,11 +224,9 @@ TEST(SurfaceScan, MergesThatOnlyRenameReadNoBlock) {
       v->votes[1] = LabelVote{p, 2};
       v->votes[2] = LabelVote{q, 2};
     }
-    scan.refresh(map, registry, 2.0f, &pool);
-    expectSame(scan, map, registry);
+    refreshAndCompare();
     registry.merge(p, q);
-    scan.refresh(map, registry, 2.0f, &pool);
-    expectSame(scan, map, registry);
+    refreshAndCompare();
     EXPECT_GT(scan.blocksRead(), 0u);
   }
 }
