@@ -211,7 +211,7 @@ void SurfaceScan::refresh(const TsdfMap& map, const LabelRegistry& registry, flo
   forRange(pool, renames.size(), [&](size_t begin, size_t end, int) {
     for (size_t k = begin; k < end; ++k) {
       const Summary& s = summaries_[renames[k]];
-      if (!s.read || !namesMergedLabel(s, roots)) continue;
+      if (!namesMergedLabel(s, roots)) continue;  // blocks never read are read (kRead)
       renamed_summaries[k] = renamed(s, roots);
       renamed_any[k] = 1;
     }
@@ -265,10 +265,10 @@ void SurfaceScan::readBlocks(const TsdfMap& map, const std::vector<int32_t>& roo
         }
         const bool on_surface = voxel.weight > 0.0f && std::fabs(voxel.sdf_m) <= band_m;
         if (!on_surface && !full) continue;
-        bool tie = false;
-        const int32_t label = argmaxLabel(voxel, resolve, &tie);
+        bool tie = false;  // asked only of full reads: only their summaries keep it
+        const int32_t label = argmaxLabel(voxel, resolve, full ? &tie : nullptr);
         if (label <= 0) continue;
-        if (full && tie) {
+        if (tie) {
           for (const LabelVote& vote : voxel.votes) {
             const int32_t root = resolve(vote.label);
             if (vote.count > 0 && std::find(s.tied.begin(), s.tied.end(), root) == s.tied.end()) {
