@@ -197,9 +197,8 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
       }
     }
   };
-  auto sortHits = [](std::vector<Hit>* hits) {
-    std::sort(hits->begin(), hits->end());
-    hits->erase(std::unique(hits->begin(), hits->end()), hits->end());
+  auto sortHits = [](ThreadScratch* scratch) {
+    internal::sortUniqueHits(&scratch->hits, &scratch->sort_scratch);
   };
   const int threads = pool_ ? pool_->size() : 1;
   thread_scratch_.resize(static_cast<size_t>(threads));
@@ -209,11 +208,11 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
       collect(r0, r1, &thread_scratch_[static_cast<size_t>(t)]);
     });
     pool_->parallelFor(thread_scratch_.size(), [&](size_t t0, size_t t1, int) {
-      for (size_t t = t0; t < t1; ++t) sortHits(&thread_scratch_[t].hits);
+      for (size_t t = t0; t < t1; ++t) sortHits(&thread_scratch_[t]);
     });
   } else {
     collect(0, rows, &thread_scratch_[0]);
-    sortHits(&thread_scratch_[0].hits);
+    sortHits(&thread_scratch_[0]);
   }
   // N^S_o counts unique voxels: many pixels see the same voxel up close.
   std::vector<Hit>& hits = hits_;
@@ -316,7 +315,8 @@ size_t GraphAccumulator::memoryBytes() const {
   size_t bytes = mapNodesBytes(scores_) + edges_.memoryBytes() + surface_scan_.memoryBytes();
   for (const auto& [label, by_class] : scores_) bytes += mapNodesBytes(by_class);
   for (const ThreadScratch& scratch : thread_scratch_) {
-    bytes += vectorBytes(scratch.hits) + vectorBytes(scratch.samples) + vectorBytes(scratch.masks) +
+    bytes += vectorBytes(scratch.hits) + vectorBytes(scratch.sort_scratch) +
+             vectorBytes(scratch.samples) + vectorBytes(scratch.masks) +
              vectorBytes(scratch.labels) + vectorBytes(scratch.voxels);
   }
   bytes += vectorBytes(groups_) +

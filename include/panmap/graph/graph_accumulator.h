@@ -11,6 +11,7 @@
 #include "panmap/core/frame.h"
 #include "panmap/core/thread_pool.h"
 #include "panmap/graph/internal/edge_table.h"
+#include "panmap/graph/internal/mask_hits.h"
 #include "panmap/graph/superpoint_graph.h"
 #include "panmap/graph/surface_adjacency.h"
 #include "panmap/graph/surface_scan.h"
@@ -144,20 +145,12 @@ class GraphAccumulator {
 
   mutable SurfaceScan surface_scan_;
 
-  /// A sampled pixel's mask, the voxel its ray reaches and that voxel's super-point.
-  struct Hit {
-    uint64_t voxel;
-    int32_t mask;
-    int32_t label;
-    bool operator<(const Hit& o) const {
-      return mask < o.mask || (mask == o.mask && voxel < o.voxel);
-    }
-    bool operator==(const Hit& o) const { return mask == o.mask && voxel == o.voxel; }
-  };
+  using Hit = internal::MaskHit;
 
   /// Per-thread scratch of the sampling pass.
   struct ThreadScratch {
     std::vector<Hit> hits;
+    std::vector<Hit> sort_scratch;
     std::vector<RowSample> samples;  // one row's
     std::vector<int32_t> masks, labels;
     std::vector<Eigen::Vector3i> voxels;

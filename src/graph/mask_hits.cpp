@@ -1,0 +1,112 @@
+#include "panmap/graph/internal/mask_hits.h"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+
+namespace panmap::internal {
+
+namespace {
+
+constexpr int kFieldBits = 21;
+constexpr uint64_t kFieldMask = (uint64_t{1} << kFieldBits) - 1;
+constexpr int kMaxDigitBits = 11;
+constexpr int kMaxPasses = (64 + kMaxDigitBits - 1) / kMaxDigitBits;
+// Below this many hits the radix passes' fixed costs are not worth it.
+constexpr size_t kMinRadixHits = 512;
+
+uint64_t field(uint64_t key, int axis) { return (key >> (kFieldBits * (2 - axis))) & kFieldMask; }
+
+int bitsFor(uint64_t range) {
+  int bits = 0;
+  while (bits < 64 && (range >> bits) != 0) ++bits;
+  return bits;
+}
+
+void sortAndUnique(std::vector<MaskHit>* hits) {
+  std::sort(hits->begin(), hits->end());
+  hits->erase(std::unique(hits->begin(), hits->end()), hits->end());
+}
+
+}  // namespace
+
+void sortUniqueHits(std::vector<MaskHit>* hits, std::vector<MaskHit>* scratch) {
+  const size_t n = hits->size();
+  if (n < kMinRadixHits) return sortAndUnique(hits);
+  // One frame's hits span a few masks and a room's worth of voxels: the offsets of each from
+  // its minimum fit in far fewer than the key's 96 bits. Packed in (mask, x, y, z) order they
+  // sort as the hits do, in a few counting passes (std::sort took 2.1 ms of a 5.2 ms graph
+  // update per frame at 1 cm; these passes about a third of that, and half of Boost's
+  // spreadsort or pdqsort on the same keys).
+  int32_t mask_lo = (*hits)[0].mask, mask_hi = mask_lo;
+  std::array<uint64_t, 3> lo, hi;
+  for (int a = 0; a < 3; ++a) lo[a] = hi[a] = field((*hits)[0].voxel, a);
+  for (const MaskHit& h : *hits) {
+    mask_lo = std::min(mask_lo, h.mask);
+    mask_hi = std::max(mask_hi, h.mask);
+    for (int a = 0; a < 3; ++a) {
+      const uint64_t f = field(h.voxel, a);
+      lo[a] = std::min(lo[a], f);
+      hi[a] = std::max(hi[a], f);
+    }
+  }
+  const int mask_bits =
+      bitsFor(static_cast<uint64_t>(static_cast<int64_t>(mask_hi) - static_cast<int64_t>(mask_lo)));
+  std::array<int, 3> bits;
+  for (int a = 0; a < 3; ++a) bits[a] = bitsFor(hi[a] - lo[a]);
+  const int total = mask_bits + bits[0] + bits[1] + bits[2];
+  if (total > 64) return sortAndUnique(hits);
+  const int shift_z = 0, shift_y = bits[2], shift_x = bits[1] + bits[2];
+  const int shift_mask = bits[0] + bits[1] + bits[2];
+  for (MaskHit& h : *hits) {
+    uint64_t key = ((field(h.voxel, 0) - lo[0]) << shift_x) |
+                   ((field(h.voxel, 1) - lo[1]) << shift_y) |
+                   ((field(h.voxel, 2) - lo[2]) << shift_z);
+    if (mask_bits > 0) {
+      key |= static_cast<uint64_t>(static_cast<int64_t>(h.mask) - mask_lo) << shift_mask;
+    }
+    h.voxel = key;
+  }
+
+  // Least significant digit first; each pass is stable, so the last one leaves them sorted.
+  const int passes = std::max(1, (total + kMaxDigitBits - 1) / kMaxDigitBits);
+  const int digit_bits = std::max(1, (total + passes - 1) / passes);
+  const size_t buckets = size_t{1} << digit_bits;
+  const uint64_t digit_mask = buckets - 1;
+  std::vector<uint32_t> counts(static_cast<size_t>(kMaxPasses) * buckets, 0);
+  for (const MaskHit& h : *hits) {
+    for (int p = 0; p < passes; ++p)
+      ++counts[p * buckets + ((h.voxel >> (p * digit_bits)) & digit_mask)];
+  }
+  scratch->resize(n);
+  MaskHit* from = hits->data();
+  MaskHit* to = scratch->data();
+  for (int p = 0; p < passes; ++p) {
+    uint32_t* offset = counts.data() + p * buckets;
+    const int shift = p * digit_bits;
+    // A digit every hit shares moves nothing.
+    if (offset[(from[0].voxel >> shift) & digit_mask] == n) continue;
+    uint32_t sum = 0;
+    for (size_t b = 0; b < buckets; ++b) {
+      const uint32_t c = offset[b];
+      offset[b] = sum;
+      sum += c;
+    }
+    for (size_t i = 0; i < n; ++i) to[offset[(from[i].voxel >> shift) & digit_mask]++] = from[i];
+    std::swap(from, to);
+  }
+  if (from != hits->data()) std::memcpy(hits->data(), from, n * sizeof(MaskHit));
+
+  const uint64_t mask_x = (uint64_t{1} << bits[0]) - 1, mask_y = (uint64_t{1} << bits[1]) - 1,
+                 mask_z = (uint64_t{1} << bits[2]) - 1;
+  for (MaskHit& h : *hits) {
+    const uint64_t key = h.voxel;
+    h.mask = mask_bits > 0 ? static_cast<int32_t>(mask_lo + static_cast<int64_t>(key >> shift_mask))
+                           : mask_lo;
+    h.voxel = (((key >> shift_x) & mask_x) + lo[0]) << (2 * kFieldBits) |
+              (((key >> shift_y) & mask_y) + lo[1]) << kFieldBits | ((key & mask_z) + lo[2]);
+  }
+  hits->erase(std::unique(hits->begin(), hits->end()), hits->end());
+}
+
+}  // namespace panmap::internal
