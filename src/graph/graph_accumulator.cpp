@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <memory>
 #include <tuple>
 #include <vector>
@@ -19,6 +20,8 @@ namespace {
 constexpr size_t kRowsPerChunk = 8;
 // Edge pairs between fetching a pair's slot and updating it.
 constexpr size_t kPrefetchPairs = 16;
+// Stored pairs from which the final graph's edges are built on every thread.
+constexpr size_t kParallelEdges = 1024;
 
 }  // namespace
 
@@ -465,45 +468,74 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
   auto total = [&](int32_t l) {
     return l >= 0 && static_cast<size_t>(l) < num_labels ? totals_by_label[l] : scoreTotal(l);
   };
-  g.edges.reserve(stored.size());
   // The pairs' classes sit in the table's slots, in hash order: visited in pair order each is a
   // cache miss, so they are asked for a few pairs ahead.
   constexpr size_t kPrefetchAhead = 16;
-  for (size_t k = 0; k < std::min(kPrefetchAhead, stored.size()); ++k) {
-    __builtin_prefetch(stored[k].classes);
-  }
-  for (size_t i = 0; i < stored.size();) {
-    if (i + kPrefetchAhead < stored.size()) __builtin_prefetch(stored[i + kPrefetchAhead].classes);
-    size_t j = i + 1;
-    while (j < stored.size() && stored[j].a == stored[i].a && stored[j].b == stored[i].b) ++j;
-    // P_eps^C (C > 0) and P_sep^C (C < 0); P_apart (0) only weighs them.
-    double strongest = 0.0;
-    if (j == i + 1) {
-      for (const auto& [cls, value] : *stored[i].classes) {
-        if (cls != 0) strongest = std::max(strongest, value);
+  // Edges of stored[begin, end), which starts and ends at a pair boundary.
+  auto edgesOf = [&](size_t begin, size_t end, std::vector<GraphEdge>* out) {
+    out->reserve(end - begin);
+    for (size_t k = begin; k < std::min(begin + kPrefetchAhead, end); ++k) {
+      __builtin_prefetch(stored[k].classes);
+    }
+    for (size_t i = begin; i < end;) {
+      if (i + kPrefetchAhead < end) __builtin_prefetch(stored[i + kPrefetchAhead].classes);
+      size_t j = i + 1;
+      while (j < end && stored[j].a == stored[i].a && stored[j].b == stored[i].b) ++j;
+      // P_eps^C (C > 0) and P_sep^C (C < 0); P_apart (0) only weighs them.
+      double strongest = 0.0;
+      if (j == i + 1) {
+        for (const auto& [cls, value] : *stored[i].classes) {
+          if (cls != 0) strongest = std::max(strongest, value);
+        }
+        // After the sums: a pair's evidence is judged whole.
+        if (!surface || keepEdgeWith(stored[i].a, stored[i].b, strongest, *surface, total)) {
+          out->push_back(toEdge(stored[i]));
+        }
+        i = j;
+        continue;
       }
-      // After the sums: a pair's evidence is judged whole.
-      if (!surface || keepEdgeWith(stored[i].a, stored[i].b, strongest, *surface, total)) {
-        g.edges.push_back(toEdge(stored[i]));
+      // Pending merges can map two stored edges onto one pair: add them up.
+      GraphEdge sum = toEdge(stored[i]);
+      for (size_t k = i + 1; k < j; ++k) {
+        const GraphEdge e = toEdge(stored[k]);
+        for (const auto& [cls, c] : e.confidences) sum.confidences[cls] += c;
+        for (const auto& [cls, c] : e.separations) sum.separations[cls] += c;
+        sum.apart += e.apart;
+      }
+      for (const auto& [cls, c] : sum.confidences) strongest = std::max(strongest, c);
+      for (const auto& [cls, c] : sum.separations) strongest = std::max(strongest, c);
+      if (!surface || keepEdgeWith(sum.a, sum.b, strongest, *surface, total)) {
+        out->push_back(std::move(sum));
       }
       i = j;
-      continue;
     }
-    // Pending merges can map two stored edges onto one pair: add them up.
-    GraphEdge sum = toEdge(stored[i]);
-    for (size_t k = i + 1; k < j; ++k) {
-      const GraphEdge e = toEdge(stored[k]);
-      for (const auto& [cls, c] : e.confidences) sum.confidences[cls] += c;
-      for (const auto& [cls, c] : e.separations) sum.separations[cls] += c;
-      sum.apart += e.apart;
+  };
+  // Building the edges (two small maps each) is most of the graph's time on a building: the
+  // threads take consecutive slices, cut between pairs, and the slices are joined in order,
+  // so the edges are those of one pass.
+  const size_t parts = pool_ && stored.size() >= kParallelEdges ? pool_->size() : 1;
+  std::vector<size_t> cuts(parts + 1, stored.size());
+  cuts[0] = 0;
+  for (size_t p = 1; p < parts; ++p) {
+    size_t c = std::max(cuts[p - 1], stored.size() * p / parts);
+    while (c > cuts[p - 1] && c < stored.size() && stored[c].a == stored[c - 1].a &&
+           stored[c].b == stored[c - 1].b) {
+      ++c;
     }
-    for (const auto& [cls, c] : sum.confidences) strongest = std::max(strongest, c);
-    for (const auto& [cls, c] : sum.separations) strongest = std::max(strongest, c);
-    if (!surface || keepEdgeWith(sum.a, sum.b, strongest, *surface, total)) {
-      g.edges.push_back(std::move(sum));
-    }
-    i = j;
+    cuts[p] = c;
   }
+  if (parts == 1) {
+    edgesOf(0, stored.size(), &g.edges);
+    return g;
+  }
+  std::vector<std::vector<GraphEdge>> sliced(parts);
+  pool_->parallelFor(parts, [&](size_t p0, size_t p1, int) {
+    for (size_t p = p0; p < p1; ++p) edgesOf(cuts[p], cuts[p + 1], &sliced[p]);
+  });
+  size_t count = 0;
+  for (const auto& slice : sliced) count += slice.size();
+  g.edges.reserve(count);
+  for (auto& slice : sliced) std::move(slice.begin(), slice.end(), std::back_inserter(g.edges));
   return g;
 }
 

@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <array>
-#include <cstring>
+
+#include "panmap/core/radix_sort.h"
 
 namespace panmap::internal {
 
@@ -10,18 +11,10 @@ namespace {
 
 constexpr int kFieldBits = 21;
 constexpr uint64_t kFieldMask = (uint64_t{1} << kFieldBits) - 1;
-constexpr int kMaxDigitBits = 11;
-constexpr int kMaxPasses = (64 + kMaxDigitBits - 1) / kMaxDigitBits;
 // Below this many hits the radix passes' fixed costs are not worth it.
 constexpr size_t kMinRadixHits = 512;
 
 uint64_t field(uint64_t key, int axis) { return (key >> (kFieldBits * (2 - axis))) & kFieldMask; }
-
-int bitsFor(uint64_t range) {
-  int bits = 0;
-  while (bits < 64 && (range >> bits) != 0) ++bits;
-  return bits;
-}
 
 void sortAndUnique(std::vector<MaskHit>* hits) {
   std::sort(hits->begin(), hits->end());
@@ -50,10 +43,10 @@ void sortUniqueHits(std::vector<MaskHit>* hits, std::vector<MaskHit>* scratch) {
       hi[a] = std::max(hi[a], f);
     }
   }
-  const int mask_bits =
-      bitsFor(static_cast<uint64_t>(static_cast<int64_t>(mask_hi) - static_cast<int64_t>(mask_lo)));
+  const int mask_bits = bitWidth(
+      static_cast<uint64_t>(static_cast<int64_t>(mask_hi) - static_cast<int64_t>(mask_lo)));
   std::array<int, 3> bits;
-  for (int a = 0; a < 3; ++a) bits[a] = bitsFor(hi[a] - lo[a]);
+  for (int a = 0; a < 3; ++a) bits[a] = bitWidth(hi[a] - lo[a]);
   const int total = mask_bits + bits[0] + bits[1] + bits[2];
   if (total > 64) return sortAndUnique(hits);
   const int shift_z = 0, shift_y = bits[2], shift_x = bits[1] + bits[2];
@@ -68,34 +61,7 @@ void sortUniqueHits(std::vector<MaskHit>* hits, std::vector<MaskHit>* scratch) {
     h.voxel = key;
   }
 
-  // Least significant digit first; each pass is stable, so the last one leaves them sorted.
-  const int passes = std::max(1, (total + kMaxDigitBits - 1) / kMaxDigitBits);
-  const int digit_bits = std::max(1, (total + passes - 1) / passes);
-  const size_t buckets = size_t{1} << digit_bits;
-  const uint64_t digit_mask = buckets - 1;
-  std::vector<uint32_t> counts(static_cast<size_t>(kMaxPasses) * buckets, 0);
-  for (const MaskHit& h : *hits) {
-    for (int p = 0; p < passes; ++p)
-      ++counts[p * buckets + ((h.voxel >> (p * digit_bits)) & digit_mask)];
-  }
-  scratch->resize(n);
-  MaskHit* from = hits->data();
-  MaskHit* to = scratch->data();
-  for (int p = 0; p < passes; ++p) {
-    uint32_t* offset = counts.data() + p * buckets;
-    const int shift = p * digit_bits;
-    // A digit every hit shares moves nothing.
-    if (offset[(from[0].voxel >> shift) & digit_mask] == n) continue;
-    uint32_t sum = 0;
-    for (size_t b = 0; b < buckets; ++b) {
-      const uint32_t c = offset[b];
-      offset[b] = sum;
-      sum += c;
-    }
-    for (size_t i = 0; i < n; ++i) to[offset[(from[i].voxel >> shift) & digit_mask]++] = from[i];
-    std::swap(from, to);
-  }
-  if (from != hits->data()) std::memcpy(hits->data(), from, n * sizeof(MaskHit));
+  radixSortByKey(hits, scratch, total, [](const MaskHit& h) { return h.voxel; });
 
   const uint64_t mask_x = (uint64_t{1} << bits[0]) - 1, mask_y = (uint64_t{1} << bits[1]) - 1,
                  mask_z = (uint64_t{1} << bits[2]) - 1;

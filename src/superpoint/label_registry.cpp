@@ -9,8 +9,7 @@ int32_t LabelRegistry::create() {
   return parent_.back();
 }
 
-int32_t LabelRegistry::resolve(int32_t label) const {
-  if (label <= 0 || label >= static_cast<int32_t>(parent_.size())) return 0;
+int32_t LabelRegistry::resolveDeep(int32_t label) const {
   int32_t root = label;
   while (parent_[root] != root) root = parent_[root];
   while (parent_[label] != root) {  // path compression

@@ -1,3 +1,8 @@
+#include <functional>
+#include <random>
+#include <tuple>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "panmap/core/error.h"
@@ -235,6 +240,68 @@ TEST(GraphAccumulator, ForgetsSuperpointsWithoutVotes) {
   EXPECT_EQ(0.5, after.scores.at(4).at(5));
   ASSERT_EQ(1u, after.edges.size());
   EXPECT_EQ(0.9, after.edges.at({1, 4}).at(5));
+}
+
+// The final graph of `merged_into` (a label's parent, <= it) and 6,000 random stored edges
+// among 400 labels, built without threads and with two: equal edge for edge.
+void expectThreadsGiveOnePass(const std::function<int32_t(int32_t)>& merged_into,
+                              size_t min_edges) {
+  constexpr int32_t kLabels = 400;
+  SuperpointTracker::Snapshot tracked;
+  tracked.parents.resize(kLabels + 1);
+  for (int32_t l = 0; l <= kLabels; ++l) {
+    tracked.parents[l] = l == 0 ? 0 : merged_into(l);
+    if (l > 0 && tracked.parents[l] == l) tracked.states[l].class_counts[5] = 1.0;
+  }
+  SuperpointTracker tracker{SuperpointConfig{}};
+  tracker.restore(tracked);
+  GraphAccumulator::Snapshot state;
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int32_t> label(1, kLabels), cls(-3, 4);
+  std::uniform_real_distribution<double> value(0.01, 1.0);
+  while (state.edges.size() < 6000) {
+    const int32_t a = label(rng), b = label(rng);
+    if (a >= b) continue;
+    auto& classes = state.edges[{a, b}];
+    for (int k = 0; k < 2; ++k) classes[cls(rng)] += value(rng);
+  }
+  GraphConfig config;
+  config.prune_edges = false;  // an empty map owns no surface: keep every edge
+  GraphAccumulator one(config);
+  one.restore(state);
+  ThreadPool pool(2);
+  GraphAccumulator two(config, &pool);
+  two.restore(state);
+  const TsdfMap map(TsdfMap::Config{0.05f});
+  const SuperpointGraph g1 = one.graph(map, tracker), g2 = two.graph(map, tracker);
+  ASSERT_GE(g1.edges.size(), min_edges);
+  ASSERT_LT(g1.edges.size(), state.edges.size());  // merged pairs were summed into one
+  ASSERT_EQ(g1.edges.size(), g2.edges.size());
+  for (size_t i = 0; i < g1.edges.size(); ++i) {
+    const GraphEdge &e1 = g1.edges[i], &e2 = g2.edges[i];
+    EXPECT_EQ(e1.a, e2.a);
+    EXPECT_EQ(e1.b, e2.b);
+    EXPECT_EQ(e1.confidences, e2.confidences);
+    EXPECT_EQ(e1.separations, e2.separations);
+    EXPECT_EQ(e1.apart, e2.apart);
+    EXPECT_TRUE(tracker.labels().isRoot(e1.a) && tracker.labels().isRoot(e1.b));
+    if (i > 0) EXPECT_LT(std::tie(g1.edges[i - 1].a, g1.edges[i - 1].b), std::tie(e1.a, e1.b));
+  }
+}
+
+// The final graph's edges are built on every thread in slices cut between pairs; with
+// pending merges (several stored edges onto one pair, summed) they equal a single pass's.
+TEST(GraphAccumulatorEdges, ThreadsGiveTheGraphOfOnePass) {
+  // Every fifth label merged into a smaller one, some through chains.
+  std::mt19937 rng(5);
+  std::vector<int32_t> parent(401);
+  for (int32_t l = 1; l <= 400; ++l) {
+    parent[l] = l > 1 && l % 5 == 0 ? static_cast<int32_t>(rng() % (l - 1)) + 1 : l;
+  }
+  expectThreadsGiveOnePass([&](int32_t l) { return parent[l]; }, 4000);
+  // Everything merged into 16 super-points: runs of 50 stored edges per pair, so a slice cut
+  // by position alone would split one.
+  expectThreadsGiveOnePass([](int32_t l) { return l <= 16 ? l : (l % 16) + 1; }, 100);
 }
 
 }  // namespace

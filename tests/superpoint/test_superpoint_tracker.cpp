@@ -474,6 +474,24 @@ TEST(LabelRegistry, MergesResolveToTheOldestId) {
   EXPECT_THROW(copy.restore({0, 2}), Error);
 }
 
+TEST(LabelRegistry, LongChainsResolveAndCompress) {
+  LabelRegistry labels;
+  for (int i = 0; i < 6; ++i) labels.create();
+  // Each merge puts the previous root under a smaller one: 6 -> 5 -> 4 -> 3 -> 2 -> 1.
+  for (int32_t keep = 5; keep >= 1; --keep) EXPECT_EQ(labels.merge(keep + 1, keep), keep);
+  EXPECT_EQ(labels.parents(), (std::vector<int32_t>{0, 1, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(labels.resolve(6), 1);
+  // The path from 6 now points at the root; 2 (a root's child) was never longer.
+  EXPECT_EQ(labels.parents(), (std::vector<int32_t>{0, 1, 1, 1, 1, 1, 1}));
+  labels.create();                   // 7
+  labels.create();                   // 8
+  EXPECT_EQ(labels.merge(8, 7), 7);  // 8 -> 7
+  EXPECT_EQ(labels.merge(7, 1), 1);  // 8 -> 7 -> 1
+  labels.flatten();
+  EXPECT_EQ(labels.parents()[8], 1);
+  for (int32_t l = 1; l <= 8; ++l) EXPECT_EQ(labels.resolve(l), 1) << l;
+}
+
 }  // namespace
 }  // namespace panmap
 

@@ -13,7 +13,14 @@ class LabelRegistry {
   /// A new label (ids are consecutive from 1).
   int32_t create();
   /// The label a (possibly merged-away) label belongs to now; 0 stays 0.
-  int32_t resolve(int32_t label) const;
+  int32_t resolve(int32_t label) const {
+    if (label <= 0 || label >= static_cast<int32_t>(parent_.size())) return 0;
+    // Inline for the common case, a root or a root's child (always after flatten()): the
+    // scans, graph update and meshing call it per voxel.
+    const int32_t parent = parent_[label];
+    if (parent_[parent] == parent) return parent;
+    return resolveDeep(label);
+  }
   /// Points every label straight at its root. Until the next merge or create, resolve() then
   /// only reads, so several threads may call it at once.
   void flatten() const;
@@ -31,6 +38,9 @@ class LabelRegistry {
   void restore(std::vector<int32_t> parents);
 
  private:
+  // resolve() of a label two or more links below its root; compresses the path.
+  int32_t resolveDeep(int32_t label) const;
+
   // Mutable: resolve() compresses paths (the result never changes, only the speed).
   mutable std::vector<int32_t> parent_ = {0};
 };
