@@ -112,8 +112,7 @@ void EdgeTable::forEachSorted(
   }
   if (!entries.empty()) {
     // Keys are distinct, so any sort gives one order: the halves' offsets from their minima,
-    // side by side, are a few dozen bits for counting passes (std::sort of 300k keys took a
-    // fifth of the building's final graph).
+    // side by side, are a few dozen bits for counting passes.
     const int low_bits = bitWidth(hi[1] - lo[1]);
     const int bits = bitWidth(hi[0] - lo[0]) + low_bits;
     const uint64_t first_lo = lo[0], second_lo = lo[1];
