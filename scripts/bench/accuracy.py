@@ -483,8 +483,8 @@ def main():
                 saved, missing[0]))
     else:
         version = code_version()  # before mapping: what the maps were made with
-        results = suite.run_all(args.work, real + likes + boxes + weaker, args.voxel_size, args.jobs,
-                                args.keep_logs, args.config, label="accuracy")
+        results = suite.run_all(args.work, real + likes + boxes + weaker, args.voxel_size,
+                                args.jobs, args.keep_logs, args.config, label="accuracy")
         minutes = (time.time() - start) / 60
         with open(saved, "w") as f:
             json.dump({"results": results, "minutes": minutes, "version": version}, f,
