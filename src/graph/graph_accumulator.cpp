@@ -191,9 +191,7 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
         if (label <= 0) continue;
         const int32_t id = scratch->masks[k];
         const Eigen::Vector3i& g = scratch->voxels[k];
-        const uint64_t key = (static_cast<uint64_t>(g.x() & 0x1FFFFF) << 42) |
-                             (static_cast<uint64_t>(g.y() & 0x1FFFFF) << 21) |
-                             static_cast<uint64_t>(g.z() & 0x1FFFFF);
+        const uint64_t key = internal::maskHitVoxelKey(g.x(), g.y(), g.z());
         // Neighbouring pixels often repeat the last hit: keep the sort below small.
         if (!out.empty() && out.back().mask == id && out.back().voxel == key) continue;
         out.push_back({key, id, label});

@@ -11,12 +11,7 @@ namespace panmap {
 namespace {
 
 using internal::MaskHit;
-
-// The graph update's voxel key: three 21-bit fields, negative coordinates wrapped.
-uint64_t voxelKey(int x, int y, int z) {
-  return (static_cast<uint64_t>(x & 0x1FFFFF) << 42) | (static_cast<uint64_t>(y & 0x1FFFFF) << 21) |
-         static_cast<uint64_t>(z & 0x1FFFFF);
-}
+using internal::maskHitVoxelKey;
 
 std::vector<MaskHit> reference(std::vector<MaskHit> hits) {
   std::sort(hits.begin(), hits.end());
@@ -46,7 +41,7 @@ std::vector<MaskHit> randomHits(size_t n, int lo, int extent, std::vector<int32_
   std::vector<MaskHit> hits;
   for (size_t i = 0; i < n; ++i) {
     const int x = coord(rng), y = coord(rng), z = coord(rng);
-    hits.push_back({voxelKey(x, y, z), masks[pick(rng)], (x * 7 + y * 3 + z) & 0xFF});
+    hits.push_back({maskHitVoxelKey(x, y, z), masks[pick(rng)], (x * 7 + y * 3 + z) & 0xFF});
     if (i % 5 == 0) hits.push_back(hits.back());  // the same pixel ray twice
   }
   return hits;
@@ -69,16 +64,16 @@ TEST(MaskHits, EdgeCases) {
   internal::sortUniqueHits(&empty, &scratch);
   EXPECT_TRUE(empty.empty());
   // Every hit identical: one digit-free key, one hit left.
-  std::vector<MaskHit> same(2000, MaskHit{voxelKey(-1, 2, -3), 9, 4});
+  std::vector<MaskHit> same(2000, MaskHit{maskHitVoxelKey(-1, 2, -3), 9, 4});
   internal::sortUniqueHits(&same, &scratch);
   ASSERT_EQ(same.size(), 1u);
-  EXPECT_EQ(same[0].voxel, voxelKey(-1, 2, -3));
+  EXPECT_EQ(same[0].voxel, maskHitVoxelKey(-1, 2, -3));
   EXPECT_EQ(same[0].mask, 9);
   EXPECT_EQ(same[0].label, 4);
   // Extreme field values: the wrapped -1 (all ones) and 0 on every axis.
   std::vector<MaskHit> corners;
   for (int i = 0; i < 1024; ++i) {
-    corners.push_back({voxelKey(i & 1 ? -1 : 0, i & 2 ? -1 : 0, i & 4 ? -1 : 0), i % 3, 1});
+    corners.push_back({maskHitVoxelKey(i & 1 ? -1 : 0, i & 2 ? -1 : 0, i & 4 ? -1 : 0), i % 3, 1});
   }
   expectSameAsReference(corners);
 }

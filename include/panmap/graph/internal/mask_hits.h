@@ -17,6 +17,12 @@ struct MaskHit {
   bool operator==(const MaskHit& o) const { return mask == o.mask && voxel == o.voxel; }
 };
 
+/// The voxel key of a MaskHit for global voxel coordinates (x, y, z).
+inline uint64_t maskHitVoxelKey(int x, int y, int z) {
+  return (static_cast<uint64_t>(x & 0x1FFFFF) << 42) | (static_cast<uint64_t>(y & 0x1FFFFF) << 21) |
+         static_cast<uint64_t>(z & 0x1FFFFF);
+}
+
 /// Sorts `hits` by (mask, voxel) and keeps one of each equal pair: the order and the result of
 /// std::sort followed by std::unique. `scratch` is working memory (its contents are lost).
 void sortUniqueHits(std::vector<MaskHit>* hits, std::vector<MaskHit>* scratch);
