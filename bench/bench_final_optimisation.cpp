@@ -1,10 +1,13 @@
 // The final optimisation of a saved map, as panmap-mapper runs it at the end of a session:
 // the super-point graph of the live super-points (Mapper::graph), then the solve (optimise).
-// Prints the median of each over --repeats runs.
+// Prints each run, the median of each over --repeats runs, and a digest of the labels (FNV-1a of
+// every super-point's id, class and instance) so that a faster build can be checked for equal
+// output.
 //   panmap-bench-final MAP.panmap [--repeats 5]
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -19,6 +22,24 @@ namespace {
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+/// FNV-1a over the labels, in id order.
+uint64_t labelsDigest(const panmap::GraphLabels& labels) {
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](int64_t v) {
+    for (int k = 0; k < 8; ++k) {
+      h ^= static_cast<uint64_t>(v >> (8 * k)) & 0xFFu;
+      h *= 1099511628211ull;
+    }
+  };
+  for (const auto& [id, cls] : labels.semantic) {
+    mix(id);
+    mix(cls);
+    const auto it = labels.instance.find(id);
+    mix(it == labels.instance.end() ? -1 : it->second);
+  }
+  return h;
 }
 
 double msSince(std::chrono::steady_clock::time_point start) {
@@ -41,6 +62,7 @@ int main(int argc, char** argv) {
     const auto mapper = panmap::Mapper::load(path);
     std::vector<double> graph_ms, solve_ms;
     size_t vertices = 0, edges = 0;
+    uint64_t digest = 0;
     for (int r = 0; r < repeats; ++r) {
       auto start = std::chrono::steady_clock::now();
       const panmap::SuperpointGraph graph = mapper->graph();
@@ -48,16 +70,18 @@ int main(int argc, char** argv) {
       start = std::chrono::steady_clock::now();
       const panmap::GraphLabels labels = panmap::optimise(graph, panmap::OptimiserConfig());
       solve_ms.push_back(msSince(start));
+      digest = labelsDigest(labels);
       vertices = graph.vertices.size();
       edges = graph.edges.size();
-      std::fprintf(stderr, "\r  run %d/%d", r + 1, repeats);
+      std::fprintf(stderr, "  run %d/%d: graph %.1f ms, solve %.1f ms\n", r + 1, repeats,
+                   graph_ms.back(), solve_ms.back());
     }
-    std::fprintf(stderr, "\n");
     std::printf(
         "%s: %zu blocks, %zu vertices, %zu edges; median of %d: graph %.1f ms, solve %.1f ms, "
-        "total %.1f ms\n",
+        "total %.1f ms; labels %016llx\n",
         path.c_str(), mapper->map().numBlocks(), vertices, edges, repeats, median(graph_ms),
-        median(solve_ms), median(graph_ms) + median(solve_ms));
+        median(solve_ms), median(graph_ms) + median(solve_ms),
+        static_cast<unsigned long long>(digest));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-bench-final: error: %s\n", e.what());
     return 1;

@@ -426,7 +426,10 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
     vertex.semantic = state.semanticClass();
     vertex.void_share = state.voidShare();
     const auto s = scores_.find(label);
-    if (s != scores_.end()) vertex.scores = s->second;
+    if (s != scores_.end()) {
+      vertex.scores.insert(boost::container::ordered_unique_range, s->second.begin(),
+                           s->second.end());
+    }
     g.vertices.push_back(vertex);
   }
   // Stored pairs between live super-points (merges are folded in at the next update), in pair
@@ -466,9 +469,11 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
   auto total = [&](int32_t l) {
     return l >= 0 && static_cast<size_t>(l) < num_labels ? totals_by_label[l] : scoreTotal(l);
   };
-  // The pairs' classes sit in the table's slots, in hash order: visited in pair order each is a
-  // cache miss, so they are asked for a few pairs ahead.
+  // The pairs' classes sit in the table's slots, in hash order, and those of a pair with more
+  // than one class behind a pointer in the slot: visited in pair order each is two cache misses,
+  // so the slots are asked for kPrefetchAhead pairs ahead, and what they point to half as far.
   constexpr size_t kPrefetchAhead = 16;
+  constexpr size_t kPrefetchDataAhead = kPrefetchAhead / 2;
   // Edges of stored[begin, end), which starts and ends at a pair boundary.
   auto edgesOf = [&](size_t begin, size_t end, std::vector<GraphEdge>* out) {
     out->reserve(end - begin);
@@ -477,6 +482,9 @@ SuperpointGraph GraphAccumulator::graph(const TsdfMap& map,
     }
     for (size_t i = begin; i < end;) {
       if (i + kPrefetchAhead < end) __builtin_prefetch(stored[i + kPrefetchAhead].classes);
+      if (i + kPrefetchDataAhead < end) {
+        __builtin_prefetch(stored[i + kPrefetchDataAhead].classes->data());
+      }
       size_t j = i + 1;
       while (j < end && stored[j].a == stored[i].a && stored[j].b == stored[i].b) ++j;
       // P_eps^C (C > 0) and P_sep^C (C < 0); P_apart (0) only weighs them.

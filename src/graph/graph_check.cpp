@@ -14,7 +14,7 @@ namespace {
 // `field` names the map only when a value is bad: building the name for each of a building's
 // 300k edges took 40 ms, a tenth of the final optimisation.
 template <typename Field>
-void checkValues(const std::map<int32_t, double>& values, const Field& field, const char* name) {
+void checkValues(const ClassValues& values, const Field& field, const char* name) {
   for (const auto& [c, v] : values) {
     if (!std::isfinite(v) || v < 0.0) {
       throw Error(field() + name + "[" + std::to_string(c) + "]: " + std::to_string(v) +

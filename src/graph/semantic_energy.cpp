@@ -14,7 +14,7 @@ namespace internal {
 namespace {
 
 /// Sum of the values whose class is in `classes` (classes outside the label space ignored).
-double sumOver(const std::map<int32_t, double>& values, const ClassSet& classes) {
+double sumOver(const ClassValues& values, const ClassSet& classes) {
   double sum = 0.0;
   for (const auto& [c, v] : values) {
     if (classes.contains(c)) sum += v;
@@ -33,7 +33,7 @@ double edgeEvidence(const GraphEdge& e, const ClassSet& classes, const Optimiser
 }
 
 /// The value of class c, 0 when absent or outside `classes`.
-double valueOf(const std::map<int32_t, double>& values, const ClassSet& classes, int32_t c) {
+double valueOf(const ClassValues& values, const ClassSet& classes, int32_t c) {
   if (!classes.contains(c)) return 0.0;
   const auto it = values.find(c);
   return it == values.end() ? 0.0 : it->second;

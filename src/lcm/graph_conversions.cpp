@@ -9,7 +9,7 @@ namespace panmap {
 namespace {
 
 template <typename Keys, typename Values>
-void putClassMap(const std::map<int32_t, double>& m, int32_t* count, Keys* keys, Values* values) {
+void putClassMap(const ClassValues& m, int32_t* count, Keys* keys, Values* values) {
   *count = static_cast<int32_t>(m.size());
   for (const auto& [cls, value] : m) {
     keys->push_back(cls);
@@ -17,12 +17,13 @@ void putClassMap(const std::map<int32_t, double>& m, int32_t* count, Keys* keys,
   }
 }
 
-std::map<int32_t, double> getClassMap(int32_t count, const std::vector<int32_t>& keys,
-                                      const std::vector<double>& values, const std::string& what) {
+ClassValues getClassMap(int32_t count, const std::vector<int32_t>& keys,
+                        const std::vector<double>& values, const std::string& what) {
   if (count < 0 || keys.size() != static_cast<size_t>(count) || values.size() != keys.size()) {
     throw Error(what + ": class arrays disagree with their count");
   }
-  std::map<int32_t, double> m;
+  ClassValues m;
+  m.reserve(keys.size());
   for (size_t i = 0; i < keys.size(); ++i) {
     if (!m.emplace(keys[i], values[i]).second) throw Error(what + ": class listed twice");
   }

@@ -9,7 +9,7 @@
 namespace panmap {
 namespace {
 
-nlohmann::json classMap(const std::map<int32_t, double>& m) {
+nlohmann::json classMap(const ClassValues& m) {
   nlohmann::json out = nlohmann::json::object();
   for (const auto& [cls, value] : m) out[std::to_string(cls)] = value;
   return out;

@@ -285,7 +285,9 @@ void expectThreadsGiveOnePass(const std::function<int32_t(int32_t)>& merged_into
     EXPECT_EQ(e1.separations, e2.separations);
     EXPECT_EQ(e1.apart, e2.apart);
     EXPECT_TRUE(tracker.labels().isRoot(e1.a) && tracker.labels().isRoot(e1.b));
-    if (i > 0) EXPECT_LT(std::tie(g1.edges[i - 1].a, g1.edges[i - 1].b), std::tie(e1.a, e1.b));
+    if (i > 0) {
+      EXPECT_LT(std::tie(g1.edges[i - 1].a, g1.edges[i - 1].b), std::tie(e1.a, e1.b));
+    }
   }
 }
 

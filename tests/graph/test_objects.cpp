@@ -13,7 +13,7 @@
 namespace panmap {
 namespace {
 
-GraphVertex vertex(int32_t id, int32_t voxels, std::map<int32_t, double> scores) {
+GraphVertex vertex(int32_t id, int32_t voxels, ClassValues scores) {
   GraphVertex v;
   v.id = id;
   v.num_voxels = voxels;
@@ -21,7 +21,7 @@ GraphVertex vertex(int32_t id, int32_t voxels, std::map<int32_t, double> scores)
   return v;
 }
 
-GraphEdge edge(int32_t a, int32_t b, std::map<int32_t, double> confidences) {
+GraphEdge edge(int32_t a, int32_t b, ClassValues confidences) {
   GraphEdge e;
   e.a = a;
   e.b = b;
@@ -41,10 +41,14 @@ struct Case {
   Case() {
     graph.voxel_size_m = 0.02;
     graph.classes = {5, 7};
-    graph.vertices = {vertex(1, 150, {{5, 1500.0}, {7, 500.0}}), vertex(2, 100, {{5, 1000.0}}),
-                      vertex(3, 40, {{5, 40.0}}),   vertex(4, 30, {{5, 30.0}}),
-                      vertex(5, 60, {{5, 60.0}}),   vertex(6, 70, {{5, 70.0}}),
-                      vertex(7, 50, {{5, 50.0}}),   vertex(8, 20, {{7, 20.0}})};
+    graph.vertices = {vertex(1, 150, {{5, 1500.0}, {7, 500.0}}),
+                      vertex(2, 100, {{5, 1000.0}}),
+                      vertex(3, 40, {{5, 40.0}}),
+                      vertex(4, 30, {{5, 30.0}}),
+                      vertex(5, 60, {{5, 60.0}}),
+                      vertex(6, 70, {{5, 70.0}}),
+                      vertex(7, 50, {{5, 50.0}}),
+                      vertex(8, 20, {{7, 20.0}})};
     graph.edges = {edge(1, 2, {{5, 9.0}}), edge(1, 3, {{5, 3.0}}), edge(2, 4, {{5, 4.0}}),
                    edge(2, 8, {{7, 6.0}}), edge(3, 4, {{5, 5.0}}), edge(6, 7, {{5, 2.0}})};
   }

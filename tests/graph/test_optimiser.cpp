@@ -28,8 +28,7 @@ OptimiserConfig handConfig() {
   return config;
 }
 
-GraphVertex vertex(int32_t id, std::map<int32_t, double> scores, int32_t instance = 0,
-                   int32_t semantic = 0) {
+GraphVertex vertex(int32_t id, ClassValues scores, int32_t instance = 0, int32_t semantic = 0) {
   GraphVertex v;
   v.id = id;
   v.num_voxels = 10;
@@ -39,7 +38,7 @@ GraphVertex vertex(int32_t id, std::map<int32_t, double> scores, int32_t instanc
   return v;
 }
 
-GraphEdge edge(int32_t a, int32_t b, std::map<int32_t, double> confidences) {
+GraphEdge edge(int32_t a, int32_t b, ClassValues confidences) {
   GraphEdge e;
   e.a = a;
   e.b = b;
@@ -58,7 +57,7 @@ SuperpointGraph randomGraph(uint64_t seed, int max_vertices, const std::vector<i
   graph.classes = classes;
   const int n = 2 + static_cast<int>(rng.below(max_vertices - 1));
   for (int i = 0; i < n; ++i) {
-    std::map<int32_t, double> scores;
+    ClassValues scores;
     if (!rng.bernoulli(0.15)) {
       for (int32_t c : classes) {
         if (rng.bernoulli(score_probability)) scores[c] = rng.uniform(0.1, 10.0);
@@ -72,7 +71,7 @@ SuperpointGraph randomGraph(uint64_t seed, int max_vertices, const std::vector<i
   for (int a = 1; a <= n; ++a) {
     for (int b = a + 1; b <= n; ++b) {
       if (!rng.bernoulli(0.5)) continue;
-      std::map<int32_t, double> confidences;
+      ClassValues confidences;
       for (int32_t c : classes) {
         if (rng.bernoulli(0.5)) confidences[c] = rng.uniform(0.0, 3.0);
       }
@@ -461,7 +460,7 @@ TEST(Optimiser, Deterministic) {
   graph.background = {1};
   Rng rng(42);
   for (int i = 1; i <= 300; ++i) {
-    std::map<int32_t, double> scores;
+    ClassValues scores;
     scores[1 + static_cast<int32_t>(rng.below(6))] = rng.uniform(1.0, 20.0);
     scores[1 + static_cast<int32_t>(rng.below(6))] += rng.uniform(0.1, 10.0);
     graph.vertices.push_back(vertex(i, scores, static_cast<int32_t>(rng.below(40))));

@@ -5,8 +5,14 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <boost/container/flat_map.hpp>
 
 namespace panmap {
+
+/// Values per class (NYU40 id), sorted by class. A flat map (one array): a super-point or an edge
+/// carries one to a few classes, and std::map's node per class made building and solving a
+/// building's graph (300k edges) allocation-bound.
+using ClassValues = boost::container::flat_map<int32_t, double>;
 
 /// A vertex of the super-point graph (paper III-C): one live super-point.
 struct GraphVertex {
@@ -18,7 +24,7 @@ struct GraphVertex {
   /// Share of the frames that showed it in which no mask of a known class covered it (the
   /// frame counts' class 0): what the network left void.
   double void_share = 0.0;
-  std::map<int32_t, double> scores;  ///< P_nu^C(L_S) per class C (Eq. 5); absent = 0
+  ClassValues scores;  ///< P_nu^C(L_S) per class C (Eq. 5); absent = 0
 };
 
 /// An edge of the super-point graph: the panoptic-spatial confidence that two super-points
@@ -26,10 +32,10 @@ struct GraphVertex {
 struct GraphEdge {
   int32_t a = 0;  ///< super-point id, a < b
   int32_t b = 0;
-  std::map<int32_t, double> confidences;  ///< P_eps^C(a, b) per class C (Eq. 6); absent = 0
+  ClassValues confidences;  ///< P_eps^C(a, b) per class C (Eq. 6); absent = 0
   /// P_sep^C(a, b) per thing class C: the same sum over frames that showed a and b under two
   /// different masks of class C (evidence of two objects; not in the paper); absent = 0.
-  std::map<int32_t, double> separations;
+  ClassValues separations;
   /// P_apart(a, b): the same sum (without P_s) over frames that showed a and b under two
   /// different masks of any classes, for pairs co-observed under one mask (not in the paper).
   double apart = 0.0;
