@@ -60,7 +60,8 @@ InstanceLabels clusterInstances(const SuperpointGraph& graph, const std::vector<
   // A pair's entry is pushed when its link is made or changes. A join grows the coverage a
   // cluster's links need (observed only grows), so that test is repeated when an entry comes
   // out; an entry whose link changed since is stale (the link's newer entry is in the heap).
-  // Re-pushing every link of a joined cluster instead cost 80 ms on a building's graph.
+  // Re-pushing every link of a joined cluster instead filled the heap with entries stale by the
+  // time they came out (docs/MAPPING.md: on a building's graph, about half of this stage).
   std::priority_queue<Candidate> heap;
   const auto affinityOf = [](const Between& between) {
     return between.same / (between.same + between.apart);
