@@ -1,8 +1,8 @@
 // The final optimisation of a saved map, as panmap-mapper runs it at the end of a session:
 // the super-point graph of the live super-points (Mapper::graph), then the solve (optimise).
-// Prints each run, the median of each over --repeats runs, and a digest of the labels (FNV-1a of
-// every super-point's id, class and instance) so that a faster build can be checked for equal
-// output.
+// Prints each run, the median of each over --repeats runs, and a digest of the labels (a
+// fingerprint of every super-point's id, class and instance) so that a faster build can be checked
+// for equal output.
 //   panmap-bench-final MAP.panmap [--repeats 5]
 
 #include <algorithm>
@@ -14,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "panmap/core/fingerprint.h"
 #include "panmap/graph/optimiser.h"
 #include "panmap/mapper/mapper.h"
 
@@ -24,22 +25,15 @@ double median(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
-/// FNV-1a over the labels, in id order.
+/// Fingerprint of the labels, in id order.
 uint64_t labelsDigest(const panmap::GraphLabels& labels) {
-  uint64_t h = 1469598103934665603ull;
-  auto mix = [&h](int64_t v) {
-    for (int k = 0; k < 8; ++k) {
-      h ^= static_cast<uint64_t>(v >> (8 * k)) & 0xFFu;
-      h *= 1099511628211ull;
-    }
-  };
+  panmap::Fingerprint f;
   for (const auto& [id, cls] : labels.semantic) {
-    mix(id);
-    mix(cls);
     const auto it = labels.instance.find(id);
-    mix(it == labels.instance.end() ? -1 : it->second);
+    const int64_t values[3] = {id, cls, it == labels.instance.end() ? -1 : it->second};
+    f.add(values, sizeof(values));
   }
-  return h;
+  return f.value();
 }
 
 double msSince(std::chrono::steady_clock::time_point start) {

@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 
 #include "panmap/core/error.h"
+#include "panmap/core/fingerprint.h"
 #include "panmap/core/progress.h"
 #include "panmap/core/thread_pool.h"
 #include "panmap/io/dataset_reader.h"
@@ -56,12 +57,10 @@ Summary summarise(std::vector<double> values) {
 // 200 label images in memory to compare would cost 250 MB.
 template <typename Image>
 uint64_t fingerprint(const Image& image) {
-  uint64_t h = 1469598103934665603ull;
-  const auto* bytes = reinterpret_cast<const uint8_t*>(image.data());
-  for (size_t i = 0; i < image.size() * sizeof(typename Image::Pixel); ++i) {
-    h = (h ^ bytes[i]) * 1099511628211ull;
-  }
-  return h ^ (static_cast<uint64_t>(image.width()) << 32) ^ static_cast<uint64_t>(image.height());
+  panmap::Fingerprint f;
+  f.add(image.data(), image.size() * sizeof(typename Image::Pixel));
+  return f.value() ^ (static_cast<uint64_t>(image.width()) << 32) ^
+         static_cast<uint64_t>(image.height());
 }
 
 }  // namespace

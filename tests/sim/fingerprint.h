@@ -1,35 +1,18 @@
 #pragma once
 
-// 64-bit FNV-1a fingerprints of generated data: a test pins the value measured before a change
-// to show that the change left the output bit for bit as it was.
+// Fingerprints (core/fingerprint.h) of generated data: a test pins the value measured before a
+// change to show that the change left the output bit for bit as it was.
 
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
+#include "panmap/core/fingerprint.h"
 #include "panmap/core/labelled_mesh.h"
 #include "panmap/core/pose.h"
 
 namespace panmap {
 namespace test {
-
-/// FNV-1a over raw bytes.
-class Fingerprint {
- public:
-  /// Mixes in `n` bytes at `data`.
-  void add(const void* data, size_t n) {
-    const auto* b = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) {
-      hash_ ^= b[i];
-      hash_ *= 1099511628211ull;
-    }
-  }
-  /// The fingerprint so far.
-  uint64_t value() const { return hash_; }
-
- private:
-  uint64_t hash_ = 1469598103934665603ull;
-};
 
 /// Vertices, faces, classes, instances and colours of a mesh, in that order.
 inline uint64_t fingerprint(const LabelledMesh& mesh) {
