@@ -87,6 +87,32 @@ TEST(InstanceClustering, AFewSharedMasksAmongManyViewsJoinNothing) {
             (std::vector<int32_t>{3, 3}));
 }
 
+// Candidate joins wait in a heap; a join changes what the waiting ones stand on. Super-points
+// 1 (P_nu 10), 2 (1000) and 3: 1-2 share masks strongly (P_eps 100) and join first; 1-3 share
+// one (P_eps 1, affinity 1), enough for 1 alone (1 >= 0.05 x 10).
+TEST(InstanceClustering, AJoinRechecksTheLinksWaitingOnIt) {
+  OptimiserConfig config;
+  config.join_affinity = 0.6;
+  config.min_coverage = 0.05;
+  SuperpointGraph g;
+  g.classes = {5};
+  // 3 seen 1000 times: once 1 holds 2, the link covers 1 / min(1010, 1000), under 5 %.
+  g.vertices = {vertex(1, 10, 3), vertex(2, 1000, 3), vertex(3, 1000, 4)};
+  g.edges = {edge(1, 2, 100, 0), edge(1, 3, 1, 0)};
+  EXPECT_EQ(internal::clusterInstances(g, {5, 5, 5}, config).instance,
+            (std::vector<int32_t>{3, 3, 4}));
+  // 3 seen 10 times, but 2 and 3 were two objects in 100 frames: the join sums that into the
+  // 1-3 link (affinity 1 / 101), whose waiting entry no longer holds.
+  g.vertices = {vertex(1, 10, 3), vertex(2, 1000, 3), vertex(3, 10, 4)};
+  g.edges = {edge(1, 2, 100, 0), edge(1, 3, 1, 0), edge(2, 3, 0, 100)};
+  EXPECT_EQ(internal::clusterInstances(g, {5, 5, 5}, config).instance,
+            (std::vector<int32_t>{3, 3, 4}));
+  // Without the join 1 and 3 do join (2 alone gets a new id: 3 is taken).
+  g.edges = {edge(1, 3, 1, 0)};
+  EXPECT_EQ(internal::clusterInstances(g, {5, 5, 5}, config).instance,
+            (std::vector<int32_t>{3, 5, 3}));
+}
+
 TEST(InstanceClustering, StuffGetsNoInstanceAndOptimiseUsesIt) {
   SuperpointGraph g = twoChairs();
   g.vertices.push_back(vertex(9, 100, 2, 1));  // a wall
