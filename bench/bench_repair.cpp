@@ -4,15 +4,21 @@
 // 10th frame's pose by a slow drift-like move and repairs: once blocking (repairMap, the
 // offline path), once on its own thread (BackgroundRepair, the live path) while new frames are
 // mapped at the given rate. Prints the repair times, what loading the frames costs of it, and
-// the mapping latency of the frames that arrived during the background repair.
-//   panmap-bench-repair [--data DIR] [--frames N] [--voxel-size M] [--threads N]
-//                       [--rate-hz R] [--live-frames K]
+// the mapping latency of the frames that arrived during the background repair. With --room S
+// the frames are a ScanNet-like procedural room rendered with `m2f` masks (panmap-synth
+// --room S --room-style scannet, surveyed twice at 5 Hz): the store keeps the masks and the
+// repair maps the frames again, as it does for every labelled map (--segment-again: without the
+// geometric segments kept in the store).
+//   panmap-bench-repair [--data DIR | --room S [--segment-again]] [--frames N] [--voxel-size M]
+//                       [--threads N] [--rate-hz R] [--live-frames K]
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -26,6 +32,8 @@
 #include "panmap/loop/frame_store.h"
 #include "panmap/loop/map_repair.h"
 #include "panmap/mapper/mapper.h"
+#include "panmap/sim/procedural_room.h"
+#include "panmap/sim/sequence.h"
 
 namespace {
 
@@ -78,6 +86,13 @@ panmap::PoseCorrection driftCorrection(const std::vector<panmap::StampedPose>& t
   return c;
 }
 
+// A frame to map: from a dataset (no masks) or rendered (with masks).
+struct InputFrame {
+  panmap::RgbdFrame rgbd;
+  std::optional<Eigen::Isometry3d> T_W_C;
+  std::optional<panmap::PanopticFrame> panoptic;
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -89,11 +104,18 @@ int main(int argc, char** argv) {
 #else
   std::string data = "../shared/data/7scenes-200";
 #endif
-  int frames = 1000, threads = 2, live_frames = 0;
+  int frames = 1000, threads = 2, live_frames = 0, room = -1;
+  bool segment_again = false;
   double rate_hz = 5.0;
   float voxel_size_m = 0.02f;
   app.add_option("--data", data, "dataset folder (7-Scenes, ScanNet export, TUM, folder)")
       ->capture_default_str();
+  app.add_option("--room", room,
+                 "render ScanNet-like procedural room S with m2f masks instead (labelled map: "
+                 "the repair maps the frames again)");
+  app.add_flag("--segment-again", segment_again,
+               "store no geometric segments, so that the repair segments every frame again (what "
+               "keeping them saves)");
   app.add_option("--frames", frames, "frames in the map when the correction comes")
       ->capture_default_str();
   app.add_option("--voxel-size", voxel_size_m, "voxel size, metres")->capture_default_str();
@@ -111,8 +133,42 @@ int main(int argc, char** argv) {
     std::string pattern = (fs::temp_directory_path() / "panmap-bench-repair-XXXXXX").string();
     if (!::mkdtemp(pattern.data())) throw panmap::Error("cannot create a temporary folder");
     temp_dir = pattern;
-    const auto reader = panmap::openDataset(data, panmap::DatasetOptions{});
-    if (reader->size() == 0) throw panmap::Error(data + ": no frames");
+    // Frame i of the input: the dataset replayed back and forth, or the room's survey (planned
+    // long enough for the frames mapped during the background repair too).
+    std::unique_ptr<panmap::DatasetReader> reader;
+    std::unique_ptr<panmap::SequenceSynthesizer> synth;
+    if (room >= 0) {
+      const panmap::ProceduralRoom scene =
+          panmap::generateRoom(static_cast<uint64_t>(room), panmap::RoomConfig::scanNetLike());
+      panmap::SurveyConfig survey;
+      survey.num_frames = frames + 400;
+      survey.rate_hz = 5.0;
+      survey.laps = 2;
+      panmap::SynthConfig synth_config;
+      synth_config.seed = static_cast<uint64_t>(room);
+      synth_config.poses = panmap::PoseDriftConfig::fromPreset("gt");
+      synth = std::make_unique<panmap::SequenceSynthesizer>(
+          scene.mesh, panmap::planSurvey(scene.mesh, survey, synth_config.seed), synth_config);
+      data = "ScanNet-like room " + std::to_string(room) + ", m2f masks";
+    } else {
+      reader = panmap::openDataset(data, panmap::DatasetOptions{});
+      if (reader->size() == 0) throw panmap::Error(data + ": no frames");
+    }
+    auto input = [&](size_t i) -> std::optional<InputFrame> {
+      InputFrame in;
+      if (synth) {
+        if (i >= synth->size()) return std::nullopt;
+        panmap::SynthFrame f = synth->frame(i);
+        in.rgbd = std::move(f.rgbd);
+        in.T_W_C = f.gt_pose.T_W_C;
+        in.panoptic = std::move(f.panoptic);
+        return in;
+      }
+      panmap::DatasetFrame f = replayed(*reader, i);
+      in.rgbd = std::move(f.rgbd);
+      in.T_W_C = f.T_W_C;
+      return in;
+    };
 
     panmap::MapperConfig config;
     config.map.voxel_size_m = voxel_size_m;
@@ -124,17 +180,23 @@ int main(int argc, char** argv) {
     panmap::Mapper mapper(config);
     std::vector<double> map_ms;
     size_t next = 0;
+    // Maps the next input frame and stores it as a live mapper does; false when there is none.
     auto mapNext = [&]() {
-      const panmap::DatasetFrame f = replayed(*reader, next++);
-      if (!f.T_W_C) return;
+      const std::optional<InputFrame> f = input(next++);
+      if (!f) return false;
+      if (!f->T_W_C) return true;
+      const panmap::PanopticFrame* panoptic = f->panoptic ? &*f->panoptic : nullptr;
       const auto start = Clock::now();
-      const panmap::FrameStats s = mapper.integrate(f.rgbd, *f.T_W_C, nullptr);
+      const panmap::FrameStats s = mapper.integrate(f->rgbd, *f->T_W_C, panoptic);
       map_ms.push_back(msSince(start));
-      store.add(f.rgbd, s.T_W_C, mapper.lastPixelLabels());
+      const panmap::GeometricSegments geometric = mapper.lastGeometricSegments();
+      store.add(f->rgbd, s.T_W_C, mapper.lastPixelLabels(), panoptic,
+                panoptic && !segment_again ? &geometric : nullptr);
+      return true;
     };
     panmap::ProgressLine progress("map + store", "frames");
     while (mapper.trajectory().size() < static_cast<size_t>(frames)) {
-      mapNext();
+      if (!mapNext()) throw panmap::Error("the input ran out of frames");
       progress.update(mapper.trajectory().size(), frames);
     }
     progress.finish();
@@ -176,7 +238,10 @@ int main(int argc, char** argv) {
       }
       std::this_thread::sleep_until(due);  // the camera's rate, not a wait for the repair
       due += period;
-      mapNext();
+      if (!mapNext()) {  // the rendered survey is over: wait for the repair
+        done = repair.finish();
+        break;
+      }
       ++offered;
       repair.frameIntegrated();
       done = repair.poll();
@@ -187,8 +252,9 @@ int main(int argc, char** argv) {
         "  %d frames mapped meanwhile at %.1f Hz: %.1f ms median, %.1f ms p95 each "
         "(before: %.1f ms median); swapped in %.2f s after the correction\n",
         offered, rate_hz, median(map_ms), p95(map_ms), map_median_ms, wall_s);
-    std::printf("machine: %u hardware threads; %zu frames at %.0f cm, mapping threads %d\n",
-                std::thread::hardware_concurrency(), n, voxel_size_m * 100.0, threads);
+    std::printf("machine: %u hardware threads; %zu frames of %s at %.0f cm, mapping threads %d\n",
+                std::thread::hardware_concurrency(), n, data.c_str(), voxel_size_m * 100.0,
+                threads);
     fs::remove_all(temp_dir);
     return done && done->reintegration.completed ? 0 : 1;
   } catch (const std::exception& e) {

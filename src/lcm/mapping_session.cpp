@@ -144,10 +144,12 @@ void MappingSession::repair(const PoseCorrection& correction) {
             *labels = std::move(stored.labels);
           },
           options_.frame_store, options_.repair,
-          [writer](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic) {
+          [writer](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic,
+                   GeometricSegments* kept) {
             StoredFrame stored = writer->load(utime);
             *frame = std::move(stored.rgbd);
             *panoptic = std::move(stored.panoptic);
+            *kept = std::move(stored.geometric);
             return stored.has_panoptic;
           },
           // The writer may not have written any frame yet: what was handed to it counts.
@@ -243,7 +245,8 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
         const auto start = std::chrono::steady_clock::now();
         try {
           writer_->add(f.frame, s.T_W_C, mapper_->lastPixelLabels(),
-                       f.panoptic ? &*f.panoptic : nullptr);
+                       f.panoptic ? &*f.panoptic : nullptr,
+                       f.panoptic ? mapper_->lastGeometricSegments() : GeometricSegments());
           stored_segmentation_ = stored_segmentation_ || f.panoptic.has_value();
         } catch (const Error& e) {
           ++stats_.rejected["frame store: " + reasonOf(e.what())];

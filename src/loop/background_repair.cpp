@@ -107,32 +107,36 @@ void BackgroundRepair::frameIntegrated() {
 }
 
 void BackgroundRepair::reintegrate(const StampedPose& job, RgbdFrame* frame, LabelImage* labels,
-                                   PanopticFrame* panoptic) {
+                                   PanopticFrame* panoptic, GeometricSegments* kept) {
   *frame = RgbdFrame();
   *labels = LabelImage();
   if (remap_) {
     *panoptic = PanopticFrame();
-    const bool has_panoptic = panoptic_load_(job.utime, frame, panoptic);
-    addLoaded(job, *frame, *labels, has_panoptic ? panoptic : nullptr);
+    *kept = GeometricSegments();
+    const bool has_panoptic = panoptic_load_(job.utime, frame, panoptic, kept);
+    addLoaded(job, *frame, *labels, has_panoptic ? panoptic : nullptr,
+              kept->ids.empty() ? nullptr : kept);
   } else {
     load_(job.utime, frame, labels);
-    addLoaded(job, *frame, *labels, nullptr);
+    addLoaded(job, *frame, *labels, nullptr, nullptr);
   }
 }
 
 void BackgroundRepair::addLoaded(const StampedPose& job, const RgbdFrame& frame,
-                                 const LabelImage& labels, const PanopticFrame* panoptic) {
+                                 const LabelImage& labels, const PanopticFrame* panoptic,
+                                 const GeometricSegments* kept) {
   if (frame.utime != job.utime) {
     throw Error("asked for the frame of utime " + std::to_string(job.utime) + ", got " +
                 std::to_string(frame.utime));
   }
-  rebuild_->add(frame, job.T_W_C, &labels, panoptic);
+  rebuild_->add(frame, job.T_W_C, &labels, panoptic, kept);
 }
 
 void BackgroundRepair::work() {
   RgbdFrame frame;
   LabelImage labels;
   PanopticFrame panoptic;
+  GeometricSegments kept;
   // The frames the correction covers are decoded ahead on another thread; those mapped since
   // come one by one, as the mapping thread hands them over.
   std::vector<int64_t> covered;
@@ -155,10 +159,11 @@ void BackgroundRepair::work() {
     }
     try {
       if (next_ < corrected_.poses.size()) {
-        const bool has_panoptic = prefetched->next(&frame, &labels, &panoptic);
-        addLoaded(job, frame, labels, has_panoptic ? &panoptic : nullptr);
+        const bool has_panoptic = prefetched->next(&frame, &labels, &panoptic, &kept);
+        addLoaded(job, frame, labels, has_panoptic ? &panoptic : nullptr,
+                  kept.ids.empty() ? nullptr : &kept);
       } else {
-        reintegrate(job, &frame, &labels, &panoptic);
+        reintegrate(job, &frame, &labels, &panoptic, &kept);
       }
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -188,6 +193,7 @@ MapRepairResult BackgroundRepair::commit() {
   stats.frames = rebuild_->poses().size();
   stats.reassociated = rebuild_->remaps();
   stats.votes_evicted = rebuild_->votesEvicted();
+  stats.frames_with_kept_segments = rebuild_->framesWithKeptSegments();
   for (size_t i = 0; i < corrected_.poses.size(); ++i) {
     stats.frames_moved += corrected_.translation_m[i] > 0.0 || corrected_.rotation_rad[i] > 0.0;
   }
@@ -225,9 +231,10 @@ std::optional<MapRepairResult> BackgroundRepair::poll() {
     RgbdFrame frame;
     LabelImage labels;
     PanopticFrame panoptic;
+    GeometricSegments kept;
     try {
       for (; next_ < jobs_.size(); ++next_) {
-        reintegrate(jobs_[next_], &frame, &labels, &panoptic);
+        reintegrate(jobs_[next_], &frame, &labels, &panoptic, &kept);
       }
     } catch (const std::exception& e) {
       failure_ = e.what();

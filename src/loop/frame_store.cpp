@@ -40,6 +40,9 @@ constexpr double kRigidTolerance = 1e-4;
 constexpr size_t kFrameTokens = 30;
 constexpr size_t kPoseTokens = 15;
 constexpr size_t kMaskTokens = 9;
+constexpr size_t kGeometricTokens = 6;
+// The geometric segments' plane (version 2 only).
+constexpr char kGeometricSuffix[] = ".geometric.zst";
 
 // File names of a frame's images, by store version: version 1 split labels above 2^24 into a
 // second PNG, a plane holds every int32 in one file.
@@ -342,6 +345,25 @@ void FrameStore::readIndex(Check check) {
       e.masks = records[0];
       e.masks_hi = records[1];
       e.segments = records[2];
+    } else if (tokens.size() + 1 == kGeometricTokens && tokens[0] == "geometric" &&
+               parseInt64(tokens[1], &utime)) {
+      const auto it = entries_.find(utime);
+      uint64_t key = 0, crc = 0;
+      FileRecord record;
+      if (it == entries_.end() || it->second.masks.size == 0) {
+        problems_.push_back(where + ": geometric segments of utime " + std::to_string(utime) +
+                            ", which no earlier line adds with masks, ignored");
+        continue;
+      }
+      if (version_ == 1 || !parseUint(tokens[2], 16, &key) ||
+          !parseUint(tokens[3], 10, &record.size) || record.size == 0 ||
+          !parseUint(tokens[4], 16, &crc) || crc > 0xffffffffu) {
+        problems_.push_back(where + ": not a valid geometric line, ignored");
+        continue;
+      }
+      record.crc = static_cast<uint32_t>(crc);
+      it->second.geometric = record;
+      it->second.geometric_key = key;
     } else if (tokens.size() + 1 == kPoseTokens && tokens[0] == "pose" &&
                parseInt64(tokens[1], &utime)) {
       Eigen::Isometry3d T;
@@ -377,11 +399,11 @@ void FrameStore::readIndex(Check check) {
 
 std::string FrameStore::checkFiles(int64_t utime, const Entry& entry, Check check) const {
   const Suffixes& sfx = suffixesOf(version_);
-  const std::pair<const FileRecord*, const char*> files[7] = {
-      {&entry.depth, sfx.depth},         {&entry.labels, sfx.labels},
-      {&entry.labels_hi, sfx.labels_hi}, {&entry.color, ".color.jpg"},
-      {&entry.masks, sfx.masks},         {&entry.masks_hi, sfx.masks_hi},
-      {&entry.segments, ".segments.txt"}};
+  const std::pair<const FileRecord*, const char*> files[8] = {
+      {&entry.depth, sfx.depth},          {&entry.labels, sfx.labels},
+      {&entry.labels_hi, sfx.labels_hi},  {&entry.color, ".color.jpg"},
+      {&entry.masks, sfx.masks},          {&entry.masks_hi, sfx.masks_hi},
+      {&entry.segments, ".segments.txt"}, {&entry.geometric, kGeometricSuffix}};
   const std::string what = "frame " + std::to_string(utime) + ": ";
   for (const auto& [record, suffix] : files) {
     if (record->size == 0) continue;
@@ -428,7 +450,8 @@ void FrameStore::appendIndexLine(const std::string& line) {
 
 void FrameStore::add(int64_t utime, const Eigen::Isometry3d& T_W_C, const PinholeCamera& camera,
                      double depth_scale_m, const DepthImage& depth, const LabelImage& labels,
-                     const ColorImage* color, const PanopticFrame* panoptic) {
+                     const ColorImage* color, const PanopticFrame* panoptic,
+                     const GeometricSegments* geometric) {
   const std::string what = "frame store: frame " + std::to_string(utime);
   std::string why;
   if (!camera.isValid(&why)) throw Error(what + ": intrinsics: " + why);
@@ -453,6 +476,12 @@ void FrameStore::add(int64_t utime, const Eigen::Isometry3d& T_W_C, const Pinhol
   }
   if (panoptic && !sizeMatches(panoptic->segment_ids.width(), panoptic->segment_ids.height())) {
     throw Error(what + ": panoptic segment image is not " + camera_size + " as the intrinsics say");
+  }
+  // Kept only where a repair maps the frame again, and only as a plane.
+  const bool with_geometric = panoptic && geometric && !geometric->ids.empty() && version_ != 1;
+  if (with_geometric && !sizeMatches(geometric->ids.width(), geometric->ids.height())) {
+    throw Error(what + ": geometric segment image is not " + camera_size +
+                " as the intrinsics say");
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -528,6 +557,11 @@ void FrameStore::add(int64_t utime, const Eigen::Isometry3d& T_W_C, const Pinhol
     if (text.empty()) text = "\n";  // a segmentation without segments is still one
     store(std::vector<uint8_t>(text.begin(), text.end()), ".segments.txt", &entry.segments);
   }
+  if (with_geometric) {
+    store(encodePlane(geometric->ids, config_.compression_level), kGeometricSuffix,
+          &entry.geometric);
+    entry.geometric_key = geometric->config_key;
+  }
   // Files an earlier, interrupted add() of this utime may have left (never in the index).
   if (!labels_high) std::remove(framePath(utime, sfx.labels_hi).c_str());
   if (!with_color) std::remove(framePath(utime, ".color.jpg").c_str());
@@ -536,6 +570,7 @@ void FrameStore::add(int64_t utime, const Eigen::Isometry3d& T_W_C, const Pinhol
     std::remove(framePath(utime, sfx.masks).c_str());
     std::remove(framePath(utime, ".segments.txt").c_str());
   }
+  if (!with_geometric) std::remove(framePath(utime, kGeometricSuffix).c_str());
 
   std::string line = "frame " + std::to_string(utime);
   for (double v : {camera.fx, camera.fy, camera.cx, camera.cy}) appendDouble(&line, v);
@@ -555,6 +590,14 @@ void FrameStore::add(int64_t utime, const Eigen::Isometry3d& T_W_C, const Pinhol
     }
     lines += "\n" + sealed(masks);
   }
+  if (with_geometric) {
+    // After the masks line: cut away by a crash, the frame is segmented again when remapped.
+    char key[24];
+    std::snprintf(key, sizeof(key), "%016llx",
+                  static_cast<unsigned long long>(entry.geometric_key));
+    lines += "\n" + sealed("geometric " + std::to_string(utime) + " " + key + " " +
+                           std::to_string(entry.geometric.size) + " " + hex32(entry.geometric.crc));
+  }
   std::lock_guard<std::mutex> lock(mutex_);
   appendIndexLine(lines);
   entries_[utime] = entry;
@@ -562,9 +605,10 @@ void FrameStore::add(int64_t utime, const Eigen::Isometry3d& T_W_C, const Pinhol
 }
 
 void FrameStore::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
-                     const LabelImage& labels, const PanopticFrame* panoptic) {
+                     const LabelImage& labels, const PanopticFrame* panoptic,
+                     const GeometricSegments* geometric) {
   add(frame.utime, T_W_C, frame.camera, frame.depth_scale_m, frame.depth, labels,
-      frame.color.empty() ? nullptr : &frame.color, panoptic);
+      frame.color.empty() ? nullptr : &frame.color, panoptic, geometric);
 }
 
 void FrameStore::updatePose(int64_t utime, const Eigen::Isometry3d& T_W_C) {
@@ -667,6 +711,11 @@ StoredFrame FrameStore::load(int64_t utime) const {
       out.panoptic.segments.push_back(seg);
     }
   }
+  if (entry.geometric.size > 0) {
+    const std::vector<uint8_t> bytes = read(kGeometricSuffix, entry.geometric);
+    out.geometric.ids = decodeLabelPlane(bytes.data(), bytes.size(), name + "geometric segments");
+    out.geometric.config_key = entry.geometric_key;
+  }
   if (entry.color.size > 0) {
     const std::vector<uint8_t> bytes = read(".color.jpg", entry.color);
     out.rgbd.color = decodeColor(bytes.data(), bytes.size(), name + "colour");
@@ -677,7 +726,9 @@ StoredFrame FrameStore::load(int64_t utime) const {
       !sized(out.labels.width(), out.labels.height()) ||
       (!out.rgbd.color.empty() && !sized(out.rgbd.color.width(), out.rgbd.color.height())) ||
       (out.has_panoptic &&
-       !sized(out.panoptic.segment_ids.width(), out.panoptic.segment_ids.height()))) {
+       !sized(out.panoptic.segment_ids.width(), out.panoptic.segment_ids.height())) ||
+      (!out.geometric.ids.empty() &&
+       !sized(out.geometric.ids.width(), out.geometric.ids.height()))) {
     throw Error(name + "an image's size differs from the stored intrinsics");
   }
   return out;
@@ -742,6 +793,7 @@ FrameStore::FrameBytes FrameStore::frameBytes(int64_t utime) const {
   out.labels = it->second.labels.size + it->second.labels_hi.size;
   out.color = it->second.color.size;
   out.masks = it->second.masks.size + it->second.masks_hi.size + it->second.segments.size;
+  out.geometric = it->second.geometric.size;
   return out;
 }
 

@@ -24,9 +24,15 @@ FrameStoreWriter::~FrameStoreWriter() {
 }
 
 void FrameStoreWriter::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
-                           const LabelImage& labels, const PanopticFrame* panoptic) {
+                           const LabelImage& labels, const PanopticFrame* panoptic,
+                           GeometricSegments geometric) {
   // Copied before the lock: a few MB.
-  Job job{frame, T_W_C, labels, panoptic != nullptr, panoptic ? *panoptic : PanopticFrame()};
+  Job job{frame,
+          T_W_C,
+          labels,
+          panoptic != nullptr,
+          panoptic ? *panoptic : PanopticFrame(),
+          std::move(geometric)};
   std::unique_lock<std::mutex> lock(mutex_);
   if (unwritten_.count(frame.utime)) {
     throw Error("frame store: frame " + std::to_string(frame.utime) + " is already queued");
@@ -51,7 +57,8 @@ void FrameStoreWriter::work() {
     cv_.notify_all();  // room in the queue
     std::string error;
     try {
-      store_->add(job.frame, job.T_W_C, job.labels, job.has_panoptic ? &job.panoptic : nullptr);
+      store_->add(job.frame, job.T_W_C, job.labels, job.has_panoptic ? &job.panoptic : nullptr,
+                  job.geometric.ids.empty() ? nullptr : &job.geometric);
     } catch (const std::exception& e) {
       error = e.what();
     }

@@ -23,12 +23,14 @@ FrameLoader storeLoader(const FrameStore* store) {
 
 PanopticFrameLoader storePanopticLoader(const FrameStore* store) {
   if (!store) throw Error("frame loader: no frame store");
-  return [store](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic) {
-    StoredFrame stored = store->load(utime);
-    *frame = std::move(stored.rgbd);
-    *panoptic = std::move(stored.panoptic);
-    return stored.has_panoptic;
-  };
+  return
+      [store](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic, GeometricSegments* kept) {
+        StoredFrame stored = store->load(utime);
+        *frame = std::move(stored.rgbd);
+        *panoptic = std::move(stored.panoptic);
+        *kept = std::move(stored.geometric);
+        return stored.has_panoptic;
+      };
 }
 
 MapRepairResult repairMap(Mapper* mapper, FrameStore* store, const PoseCorrection& correction,
@@ -94,6 +96,10 @@ std::string describe(const MapRepairResult& r) {
                 r.reintegration.reassociated ? "mapped again" : "re-integrated",
                 r.reintegration.frames_moved, r.reintegration.seconds, r.max_translation_m,
                 r.max_rotation_rad * 180.0 / M_PI);
+  if (r.reintegration.frames_with_kept_segments > 0) {
+    return line + ("; kept geometric segments of " +
+                   std::to_string(r.reintegration.frames_with_kept_segments) + " frames");
+  }
   return line;
 }
 

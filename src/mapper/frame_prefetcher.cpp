@@ -19,7 +19,7 @@ FramePrefetcher::FramePrefetcher(PanopticFrameLoader load, std::vector<int64_t> 
                                  size_t ahead)
     : FramePrefetcher(
           load ? std::function<void(int64_t, Loaded*)>([load](int64_t utime, Loaded* out) {
-            out->has_panoptic = load(utime, &out->frame, &out->panoptic);
+            out->has_panoptic = load(utime, &out->frame, &out->panoptic, &out->kept);
           })
                : nullptr,
           std::move(utimes), ahead) {}
@@ -64,7 +64,8 @@ void FramePrefetcher::work() {
   }
 }
 
-bool FramePrefetcher::next(RgbdFrame* frame, LabelImage* labels, PanopticFrame* panoptic) {
+bool FramePrefetcher::next(RgbdFrame* frame, LabelImage* labels, PanopticFrame* panoptic,
+                           GeometricSegments* kept) {
   if (taken_ >= utimes_.size()) {
     throw Error("FramePrefetcher: all " + std::to_string(utimes_.size()) + " frames taken");
   }
@@ -85,6 +86,7 @@ bool FramePrefetcher::next(RgbdFrame* frame, LabelImage* labels, PanopticFrame* 
   *frame = std::move(loaded.frame);
   *labels = std::move(loaded.labels);
   if (panoptic) *panoptic = std::move(loaded.panoptic);
+  if (kept) *kept = std::move(loaded.kept);
   return loaded.has_panoptic;
 }
 

@@ -29,18 +29,20 @@ MapRebuild::~MapRebuild() = default;
 const TsdfMap& MapRebuild::map() const { return mapper_ ? mapper_->map() : *map_; }
 
 void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
-                     const LabelImage* labels, const PanopticFrame* panoptic) {
+                     const LabelImage* labels, const PanopticFrame* panoptic,
+                     const GeometricSegments* kept) {
   const std::string name = "frame of utime " + std::to_string(frame.utime);
   StampedPose pose;
   pose.utime = frame.utime;
   pose.T_W_C = T_W_C;
   if (mapper_) {
     try {
-      mapper_->integrate(frame, T_W_C, panoptic);
+      mapper_->integrate(frame, T_W_C, panoptic, PoseSource::kUnknown, kept);
     } catch (const Error& e) {
       throw Error(name + ": " + e.what());
     }
     votes_evicted_ = mapper_->voteEvictions();
+    frames_with_kept_segments_ = static_cast<size_t>(mapper_->framesWithKeptSegments());
     poses_.push_back(pose);
     return;
   }

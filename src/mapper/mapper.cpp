@@ -192,7 +192,8 @@ void Mapper::forgetUnvotedSuperpoints() {
 }
 
 FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C_given,
-                             const PanopticFrame* panoptic, PoseSource source) {
+                             const PanopticFrame* panoptic, PoseSource source,
+                             const GeometricSegments* kept) {
   using Clock = std::chrono::steady_clock;
   auto ms = [](Clock::time_point a, Clock::time_point b) {
     return std::chrono::duration<double, std::milli>(b - a).count();
@@ -228,7 +229,9 @@ FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_
   const auto t0 = Clock::now();
   stats.tracking_ms = stats.tracked ? ms(t_start, t0) : 0.0;
   FrameSegmentation& segmentation = segmentation_;
-  segmenter_->segment(frame, config_.fusion.geometry_only ? nullptr : panoptic, &segmentation);
+  segmenter_->segment(frame, config_.fusion.geometry_only ? nullptr : panoptic, &segmentation,
+                      kept);
+  frames_with_kept_segments_ += segmenter_->keptLast();
   const auto t1 = Clock::now();
   // Association runs on one thread, so the occupancy update (which needs only the frame and
   // its pose) takes the other one meanwhile.

@@ -86,15 +86,17 @@ ReintegrationStats Mapper::rebuildFrom(const std::vector<StampedPose>& poses,
   RgbdFrame frame;
   LabelImage labels;
   PanopticFrame panoptic;
+  GeometricSegments kept;
   for (size_t i = 0; i < poses.size(); ++i) {
     const int64_t utime = poses[i].utime;
-    const bool has_panoptic = frames->next(&frame, &labels, &panoptic);
+    const bool has_panoptic = frames->next(&frame, &labels, &panoptic, &kept);
     if (frame.utime != utime) {
       throw Error(std::string(what) + ": asked for the frame of utime " + std::to_string(utime) +
                   ", got " + std::to_string(frame.utime));
     }
     try {
-      rebuild->add(frame, poses[i].T_W_C, &labels, has_panoptic ? &panoptic : nullptr);
+      rebuild->add(frame, poses[i].T_W_C, &labels, has_panoptic ? &panoptic : nullptr,
+                   kept.ids.empty() ? nullptr : &kept);
     } catch (const Error& e) {
       throw Error(std::string(what) + ": " + e.what());
     }
@@ -109,6 +111,7 @@ ReintegrationStats Mapper::rebuildFrom(const std::vector<StampedPose>& poses,
     }
   }
   stats.votes_evicted = rebuild->votesEvicted();
+  stats.frames_with_kept_segments = rebuild->framesWithKeptSegments();
   commitRebuild(std::move(rebuild));
   stats.completed = true;
   stats.blocks_after = map_->numBlocks();

@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "panmap/core/error.h"
+#include "panmap/core/fingerprint.h"
 #include "panmap/core/thread_pool.h"
 #include "panmap/segmentation/internal/depth_edges.h"
 #include "panmap/segmentation/internal/depth_geometry.h"
@@ -40,6 +41,18 @@ std::string sizeText(int width, int height) {
 }
 
 }  // namespace
+
+uint64_t DepthSegmentationConfig::key() const {
+  Fingerprint f;
+  const auto mix = [&f](const auto& value) { f.add(&value, sizeof(value)); };
+  mix(normals_window_px);
+  mix(min_convexity_window_px);
+  mix(min_convexity_threshold);
+  mix(depth_discontinuity_ratio);
+  mix(min_segment_px);
+  mix(max_depth_m);
+  return f.value();
+}
 
 void DepthSegmentationConfig::check() const {
   requireOddWindow(normals_window_px, "normals_window_px");
@@ -81,6 +94,7 @@ struct PanopticGeometricSegmenter::Impl {
   Impl(const DepthSegmentationConfig& depth, const SurfaceFusionConfig& fusion)
       : depth_config(depth),
         fusion_config(fusion),
+        config_key(depth.key()),
         pool(depth.num_threads),
         normal_estimators(depth.num_threads),
         edge_scratch(depth.num_threads) {}
@@ -90,6 +104,8 @@ struct PanopticGeometricSegmenter::Impl {
 
   const DepthSegmentationConfig depth_config;
   const SurfaceFusionConfig fusion_config;
+  const uint64_t config_key;
+  bool kept_last = false;  ///< the last segment() took kept geometric segments
   ThreadPool pool;
   std::vector<internal::NormalEstimator> normal_estimators;  ///< one per thread
   std::vector<internal::EdgeScratch> edge_scratch;           ///< one per thread
@@ -190,11 +206,21 @@ FrameSegmentation PanopticGeometricSegmenter::segment(const RgbdFrame& frame,
 }
 
 void PanopticGeometricSegmenter::segment(const RgbdFrame& frame, const PanopticFrame* panoptic,
-                                         FrameSegmentation* out) {
+                                         FrameSegmentation* out, const GeometricSegments* kept) {
   Impl& impl = *impl_;
   impl.checkInputs(frame, panoptic);
   const int width = frame.depth.width();
   const int height = frame.depth.height();
+  impl.kept_last = kept && kept->config_key == impl.config_key && kept->ids.width() == width &&
+                   kept->ids.height() == height;
+  if (impl.kept_last) {
+    if (out->surfaces.width() != width || out->surfaces.height() != height) {
+      out->surfaces = LabelImage(width, height);
+    }
+    out->geometric = kept->ids;
+    impl.fuser.fuse(panoptic, impl.fusion_config, out, &impl.pool);
+    return;
+  }
   impl.geometry.resize(width, height);
   impl.edges.resize(width, height);
 
@@ -234,6 +260,8 @@ void PanopticGeometricSegmenter::segment(const RgbdFrame& frame, const PanopticF
   impl.geometricSegments(&out->geometric);
   impl.fuser.fuse(panoptic, impl.fusion_config, out, &impl.pool);
 }
+
+bool PanopticGeometricSegmenter::keptLast() const { return impl_->kept_last; }
 
 Eigen::Vector3f PanopticGeometricSegmenter::normal(int u, int v) const {
   const internal::DepthGeometry& g = impl_->geometry;

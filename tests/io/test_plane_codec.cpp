@@ -64,6 +64,37 @@ TEST(PlaneCodec, LargeUniformImagesShrink) {
   EXPECT_EQ(decodeLabelPlane(bytes.data(), bytes.size(), "t"), LabelImage(640, 480, 7));
 }
 
+// Labels that all fit in 8 or 16 bits are coded in them (pixel types 3 and 4): smaller files,
+// the same labels back.
+TEST(PlaneCodec, LabelsAreCodedInTheFewestBytesThatHoldThem) {
+  LabelImage segments(640, 480);
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 640; ++u) segments(u, v) = (u / 37 + 7 * (v / 29)) % 256;
+  }
+  LabelImage wide = segments;
+  wide(3, 3) = 65535;
+  LabelImage widest = segments;
+  widest(3, 3) = 65536;
+  LabelImage negative = segments;
+  negative(3, 3) = -2;
+  std::vector<size_t> sizes;
+  for (const auto& [image, type] : {std::make_pair(segments, 3), std::make_pair(wide, 4),
+                                    std::make_pair(widest, 2), std::make_pair(negative, 2)}) {
+    const auto bytes = encodePlane(image);
+    ASSERT_GT(bytes.size(), 16u);
+    EXPECT_EQ(bytes[4], type);
+    EXPECT_EQ(decodeLabelPlane(bytes.data(), bytes.size(), "t"), image);
+    sizes.push_back(bytes.size());
+    // Narrow planes are still not depth planes, and every cut is named.
+    expectError([&] { decodeDepthPlane(bytes.data(), bytes.size(), "f"); }, {"f", "not a depth"});
+    for (size_t n : {size_t{0}, size_t{4}, size_t{15}, bytes.size() / 2, bytes.size() - 1}) {
+      expectError([&] { decodeLabelPlane(bytes.data(), n, "f.labels.zst"); }, {"f.labels.zst"});
+    }
+  }
+  EXPECT_LT(sizes[0], sizes[2]);
+  EXPECT_LT(sizes[1], sizes[2]);
+}
+
 TEST(PlaneCodec, BadBytesGetAnErrorNamingTheFile) {
   const auto good = encodePlane(someDepth());
   // Every cut, from an empty file to one byte short.

@@ -196,6 +196,9 @@ TEST_F(MappingSessionTest, ACorrectionRepairsTheMapFromTheFrameStore) {
   // corrected poses: the same as remapping a map of the same stream.
   EXPECT_EQ(store.sizeWithPanoptic(), 12u);
   EXPECT_NE(stats.repairs[0].find("12 frames mapped again"), std::string::npos) << stats.repairs[0];
+  // With the geometric segments the frames were mapped with: not segmented again.
+  EXPECT_NE(stats.repairs[0].find("kept geometric segments of 12 frames"), std::string::npos)
+      << stats.repairs[0];
   Mapper clean(test::streamMapperConfig());
   MappingSession plain(SessionOptions{}, &clean);
   feed(&plain, stream_.messages());

@@ -554,6 +554,62 @@ TEST(FrameStore, ACutMasksLineKeepsTheFrameWithoutItsSegmentation) {
   EXPECT_NE(store->problems()[0].find("cut last line"), std::string::npos);
 }
 
+// The geometric segments a frame was mapped with come back with their config key, so that a
+// repair mapping the frame again skips the depth stages; they are kept only with masks.
+TEST(FrameStore, GeometricSegmentsRoundTripWithTheirKey) {
+  TempDir dir;
+  const PanopticFrame p = segmentation();
+  const GeometricSegments g{labels(4), 0x0123456789abcdefull};
+  {
+    FrameStore store(configIn(dir));
+    for (int64_t utime : {10, 11, 12}) {
+      store.add(utime, pose(0.5), camera(), 0.001, depth(3), LabelImage(kWidth, kHeight, 9),
+                nullptr, &p, &g);
+    }
+    // Without masks there is no remap to use them: not stored.
+    store.add(20, pose(0.5), camera(), 0.001, depth(3), LabelImage(kWidth, kHeight, 9), nullptr,
+              nullptr, &g);
+    EXPECT_GT(store.frameBytes(10).geometric, 0u);
+    EXPECT_EQ(store.frameBytes(20).geometric, 0u);
+    const GeometricSegments small{LabelImage(8, 8, 1), 1};
+    expectError(
+        [&] {
+          store.add(30, pose(0.1), camera(), 0.001, depth(1), LabelImage(kWidth, kHeight, 1),
+                    nullptr, &p, &small);
+        },
+        {"frame 30", "geometric segment image"});
+    EXPECT_EQ(store.size(), 4u);
+  }
+  EXPECT_FALSE(fs::exists(dir.path("store/frames/20.geometric.zst")));
+  flipByte(dir.path("store/frames/11.geometric.zst"), 3);
+  {
+    const auto store = FrameStore::open(dir.path("store"));
+    EXPECT_EQ(store->utimes(), (std::vector<int64_t>{10, 12, 20}));
+    ASSERT_EQ(store->problems().size(), 1u);
+    EXPECT_NE(store->problems()[0].find("11.geometric.zst is corrupt"), std::string::npos)
+        << store->problems()[0];
+    const StoredFrame f = store->load(10);
+    ASSERT_TRUE(f.has_panoptic);
+    EXPECT_TRUE(f.geometric.ids == g.ids);
+    EXPECT_EQ(f.geometric.config_key, g.config_key);
+    EXPECT_TRUE(store->load(20).geometric.ids.empty());
+  }
+  // A crash that cuts the geometric line keeps the frame and its masks, without them.
+  const std::string index = dir.path("store/index.txt");
+  std::string text;
+  {
+    std::ifstream in(index);
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const size_t last = text.rfind("geometric 12 ");
+  ASSERT_NE(last, std::string::npos);
+  fs::resize_file(index, last + 20);
+  const auto store = FrameStore::open(dir.path("store"));
+  const StoredFrame f = store->load(12);
+  EXPECT_TRUE(f.has_panoptic);
+  EXPECT_TRUE(f.geometric.ids.empty());
+}
+
 TEST(FrameStore, ThreadsAddingAtOnceLoseNoFrame) {
   TempDir dir;
   FrameStore store(configIn(dir));

@@ -28,7 +28,9 @@ class MapRepair : public BoxScene {
       frameAt(k, &frame, &panoptic);
       const PanopticFrame* used = k < unmasked_from ? &panoptic : nullptr;
       const FrameStats stats = mapper->integrate(frame, pose(k), used);
-      store->add(frame, stats.T_W_C, mapper->lastPixelLabels(), with_masks ? used : nullptr);
+      const GeometricSegments geometric = mapper->lastGeometricSegments();
+      store->add(frame, stats.T_W_C, mapper->lastPixelLabels(), with_masks ? used : nullptr,
+                 &geometric);
     }
     return mapper;
   }
@@ -107,6 +109,10 @@ TEST_F(MapRepair, WithTheMasksStoredTheFramesAreMappedAgain) {
   ASSERT_TRUE(result.reintegration.completed);
   EXPECT_TRUE(result.reintegration.reassociated);
   EXPECT_NE(describe(result).find("6 frames mapped again"), std::string::npos) << describe(result);
+  // The four frames stored with masks kept their geometric segments: not segmented again.
+  EXPECT_EQ(result.reintegration.frames_with_kept_segments, 4u);
+  EXPECT_NE(describe(result).find("kept geometric segments of 4 frames"), std::string::npos)
+      << describe(result);
   // The stored frames (their colour is a JPEG) at the repaired poses.
   Mapper reference(config());
   for (const StampedPose& p : mapper->trajectory()) {

@@ -20,6 +20,7 @@ struct Recorded {
   RgbdFrame frame;
   LabelImage labels;
   PanopticFrame panoptic;
+  GeometricSegments geometric;
 };
 
 class Reintegration : public BoxScene {
@@ -32,16 +33,20 @@ class Reintegration : public BoxScene {
       frameAt(k, &r.frame, &r.panoptic);
       mapper->integrate(r.frame, pose(k), &r.panoptic);
       r.labels = mapper->lastPixelLabels();
+      r.geometric = mapper->lastGeometricSegments();
       stored_[r.frame.utime] = r;
     }
     return mapper;
   }
-  PanopticFrameLoader panopticLoader() const {
-    return [this](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic) {
+  // With `kept`, each frame's geometric segments come back with it, as a frame store gives them.
+  PanopticFrameLoader panopticLoader(bool kept = false) const {
+    return [this, kept](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic,
+                        GeometricSegments* geometric) {
       const auto it = stored_.find(utime);
       if (it == stored_.end()) throw Error("no stored frame of utime " + std::to_string(utime));
       *frame = it->second.frame;
       *panoptic = it->second.panoptic;
+      if (kept) *geometric = it->second.geometric;
       return true;
     };
   }
@@ -269,11 +274,18 @@ TEST_F(Reintegration, ARemapIsTheMapOfTheFramesMappedAtTheNewPoses) {
   D.linear() = Eigen::AngleAxisd(0.04, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   D.translation() = Eigen::Vector3d(0.05, -0.03, 0.01);
   const std::vector<StampedPose> poses = moved(*mapper, D);
-  const ReintegrationStats stats = mapper->remap(poses, panopticLoader());
+  // A remap with the frames' kept geometric segments skips the depth stages and gives the
+  // same map as one that segments every frame again.
+  auto again = record(6);
+  const ReintegrationStats segmented = again->remap(poses, panopticLoader(false));
+  EXPECT_EQ(segmented.frames_with_kept_segments, 0u);
+  const ReintegrationStats stats = mapper->remap(poses, panopticLoader(true));
   ASSERT_TRUE(stats.completed);
   EXPECT_TRUE(stats.reassociated);
   EXPECT_EQ(stats.frames, 6u);
   EXPECT_EQ(stats.frames_moved, 6u);
+  EXPECT_EQ(stats.frames_with_kept_segments, 6u);
+  EXPECT_EQ(bytes(*mapper), bytes(*again));
 
   Mapper reference(config());
   for (int k = 0; k < 6; ++k) {

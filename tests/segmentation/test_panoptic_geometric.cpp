@@ -419,6 +419,55 @@ TEST(SurfaceFusion, DeterministicAcrossRunsAndThreads) {
   EXPECT_EQ(reused.surface_list.size(), first.surface_list.size());
 }
 
+TEST(SurfaceFusion, KeptGeometricSegmentsAreTakenOnlyFromTheSameConfig) {
+  RgbdFrame frame =
+      render([](double x, double y) { return std::min(boxBeforeWall(x, y), floorAndWall(x, y)); });
+  BandedWall masks;
+  DepthSegmentationConfig config;
+  PanopticGeometricSegmenter first(config, {});
+  const FrameSegmentation computed = first.segment(frame, &masks.panoptic);
+  EXPECT_FALSE(first.keptLast());
+  ASSERT_GE(computed.surface_list.size(), 4u);
+
+  // Kept from that run: the same surfaces without the depth stages.
+  GeometricSegments kept{computed.geometric, config.key()};
+  PanopticGeometricSegmenter second(config, {});
+  FrameSegmentation out;
+  second.segment(frame, &masks.panoptic, &out, &kept);
+  EXPECT_TRUE(second.keptLast());
+  EXPECT_EQ(out.geometric, computed.geometric);
+  EXPECT_EQ(out.surfaces, computed.surfaces);
+  ASSERT_EQ(out.surface_list.size(), computed.surface_list.size());
+  for (size_t k = 0; k < out.surface_list.size(); ++k) {
+    EXPECT_EQ(out.surface_list[k].num_pixels, computed.surface_list[k].num_pixels);
+    EXPECT_EQ(out.surface_list[k].panoptic_segment, computed.surface_list[k].panoptic_segment);
+  }
+  // They are what is used: altered segments give other surfaces.
+  GeometricSegments altered = kept;
+  for (int v = 0; v < 240; ++v) {
+    for (int u = 0; u < 640; ++u) altered.ids(u, v) = 0;
+  }
+  second.segment(frame, &masks.panoptic, &out, &altered);
+  EXPECT_TRUE(second.keptLast());
+  EXPECT_FALSE(out.surfaces == computed.surfaces);
+
+  // Another config's segments, or another size, are not taken: computed again.
+  DepthSegmentationConfig other = config;
+  other.min_convexity_threshold = 0.95f;
+  EXPECT_NE(other.key(), config.key());
+  DepthSegmentationConfig threaded = config;
+  threaded.num_threads = 2;
+  EXPECT_EQ(threaded.key(), config.key());  // threads do not change the segments
+  GeometricSegments foreign{altered.ids, other.key()};
+  second.segment(frame, &masks.panoptic, &out, &foreign);
+  EXPECT_FALSE(second.keptLast());
+  EXPECT_EQ(out.surfaces, computed.surfaces);
+  GeometricSegments small{LabelImage(320, 240), config.key()};
+  second.segment(frame, &masks.panoptic, &out, &small);
+  EXPECT_FALSE(second.keptLast());
+  EXPECT_EQ(out.surfaces, computed.surfaces);
+}
+
 TEST(DepthSegmentation, RealSevenScenesFrameIsSane) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   const cv::Mat png =

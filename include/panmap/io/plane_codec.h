@@ -23,7 +23,8 @@ constexpr int kDefaultPlaneLevel = 5;
 /// @param level zstd level 1..19; Error outside
 std::vector<uint8_t> encodePlane(const DepthImage& image, int level = kDefaultPlaneLevel);
 
-/// Encodes a label image (every int32, negative ones included) losslessly.
+/// Encodes a label image (every int32, negative ones included) losslessly; in 8 or 16 bits
+/// per pixel when every label fits (smaller files).
 /// @param level zstd level 1..19; Error outside
 std::vector<uint8_t> encodePlane(const LabelImage& image, int level = kDefaultPlaneLevel);
 

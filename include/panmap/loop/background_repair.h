@@ -87,10 +87,10 @@ class BackgroundRepair {
   MapRepairResult commit();
   /// Loads one frame and adds it to the rebuild at the job's pose; throws Error.
   void reintegrate(const StampedPose& job, RgbdFrame* frame, LabelImage* labels,
-                   PanopticFrame* panoptic);
+                   PanopticFrame* panoptic, GeometricSegments* kept);
   /// Adds a loaded frame at the job's pose; throws Error when it is another frame.
   void addLoaded(const StampedPose& job, const RgbdFrame& frame, const LabelImage& labels,
-                 const PanopticFrame* panoptic);
+                 const PanopticFrame* panoptic, const GeometricSegments* kept);
 
   Mapper* mapper_;
   FrameLoader load_;

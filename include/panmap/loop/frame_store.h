@@ -15,6 +15,7 @@
 #include "panmap/core/frame.h"
 #include "panmap/core/image.h"
 #include "panmap/core/pose.h"
+#include "panmap/segmentation/panoptic_geometric.h"
 
 namespace panmap {
 
@@ -53,6 +54,9 @@ struct StoredFrame {
   /// The frame's 2D panoptic segmentation (segment ids lossless for every int32, segments'
   /// scores exact), utime and frame_id set to the frame's utime and 0.
   PanopticFrame panoptic;
+  /// The geometric segments it was mapped with and their config key, when they were stored
+  /// with its segmentation (ids empty otherwise): mapping it again then skips the depth stages.
+  GeometricSegments geometric;
 };
 
 /// The frames a map was built from, on disk, so that a loop closure can re-integrate them at
@@ -64,13 +68,15 @@ struct StoredFrame {
 /// (16-bit depth as integrated, a zstd plane of io/plane_codec.h), `.labels.zst` (int32
 /// labels, a plane), `.color.jpg` (store_color only), and with a segmentation `.masks.zst`
 /// (segment ids, a plane) and `.segments.txt` (one segment per line: id, category, source
-/// category, thing 0/1, score). Stores of version 1 (`panmap-frame-store 1`) keep depth as a
-/// 16-bit PNG and labels and masks as COCO panoptic RGB PNGs (bits 0-23) with a second PNG
-/// for bits 24-31 when some id needs them (`.labels-hi.png`, `.masks-hi.png`); they are read
-/// and grow in their own format. Each file is
-/// written atomically (AtomicFileWriter) before the frame's index line is appended and synced,
-/// so a crash at any moment leaves whole frames, a frame missing from the index, or a cut last
-/// index line, which reopening names and drops.
+/// category, thing 0/1, score); a frame stored with its geometric segments too has a `geometric`
+/// line after its masks line (the segmentation config key, then the file) and
+/// `.geometric.zst` (segment ids, a plane; version 2 stores only). Stores of version 1
+/// (`panmap-frame-store 1`) keep depth as a 16-bit PNG and labels and masks as COCO panoptic RGB
+/// PNGs (bits 0-23) with a second PNG for bits 24-31 when some id needs them (`.labels-hi.png`,
+/// `.masks-hi.png`); they are read and grow in their own format. Each file is written atomically
+/// (AtomicFileWriter) before the frame's index line is appended and synced, so a crash at any
+/// moment leaves whole frames, a frame missing from the index, or a cut last index line, which
+/// reopening names and drops.
 ///
 /// Thread-safety: every member function may be called from several threads at once. A mutex
 /// guards the index; encoding, decoding and file writes run outside it, so add() and load()
@@ -116,14 +122,19 @@ class FrameStore {
   /// @param panoptic the segmentation the frame was mapped with, or null when it was mapped
   ///        without one (a repair then maps it again without); its segment image must have
   ///        the camera's size. A store holding any keeps every frame's (MapRepairConfig).
+  /// @param geometric the geometric segments it was mapped with, or null; stored only with a
+  ///        segmentation (a repair that maps the frame again takes them) and in version 2;
+  ///        the camera's size
   void add(int64_t utime, const Eigen::Isometry3d& T_W_C, const PinholeCamera& camera,
            double depth_scale_m, const DepthImage& depth, const LabelImage& labels,
-           const ColorImage* color = nullptr, const PanopticFrame* panoptic = nullptr);
+           const ColorImage* color = nullptr, const PanopticFrame* panoptic = nullptr,
+           const GeometricSegments* geometric = nullptr);
   /// add() with the frame's utime, camera, depth scale, depth and colour (if any).
   /// @param T_W_C camera-to-world pose (optical frame) it was integrated with
   /// @param panoptic the frame's panoptic segmentation, or null
+  /// @param geometric its geometric segments, or null
   void add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const LabelImage& labels,
-           const PanopticFrame* panoptic = nullptr);
+           const PanopticFrame* panoptic = nullptr, const GeometricSegments* geometric = nullptr);
 
   /// Records that a frame is now integrated at T_W_C (a repair moved it); durable on return.
   /// Throws Error naming the utime when it is not stored, or when the pose is not rigid.
@@ -160,8 +171,9 @@ class FrameStore {
     uint64_t depth = 0;
     uint64_t labels = 0;  ///< both label planes
     uint64_t color = 0;
-    uint64_t masks = 0;  ///< segment id planes and segment list
-    uint64_t total() const { return depth + labels + color + masks; }
+    uint64_t masks = 0;      ///< segment id planes and segment list
+    uint64_t geometric = 0;  ///< geometric segments plane
+    uint64_t total() const { return depth + labels + color + masks + geometric; }
   };
   /// The file sizes of a stored frame; throws Error naming the utime when it is not stored.
   FrameBytes frameBytes(int64_t utime) const;
@@ -179,9 +191,11 @@ class FrameStore {
     double depth_scale_m = 0.0;
     FileRecord depth, labels, labels_hi, color;
     FileRecord masks, masks_hi, segments;  ///< all size 0: no segmentation stored
+    FileRecord geometric;                  ///< size 0: no geometric segments stored
+    uint64_t geometric_key = 0;            ///< their DepthSegmentationConfig::key()
     uint64_t bytes() const {
       return depth.size + labels.size + labels_hi.size + color.size + masks.size + masks_hi.size +
-             segments.size;
+             segments.size + geometric.size;
     }
   };
 

@@ -39,8 +39,9 @@ class FrameStoreWriter {
   /// @param T_W_C camera-to-world pose (optical frame) it was integrated with
   /// @param labels the super-point label each pixel voted for
   /// @param panoptic the frame's panoptic segmentation, or null
+  /// @param geometric its geometric segments (kept with a segmentation only; empty: none)
   void add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const LabelImage& labels,
-           const PanopticFrame* panoptic = nullptr);
+           const PanopticFrame* panoptic = nullptr, GeometricSegments geometric = {});
   /// Waits until every frame queued so far is written (or has failed).
   void flush();
   /// FrameStore::load(), after waiting for the frame if it is still queued or being written.
@@ -59,6 +60,7 @@ class FrameStoreWriter {
     LabelImage labels;
     bool has_panoptic = false;
     PanopticFrame panoptic;
+    GeometricSegments geometric;
   };
   void work();
 

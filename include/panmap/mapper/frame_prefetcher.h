@@ -36,14 +36,17 @@ class FramePrefetcher {
   /// after a failure). Throws Error when every frame has been taken or one before failed.
   /// @param labels its pixel labels (empty from a PanopticFrameLoader)
   /// @param panoptic if not null, its segmentation (empty from a FrameLoader)
+  /// @param kept if not null, its kept geometric segments (empty when none)
   /// @return whether it has a segmentation
-  bool next(RgbdFrame* frame, LabelImage* labels, PanopticFrame* panoptic = nullptr);
+  bool next(RgbdFrame* frame, LabelImage* labels, PanopticFrame* panoptic = nullptr,
+            GeometricSegments* kept = nullptr);
 
  private:
   struct Loaded {
     RgbdFrame frame;
     LabelImage labels;
     PanopticFrame panoptic;
+    GeometricSegments kept;
     bool has_panoptic = false;
     std::exception_ptr error;
   };

@@ -14,6 +14,7 @@
 #include "panmap/map/projective_integrator.h"
 #include "panmap/map/tsdf_map.h"
 #include "panmap/occupancy/occupancy_map.h"
+#include "panmap/segmentation/panoptic_geometric.h"
 
 namespace panmap {
 
@@ -44,8 +45,11 @@ class MapRebuild {
   /// empty: geometry only), or for a remap maps it with its segmentation (null: geometry
   /// only; the labels are not used). Throws Error naming the frame's utime when the frame,
   /// the label image or the segmentation is invalid; the rebuild is then unchanged.
+  /// @param kept a remap's frame's geometric segments kept from its first mapping, or null
   void add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const LabelImage* labels,
-           const PanopticFrame* panoptic = nullptr);
+           const PanopticFrame* panoptic = nullptr, const GeometricSegments* kept = nullptr);
+  /// Frames of a remap that took kept geometric segments so far.
+  size_t framesWithKeptSegments() const { return frames_with_kept_segments_; }
   /// True for a remap.
   bool remaps() const { return static_cast<bool>(mapper_); }
 
@@ -66,6 +70,7 @@ class MapRebuild {
   std::unique_ptr<Mapper> mapper_;           // a remap's mapper (then the three above are null)
   std::vector<StampedPose> poses_;
   uint64_t votes_evicted_ = 0;
+  size_t frames_with_kept_segments_ = 0;
 };
 
 }  // namespace panmap

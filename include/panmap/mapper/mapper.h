@@ -121,9 +121,10 @@ struct FrameStats {
 using FrameLoader = std::function<void(int64_t utime, RgbdFrame* frame, LabelImage* labels)>;
 
 /// Gives a stored frame back for Mapper::remap(): the frame and, when it was mapped with one,
-/// its panoptic segmentation (returns whether it has one). Throws Error when it cannot.
-using PanopticFrameLoader =
-    std::function<bool(int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic)>;
+/// its panoptic segmentation (returns whether it has one), and the geometric segments it was
+/// mapped with when they were kept (`kept` left empty otherwise). Throws Error when it cannot.
+using PanopticFrameLoader = std::function<bool(int64_t utime, RgbdFrame* frame,
+                                               PanopticFrame* panoptic, GeometricSegments* kept)>;
 
 /// Called after each re-integrated frame with (frames done, frames in all); returning false
 /// abandons the re-integration (a newer correction supersedes it), leaving the map as it was.
@@ -141,6 +142,9 @@ struct ReintegrationStats {
   /// The frames were mapped again with their segmentations (Mapper::remap), not only
   /// re-integrated: super-points, graph and objects were made anew.
   bool reassociated = false;
+  /// Of a remap's frames, those whose geometric segments were kept with them (not computed
+  /// again from the depth).
+  size_t frames_with_kept_segments = 0;
 };
 
 /// The mapping core: takes (RGB-D frame, T_W_C, panoptic segmentation) and keeps a label-TSDF
@@ -159,8 +163,11 @@ class Mapper {
   /// @param panoptic the frame's 2D panoptic segmentation, or null (geometry only)
   /// @param source where the pose comes from; SLAM / odometry poses are refined against the
   ///        map first (MapperConfig::tracking_mode)
+  /// @param kept the frame's geometric segments from when it was first mapped (a stored frame
+  ///        mapped again), or null; used when made with this config (GeometricSegments)
   FrameStats integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
-                       const PanopticFrame* panoptic, PoseSource source = PoseSource::kUnknown);
+                       const PanopticFrame* panoptic, PoseSource source = PoseSource::kUnknown,
+                       const GeometricSegments* kept = nullptr);
 
   /// The label-TSDF.
   const TsdfMap& map() const { return *map_; }
@@ -197,6 +204,13 @@ class Mapper {
   /// The super-point label each pixel of the last integrated frame voted for (0 = none): what
   /// a frame store keeps so that the frame can be re-integrated at a corrected pose.
   const LabelImage& lastPixelLabels() const { return association_.pixel_labels; }
+  /// The geometric segments of the last integrated frame and the key of the config that made
+  /// them: what a frame store keeps so that mapping the frame again skips the depth stages.
+  GeometricSegments lastGeometricSegments() const {
+    return GeometricSegments{segmentation_.geometric, config_.depth_segmentation.key()};
+  }
+  /// Frames whose kept geometric segments integrate() took so far.
+  int64_t framesWithKeptSegments() const { return frames_with_kept_segments_; }
 
   /// Rebuilds the label-TSDF and the occupancy map from every integrated frame at new poses: the
   /// repair after a loop closure (docs/LOOP_CLOSURE.md). Each frame votes again for the
@@ -309,7 +323,8 @@ class Mapper {
   int64_t frames_ = 0;
   uint64_t vote_evictions_ = 0;
   FrameSegmentation segmentation_;  // scratch, reused every frame
-  FrameAssociation association_;    // scratch, reused every frame
+  int64_t frames_with_kept_segments_ = 0;
+  FrameAssociation association_;  // scratch, reused every frame
   uint64_t superpoints_forgotten_ = 0;
   uint64_t edges_pruned_ = 0;
 };

@@ -25,6 +25,9 @@ struct DepthSegmentationConfig {
   int num_threads = 1;
   /// Throws Error naming the bad field.
   void check() const;
+  /// Fingerprint of every field that shapes the segments (not num_threads): segments kept from
+  /// a run with another key are not reused (GeometricSegments).
+  uint64_t key() const;
 };
 
 /// How geometric segments and panoptic masks are fused into surfaces.
@@ -59,6 +62,15 @@ struct FrameSegmentation {
   std::vector<Surface> surface_list;  ///< indexed by id - 1
 };
 
+/// A frame's geometric segments (FrameSegmentation::geometric) kept from an earlier
+/// segmentation of the same depth image and intrinsics, with the key of the config that made
+/// them. Mapping a stored frame again can take them instead of running the depth stages, the
+/// costliest part of a frame (docs/LOOP_CLOSURE.md).
+struct GeometricSegments {
+  LabelImage ids;           ///< empty: none kept
+  uint64_t config_key = 0;  ///< DepthSegmentationConfig::key() of the run that made them
+};
+
 /// Why a pixel is an edge of the geometric segmentation (bit flags of
 /// PanopticGeometricSegmenter::edgeFlags()); 0 = inside a segment candidate.
 enum DepthEdge : uint8_t {
@@ -87,7 +99,15 @@ class PanopticGeometricSegmenter {
 
   /// The same into `out`, reusing its buffers: once the image size is stable, a frame
   /// allocates nothing (but inside OpenCV's connected components).
-  void segment(const RgbdFrame& frame, const PanopticFrame* panoptic, FrameSegmentation* out);
+  /// @param kept the frame's geometric segments from an earlier run, or null: taken as they
+  ///        are when their key is this segmenter's config key and their size the depth
+  ///        image's (normal(), minConvexity() and edgeFlags() then keep the previous frame's),
+  ///        computed from the depth otherwise
+  void segment(const RgbdFrame& frame, const PanopticFrame* panoptic, FrameSegmentation* out,
+               const GeometricSegments* kept = nullptr);
+
+  /// Whether the last segment() took kept geometric segments instead of computing them.
+  bool keptLast() const;
 
   /// Unit surface normal at pixel (u, v) of the last segmented frame, camera frame, pointing
   /// toward the camera; zero where the pixel has none.
