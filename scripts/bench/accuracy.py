@@ -12,6 +12,7 @@ import argparse
 import datetime
 import json
 import os
+import shlex
 import subprocess
 import sys
 import time
@@ -501,7 +502,7 @@ def main():
           "commit %s, %s, %d cores, in %.1f minutes." % (
               datetime.date.today().isoformat(), version, cpu, os.cpu_count(), minutes), "",
           "Command: `scripts/bench/accuracy.sh %s`" % " ".join(
-              a for a in sys.argv[1:] if a != "--report-only"), "",
+              shlex.quote(a) for a in sys.argv[1:] if a != "--report-only"), "",
           "Metrics from `panmap-eval` (ScanNet's `evaluate_semantic_instance` matching, the 18 "
           "ScanNet classes, label transfer within 5 cm), in percent: mAP and PQ are class "
           "averages, then means over seeds and scenes; diagnostics (super-point purity, "
