@@ -8,6 +8,7 @@
 #include <memory>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "panmap/core/error.h"
 #include "panmap/core/pose.h"
@@ -90,18 +91,24 @@ MeshUpdate Mapper::updateMesh(const GraphLabels* labels) {
   mesher_->update(map_.get(), [&](const BlockMesh& mesh, int thread) {
     labelled[thread].emplace_back(mesh.index, block_labellers[thread]->label(mesh));
   });
-  std::vector<std::pair<BlockIndex, LabelledMesh>> all;
-  for (auto& list : labelled) std::move(list.begin(), list.end(), std::back_inserter(all));
-  std::sort(all.begin(), all.end(),
-            [](const auto& a, const auto& b) { return blockIndexLess(a.first, b.first); });
+  // Sorted as (block, thread, position) triples, not as the meshes themselves: each mesh is
+  // moved once, into its place.
+  std::vector<std::tuple<BlockIndex, int, size_t>> all;
+  for (int t = 0; t < threads; ++t) {
+    for (size_t k = 0; k < labelled[t].size(); ++k) all.emplace_back(labelled[t][k].first, t, k);
+  }
+  std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
+    return blockIndexLess(std::get<0>(a), std::get<0>(b));
+  });
   MeshUpdate update;
   update.blocks = mesher_->takeChangedBlocks();
   update.meshes.resize(update.blocks.size());
   // Both lists are sorted; blocks re-meshed earlier by extractMesh() are labelled now.
   auto next = all.begin();
   for (size_t i = 0; i < update.blocks.size(); ++i) {
-    if (next != all.end() && next->first == update.blocks[i]) {
-      update.meshes[i] = std::move((next++)->second);
+    if (next != all.end() && std::get<0>(*next) == update.blocks[i]) {
+      update.meshes[i] = std::move(labelled[std::get<1>(*next)][std::get<2>(*next)].second);
+      ++next;
     } else {
       // A block dropped by a rebuild and not meshed since has no surface any more.
       const BlockMesh* mesh = mesher_->find(update.blocks[i]);
