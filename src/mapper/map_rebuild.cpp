@@ -28,6 +28,10 @@ MapRebuild::~MapRebuild() = default;
 
 const TsdfMap& MapRebuild::map() const { return mapper_ ? mapper_->map() : *map_; }
 
+size_t MapRebuild::framesWithKeptSegments() const {
+  return mapper_ ? static_cast<size_t>(mapper_->framesWithKeptSegments()) : 0;
+}
+
 void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
                      const LabelImage* labels, const PanopticFrame* panoptic,
                      const GeometricSegments* kept) {
@@ -42,7 +46,6 @@ void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
       throw Error(name + ": " + e.what());
     }
     votes_evicted_ = mapper_->voteEvictions();
-    frames_with_kept_segments_ = static_cast<size_t>(mapper_->framesWithKeptSegments());
     poses_.push_back(pose);
     return;
   }

@@ -49,7 +49,7 @@ class MapRebuild {
   void add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C, const LabelImage* labels,
            const PanopticFrame* panoptic = nullptr, const GeometricSegments* kept = nullptr);
   /// Frames of a remap that took kept geometric segments so far.
-  size_t framesWithKeptSegments() const { return frames_with_kept_segments_; }
+  size_t framesWithKeptSegments() const;
   /// True for a remap.
   bool remaps() const { return static_cast<bool>(mapper_); }
 
@@ -70,7 +70,6 @@ class MapRebuild {
   std::unique_ptr<Mapper> mapper_;           // a remap's mapper (then the three above are null)
   std::vector<StampedPose> poses_;
   uint64_t votes_evicted_ = 0;
-  size_t frames_with_kept_segments_ = 0;
 };
 
 }  // namespace panmap
