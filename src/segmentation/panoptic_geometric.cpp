@@ -101,6 +101,8 @@ struct PanopticGeometricSegmenter::Impl {
 
   void checkInputs(const RgbdFrame& frame, const PanopticFrame* panoptic) const;
   void geometricSegments(LabelImage* geometric);
+  /// The depth stages: normals, edges, components into `geometric` (resized to the depth's).
+  void segmentDepth(const RgbdFrame& frame, LabelImage* geometric);
 
   const DepthSegmentationConfig depth_config;
   const SurfaceFusionConfig fusion_config;
@@ -205,6 +207,44 @@ FrameSegmentation PanopticGeometricSegmenter::segment(const RgbdFrame& frame,
   return out;
 }
 
+void PanopticGeometricSegmenter::Impl::segmentDepth(const RgbdFrame& frame, LabelImage* geometric) {
+  const int width = frame.depth.width();
+  const int height = frame.depth.height();
+  geometry.resize(width, height);
+  edges.resize(width, height);
+
+  // Each stage reads its neighbours' rows of the previous one, so the stages are separate
+  // parallel loops over bands of rows. The lambdas capture two pointers, which std::function
+  // holds without allocating.
+  Impl* const self = this;
+  const RgbdFrame* const input = &frame;
+  pool.parallelFor(height, [self, input](size_t v0, size_t v1, int) {
+    internal::backProjectRows(*input, self->depth_config.max_depth_m, static_cast<int>(v0),
+                              static_cast<int>(v1), &self->geometry);
+  });
+  pool.parallelFor(height, [self](size_t v0, size_t v1, int) {
+    internal::markDiscontinuityRows(self->depth_config.depth_discontinuity_ratio,
+                                    static_cast<int>(v0), static_cast<int>(v1), &self->geometry);
+  });
+  // Normals and edges cost more where the depth is valid, so rows are handed out in chunks to
+  // whichever thread is free; each chunk restarts its window sums, exactly (see
+  // depth_normals.cpp), so results do not depend on the split.
+  pool.parallelForDynamic(height, kRowsPerChunk, [self](size_t v0, size_t v1, int thread) {
+    self->normal_estimators[thread].computeRows(self->depth_config.normals_window_px,
+                                                static_cast<int>(v0), static_cast<int>(v1),
+                                                &self->geometry);
+  });
+  pool.parallelForDynamic(height, kRowsPerChunk, [self](size_t v0, size_t v1, int thread) {
+    internal::computeEdgeRows(self->geometry, self->depth_config, static_cast<int>(v0),
+                              static_cast<int>(v1), &self->edge_scratch[thread], &self->edges);
+  });
+  // Overwritten whole, so a buffer of the right size is reused as it is.
+  if (geometric->width() != width || geometric->height() != height) {
+    *geometric = LabelImage(width, height);
+  }
+  geometricSegments(geometric);
+}
+
 void PanopticGeometricSegmenter::segment(const RgbdFrame& frame, const PanopticFrame* panoptic,
                                          FrameSegmentation* out, const GeometricSegments* kept) {
   Impl& impl = *impl_;
@@ -214,50 +254,13 @@ void PanopticGeometricSegmenter::segment(const RgbdFrame& frame, const PanopticF
   impl.kept_last = kept && kept->config_key == impl.config_key && kept->ids.width() == width &&
                    kept->ids.height() == height;
   if (impl.kept_last) {
-    if (out->surfaces.width() != width || out->surfaces.height() != height) {
-      out->surfaces = LabelImage(width, height);
-    }
     out->geometric = kept->ids;
-    impl.fuser.fuse(panoptic, impl.fusion_config, out, &impl.pool);
-    return;
-  }
-  impl.geometry.resize(width, height);
-  impl.edges.resize(width, height);
-
-  // Each stage reads its neighbours' rows of the previous one, so the stages are separate
-  // parallel loops over bands of rows. The lambdas capture two pointers, which std::function
-  // holds without allocating.
-  Impl* const self = &impl;
-  const RgbdFrame* const input = &frame;
-  impl.pool.parallelFor(height, [self, input](size_t v0, size_t v1, int) {
-    internal::backProjectRows(*input, self->depth_config.max_depth_m, static_cast<int>(v0),
-                              static_cast<int>(v1), &self->geometry);
-  });
-  impl.pool.parallelFor(height, [self](size_t v0, size_t v1, int) {
-    internal::markDiscontinuityRows(self->depth_config.depth_discontinuity_ratio,
-                                    static_cast<int>(v0), static_cast<int>(v1), &self->geometry);
-  });
-  // Normals and edges cost more where the depth is valid, so rows are handed out in chunks to
-  // whichever thread is free; each chunk restarts its window sums, exactly (see
-  // depth_normals.cpp), so results do not depend on the split.
-  impl.pool.parallelForDynamic(height, kRowsPerChunk, [self](size_t v0, size_t v1, int thread) {
-    self->normal_estimators[thread].computeRows(self->depth_config.normals_window_px,
-                                                static_cast<int>(v0), static_cast<int>(v1),
-                                                &self->geometry);
-  });
-  impl.pool.parallelForDynamic(height, kRowsPerChunk, [self](size_t v0, size_t v1, int thread) {
-    internal::computeEdgeRows(self->geometry, self->depth_config, static_cast<int>(v0),
-                              static_cast<int>(v1), &self->edge_scratch[thread], &self->edges);
-  });
-
-  // Both images are overwritten whole, so buffers of the right size are reused as they are.
-  if (out->geometric.width() != width || out->geometric.height() != height) {
-    out->geometric = LabelImage(width, height);
+  } else {
+    impl.segmentDepth(frame, &out->geometric);
   }
   if (out->surfaces.width() != width || out->surfaces.height() != height) {
     out->surfaces = LabelImage(width, height);
   }
-  impl.geometricSegments(&out->geometric);
   impl.fuser.fuse(panoptic, impl.fusion_config, out, &impl.pool);
 }
 
