@@ -67,8 +67,15 @@ def ate(traj, reference):
 
 
 # Pose correction models (tracking.correction): name -> extra panmap-mapper arguments.
+# `calibrated` is per_frame with the depth calibration panmap-calibrate-depth learns from the
+# same log (calibration_path()).
 CORRECTIONS = {"per_frame": [],
-               "filter": ["--config", os.path.join(suite.ROOT, "configs", "drift_filter.yaml")]}
+               "filter": ["--config", os.path.join(suite.ROOT, "configs", "drift_filter.yaml")],
+               "calibrated": []}
+
+
+def calibration_path(work, tag):
+    return os.path.join(work, tag + ".depth_calibration.json")
 
 
 def map_run(log, out_dir, voxel, tracking, extra=()):
@@ -106,7 +113,10 @@ def one(work, name, folder, drift, seed, voxel, correction):
     log = os.path.join(work, tag + ".lcmlog")  # written by one_import()
     reference = os.path.join(work, tag + ".reference.txt")
     base = os.path.join(work, "%s_%gcm_%s" % (tag, voxel * 100, correction))
-    refined = map_run(log, base + "_auto", voxel, "auto", CORRECTIONS[correction])
+    extra = list(CORRECTIONS[correction])
+    if correction == "calibrated":
+        extra += ["--depth-calibration", calibration_path(work, tag)]
+    refined = map_run(log, base + "_auto", voxel, "auto", extra)
     raw = map_run(log, base + "_off", voxel, "off")
     tracking = refined.get("tracking", {})
     corrected = tracking.get("accepted", 0) + tracking.get("accepted_partially", 0)
@@ -126,6 +136,21 @@ def one(work, name, folder, drift, seed, voxel, correction):
     }
 
 
+def add_independent(rows, work, references):
+    """With references {sequence: TUM file} (poses that owe nothing to depth tracking, e.g. the
+    SfM poses of Brachmann et al. for 7-Scenes), each row's input, refined and recorded
+    trajectories' ATE against them (rigid fit; the trajectories of WORK)."""
+    for r in rows:
+        ref = references.get(r["sequence"])
+        if not ref:
+            continue
+        tag = "%s_%s_s%d" % (r["sequence"], r["drift"], r["seed"])
+        base = os.path.join(work, "%s_%gcm_%s" % (tag, r["voxel_m"] * 100, r["correction"]))
+        r["independent_recorded_m"] = ate(os.path.join(work, tag + ".reference.txt"), ref)
+        r["independent_input_m"] = ate(os.path.join(work, tag + ".input.txt"), ref)
+        r["independent_refined_m"] = ate(os.path.join(base + "_auto", "trajectory.txt"), ref)
+
+
 def verdict(row):
     """The issue's acceptance line for the row."""
     i, r = row["input_ate_m"], row["refined_ate_m"]
@@ -143,7 +168,10 @@ def render(rows, skipped, layouts, seconds):
           "`panmap-import --drift LEVEL --seed N` (none; light: 1 %%/m, 0.5 deg/m; heavy: 3x), "
           "mapped geometry-only with tracking `auto` (the poses are flagged SLAM), each "
           "correction model (`per_frame`: the default, each aligned pose used as it is; "
-          "`filter`: `configs/drift_filter.yaml`, a smooth drift estimate, docs/MAPPING.md), "
+          "`filter`: `configs/drift_filter.yaml`, a smooth drift estimate, docs/MAPPING.md; "
+          "`calibrated`: `per_frame` with the depth sensor's calibration that "
+          "`panmap-calibrate-depth --first N/2` learnt from the same drifted log, its second half "
+          "only, with no poses but the log's own refined by tracking, docs/MAPPING.md), "
           "and with `--tracking off`. ATE is against the recorded poses, **which are themselves "
           "estimates**: %s.%s Corrected / kept: frames whose alignment was fused into the "
           "drift estimate / refused (kept at the prediction). ms: median of the tracking stage "
@@ -179,20 +207,37 @@ def render(rows, skipped, layouts, seconds):
                "- recorded: %+.2f to %+.2f grey levels)." % (
                    correction, better, len(photo_rows), inputs, len(photo_rows), min(diff),
                    max(diff)), ""]
+    independent = any("independent_refined_m" in r for r in rows)
+    if independent:
+        md += ["**Independent reference** (column *vs independent*): ATE after a rigid fit against "
+               "poses that owe nothing to depth tracking, given with `--independent "
+               "SEQUENCE=TUM`: for 7scenes-200 the structure-from-motion poses of Brachmann et "
+               "al. (`pgt/sfm/7scenes/redkitchen_train.txt` of "
+               "github.com/tsattler/visloc_pseudo_gt_limitations, `scripts/bench/"
+               "colmap_poses_to_tum.py FILE sfm.txt --select seq-01/ --stride 3`), which are "
+               "poses of the colour camera (the others: of the depth camera; a constant offset "
+               "no rigid fit removes, the same for every trajectory): recorded / input / "
+               "refined, cm.", ""]
     md += ["| sequence | voxel | drift | seed | correction | input ATE cm | refined ATE cm | "
-           "target | area m2: reference map / input / refined | photometric: recorded / input "
-           "/ refined | corrected / kept | ms |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+           "target | %sarea m2: reference map / input / refined | photometric: recorded / input "
+           "/ refined | corrected / kept | ms |" % ("vs independent | " if independent else ""),
+           "|---|---|---|---|---|---|---|---|---|---|---|---|" + ("---|" if independent else "")]
     reference_area = {(r["sequence"], r["voxel_m"]): r["input_area_m2"]
                       for r in rows if r["drift"] == "none"}
     for r in rows:
         ok, target = verdict(r)
-        md.append("| %s | %g cm | %s | %s | %s | %.2f | %.2f | %s %s | %.2f / %.2f / %.2f | "
+        extra = ""
+        if independent:
+            extra = ("%.2f / %.2f / %.2f | " % (r["independent_recorded_m"] * 100,
+                                                r["independent_input_m"] * 100,
+                                                r["independent_refined_m"] * 100)
+                     if "independent_refined_m" in r else "- | ")
+        md.append("| %s | %g cm | %s | %s | %s | %.2f | %.2f | %s %s | %s%.2f / %.2f / %.2f | "
                   "%.2f / %.2f / %.2f | %d / %d | %.1f |" % (
                       r["sequence"], r["voxel_m"] * 100, r["drift"],
                       "-" if r["drift"] == "none" else r["seed"], r["correction"],
                       r["input_ate_m"] * 100,
-                      r["refined_ate_m"] * 100, target, "yes" if ok else "**no**",
+                      r["refined_ate_m"] * 100, target, "yes" if ok else "**no**", extra,
                       reference_area.get((r["sequence"], r["voxel_m"]), float("nan")),
                       r["input_area_m2"], r["refined_area_m2"],
                       r.get("photometric_reference", float("nan")),
@@ -214,6 +259,16 @@ def splice(path, section):
         f.write(text)
 
 
+def independent_files(pairs):
+    out = {}
+    for pair in pairs:
+        name, sep, path = pair.partition("=")
+        if not sep or not os.path.isfile(path):
+            sys.exit("refinement: --independent wants SEQUENCE=FILE of an existing file: " + pair)
+        out[name] = os.path.abspath(path)
+    return out
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -221,10 +276,13 @@ def main():
     parser.add_argument("--seeds", default="1,2,3")
     parser.add_argument("--voxels", default="0.01,0.02")
     parser.add_argument("--drifts", default="none,light,heavy")
-    parser.add_argument("--corrections", default="per_frame,filter")
+    parser.add_argument("--corrections", default="per_frame,filter,calibrated")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--work", default=os.path.join(suite.BUILD, "refinement"))
     parser.add_argument("--out", default=os.path.join(suite.ROOT, "docs", "RESULTS.md"))
+    parser.add_argument("--independent", action="append", default=[], metavar="SEQUENCE=TUM",
+                        help="also score against poses that owe nothing to depth tracking "
+                             "(repeatable)")
     parser.add_argument("--report-only", action="store_true",
                         help="map nothing: rewrite the section from WORK/results.json")
     args = parser.parse_args()
@@ -232,12 +290,13 @@ def main():
         with open(os.path.join(args.work, "results.json")) as f:
             saved = json.load(f)
         found, skipped = sequences(args.data)
+        add_independent(saved["rows"], args.work, independent_files(args.independent))
         splice(args.out, render(saved["rows"], skipped, [(f[0], f[2]) for f in found],
                                 saved["seconds"]))
         print("refinement: rewrote %s from %s" % (args.out, args.work), file=sys.stderr)
         return
     suite.run(["cmake", "--build", suite.BUILD, "--target", "panmap-import", "panmap-mapper",
-               "panmap-eval", "panmap-consistency"])
+               "panmap-eval", "panmap-consistency", "panmap-calibrate-depth"])
     found, skipped = sequences(args.data)
     if not found:
         sys.exit("refinement: no real sequence with >= %d frames under %s" % (MIN_FRAMES,
@@ -258,8 +317,12 @@ def main():
     start = time.time()
     # Imports first (one per sequence, drift and seed), so parallel maps never race on a log.
     imports = sorted({j[:3] for j in jobs})
+    frames = {name: count for name, _, _, count in found}
+    calibrate = "calibrated" in args.corrections.split(",")
     with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
-        list(pool.map(lambda j: one_import(args.work, j[0], folders[j[0]], *j[1:]), imports))
+        list(pool.map(lambda j: one_import(args.work, j[0], folders[j[0]], *j[1:],
+                                           calibrate_from=frames[j[0]] // 2 if calibrate
+                                           else None), imports))
     rows = []
     with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
         futures = [pool.submit(one, args.work, j[0], folders[j[0]], *j[1:]) for j in jobs]
@@ -274,6 +337,7 @@ def main():
                      r["refined_area_m2"], r["photometric_input"], r["photometric_reference"],
                      r["photometric_refined"]), file=sys.stderr)
     seconds = time.time() - start
+    add_independent(rows, args.work, independent_files(args.independent))
     with open(os.path.join(args.work, "results.json"), "w") as f:
         json.dump({"rows": rows, "seconds": seconds}, f, indent=1)
     section = render(rows, skipped, [(f[0], f[2]) for f in found], seconds)
@@ -282,11 +346,17 @@ def main():
     print("refinement: wrote %s" % args.out, file=sys.stderr)
 
 
-def one_import(work, name, folder, drift, seed):
+def one_import(work, name, folder, drift, seed, calibrate_from=None):
+    """Imports the sequence with drift; with calibrate_from, also learns the depth calibration
+    from the log's frames from that index on (one thread: imports run two at a time)."""
     tag = "%s_%s_s%d" % (name, drift, seed)
     log = os.path.join(work, tag + ".lcmlog")
     suite.run([suite.tool("panmap-import"), "-q", folder, log, "--drift",
                "gt" if drift == "none" else drift, "--seed", str(seed)])
+    if calibrate_from is not None:
+        suite.run([suite.tool("panmap-calibrate-depth"), "-q", "--log", log, "--out",
+                   calibration_path(work, tag), "--first", str(calibrate_from), "--threads", "1"],
+                  log=os.path.join(work, tag + ".calibration.log"))
 
 
 if __name__ == "__main__":

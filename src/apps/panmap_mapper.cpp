@@ -101,7 +101,8 @@ nlohmann::json mapJson(const panmap::Mapper& mapper, const panmap::OutputSummary
             {"geometry_only", mapper.config().fusion.geometry_only},
             {"semantic_consistency", mapper.config().superpoints.semantic_consistency},
             {"merge_threshold", mapper.config().superpoints.merge_threshold},
-            {"threads", mapper.config().num_threads}}}};
+            {"threads", mapper.config().num_threads},
+            {"depth_calibration", mapper.config().depth_calibration_file}}}};
 }
 
 nlohmann::json autosaveJson(const panmap::Autosaver* autosaver, double period_s) {
@@ -187,6 +188,10 @@ int main(int argc, char** argv) {
                  "refine poses against the map: off, auto (poses flagged SLAM or odometry), on "
                  "(default: the config's tracking.mode, auto)")
       ->check(CLI::IsMember({"off", "auto", "on"}));
+  std::string depth_calibration;
+  app.add_option("--depth-calibration", depth_calibration,
+                 "the depth sensor's calibration from panmap-calibrate-depth (overrides the "
+                 "config's depth_calibration)");
   app.add_option("--load", load_path, "resume from a map.panmap snapshot");
   std::string resume_dir;
   app.add_option("--resume", resume_dir,
@@ -272,6 +277,11 @@ int main(int argc, char** argv) {
       config.num_threads = threads;
     }
     if (geometry_only) config.fusion.geometry_only = true;
+    if (!depth_calibration.empty()) {
+      config.depth_calibration = std::make_shared<const panmap::DepthCalibration>(
+          panmap::DepthCalibration::load(depth_calibration));
+      config.depth_calibration_file = depth_calibration;
+    }
     config.superpoints.semantic_consistency = !spatial_only;
     if (tracking == "off") config.tracking_mode = panmap::MapperConfig::TrackingMode::kOff;
     if (tracking == "auto") config.tracking_mode = panmap::MapperConfig::TrackingMode::kAuto;

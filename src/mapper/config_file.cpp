@@ -1,5 +1,6 @@
 #include "panmap/mapper/config_file.h"
 
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -134,9 +135,10 @@ PanmapConfig loadConfig(const std::string& path) {
   PanmapConfig c;
   MapperConfig& m = c.mapper;
   const cv::FileNode root = fs.root();
-  const std::set<std::string> sections = {
-      "map",       "integrator", "depth_segmentation", "fusion",  "superpoints", "graph",
-      "occupancy", "tracking",   "optimiser",          "objects", "threads"};
+  const std::set<std::string> sections = {"map",       "integrator",  "depth_segmentation",
+                                          "fusion",    "superpoints", "graph",
+                                          "occupancy", "tracking",    "optimiser",
+                                          "objects",   "threads",     "depth_calibration"};
   for (auto it = root.begin(); it != root.end(); ++it) {
     if (!sections.count((*it).name())) throw Error(path + ": unknown section " + (*it).name());
   }
@@ -345,6 +347,26 @@ PanmapConfig loadConfig(const std::string& path) {
     if (!root["threads"].isInt()) throw Error(path + ": threads must be an integer");
     m.num_threads = static_cast<int>(root["threads"]);
   }
+  if (!root["depth_calibration"].empty()) {
+    if (!root["depth_calibration"].isString()) {
+      throw Error(path + ": depth_calibration must be a file name");
+    }
+    std::string file = static_cast<std::string>(root["depth_calibration"]);
+    file = file.substr(0, file.find('#'));  // OpenCV keeps a trailing comment in the string
+    file.erase(file.find_last_not_of(" \t") + 1);
+    // A relative name is relative to the config's folder, so configs and calibrations travel
+    // together.
+    const std::filesystem::path p(file);
+    const std::filesystem::path resolved =
+        p.is_absolute() ? p : std::filesystem::path(path).parent_path() / p;
+    m.depth_calibration_file = std::filesystem::absolute(resolved).lexically_normal().string();
+    try {
+      m.depth_calibration = std::make_shared<const DepthCalibration>(
+          DepthCalibration::load(m.depth_calibration_file));
+    } catch (const Error& e) {
+      throw Error(path + ": " + e.what());
+    }
+  }
   // One key for both: III-B must not merge into a super-point the final labelling leaves
   // unlabelled (SuperpointConfig::unlabelled_void_share).
   c.mapper.superpoints.unlabelled_void_share = c.optimiser.max_void_share;
@@ -509,6 +531,13 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   confidence_support: " << ob.support << "\n"
     << "   confidence_share: " << ob.share << "\n";
   y << "threads: " << m.num_threads << "\n";
+  if (m.depth_calibration && !m.depth_calibration->empty()) {
+    y << "depth_calibration: \"" << m.depth_calibration_file
+      << "\"   # the depth sensor's calibration (panmap-calibrate-depth)\n";
+  } else {
+    y << "# depth_calibration: \"FILE\"   # a depth sensor's calibration from "
+         "panmap-calibrate-depth\n";
+  }
   return y.str();
 }
 

@@ -29,7 +29,9 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 //     are converted on loading (a voxel's counts scaled together where one exceeds that).
 // 11: 32-byte voxels (distance and weight as 2-byte floats); older files' voxels are rounded
 //     to them on loading.
-constexpr uint32_t kVersion = 11;
+// 12: the depth calibration (MapperConfig::depth_calibration); older files load without one,
+//     as they were built.
+constexpr uint32_t kVersion = 12;
 
 // Reads a block's voxels as files before version 11 stored them: a 4-byte float distance and
 // weight, colour, flags, then four vote slots of a 4-byte label and a count of 4 bytes (before
@@ -162,6 +164,16 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
     w->put(v);
   }
   w->put<int32_t>(c.num_threads);
+  const bool calibrated = c.depth_calibration && !c.depth_calibration->empty();
+  w->put<uint8_t>(calibrated);
+  if (calibrated) {
+    const DepthCalibration& k = *c.depth_calibration;
+    for (int v : {k.width(), k.height(), k.cellsX(), k.cellsY(), k.knots()}) w->put<int32_t>(v);
+    w->put(k.knotSpacingM());
+    w->put<uint64_t>(k.offsetsM().size());
+    w->putBytes(k.offsetsM().data(), k.offsetsM().size() * sizeof(float));
+    w->putString(c.depth_calibration_file);
+  }
 }
 
 MapperConfig getConfig(BinaryReader* r, uint32_t version) {
@@ -231,6 +243,16 @@ MapperConfig getConfig(BinaryReader* r, uint32_t version) {
     *v = r->get<double>();
   }
   c.num_threads = r->get<int32_t>();
+  if (version >= 12 && r->get<uint8_t>() != 0) {
+    int v[5];
+    for (int& x : v) x = r->get<int32_t>();
+    const double spacing_m = r->get<double>();
+    std::vector<float> offsets(r->getCount(sizeof(float)));
+    r->getBytes(offsets.data(), offsets.size() * sizeof(float));
+    c.depth_calibration = std::make_shared<const DepthCalibration>(v[0], v[1], v[2], v[3], v[4],
+                                                                   spacing_m, std::move(offsets));
+    c.depth_calibration_file = r->getString();
+  }
   return c;
 }
 

@@ -10,7 +10,7 @@
 namespace panmap {
 
 MapRebuild::MapRebuild(const MapperConfig& config, ThreadPool* pool, bool remap)
-    : config_(std::make_unique<MapperConfig>(config)) {
+    : config_(std::make_unique<MapperConfig>(config)), pool_(pool) {
   if (!pool) throw Error("MapRebuild: no thread pool");
   if (remap) {
     // The poses are the back-end's corrected ones: nothing to refine them against. The
@@ -54,6 +54,16 @@ void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
   } catch (const Error& e) {
     throw Error(name + ": " + e.what());
   }
+  // Stored frames hold the depth as read: corrected here as Mapper::integrate() corrects it.
+  const bool calibrated = config_->depth_calibration && !config_->depth_calibration->empty();
+  if (calibrated) {
+    try {
+      config_->depth_calibration->apply(frame, &calibrated_, pool_);
+    } catch (const Error& e) {
+      throw Error(name + ": " + e.what());
+    }
+  }
+  const RgbdFrame& f = calibrated ? calibrated_ : frame;
   const bool labelled = labels && !labels->empty();
   if (labelled &&
       (labels->width() != frame.camera.width || labels->height() != frame.camera.height)) {
@@ -66,11 +76,11 @@ void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
   // ends of loops): a 1,000-frame repair went from 7.9 to 6.0 s (docs/LOOP_CLOSURE.md).
   std::future<void> occupancy;
   if (occupancy_) {
-    occupancy = std::async(std::launch::async, [&] { occupancy_->integrate(frame, T_W_C); });
+    occupancy = std::async(std::launch::async, [&] { occupancy_->integrate(f, T_W_C); });
   }
   IntegrationStats integration;
   try {
-    integration = integrator_->integrate(frame, T_W_C, labelled ? labels : nullptr, map_.get());
+    integration = integrator_->integrate(f, T_W_C, labelled ? labels : nullptr, map_.get());
   } catch (...) {
     if (occupancy.valid()) occupancy.wait();  // it reads the frame
     throw;

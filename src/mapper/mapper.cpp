@@ -198,14 +198,20 @@ void Mapper::forgetUnvotedSuperpoints() {
   if (config_.graph.prune_edges) edges_pruned_ += graph_->pruneEdges(scan.adjacency(), registry);
 }
 
-FrameStats Mapper::integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C_given,
+FrameStats Mapper::integrate(const RgbdFrame& raw_frame, const Eigen::Isometry3d& T_W_C_given,
                              const PanopticFrame* panoptic, PoseSource source,
                              const GeometricSegments* kept) {
   using Clock = std::chrono::steady_clock;
   auto ms = [](Clock::time_point a, Clock::time_point b) {
     return std::chrono::duration<double, std::milli>(b - a).count();
   };
-  validate(frame, T_W_C_given, panoptic);
+  validate(raw_frame, T_W_C_given, panoptic);
+  // Every stage sees the calibrated depth: tracking and the map must agree on the geometry
+  // (correcting only the frames aligned to an uncorrected map was measured to make pose
+  // refinement worse, docs/MAPPING.md).
+  const bool calibrated = config_.depth_calibration && !config_.depth_calibration->empty();
+  if (calibrated) config_.depth_calibration->apply(raw_frame, &calibrated_frame_, pool_.get());
+  const RgbdFrame& frame = calibrated ? calibrated_frame_ : raw_frame;
   FrameStats stats;
   const auto t_start = Clock::now();
   // Refine the pose against the map first: every later stage then sees the refined pose.

@@ -264,6 +264,23 @@ std::vector<uint8_t> reseal(std::vector<uint8_t> file, uint32_t version) {
   return file;
 }
 
+// A file of today's `config` without the byte that version 12 added at the end of the config
+// (whether a depth calibration follows): its layout before version 12. The byte follows the
+// thread count, found where two files that differ only in it differ.
+std::vector<uint8_t> withoutCalibrationFlag(std::vector<uint8_t> file, const MapperConfig& config) {
+  MapperConfig one = config, three = config;
+  one.num_threads = 1;
+  three.num_threads = 3;
+  const std::vector<uint8_t> a = Mapper(one).serialize(), b = Mapper(three).serialize();
+  size_t threads = 0;
+  while (threads < a.size() && a[threads] == b[threads]) ++threads;
+  const size_t flag = threads + sizeof(int32_t);
+  EXPECT_LT(flag, file.size());
+  EXPECT_EQ(file[flag], 0);  // no calibration
+  file.erase(file.begin() + static_cast<std::ptrdiff_t>(flag));
+  return file;
+}
+
 std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, uint32_t version) {
   const size_t flag = share_offset + 8 + 4;
   const size_t apart = flag + 1;
@@ -286,7 +303,7 @@ std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, u
   return reseal(std::move(file), version);
 }
 
-TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToNine) {
+TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToTwelve) {
   MapperConfig a;
   a.map.voxel_size_m = 0.05f;
   a.graph.prune_edges = false;
@@ -309,8 +326,8 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToNine) {
   b.graph.prune_edges = true;
   MapperConfig c = b;
   c.graph.edge_min_share = 0.1;
-  const std::vector<uint8_t> bytes_b = Mapper(b).serialize();
-  const std::vector<uint8_t> bytes_c = Mapper(c).serialize();
+  const std::vector<uint8_t> bytes_b = withoutCalibrationFlag(Mapper(b).serialize(), b);
+  const std::vector<uint8_t> bytes_c = withoutCalibrationFlag(Mapper(c).serialize(), c);
   ASSERT_EQ(bytes_b.size(), bytes_c.size());
   size_t offset = 0;
   while (offset < bytes_b.size() && bytes_b[offset] == bytes_c[offset]) ++offset;
@@ -319,7 +336,8 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToNine) {
   EXPECT_FALSE(old->config().graph.prune_edges);
   EXPECT_FALSE(old->config().superpoints.mask_verdicts);
   EXPECT_EQ(old->config().map.voxel_size_m, 0.05f);
-  EXPECT_EQ(Mapper(old->config()).serialize().size(), bytes_b.size());
+  EXPECT_EQ(withoutCalibrationFlag(Mapper(old->config()).serialize(), old->config()).size(),
+            bytes_b.size());
 
   // A version 6 file keeps its pruning and was built without III-B's mask verdicts.
   const auto six = Mapper::deserialize(asVersion(bytes_b, offset, 6), "six.panmap");
@@ -345,11 +363,15 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToNine) {
   const auto nine = Mapper::deserialize(asVersion(bytes_b, offset, 9), "nine.panmap");
   EXPECT_EQ(nine->config().superpoints.unlabelled_void_share, 0.75);
 
-  // Versions outside 5-11 are refused by name.
-  std::vector<uint8_t> future = bytes_b;
-  future[8] = 12;
+  // A version 11 file has no depth calibration.
+  EXPECT_FALSE(
+      Mapper::deserialize(asVersion(bytes_b, offset, 11), "11.panmap")->config().depth_calibration);
+
+  // Versions outside 5-12 are refused by name.
+  std::vector<uint8_t> future = Mapper(b).serialize();
+  future[8] = 13;
   test::expectError([&] { Mapper::deserialize(future, "future.panmap"); },
-                    {"future.panmap", "version 12", "reads 5 to 11"});
+                    {"future.panmap", "version 13", "reads 5 to 12"});
 }
 
 // `file` (written by `mapper`) with its voxels as versions before 11 stored them: 4-byte
@@ -414,7 +436,7 @@ std::vector<uint8_t> withLegacyVoxels(const std::vector<uint8_t>& file, const Ts
 // 2-byte floats round-trip through 4-byte ones exactly); counts beyond 65,535 are scaled down.
 TEST_F(BoxScene, MapFilesBeforeVersionElevenLoadTheirVoxels) {
   const auto mapper = run(config(), 3);
-  const std::vector<uint8_t> file = mapper->serialize();
+  const std::vector<uint8_t> file = withoutCalibrationFlag(mapper->serialize(), mapper->config());
   const TsdfMap& map = mapper->map();
   ASSERT_GT(map.numBlocks(), 10u);
   const uint32_t nine_counts[kVoteSlots] = {140000, 70000, 1, 0};

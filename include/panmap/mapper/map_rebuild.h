@@ -64,12 +64,14 @@ class MapRebuild {
   friend class Mapper;
 
   std::unique_ptr<MapperConfig> config_;
+  ThreadPool* pool_;  // not owned
   std::unique_ptr<ProjectiveIntegrator> integrator_;
   std::unique_ptr<TsdfMap> map_;
   std::unique_ptr<OccupancyMap> occupancy_;  // null when the mapper keeps none
   std::unique_ptr<Mapper> mapper_;           // a remap's mapper (then the three above are null)
   std::vector<StampedPose> poses_;
   uint64_t votes_evicted_ = 0;
+  RgbdFrame calibrated_;  // scratch: a frame with the depth calibration applied
 };
 
 }  // namespace panmap

@@ -11,6 +11,7 @@
 #include <absl/container/flat_hash_map.h>
 #include <Eigen/Geometry>
 
+#include "panmap/calibration/depth_calibration.h"
 #include "panmap/core/byte_sink.h"
 #include "panmap/core/frame.h"
 #include "panmap/core/pose.h"
@@ -72,6 +73,12 @@ struct MapperConfig {
   /// The smooth drift estimate (kFilter).
   DriftFilter::Config drift;
   int num_threads = 2;  ///< threads for segmentation and integration (association uses one)
+  /// The depth sensor's calibration (panmap-calibrate-depth, docs/MAPPING.md), added to every
+  /// frame's depth before anything else reads it; null: the depth as the sensor read it. Kept in
+  /// map files, so a loaded map and a loop-closure repair correct frames the same way.
+  std::shared_ptr<const DepthCalibration> depth_calibration;
+  /// Where depth_calibration was read from (reports only).
+  std::string depth_calibration_file;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -323,6 +330,7 @@ class Mapper {
   int64_t frames_ = 0;
   uint64_t vote_evictions_ = 0;
   FrameSegmentation segmentation_;  // scratch, reused every frame
+  RgbdFrame calibrated_frame_;      // scratch: the frame with the depth calibration applied
   int64_t frames_with_kept_segments_ = 0;
   FrameAssociation association_;  // scratch, reused every frame
   uint64_t superpoints_forgotten_ = 0;
