@@ -1,5 +1,7 @@
 // panmap-calibrate-depth: learns a depth sensor's fixed-pattern depth error from a recording
 // (docs/MAPPING.md, "Depth calibration"), for panmap-mapper --depth-calibration.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -96,7 +98,9 @@ int main(int argc, char** argv) {
   app.add_option("--every", every, "learn from every Nth frame (memory: 0.6 MB per 640x480 frame)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--cells", cal.cells_x, "image cells across (down: 3/4 of it)")
+  app.add_option("--cells", cal.cells_x,
+                 "image cells across (down: as many as the image's "
+                 "aspect ratio gives)")
       ->capture_default_str();
   app.add_option("--passes", cal.passes, "map-and-measure passes per round")->capture_default_str();
   app.add_option("--calibration-voxel-size", cal.voxel_size_m,
@@ -109,7 +113,6 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
-    cal.cells_y = std::max(1, cal.cells_x * 3 / 4);
     cal.check();
     panmap::MapperConfig config;
     if (!config_path.empty()) config = panmap::loadConfig(config_path).mapper;
@@ -123,7 +126,6 @@ int main(int argc, char** argv) {
     if (tracking == "auto") config.tracking_mode = panmap::MapperConfig::TrackingMode::kAuto;
     if (tracking == "on") config.tracking_mode = panmap::MapperConfig::TrackingMode::kOn;
     config.check();
-    const panmap::DepthCalibrator calibrator(cal);
     panmap::ThreadPool pool(threads);
     std::shared_ptr<const panmap::DepthCalibration> calibration;
     Round round;
@@ -135,6 +137,12 @@ int main(int argc, char** argv) {
         throw panmap::Error("no frames to learn from in " + log_path + " (frames " +
                             std::to_string(first) + " to " + std::to_string(last) + ")");
       }
+      // Square cells: as many down as the image's aspect ratio gives.
+      const panmap::PinholeCamera& camera = round.frames.front().camera;
+      cal.cells_y = std::max(
+          1, static_cast<int>(
+                 std::lround(cal.cells_x * static_cast<double>(camera.height) / camera.width)));
+      const panmap::DepthCalibrator calibrator(cal);
       std::vector<panmap::CalibrationPass> passes;
       calibration = std::make_shared<const panmap::DepthCalibration>(
           calibrator.calibrate(round.frames, &pool, &passes, [&](int done, int total) {
