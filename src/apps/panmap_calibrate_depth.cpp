@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -114,6 +115,11 @@ int main(int argc, char** argv) {
 
   try {
     cal.check();
+    // Fail before the work, not after it.
+    const std::filesystem::path out_dir = std::filesystem::path(out_path).parent_path();
+    if (!out_dir.empty() && !std::filesystem::is_directory(out_dir)) {
+      throw panmap::Error("output folder " + out_dir.string() + " does not exist");
+    }
     panmap::MapperConfig config;
     if (!config_path.empty()) config = panmap::loadConfig(config_path).mapper;
     config.map.voxel_size_m = voxel_m;
@@ -135,7 +141,8 @@ int main(int argc, char** argv) {
       round = mapOnce(log_path, config, first, last, every, quiet);
       if (round.frames.empty()) {
         throw panmap::Error("no frames to learn from in " + log_path + " (frames " +
-                            std::to_string(first) + " to " + std::to_string(last) + ")");
+                            std::to_string(first) + " to " +
+                            (last < 0 ? std::string("the end") : std::to_string(last)) + ")");
       }
       // Square cells: as many down as the image's aspect ratio gives.
       const panmap::PinholeCamera& camera = round.frames.front().camera;

@@ -178,6 +178,17 @@ TEST(CalibrateDepthCli, LearnsFromALogAndRefusesBadInput) {
                                         dir.path("none.lcmlog") + " --out " + out);
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.output.find("none.lcmlog does not exist"), std::string::npos) << missing.output;
+  const auto no_folder =
+      test::runCommand(test::binPath("panmap-calibrate-depth") + " --log " +
+                       dir.path("r/sequence.lcmlog") + " --out " + dir.path("none/sensor.json"));
+  EXPECT_EQ(no_folder.exit_code, 1);
+  EXPECT_NE(no_folder.output.find("output folder"), std::string::npos) << no_folder.output;
+  const auto no_frames =
+      test::runCommand(test::binPath("panmap-calibrate-depth") + " --log " +
+                       dir.path("r/sequence.lcmlog") + " --out " + out + " --first 1000 -q");
+  EXPECT_EQ(no_frames.exit_code, 1);
+  EXPECT_NE(no_frames.output.find("no frames to learn from"), std::string::npos)
+      << no_frames.output;
   const auto help = test::runCommand(test::binPath("panmap-calibrate-depth") + " --help");
   EXPECT_EQ(help.exit_code, 0);
 }
