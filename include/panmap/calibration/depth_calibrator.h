@@ -29,16 +29,16 @@ struct CalibrationPass {
 /// by the calibration so far) into a TSDF, measure each point's depth disagreement with that
 /// map along its ray (the signed distance at the point over the cosine between ray and surface
 /// normal), and add its mean per grid cell and depth knot (shrunk towards 0 where few points
-/// count) to the calibration; repeat. The map averages the frames' errors, so it holds part of
-/// each one and a pass measures only what is left: the passes add up to the whole. A map
-/// built from many viewpoints averages the sensor's pattern away, so the disagreement of a
-/// frame with it is the pattern. What the data cannot tell from a scale error is left out: the
-/// mean offset of each depth knot is removed, so the calibration bends depth, never scales it.
+/// count) to the calibration; repeat. A map built from many viewpoints averages the sensor's
+/// pattern away, so a frame's disagreement with it is the pattern; but the map still holds part
+/// of each frame's error, so one pass measures only part of it, and the passes add up to the
+/// whole. What the data cannot tell from a scale error is left out: the mean offset of each
+/// depth knot is removed, so the calibration bends depth, never scales it.
 ///
 /// The poses should be good: a wrong pose also disagrees with the map, in a pattern that moves
 /// from frame to frame and mostly averages out, but not wholly. Poses refined by the mapper's
 /// own tracking improve with a calibration, so calibrating again from them converges
-/// (panmap-calibrate-depth --rounds). Deterministic for a given thread count.
+/// (panmap-calibrate-depth --rounds). Deterministic, whatever the thread count.
 class DepthCalibrator {
  public:
   /// Parameters; units in the names.
