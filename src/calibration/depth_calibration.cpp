@@ -62,6 +62,22 @@ double DepthCalibration::offsetAt(const internal::GridLerp& x, const internal::G
   return z.t > 0.0 ? (1.0 - z.t) * layer(z.i0) + z.t * layer(z.i1) : layer(z.i0);
 }
 
+uint16_t DepthCalibration::roundedUnits(uint16_t raw, double depth_scale_m, double units_per_m,
+                                        const internal::GridLerp& x,
+                                        const internal::GridLerp& y) const {
+  const double z_m = raw * depth_scale_m;
+  const long units = std::lround((z_m + offsetAt(x, y, z_m)) * units_per_m);
+  return static_cast<uint16_t>(std::clamp(units, 1L, 65535L));
+}
+
+uint16_t DepthCalibration::correctedReading(int u, int v, uint16_t raw,
+                                            double depth_scale_m) const {
+  if (empty() || raw == 0) return raw;
+  return roundedUnits(raw, depth_scale_m, 1.0 / depth_scale_m,
+                      internal::cellLerp(u, width_, cells_x_),
+                      internal::cellLerp(v, height_, cells_y_));
+}
+
 double DepthCalibration::offsetM(double u, double v, double z_m) const {
   if (empty()) return 0.0;
   return offsetAt(internal::cellLerp(u, width_, cells_x_), internal::cellLerp(v, height_, cells_y_),
@@ -89,9 +105,7 @@ void DepthCalibration::apply(const DepthImage& raw, double depth_scale_m, DepthI
       for (int u = 0; u < raw.width(); ++u) {
         const uint16_t d = raw(u, v);
         if (d == 0) continue;
-        const double z_m = d * depth_scale_m;
-        const long units = std::lround((z_m + offsetAt(columns[u], row, z_m)) * units_per_m);
-        (*corrected)(u, v) = static_cast<uint16_t>(std::clamp(units, 1L, 65535L));
+        (*corrected)(u, v) = roundedUnits(d, depth_scale_m, units_per_m, columns[u], row);
       }
     }
   };

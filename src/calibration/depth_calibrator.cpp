@@ -101,14 +101,15 @@ DepthCalibration DepthCalibrator::calibrate(const std::vector<CalibrationFrame>&
   for (int pass = 0; pass < c.passes; ++pass) {
     const DepthCalibration current(width, height, c.cells_x, c.cells_y, c.knots, c.knot_spacing_m,
                                    std::vector<float>(offsets.begin(), offsets.end()));
-    // Corrected depth of every frame, then the map of it.
-    std::vector<RgbdFrame> corrected(frames.size());
+    // The map of the frames' corrected depth (one frame corrected at a time: the measurement
+    // below corrects only the pixels it reads, so no frame is held twice).
     TsdfMap map(TsdfMap::Config{c.voxel_size_m});
-    for (size_t i = 0; i < frames.size(); ++i) {
-      corrected[i].camera = frames[i].camera;
-      corrected[i].depth_scale_m = frames[i].depth_scale_m;
-      current.apply(frames[i].depth, frames[i].depth_scale_m, &corrected[i].depth);
-      integrator.integrate(corrected[i], frames[i].T_W_C, nullptr, &map);
+    RgbdFrame scratch;
+    for (const CalibrationFrame& f : frames) {
+      scratch.camera = f.camera;
+      scratch.depth_scale_m = f.depth_scale_m;
+      current.apply(f.depth, f.depth_scale_m, &scratch.depth, pool);
+      integrator.integrate(scratch, f.T_W_C, nullptr, &map);
     }
     // Each corrected point's disagreement with the map along its ray.
     std::vector<Sums> block_sums(blocks, Sums(n));
@@ -118,11 +119,11 @@ DepthCalibration DepthCalibrator::calibrate(const std::vector<CalibrationFrame>&
         Sums& sums = block_sums[b];
         for (size_t i = b * kBlockFrames; i < std::min(frames.size(), (b + 1) * kBlockFrames);
              ++i) {
-          const RgbdFrame& f = corrected[i];
-          const Eigen::Isometry3f T = frames[i].T_W_C.cast<float>();
+          const CalibrationFrame& f = frames[i];
+          const Eigen::Isometry3f T = f.T_W_C.cast<float>();
           for (int v = c.pixel_stride / 2; v < height; v += c.pixel_stride) {
             for (int u = c.pixel_stride / 2; u < width; u += c.pixel_stride) {
-              const uint16_t d = f.depth(u, v);
+              const uint16_t d = current.correctedReading(u, v, f.depth(u, v), f.depth_scale_m);
               if (d == 0) continue;
               const double z_m = d * f.depth_scale_m;
               if (z_m > c.max_depth_m) continue;

@@ -531,7 +531,7 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   confidence_support: " << ob.support << "\n"
     << "   confidence_share: " << ob.share << "\n";
   y << "threads: " << m.num_threads << "\n";
-  if (m.depth_calibration && !m.depth_calibration->empty()) {
+  if (m.hasDepthCalibration()) {
     y << "depth_calibration: \"" << m.depth_calibration_file
       << "\"   # the depth sensor's calibration (panmap-calibrate-depth)\n";
   } else {

@@ -164,7 +164,7 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
     w->put(v);
   }
   w->put<int32_t>(c.num_threads);
-  const bool calibrated = c.depth_calibration && !c.depth_calibration->empty();
+  const bool calibrated = c.hasDepthCalibration();
   w->put<uint8_t>(calibrated);
   if (calibrated) {
     const DepthCalibration& k = *c.depth_calibration;

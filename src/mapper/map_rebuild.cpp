@@ -55,7 +55,7 @@ void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
     throw Error(name + ": " + e.what());
   }
   // Stored frames hold the depth as read: corrected here as Mapper::integrate() corrects it.
-  const bool calibrated = config_->depth_calibration && !config_->depth_calibration->empty();
+  const bool calibrated = config_->hasDepthCalibration();
   if (calibrated) {
     try {
       config_->depth_calibration->apply(frame, &calibrated_, pool_);

@@ -209,7 +209,7 @@ FrameStats Mapper::integrate(const RgbdFrame& raw_frame, const Eigen::Isometry3d
   // Every stage sees the calibrated depth: tracking and the map must agree on the geometry
   // (correcting only the frames aligned to an uncorrected map was measured to make pose
   // refinement worse, docs/MAPPING.md).
-  const bool calibrated = config_.depth_calibration && !config_.depth_calibration->empty();
+  const bool calibrated = config_.hasDepthCalibration();
   if (calibrated) config_.depth_calibration->apply(raw_frame, &calibrated_frame_, pool_.get());
   const RgbdFrame& frame = calibrated ? calibrated_frame_ : raw_frame;
   FrameStats stats;

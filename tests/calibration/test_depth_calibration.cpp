@@ -47,10 +47,15 @@ TEST(DepthCalibration, ApplyCorrectsReadingsAndKeepsHoles) {
   EXPECT_EQ(out(1, 0), 1012);
   EXPECT_EQ(out(3, 1), 1);
   EXPECT_EQ(out(0, 0), 0);  // no reading stays none
-  ThreadPool pool(2);  // rows shared among threads: the same image
+  ThreadPool pool(2);       // rows shared among threads: the same image
   DepthImage shared;
   k.apply(raw, 0.001, &shared, &pool);
   EXPECT_EQ(shared.pixels(), out.pixels());
+  for (int v = 0; v < raw.height(); ++v) {  // one reading at a time: the same bits
+    for (int u = 0; u < raw.width(); ++u) {
+      EXPECT_EQ(k.correctedReading(u, v, raw(u, v), 0.001), out(u, v)) << u << " " << v;
+    }
+  }
   DepthImage wrong(5, 2);
   test::expectError([&] { k.apply(wrong, 0.001, &out); }, {"depth calibration is for 4x2"});
   DepthCalibration().apply(wrong, 0.001, &out);  // the identity fits any size

@@ -49,6 +49,10 @@ class DepthCalibration {
   /// Offset (metres) to add to a depth of z_m read at pixel (u, v); 0 for the identity.
   double offsetM(double u, double v, double z_m) const;
 
+  /// The reading `raw` (units of depth_scale_m; 0 = none, kept) at pixel (u, v) corrected, as
+  /// apply() corrects it, bit for bit: for the few pixels of a frame that are needed.
+  uint16_t correctedReading(int u, int v, uint16_t raw, double depth_scale_m) const;
+
   /// `raw` (depth units of depth_scale_m, 0 = no reading) with the offsets added, rounded to
   /// the unit; readings stay readings (at least 1 unit). Throws Error when the image size differs
   /// from the calibration's; the identity copies.
@@ -75,6 +79,9 @@ class DepthCalibration {
  private:
   // The offset at interpolated image coordinates and a depth.
   double offsetAt(const internal::GridLerp& x, const internal::GridLerp& y, double z_m) const;
+  // A non-zero reading corrected and rounded to the unit, at least 1.
+  uint16_t roundedUnits(uint16_t raw, double depth_scale_m, double units_per_m,
+                        const internal::GridLerp& x, const internal::GridLerp& y) const;
 
   int width_ = 0, height_ = 0;
   int cells_x_ = 0, cells_y_ = 0, knots_ = 0;

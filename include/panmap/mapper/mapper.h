@@ -79,6 +79,8 @@ struct MapperConfig {
   std::shared_ptr<const DepthCalibration> depth_calibration;
   /// Where depth_calibration was read from (reports only).
   std::string depth_calibration_file;
+  /// True when frames are corrected: a calibration is set and not the identity.
+  bool hasDepthCalibration() const { return depth_calibration && !depth_calibration->empty(); }
   /// Throws Error naming the bad field.
   void check() const;
 };
