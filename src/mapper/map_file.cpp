@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <memory>
 
 #include "panmap/core/binary_io.h"
 #include "panmap/io/atomic_file.h"
@@ -457,38 +459,119 @@ void Mapper::save(const std::string& path) const {
   file.commit();
 }
 
+namespace {
+
+// Reads the header (magic, version, payload size) of a map file of `total_bytes` and checks it
+// against that length; returns the payload size and sets `version`.
+uint64_t readHeader(BinaryReader* header, size_t total_bytes, const std::string& path,
+                    uint32_t* version) {
+  char magic[8];
+  header->getBytes(magic, sizeof(magic));
+  if (std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)
+    throw Error(path + ": not a panmap map file");
+  *version = header->get<uint32_t>();
+  if (*version < kOldestVersion || *version > kVersion) {
+    throw Error(path + ": map file version " + std::to_string(*version) + ", this panmap reads " +
+                std::to_string(kOldestVersion) + " to " + std::to_string(kVersion));
+  }
+  const uint64_t size = header->get<uint64_t>();
+  const size_t after = total_bytes - kHeaderBytes;
+  if (size > after || after - size != sizeof(uint32_t)) {
+    throw Error(path + ": " + (size + sizeof(uint32_t) > after ? "truncated" : "overlong") +
+                " map file (" + std::to_string(total_bytes) +
+                " bytes; the header at offset 12 announces " +
+                std::to_string(kHeaderBytes + size + sizeof(uint32_t)) + ")");
+  }
+  return size;
+}
+
+std::string checksumMismatch(const std::string& path, uint64_t size) {
+  return path + ": checksum mismatch over bytes " + std::to_string(kHeaderBytes) + "-" +
+         std::to_string(kHeaderBytes + size) + " (corrupt map file)";
+}
+
+// A map file's payload read in order, with the CRC-32 of what was read so far.
+class ChecksummingFileSource : public ByteSource {
+ public:
+  ChecksummingFileSource(std::FILE* file, std::string path) : file_(file), path_(std::move(path)) {}
+  void read(uint8_t* out, size_t size) override {
+    if (std::fread(out, 1, size, file_) != size) {
+      throw Error(path_ + ": cannot read (the file changed or shrank while it was loaded)");
+    }
+    crc_ = crc32_z(crc_, out, size);
+  }
+  uint32_t crc() const { return static_cast<uint32_t>(crc_); }
+
+ private:
+  std::FILE* file_;
+  std::string path_;
+  uLong crc_ = crc32(0L, Z_NULL, 0);
+};
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+
+}  // namespace
+
 std::unique_ptr<Mapper> Mapper::load(const std::string& path) {
-  return deserialize(readFileBytes(path), path);
+  std::error_code ec;
+  const bool regular = std::filesystem::is_regular_file(path, ec);
+  const std::uintmax_t total = regular ? std::filesystem::file_size(path, ec) : 0;
+  // Pipes and devices have no size to check the header against: read them whole.
+  if (!regular || ec) return deserialize(readFileBytes(path), path);
+  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+  if (!file) throw Error("cannot read " + path);
+  // Streamed, so that loading needs the map's memory and not also the file's (a 2 cm building
+  // is 3.6 GB of both). The payload is parsed as it is read and its checksum compared at the
+  // end; a corrupt file is reported as such even when the corruption also broke the parsing.
+  uint8_t head[kHeaderBytes];
+  const size_t head_bytes = std::min<size_t>(kHeaderBytes, static_cast<size_t>(total));
+  if (std::fread(head, 1, head_bytes, file.get()) != head_bytes) throw Error("cannot read " + path);
+  BinaryReader header(head, head_bytes, path);
+  uint32_t version = 0;
+  const uint64_t size = readHeader(&header, static_cast<size_t>(total), path, &version);
+  ChecksummingFileSource source(file.get(), path);
+  BinaryReader r(&source, size, path, kHeaderBytes);
+  std::unique_ptr<Mapper> mapper;
+  try {
+    mapper = parsePayload(&r, version, path);
+  } catch (const Error&) {
+    r.skipRest();
+    uint32_t stored_crc = 0;
+    if (std::fread(&stored_crc, 1, sizeof(stored_crc), file.get()) == sizeof(stored_crc) &&
+        stored_crc != source.crc()) {
+      throw Error(checksumMismatch(path, size));
+    }
+    throw;
+  }
+  uint32_t stored_crc = 0;
+  if (std::fread(&stored_crc, 1, sizeof(stored_crc), file.get()) != sizeof(stored_crc)) {
+    throw Error("cannot read " + path);
+  }
+  if (stored_crc != source.crc()) throw Error(checksumMismatch(path, size));
+  return mapper;
 }
 
 std::unique_ptr<Mapper> Mapper::deserialize(const std::vector<uint8_t>& bytes,
                                             const std::string& path) {
   BinaryReader header(bytes.data(), bytes.size(), path);
-  char magic[8];
-  header.getBytes(magic, sizeof(magic));
-  if (std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)
-    throw Error(path + ": not a panmap map file");
-  const uint32_t version = header.get<uint32_t>();
-  if (version < kOldestVersion || version > kVersion) {
-    throw Error(path + ": map file version " + std::to_string(version) + ", this panmap reads " +
-                std::to_string(kOldestVersion) + " to " + std::to_string(kVersion));
-  }
-  const uint64_t size = header.get<uint64_t>();
-  if (size > header.remaining() || header.remaining() - size != sizeof(uint32_t)) {
-    throw Error(path + ": " +
-                (size + sizeof(uint32_t) > header.remaining() ? "truncated" : "overlong") +
-                " map file (" + std::to_string(bytes.size()) +
-                " bytes; the header at offset 12 announces " +
-                std::to_string(kHeaderBytes + size + sizeof(uint32_t)) + ")");
-  }
+  uint32_t version = 0;
+  const uint64_t size = readHeader(&header, bytes.size(), path, &version);
   const uint8_t* payload = bytes.data() + (bytes.size() - header.remaining());
   uint32_t stored_crc;
   std::memcpy(&stored_crc, payload + size, sizeof(stored_crc));
-  if (stored_crc != static_cast<uint32_t>(crc32(0L, payload, static_cast<uInt>(size)))) {
-    throw Error(path + ": checksum mismatch over bytes " + std::to_string(kHeaderBytes) + "-" +
-                std::to_string(kHeaderBytes + size) + " (corrupt map file)");
+  // crc32_z: crc32 takes a 32-bit length, and a 2 cm building's payload is near 4 GiB.
+  if (stored_crc != static_cast<uint32_t>(crc32_z(0L, payload, static_cast<size_t>(size)))) {
+    throw Error(checksumMismatch(path, size));
   }
   BinaryReader r(payload, size, path, kHeaderBytes);
+  return parsePayload(&r, version, path);
+}
+
+std::unique_ptr<Mapper> Mapper::parsePayload(BinaryReader* reader, uint32_t version,
+                                             const std::string& path) {
+  BinaryReader& r = *reader;
   auto mapper = std::make_unique<Mapper>(getConfig(&r, version));
   mapper->frames_ = r.get<int64_t>();
   mapper->vote_evictions_ = r.get<uint64_t>();

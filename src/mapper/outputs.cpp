@@ -17,18 +17,26 @@ namespace panmap {
 
 namespace {
 
-LabelledMesh recoloured(const LabelledMesh& mesh, Rgb8 (*colour)(int32_t),
-                        const std::vector<int32_t>& ids) {
-  LabelledMesh out = mesh;
-  out.colors.resize(mesh.vertices.size());
-  for (size_t i = 0; i < ids.size(); ++i) out.colors[i] = colour(ids[i]);
-  return out;
+// The vertex colours of `ids` under `colour`; a mesh without those labels keeps its colours
+// (black without colours either).
+OverviewColouring byLabel(const LabelledMesh& mesh, Rgb8 (*colour)(int32_t),
+                          const std::vector<int32_t>& ids) {
+  if (!ids.empty()) return [colour, &ids](size_t v) { return colour(ids[v]); };
+  if (!mesh.colors.empty()) return [&mesh](size_t v) { return mesh.colors[v]; };
+  return [](size_t) { return Rgb8{0, 0, 0}; };
 }
 
-void writePng(const std::string& dir, const std::string& name, const LabelledMesh& mesh,
-              OutputSummary* summary) {
-  writeFileBytes(dir + "/" + name, encodePng(renderOverview(mesh)));
-  summary->files.push_back(name);
+// The four overview pictures, rasterised once (a building's mesh is 14 M faces).
+void writeSnapshots(const std::string& dir, const LabelledMesh& mesh, OutputSummary* summary) {
+  const std::vector<std::string> names = {"snapshot_semantic.png", "snapshot_instance.png",
+                                          "snapshot_superpoint.png", "snapshot_color.png"};
+  const std::vector<ColorImage> pictures = renderOverviews(
+      mesh, {byLabel(mesh, &semanticColor, mesh.semantic), byLabel(mesh, &idColor, mesh.instance),
+             byLabel(mesh, &idColor, mesh.superpoint), vertexColours(mesh)});
+  for (size_t i = 0; i < names.size(); ++i) {
+    writeFileBytes(dir + "/" + names[i], encodePng(pictures[i]));
+    summary->files.push_back(names[i]);
+  }
 }
 
 }  // namespace
@@ -85,11 +93,7 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
   }
   step("config.yaml");
   if (options.snapshots && !mesh.faces.empty()) {
-    writePng(dir, "snapshot_semantic.png", recoloured(mesh, &semanticColor, mesh.semantic),
-             &summary);
-    writePng(dir, "snapshot_instance.png", recoloured(mesh, &idColor, mesh.instance), &summary);
-    writePng(dir, "snapshot_superpoint.png", recoloured(mesh, &idColor, mesh.superpoint), &summary);
-    writePng(dir, "snapshot_color.png", mesh, &summary);
+    writeSnapshots(dir, mesh, &summary);
     step("snapshots");
   }
   return summary;

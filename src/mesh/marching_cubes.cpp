@@ -458,6 +458,13 @@ LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const Blo
   out.vertices.reserve(offsets.back());
   out.colors.reserve(offsets.back());
   out.faces.reserve(num_faces);
+  if (labelled) {
+    // Reserved like the positions: growing by doubling would briefly hold 1.5x a building's
+    // labels on top of the rest of the mesh.
+    out.superpoint.reserve(offsets.back());
+    out.semantic.reserve(offsets.back());
+    out.instance.reserve(offsets.back());
+  }
 
   VertexLabeller label_vertex(map, labeller);
   auto findNeighbours = [&](const BlockIndex& index) {

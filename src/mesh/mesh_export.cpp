@@ -30,11 +30,20 @@ uint64_t mix(uint64_t x) {
   return x ^ (x >> 31);
 }
 
-void writeColoured(const std::string& path, LabelledMesh* mesh, const std::vector<int32_t>& ids,
-                   Rgb8 (*palette)(int32_t), PlyFormat format) {
-  mesh->colors.resize(ids.size());
-  for (size_t i = 0; i < ids.size(); ++i) mesh->colors[i] = palette(ids[i]);
-  writePly(path, *mesh, format);  // throws naming the file
+// One export: the shared mesh with colours from `palette` of `ids` (black where the mesh has
+// no such labels) and all three label properties.
+void writeColoured(const std::string& path, const LabelledMesh& mesh,
+                   const std::vector<int32_t>& ids, Rgb8 (*palette)(int32_t), PlyFormat format) {
+  std::vector<Rgb8> colors(mesh.vertices.size(), palette(0));
+  for (size_t i = 0; i < ids.size(); ++i) colors[i] = palette(ids[i]);
+  PlyColumns columns;
+  columns.vertices = &mesh.vertices;
+  columns.faces = &mesh.faces;
+  columns.colors = &colors;
+  columns.semantic = &mesh.semantic;
+  columns.instance = &mesh.instance;
+  columns.superpoint = &mesh.superpoint;
+  writePly(path, columns, format);  // throws naming the file
 }
 
 }  // namespace
@@ -63,17 +72,10 @@ void writeLabelledMeshes(const std::string& dir, const LabelledMesh& mesh, PlyFo
   if (ec || !std::filesystem::is_directory(dir)) {
     throw Error(dir + ": cannot create the output folder" + (ec ? ": " + ec.message() : ""));
   }
-  LabelledMesh out;
-  out.vertices = mesh.vertices;
-  out.faces = mesh.faces;
-  const size_t n = mesh.vertices.size();
-  out.semantic = mesh.semantic.empty() ? std::vector<int32_t>(n, 0) : mesh.semantic;
-  out.instance = mesh.instance.empty() ? std::vector<int32_t>(n, 0) : mesh.instance;
-  out.superpoint = mesh.superpoint.empty() ? std::vector<int32_t>(n, 0) : mesh.superpoint;
   const std::filesystem::path folder(dir);
-  writeColoured((folder / kSemanticMeshFile).string(), &out, out.semantic, semanticColor, format);
-  writeColoured((folder / kInstanceMeshFile).string(), &out, out.instance, idColor, format);
-  writeColoured((folder / kSuperpointMeshFile).string(), &out, out.superpoint, idColor, format);
+  writeColoured((folder / kSemanticMeshFile).string(), mesh, mesh.semantic, semanticColor, format);
+  writeColoured((folder / kInstanceMeshFile).string(), mesh, mesh.instance, idColor, format);
+  writeColoured((folder / kSuperpointMeshFile).string(), mesh, mesh.superpoint, idColor, format);
 }
 
 }  // namespace panmap

@@ -7,6 +7,24 @@
 
 namespace panmap {
 
+namespace {
+
+// Octants (2^6 = 64 cells a side, up to 512 blocks) pruned as soon as their last block is in:
+// a building's unpruned leaves alone would be 700 MB, its pruned tree is under 2 MB.
+constexpr int kPruneOctantBits = 6;
+
+// Collapses every uniform octant below `node`, deepest first (what prune() does for the whole
+// tree; pruneNode() only merges children that are equal leaves).
+void pruneBelow(octomap::OcTree* tree, octomap::OcTreeNode* node) {
+  if (!tree->nodeHasChildren(node)) return;
+  for (unsigned int i = 0; i < 8; ++i) {
+    if (tree->nodeChildExists(node, i)) pruneBelow(tree, tree->getNodeChild(node, i));
+  }
+  tree->pruneNode(node);
+}
+
+}  // namespace
+
 std::unique_ptr<octomap::OcTree> OccupancyMap::toOcTree() const {
   auto tree = std::make_unique<octomap::OcTree>(config_.resolution_m);
   tree->setProbHit(config_.prob_hit);
@@ -31,8 +49,20 @@ std::unique_ptr<octomap::OcTree> OccupancyMap::toOcTree() const {
     return morton(a->corner) < morton(b->corner);
   });
   // Maximum-likelihood leaves, as OctoMap's own writeBinary() would make them; lazy: inner
-  // nodes are computed once at the end.
-  for (const OccupancyBlock* block : blocks) {
+  // nodes are computed once at the end. In Morton order an octant's blocks are consecutive, so
+  // it is pruned when the next block lies outside it.
+  const int octant_shift = 3 * (kPruneOctantBits - 3);
+  const unsigned int octant_depth = tree->getTreeDepth() - kPruneOctantBits;
+  auto pruneOctantOf = [&](const OccupancyBlock* block) {
+    const octomap::OcTreeKey key(block->corner.x(), block->corner.y(), block->corner.z());
+    if (octomap::OcTreeNode* node = tree->search(key, octant_depth)) pruneBelow(tree.get(), node);
+  };
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    const OccupancyBlock* block = blocks[b];
+    if (b > 0 &&
+        morton(block->corner) >> octant_shift != morton(blocks[b - 1]->corner) >> octant_shift) {
+      pruneOctantOf(blocks[b - 1]);
+    }
     for (int k = 0; k < 8; ++k) {
       for (int j = 0; j < 8; ++j) {
         for (int i = 0; i < 8; ++i) {

@@ -1,5 +1,6 @@
 #include "panmap/sim/overview.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "panmap/core/error.h"
@@ -7,26 +8,41 @@
 
 namespace panmap {
 
+OverviewColouring vertexColours(const LabelledMesh& mesh) {
+  if (mesh.colors.empty()) return [](size_t) { return Rgb8{180, 180, 180}; };
+  return [&mesh](size_t v) { return mesh.colors[v]; };
+}
+
 ColorImage renderOverview(const LabelledMesh& mesh, int width, int height) {
-  if (mesh.vertices.empty() || mesh.faces.empty()) return ColorImage(width, height);
+  return renderOverviews(mesh, {vertexColours(mesh)}, width, height).front();
+}
+
+std::vector<ColorImage> renderOverviews(const LabelledMesh& mesh,
+                                        const std::vector<OverviewColouring>& colourings, int width,
+                                        int height) {
+  if (mesh.vertices.empty() || mesh.faces.empty()) {
+    return std::vector<ColorImage>(colourings.size(), ColorImage(width, height));
+  }
   Eigen::AlignedBox3f box;
   for (const auto& v : mesh.vertices) box.extend(v);
-  // Drop the faces near the top, so a room's interior shows.
-  LabelledMesh cut = mesh;
-  cut.faces.clear();
+  // Drop the faces near the top, so a room's interior shows. Only positions and faces go to
+  // the renderer: the colourings are applied to the faces it reports.
   const float top = box.max().z() - 0.2f;
+  auto kept = [&](const Eigen::Vector3i& f) {
+    return !(mesh.vertices[f[0]].z() > top && mesh.vertices[f[1]].z() > top &&
+             mesh.vertices[f[2]].z() > top);
+  };
+  LabelledMesh cut;
+  cut.vertices = mesh.vertices;
+  cut.faces.reserve(static_cast<size_t>(std::count_if(mesh.faces.begin(), mesh.faces.end(), kept)));
   for (const auto& f : mesh.faces) {
-    if (mesh.vertices[f[0]].z() > top && mesh.vertices[f[1]].z() > top &&
-        mesh.vertices[f[2]].z() > top) {
-      continue;
-    }
-    cut.faces.push_back(f);
+    if (kept(f)) cut.faces.push_back(f);
   }
   RenderConfig config;
   config.texture_contrast = 0.0f;
   config.ambient = 0.45f;
   config.far_m = 1000.0f;
-  const MeshRenderer renderer(cut, config);
+  const MeshRenderer renderer(std::move(cut), config);
   const Eigen::Vector3d centre = box.center().cast<double>();
   const Eigen::Vector3d size = box.sizes().cast<double>();
   const double extent = std::max(size.x(), size.y());
@@ -44,11 +60,29 @@ ColorImage renderOverview(const LabelledMesh& mesh, int width, int height) {
   T_W_C.translation() = eye;
   const double f = 0.5 * width / std::tan(fov_half);
   const PinholeCamera camera{f, f, 0.5 * width - 0.5, 0.5 * height - 0.5, width, height};
-  RenderedView view = renderer.render(camera, T_W_C);
-  for (size_t i = 0; i < view.color.size(); ++i) {
-    if (view.depth_m.data()[i] <= 0.0f) view.color.data()[i] = Rgb8{255, 255, 255};
+  Image<int32_t> face;
+  Image<float> cos_incidence;
+  renderer.renderFaces(camera, T_W_C, &face, &cos_incidence);
+  const std::vector<Eigen::Vector3i>& faces = renderer.mesh().faces;
+  std::vector<ColorImage> pictures;
+  for (const OverviewColouring& colouring : colourings) {
+    ColorImage picture(width, height);
+    for (size_t i = 0; i < picture.size(); ++i) {
+      const int32_t fi = face.data()[i];
+      if (fi < 0) {
+        picture.data()[i] = Rgb8{255, 255, 255};
+        continue;
+      }
+      // MeshRenderer's shading without texture: headlight plus ambient, rounded.
+      const float shade = config.ambient + (1.0f - config.ambient) * cos_incidence.data()[i];
+      const Rgb8 base = colouring(static_cast<size_t>(faces[fi][0]));
+      picture.data()[i] = Rgb8{static_cast<uint8_t>(std::min(255.0f, base.r * shade + 0.5f)),
+                               static_cast<uint8_t>(std::min(255.0f, base.g * shade + 0.5f)),
+                               static_cast<uint8_t>(std::min(255.0f, base.b * shade + 0.5f))};
+    }
+    pictures.push_back(std::move(picture));
   }
-  return view.color;
+  return pictures;
 }
 
 }  // namespace panmap

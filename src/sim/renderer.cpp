@@ -35,15 +35,21 @@ struct MeshRenderer::Scratch {
 };
 
 MeshRenderer::MeshRenderer(const LabelledMesh& mesh, const RenderConfig& config)
-    : mesh_(mesh), config_(config) {
+    : MeshRenderer(LabelledMesh(mesh), config) {}
+
+MeshRenderer::MeshRenderer(LabelledMesh&& moved, const RenderConfig& config)
+    : mesh_(std::move(moved)), config_(config) {
   config_.check();
+  const LabelledMesh& mesh = mesh_;
   const std::string problem = mesh.check();
   if (!problem.empty()) throw Error("renderer: mesh is inconsistent: " + problem);
   const size_t n = mesh.faces.size();
   face_normals_W_.resize(n);
-  face_instance_.resize(n, 0);
-  face_semantic_.resize(n, 0);
-  face_color_.resize(n, Rgb8{180, 180, 180});
+  // A mesh without labels or colours gets no per-face array for them (0 labels, grey): a whole
+  // map's overview renders 14 M faces.
+  if (!mesh.instance.empty()) face_instance_.resize(n);
+  if (!mesh.semantic.empty()) face_semantic_.resize(n);
+  if (!mesh.colors.empty()) face_color_.resize(n);
   for (size_t f = 0; f < n; ++f) {
     const Eigen::Vector3i& t = mesh.faces[f];
     const Eigen::Vector3f e1 = mesh.vertices[t[1]] - mesh.vertices[t[0]];
@@ -216,8 +222,8 @@ void MeshRenderer::drawFace(const PinholeCamera& camera, int32_t f, float near, 
   }
 }
 
-void MeshRenderer::render(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
-                          RenderedView* view) const {
+MeshRenderer::Scratch& MeshRenderer::rasteriseView(const PinholeCamera& camera,
+                                                   const Eigen::Isometry3d& T_W_C) const {
   std::string why;
   if (!camera.isValid(&why)) throw Error("renderer: camera: " + why);
   thread_local Scratch scratch;
@@ -230,6 +236,39 @@ void MeshRenderer::render(const PinholeCamera& camera, const Eigen::Isometry3d& 
             std::numeric_limits<float>::infinity());
   std::fill(scratch.face.data(), scratch.face.data() + scratch.face.size(), -1);
   rasterise(camera, T_W_C, &scratch);
+  return scratch;
+}
+
+float MeshRenderer::cosIncidence(int32_t f, int u, int v, const PinholeCamera& camera,
+                                 const Eigen::Matrix3f& R_W_C) const {
+  const Eigen::Vector3f ray_C((u - static_cast<float>(camera.cx)) / static_cast<float>(camera.fx),
+                              (v - static_cast<float>(camera.cy)) / static_cast<float>(camera.fy),
+                              1.0f);
+  const Eigen::Vector3f ray_W = R_W_C * ray_C.normalized();
+  return std::abs(face_normals_W_[f].dot(ray_W));
+}
+
+void MeshRenderer::renderFaces(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
+                               Image<int32_t>* face, Image<float>* cos_incidence) const {
+  Scratch& scratch = rasteriseView(camera, T_W_C);
+  const int w = camera.width, h = camera.height;
+  *face = scratch.face;
+  if (cos_incidence->width() != w || cos_incidence->height() != h) {
+    *cos_incidence = Image<float>(w, h);
+  }
+  const Eigen::Matrix3f R_W_C = T_W_C.linear().cast<float>();
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const int32_t f = scratch.face(u, v);
+      (*cos_incidence)(u, v) = f < 0 ? 0.0f : cosIncidence(f, u, v, camera, R_W_C);
+    }
+  }
+}
+
+void MeshRenderer::render(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
+                          RenderedView* view) const {
+  Scratch& scratch = rasteriseView(camera, T_W_C);
+  const int w = camera.width, h = camera.height;
 
   if (view->depth_m.width() != w || view->depth_m.height() != h) {
     view->depth_m = Image<float>(w, h);
@@ -256,22 +295,22 @@ void MeshRenderer::render(const PinholeCamera& camera, const Eigen::Isometry3d& 
       const Eigen::Vector3f ray_C(
           (u - static_cast<float>(camera.cx)) / static_cast<float>(camera.fx),
           (v - static_cast<float>(camera.cy)) / static_cast<float>(camera.fy), 1.0f);
-      const Eigen::Vector3f ray_W = R_W_C * ray_C.normalized();
-      const float cos_i = std::abs(face_normals_W_[f].dot(ray_W));
+      const float cos_i = cosIncidence(f, u, v, camera, R_W_C);
       view->depth_m(u, v) = z;
-      view->instance(u, v) = face_instance_[f];
-      view->semantic(u, v) = face_semantic_[f];
+      const int32_t instance = face_instance_.empty() ? 0 : face_instance_[f];
+      view->instance(u, v) = instance;
+      view->semantic(u, v) = face_semantic_.empty() ? 0 : face_semantic_[f];
       view->cos_incidence(u, v) = cos_i;
       // Headlight shading times a 3D sine texture whose phase depends on the instance, so
       // colour carries surface information a network or a photometric term could use.
       const Eigen::Vector3f p_W = R_W_C * (ray_C * z) + t_W_C;
-      const float phase = 0.7f * static_cast<float>(face_instance_[f] % 7);
+      const float phase = 0.7f * static_cast<float>(instance % 7);
       const float pattern = std::sin(two_pi_over_cell * p_W.x() + phase) *
                             std::sin(two_pi_over_cell * p_W.y() + 2.0f * phase) *
                             std::sin(two_pi_over_cell * p_W.z() + 3.0f * phase);
       const float shade = (config_.ambient + (1.0f - config_.ambient) * cos_i) *
                           (1.0f - config_.texture_contrast * (0.5f + 0.5f * pattern));
-      const Rgb8 base = face_color_[f];
+      const Rgb8 base = face_color_.empty() ? Rgb8{180, 180, 180} : face_color_[f];
       view->color(u, v) = Rgb8{static_cast<uint8_t>(std::min(255.0f, base.r * shade + 0.5f)),
                                static_cast<uint8_t>(std::min(255.0f, base.g * shade + 0.5f)),
                                static_cast<uint8_t>(std::min(255.0f, base.b * shade + 0.5f))};

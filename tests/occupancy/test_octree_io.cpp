@@ -3,6 +3,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <set>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -85,6 +87,39 @@ TEST_F(SceneMap, BinaryDataRoundTripIsExact) {
     }
   }
   EXPECT_GT(cells, 10000u);
+}
+
+// toOcTree() prunes each 64-cell octant as its last block goes in (to bound its memory on
+// large maps): the tree must be the one that setting every cell, in any order, and pruning once
+// gives. The scene spans 6 m, so many octants.
+TEST_F(SceneMap, PruningOctantByOctantGivesTheTreeOfOnePruneAtTheEnd) {
+  const auto ours = map_->toOcTree();
+  octomap::OcTree reference(ours->getResolution());
+  reference.setClampingThresMin(ours->getClampingThresMin());
+  reference.setClampingThresMax(ours->getClampingThresMax());
+  reference.setOccupancyThres(ours->getOccupancyThres());
+  reference.setProbHit(ours->getProbHit());
+  reference.setProbMiss(ours->getProbMiss());
+  size_t cells = 0, octants = 0;
+  std::set<std::tuple<int, int, int>> seen_octants;
+  for (const auto& block : map_->grid().blocks()) {
+    for (int n = 0; n < kOccupancyBlockCells; ++n) {
+      if (block->cells[n].last_frame == 0) continue;
+      const CellKey key = block->corner + CellKey(n % 8, (n / 8) % 8, n / 64);
+      const bool occupied = map_->occupancyAt(map_->grid().centreOf(key)) == Occupancy::kOccupied;
+      reference.setNodeValue(
+          octomap::OcTreeKey(key.x(), key.y(), key.z()),
+          occupied ? reference.getClampingThresMaxLog() : reference.getClampingThresMinLog(), true);
+      ++cells;
+      octants += seen_octants.insert({key.x() >> 6, key.y() >> 6, key.z() >> 6}).second;
+    }
+  }
+  reference.prune();
+  reference.updateInnerOccupancy();
+  EXPECT_GT(cells, 10000u);
+  EXPECT_GE(octants, 4u);
+  EXPECT_EQ(ours->size(), reference.size());
+  EXPECT_EQ(toBinaryData(*ours), toBinaryData(reference));
 }
 
 TEST_F(SceneMap, BtFileRoundTripAndOctomapsOwnReader) {

@@ -164,6 +164,65 @@ TEST(MapFile, CorruptionIsNamedWithFileAndOffset) {
   EXPECT_NE(error({'P', 'A', 'N'}).find("m.panmap: truncated"), std::string::npos);
 }
 
+// load() streams the file (parsing as it reads, the checksum compared at the end) instead of
+// reading it whole first: the same map and the same one-line errors as deserialize().
+TEST(MapFile, LoadingAFileGivesWhatDeserializingItsBytesGives) {
+  test::TempDir dir;
+  Mapper mapper(test::streamMapperConfig());
+  integrate(&mapper, test::syntheticStream(), 0);
+  const std::vector<uint8_t> bytes = mapper.serialize();
+  const size_t size = bytes.size();
+  const std::string path = dir.path("m.panmap");
+  auto write = [&](const std::vector<uint8_t>& b) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc)
+        .write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+  };
+  auto loadError = [&](const std::vector<uint8_t>& b) -> std::string {
+    write(b);
+    try {
+      Mapper::load(path);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  auto deserializeError = [&](const std::vector<uint8_t>& b) -> std::string {
+    try {
+      Mapper::deserialize(b, path);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  write(bytes);
+  EXPECT_EQ(Mapper::load(path)->serialize(), bytes);
+
+  std::vector<std::vector<uint8_t>> bad;
+  bad.emplace_back(bytes.begin(), bytes.begin() + static_cast<long>(size / 3));  // truncated
+  bad.push_back(bytes);
+  bad.back().push_back(0);  // overlong
+  bad.push_back(bytes);
+  bad.back()[size / 2] ^= 0x40;  // a voxel byte: parses, the checksum disagrees
+  bad.push_back(bytes);
+  bad.back()[size - 1] ^= 0x01;  // the checksum itself
+  // Early payload bytes (the config) set to 0xFF: whatever the parsing makes of them first, the
+  // error names the corruption.
+  bad.push_back(bytes);
+  for (size_t i = 0; i < 8; ++i) bad.back()[100 + i] = 0xFF;
+  bad.push_back({'P', 'A', 'N'});
+  bad.push_back({'N', 'O', 'T', 'A', 'M', 'A', 'P', '!', 0, 0, 0, 0});
+  for (const std::vector<uint8_t>& b : bad) {
+    const std::string expected = deserializeError(b);
+    EXPECT_FALSE(expected.empty());
+    EXPECT_EQ(loadError(b), expected);
+  }
+  EXPECT_NE(loadError(bad[2]).find("checksum mismatch"), std::string::npos);
+  EXPECT_NE(loadError(bad[4]).find("checksum mismatch"), std::string::npos);
+  EXPECT_EQ(loadError(bad[1]), path + ": overlong map file (" + std::to_string(size + 1) +
+                                   " bytes; the header at offset 12 announces " +
+                                   std::to_string(size) + ")");
+}
+
 TEST(AtomicFile, ReplacesWholeFilesAndNamesFailures) {
   test::TempDir dir;
   const std::string path = dir.path("f.bin");

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -195,6 +196,71 @@ TEST(Renderer, CullingLeavesTheImageBitIdentical) {
       }
     }
     EXPECT_GT(drawn, 10000) << "the view must see part of the scene";
+  }
+}
+
+// renderFaces() reports what render() shades: the same pixels, the same incidence, and the
+// colour of each pixel's face (its first vertex) shaded by it.
+TEST(Renderer, RenderFacesGivesTheFacesAndAnglesThatRenderShades) {
+  LabelledMesh mesh;
+  addBox(&mesh, {2.0f, -0.5f, -0.5f}, {3.0f, 0.5f, 0.5f}, 4, 5);
+  addQuad(&mesh, {4, -3, -2}, {4, 3, -2}, {4, 3, 2}, {4, -3, 2}, 6, 1);
+  for (size_t v = 0; v < mesh.colors.size(); ++v) {
+    mesh.colors[v] = Rgb8{static_cast<uint8_t>(v * 37), static_cast<uint8_t>(v * 11), 90};
+  }
+  RenderConfig config;
+  config.texture_contrast = 0.0f;
+  const MeshRenderer renderer(mesh, config);
+  const Eigen::Isometry3d T_W_C = lookAlong({0.0, 0.7, 0.4}, {1.0, -0.2, -0.1});
+  const RenderedView view = renderer.render(kCamera, T_W_C);
+  Image<int32_t> face;
+  Image<float> cos_incidence;
+  renderer.renderFaces(kCamera, T_W_C, &face, &cos_incidence);
+  int box = 0, wall = 0;
+  for (int v = 0; v < kCamera.height; ++v) {
+    for (int u = 0; u < kCamera.width; ++u) {
+      const int32_t f = face(u, v);
+      ASSERT_EQ(f >= 0, view.depth_m(u, v) > 0.0f) << u << "," << v;
+      if (f < 0) continue;
+      ASSERT_LT(f, static_cast<int32_t>(mesh.faces.size()));
+      const int32_t first = mesh.faces[f][0];
+      EXPECT_EQ(mesh.instance[first], view.instance(u, v));
+      ASSERT_EQ(cos_incidence(u, v), view.cos_incidence(u, v)) << u << "," << v;
+      const float shade = config.ambient + (1.0f - config.ambient) * cos_incidence(u, v);
+      const Rgb8 base = mesh.colors[first], got = view.color(u, v);
+      EXPECT_EQ(got.r, static_cast<uint8_t>(std::min(255.0f, base.r * shade + 0.5f)));
+      EXPECT_EQ(got.g, static_cast<uint8_t>(std::min(255.0f, base.g * shade + 0.5f)));
+      EXPECT_EQ(got.b, static_cast<uint8_t>(std::min(255.0f, base.b * shade + 0.5f)));
+      (view.instance(u, v) == 4 ? box : wall) += 1;
+    }
+  }
+  EXPECT_GT(box, 1000);
+  EXPECT_GT(wall, 1000);
+}
+
+// A mesh without labels or colours renders grey with no labels (the renderer then keeps no
+// per-face arrays for them); taking the mesh over gives the same image as copying it.
+TEST(Renderer, AMeshWithoutLabelsOrColoursRendersGreyAndUnlabelled) {
+  LabelledMesh mesh;
+  addQuad(&mesh, {3, -1, -1}, {3, 1, -1}, {3, 1, 1}, {3, -1, 1}, 1, 1);
+  mesh.instance.clear();
+  mesh.semantic.clear();
+  mesh.colors.clear();
+  RenderConfig config;
+  config.texture_contrast = 0.0f;
+  config.ambient = 1.0f;
+  const MeshRenderer copied(mesh, config);
+  const MeshRenderer moved(LabelledMesh(mesh), config);
+  const Eigen::Isometry3d T_W_C = lookAlong({0.0, 0.0, 0.0}, {1.0, 0.0, 0.0});
+  const RenderedView a = copied.render(kCamera, T_W_C), b = moved.render(kCamera, T_W_C);
+  ASSERT_GT(a.depth_m(320, 240), 0.0f);
+  EXPECT_EQ(a.color(320, 240).r, 180);
+  EXPECT_EQ(a.color(320, 240).b, 180);
+  EXPECT_EQ(a.instance(320, 240), 0);
+  EXPECT_EQ(a.semantic(320, 240), 0);
+  for (size_t i = 0; i < a.color.size(); ++i) {
+    ASSERT_EQ(a.depth_m.data()[i], b.depth_m.data()[i]);
+    ASSERT_EQ(a.color.data()[i].g, b.color.data()[i].g);
   }
 }
 

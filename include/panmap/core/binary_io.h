@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -72,13 +73,32 @@ class BinaryWriter {
   size_t flushed_ = 0;
 };
 
-/// Reads plain values back, refusing to read past the end (Error naming `what`).
+/// Where a streaming BinaryReader pulls its bytes from: a file, a checksum.
+class ByteSource {
+ public:
+  virtual ~ByteSource() = default;
+  /// Copies the next `size` bytes into `out`; throws Error when they cannot all be read.
+  virtual void read(uint8_t* out, size_t size) = 0;
+};
+
+/// Reads plain values back, refusing to read past the end (Error naming `what`). Either over a
+/// buffer held in memory, or streamed from a ByteSource through a small window, so that a large
+/// input (a map file) never has to be held whole in memory.
 class BinaryReader {
  public:
+  /// Reads `size` bytes held in memory.
   /// @param what names the source in error messages (e.g. the file)
   /// @param base_offset where `data` starts in that source, so errors name source offsets
   BinaryReader(const uint8_t* data, size_t size, std::string what, size_t base_offset = 0)
-      : data_(data), size_(size), what_(std::move(what)), base_(base_offset) {}
+      : data_(data), size_(size), window_end_(size), what_(std::move(what)), base_(base_offset) {}
+  /// Streams `size` bytes from `source` (not owned) through a window of `window_bytes`.
+  BinaryReader(ByteSource* source, size_t size, std::string what, size_t base_offset = 0,
+               size_t window_bytes = size_t{1} << 20)
+      : size_(size),
+        what_(std::move(what)),
+        base_(base_offset),
+        source_(source),
+        window_(std::max<size_t>(window_bytes, 1)) {}
   /// Reads a trivially copyable value.
   template <typename T>
   T get() {
@@ -94,8 +114,12 @@ class BinaryReader {
                   std::to_string(base_ + pos_) + ")");
     // memcpy with a null pointer is undefined even for 0 bytes (an empty vector's data()).
     if (size == 0) return;
-    std::memcpy(out, data_ + pos_, size);
-    pos_ += size;
+    if (size <= window_end_ - pos_) {
+      std::memcpy(out, data_ + (pos_ - window_start_), size);
+      pos_ += size;
+      return;
+    }
+    refill(static_cast<uint8_t*>(out), size);
   }
   /// Reads a count and checks that at least count * min_item_bytes remain (so corrupt counts
   /// fail cleanly instead of allocating gigabytes).
@@ -116,13 +140,46 @@ class BinaryReader {
   }
   /// Bytes not read yet.
   size_t remaining() const { return size_ - pos_; }
+  /// Reads and drops what is left (a streamed source is then read to its end, e.g. so that a
+  /// checksum over it is complete).
+  void skipRest() {
+    uint8_t scratch[4096];
+    while (remaining() > 0) getBytes(scratch, std::min(sizeof(scratch), remaining()));
+  }
 
  private:
-  const uint8_t* data_;
+  // The slow path of a streamed read: what the window holds, then whole reads straight into
+  // `out` for large requests, else a new window. Only reached with a source: in memory the
+  // window is the whole buffer and getBytes() checked the size.
+  void refill(uint8_t* out, size_t size) {
+    const size_t held = window_end_ - pos_;
+    if (held > 0) std::memcpy(out, data_ + (pos_ - window_start_), held);
+    out += held;
+    size -= held;
+    pos_ += held;
+    if (size >= window_.size()) {
+      source_->read(out, size);
+      pos_ += size;
+      window_start_ = window_end_ = pos_;
+      return;
+    }
+    const size_t n = std::min(window_.size(), size_ - pos_);
+    source_->read(window_.data(), n);
+    data_ = window_.data();
+    window_start_ = pos_;
+    window_end_ = pos_ + n;
+    std::memcpy(out, data_, size);
+    pos_ += size;
+  }
+
+  const uint8_t* data_ = nullptr;  // the window's bytes: source bytes window_start_ onwards
   size_t size_;
   size_t pos_ = 0;
+  size_t window_start_ = 0, window_end_ = 0;
   std::string what_;
   size_t base_ = 0;
+  ByteSource* source_ = nullptr;
+  std::vector<uint8_t> window_;
 };
 
 }  // namespace panmap

@@ -35,4 +35,22 @@ std::vector<int32_t> readPlyVertexIntProperty(const std::string& path, const std
 void writePly(const std::string& path, const LabelledMesh& mesh,
               PlyFormat format = PlyFormat::kBinaryLittleEndian);
 
+/// A mesh's arrays as writePly(PlyColumns) takes them (not owned), so that several files can
+/// share one mesh with other colours or labels without a copy each. A null column is not
+/// written; a label column pointing to an empty vector is written as zeros.
+struct PlyColumns {
+  const std::vector<Eigen::Vector3f>* vertices = nullptr;  ///< required
+  const std::vector<Eigen::Vector3i>* faces = nullptr;     ///< null: an empty face element
+  const std::vector<Rgb8>* colors = nullptr;
+  const std::vector<int32_t>* semantic = nullptr;
+  const std::vector<int32_t>* instance = nullptr;
+  const std::vector<int32_t>* superpoint = nullptr;
+};
+
+/// writePly() of the given columns, in the same layout; streamed to the file in chunks of
+/// about 1 MiB, never held whole in memory. Throws Error naming the file when it cannot be
+/// written, a column's length differs from the vertices', or a face index is out of range.
+void writePly(const std::string& path, const PlyColumns& columns,
+              PlyFormat format = PlyFormat::kBinaryLittleEndian);
+
 }  // namespace panmap

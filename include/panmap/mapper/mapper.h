@@ -156,10 +156,11 @@ struct ReintegrationStats {
   size_t frames_with_kept_segments = 0;
 };
 
-/// The mapping core: takes (RGB-D frame, T_W_C, panoptic segmentation) and keeps a label-TSDF
-/// whose voxels belong to semantically consistent super-points. No middleware inside.
+class BinaryReader;
 class FramePrefetcher;
 
+/// The mapping core: takes (RGB-D frame, T_W_C, panoptic segmentation) and keeps a label-TSDF
+/// whose voxels belong to semantically consistent super-points. No middleware inside.
 class Mapper {
  public:
   /// Throws Error when the config is invalid.
@@ -295,6 +296,10 @@ class Mapper {
                                              const std::string& what);
 
  private:
+  /// The map file's payload after its header (load() and deserialize() check the header and
+  /// the checksum); throws Error naming `what` and the offset where it is malformed.
+  static std::unique_ptr<Mapper> parsePayload(BinaryReader* reader, uint32_t version,
+                                              const std::string& what);
   void validate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
                 const PanopticFrame* panoptic) const;
   /// Throws Error (prefixed with `what`) unless `poses` are rigid and have trajectory()'s

@@ -41,6 +41,8 @@ class MeshRenderer {
  public:
   /// Precomputes face normals and labels. Throws Error if the mesh is inconsistent.
   explicit MeshRenderer(const LabelledMesh& mesh, const RenderConfig& config = RenderConfig());
+  /// The same, taking the mesh over instead of copying it (a whole map's mesh is hundreds of MB).
+  explicit MeshRenderer(LabelledMesh&& mesh, const RenderConfig& config = RenderConfig());
 
   /// Renders the view of a camera at T_W_C (camera to world, optical frame).
   RenderedView render(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C) const;
@@ -48,6 +50,12 @@ class MeshRenderer {
   /// Renders into an existing view (reuses its buffers: no allocation after the first frame).
   void render(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
               RenderedView* view) const;
+
+  /// What render() shades, without the shading: the index of the face each pixel sees (-1 =
+  /// none) and |cos| of its incidence angle (0 where no face). For pictures of one view in
+  /// several colourings, rasterised once.
+  void renderFaces(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
+                   Image<int32_t>* face, Image<float>* cos_incidence) const;
 
   /// The mesh being rendered.
   const LabelledMesh& mesh() const { return mesh_; }
@@ -69,6 +77,11 @@ class MeshRenderer {
                 Scratch* scratch) const;
   void rasterise(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
                  Scratch* scratch) const;
+  /// Clears the scratch's buffers for `camera`, rasterises, and returns the scratch.
+  Scratch& rasteriseView(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C) const;
+  /// |cos| of the angle between face f and the ray through pixel (u, v).
+  float cosIncidence(int32_t f, int u, int v, const PinholeCamera& camera,
+                     const Eigen::Matrix3f& R_W_C) const;
 
   LabelledMesh mesh_;
   RenderConfig config_;
