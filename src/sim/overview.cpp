@@ -25,24 +25,17 @@ std::vector<ColorImage> renderOverviews(const LabelledMesh& mesh,
   }
   Eigen::AlignedBox3f box;
   for (const auto& v : mesh.vertices) box.extend(v);
-  // Drop the faces near the top, so a room's interior shows. Only positions and faces go to
-  // the renderer: the colourings are applied to the faces it reports.
-  const float top = box.max().z() - 0.2f;
-  auto kept = [&](const Eigen::Vector3i& f) {
-    return !(mesh.vertices[f[0]].z() > top && mesh.vertices[f[1]].z() > top &&
-             mesh.vertices[f[2]].z() > top);
-  };
-  LabelledMesh cut;
-  cut.vertices = mesh.vertices;
-  cut.faces.reserve(static_cast<size_t>(std::count_if(mesh.faces.begin(), mesh.faces.end(), kept)));
-  for (const auto& f : mesh.faces) {
-    if (kept(f)) cut.faces.push_back(f);
-  }
   RenderConfig config;
   config.texture_contrast = 0.0f;
   config.ambient = 0.45f;
   config.far_m = 1000.0f;
-  const MeshRenderer renderer(std::move(cut), config);
+  // Drop the faces near the top, so a room's interior shows.
+  config.max_face_height_m = box.max().z() - 0.2f;
+  // The mesh is shared, not copied, and no per-face array is kept: only the picture's faces
+  // are shaded, by the colourings below.
+  config.keep_face_normals = false;
+  const MeshRenderer renderer(
+      std::shared_ptr<const LabelledMesh>(std::shared_ptr<const LabelledMesh>(), &mesh), config);
   const Eigen::Vector3d centre = box.center().cast<double>();
   const Eigen::Vector3d size = box.sizes().cast<double>();
   const double extent = std::max(size.x(), size.y());

@@ -22,6 +22,7 @@ void RenderConfig::check() const {
   if (!(far_m > near_m)) throw Error("render far_m must exceed near_m");
   if (!(ambient >= 0.0f && ambient <= 1.0f)) throw Error("render ambient must be in [0, 1]");
   if (!(texture_cell_m > 0.0f)) throw Error("render texture_cell_m must be > 0");
+  if (std::isnan(max_face_height_m)) throw Error("render max_face_height_m must be a number");
   if (!(texture_contrast >= 0.0f && texture_contrast <= 1.0f)) {
     throw Error("render texture_contrast must be in [0, 1]");
   }
@@ -35,29 +36,24 @@ struct MeshRenderer::Scratch {
 };
 
 MeshRenderer::MeshRenderer(const LabelledMesh& mesh, const RenderConfig& config)
-    : MeshRenderer(LabelledMesh(mesh), config) {}
+    : MeshRenderer(std::make_shared<const LabelledMesh>(mesh), config) {}
 
-MeshRenderer::MeshRenderer(LabelledMesh&& moved, const RenderConfig& config)
-    : mesh_(std::move(moved)), config_(config) {
+MeshRenderer::MeshRenderer(LabelledMesh&& mesh, const RenderConfig& config)
+    : MeshRenderer(std::make_shared<const LabelledMesh>(std::move(mesh)), config) {}
+
+MeshRenderer::MeshRenderer(std::shared_ptr<const LabelledMesh> shared, const RenderConfig& config)
+    : mesh_(std::move(shared)), config_(config) {
   config_.check();
-  const LabelledMesh& mesh = mesh_;
+  if (!mesh_) throw Error("renderer: no mesh");
+  const LabelledMesh& mesh = *mesh_;
   const std::string problem = mesh.check();
   if (!problem.empty()) throw Error("renderer: mesh is inconsistent: " + problem);
   const size_t n = mesh.faces.size();
-  face_normals_W_.resize(n);
-  // A mesh without labels or colours gets no per-face array for them (0 labels, grey): a whole
-  // map's overview renders 14 M faces.
-  if (!mesh.instance.empty()) face_instance_.resize(n);
-  if (!mesh.semantic.empty()) face_semantic_.resize(n);
-  if (!mesh.colors.empty()) face_color_.resize(n);
-  for (size_t f = 0; f < n; ++f) {
-    const Eigen::Vector3i& t = mesh.faces[f];
-    const Eigen::Vector3f e1 = mesh.vertices[t[1]] - mesh.vertices[t[0]];
-    const Eigen::Vector3f e2 = mesh.vertices[t[2]] - mesh.vertices[t[0]];
-    face_normals_W_[f] = e1.cross(e2).normalized();
-    if (!mesh.instance.empty()) face_instance_[f] = mesh.instance[t[0]];
-    if (!mesh.semantic.empty()) face_semantic_[f] = mesh.semantic[t[0]];
-    if (!mesh.colors.empty()) face_color_[f] = mesh.colors[t[0]];
+  // Labels and colours are read through the mesh (a face takes its first vertex's): no per-face
+  // copies, a whole map's overview renders 14 M faces.
+  if (config_.keep_face_normals) {
+    face_normals_W_.resize(n);
+    for (size_t f = 0; f < n; ++f) face_normals_W_[f] = faceNormal(static_cast<int32_t>(f));
   }
   for (size_t first = 0; first < n; first += kRunFaces) {
     FaceRun run;
@@ -75,6 +71,14 @@ MeshRenderer::MeshRenderer(LabelledMesh&& moved, const RenderConfig& config)
     }
     runs_.push_back(run);
   }
+}
+
+Eigen::Vector3f MeshRenderer::faceNormal(int32_t f) const {
+  const LabelledMesh& mesh = *mesh_;
+  const Eigen::Vector3i& t = mesh.faces[f];
+  const Eigen::Vector3f e1 = mesh.vertices[t[1]] - mesh.vertices[t[0]];
+  const Eigen::Vector3f e2 = mesh.vertices[t[2]] - mesh.vertices[t[0]];
+  return e1.cross(e2).normalized();
 }
 
 RenderedView MeshRenderer::render(const PinholeCamera& camera,
@@ -172,14 +176,14 @@ void MeshRenderer::rasterise(const PinholeCamera& camera, const Eigen::Isometry3
   const Eigen::Isometry3f T_C_W = T_W_C.inverse().cast<float>();
   const std::vector<const FaceRun*> runs = visibleRuns(camera, T_C_W);
   // Transform the vertices the visible runs use: the union of their index ranges.
-  s->points_C.resize(mesh_.vertices.size());
+  s->points_C.resize(mesh_->vertices.size());
   std::vector<std::pair<int32_t, int32_t>> ranges;
   for (const FaceRun* run : runs) ranges.push_back({run->first_vertex, run->end_vertex});
   std::sort(ranges.begin(), ranges.end());
   int32_t done = 0;
   for (const auto& [first, end] : ranges) {
     for (int32_t i = std::max(first, done); i < end; ++i)
-      s->points_C[i] = T_C_W * mesh_.vertices[i];
+      s->points_C[i] = T_C_W * mesh_->vertices[i];
     done = std::max(done, end);
   }
   const float near = config_.near_m;
@@ -193,7 +197,12 @@ void MeshRenderer::rasterise(const PinholeCamera& camera, const Eigen::Isometry3
 
 void MeshRenderer::drawFace(const PinholeCamera& camera, int32_t f, float near, float far,
                             Scratch* s) const {
-  const Eigen::Vector3i& t = mesh_.faces[f];
+  const Eigen::Vector3i& t = mesh_->faces[f];
+  if (config_.max_face_height_m < std::numeric_limits<float>::infinity()) {
+    const std::vector<Eigen::Vector3f>& v = mesh_->vertices;
+    const float top = config_.max_face_height_m;
+    if (v[t[0]].z() > top && v[t[1]].z() > top && v[t[2]].z() > top) return;
+  }
   const Eigen::Vector3f* p[3] = {&s->points_C[t[0]], &s->points_C[t[1]], &s->points_C[t[2]]};
   const int in_front = (p[0]->z() >= near) + (p[1]->z() >= near) + (p[2]->z() >= near);
   if (in_front == 0) return;
@@ -245,7 +254,8 @@ float MeshRenderer::cosIncidence(int32_t f, int u, int v, const PinholeCamera& c
                               (v - static_cast<float>(camera.cy)) / static_cast<float>(camera.fy),
                               1.0f);
   const Eigen::Vector3f ray_W = R_W_C * ray_C.normalized();
-  return std::abs(face_normals_W_[f].dot(ray_W));
+  const Eigen::Vector3f n = face_normals_W_.empty() ? faceNormal(f) : face_normals_W_[f];
+  return std::abs(n.dot(ray_W));
 }
 
 void MeshRenderer::renderFaces(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
@@ -297,9 +307,10 @@ void MeshRenderer::render(const PinholeCamera& camera, const Eigen::Isometry3d& 
           (v - static_cast<float>(camera.cy)) / static_cast<float>(camera.fy), 1.0f);
       const float cos_i = cosIncidence(f, u, v, camera, R_W_C);
       view->depth_m(u, v) = z;
-      const int32_t instance = face_instance_.empty() ? 0 : face_instance_[f];
+      const int32_t first = mesh_->faces[f][0];
+      const int32_t instance = mesh_->instance.empty() ? 0 : mesh_->instance[first];
       view->instance(u, v) = instance;
-      view->semantic(u, v) = face_semantic_.empty() ? 0 : face_semantic_[f];
+      view->semantic(u, v) = mesh_->semantic.empty() ? 0 : mesh_->semantic[first];
       view->cos_incidence(u, v) = cos_i;
       // Headlight shading times a 3D sine texture whose phase depends on the instance, so
       // colour carries surface information a network or a photometric term could use.
@@ -310,7 +321,7 @@ void MeshRenderer::render(const PinholeCamera& camera, const Eigen::Isometry3d& 
                             std::sin(two_pi_over_cell * p_W.z() + 3.0f * phase);
       const float shade = (config_.ambient + (1.0f - config_.ambient) * cos_i) *
                           (1.0f - config_.texture_contrast * (0.5f + 0.5f * pattern));
-      const Rgb8 base = face_color_.empty() ? Rgb8{180, 180, 180} : face_color_[f];
+      const Rgb8 base = mesh_->colors.empty() ? Rgb8{180, 180, 180} : mesh_->colors[first];
       view->color(u, v) = Rgb8{static_cast<uint8_t>(std::min(255.0f, base.r * shade + 0.5f)),
                                static_cast<uint8_t>(std::min(255.0f, base.g * shade + 0.5f)),
                                static_cast<uint8_t>(std::min(255.0f, base.b * shade + 0.5f))};

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <limits>
+#include <memory>
+
 #include <cstdint>
 #include <vector>
 
@@ -31,6 +34,12 @@ struct RenderConfig {
   /// Skip runs of consecutive faces whose bounds lie wholly outside the view frustum. The
   /// image is bit-identical either way (faces keep their order); off only to test that.
   bool cull = true;
+  /// Faces whose three corners all lie higher than this (world z, metres) are not drawn: an
+  /// overview's ceiling cut away. Infinite: every face.
+  float max_face_height_m = std::numeric_limits<float>::infinity();
+  /// Keep every face's normal (12 bytes a face) for shading; off: each shaded pixel computes
+  /// its face's, bit for bit the same, for meshes too large to hold twice (a building's).
+  bool keep_face_normals = true;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -43,6 +52,9 @@ class MeshRenderer {
   explicit MeshRenderer(const LabelledMesh& mesh, const RenderConfig& config = RenderConfig());
   /// The same, taking the mesh over instead of copying it (a whole map's mesh is hundreds of MB).
   explicit MeshRenderer(LabelledMesh&& mesh, const RenderConfig& config = RenderConfig());
+  /// The same, sharing the mesh (never changed through it).
+  explicit MeshRenderer(std::shared_ptr<const LabelledMesh> mesh,
+                        const RenderConfig& config = RenderConfig());
 
   /// Renders the view of a camera at T_W_C (camera to world, optical frame).
   RenderedView render(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C) const;
@@ -58,7 +70,7 @@ class MeshRenderer {
                    Image<int32_t>* face, Image<float>* cos_incidence) const;
 
   /// The mesh being rendered.
-  const LabelledMesh& mesh() const { return mesh_; }
+  const LabelledMesh& mesh() const { return *mesh_; }
 
  private:
   struct Scratch;
@@ -83,12 +95,12 @@ class MeshRenderer {
   float cosIncidence(int32_t f, int u, int v, const PinholeCamera& camera,
                      const Eigen::Matrix3f& R_W_C) const;
 
-  LabelledMesh mesh_;
+  /// Face f's unit normal in the world frame.
+  Eigen::Vector3f faceNormal(int32_t f) const;
+
+  std::shared_ptr<const LabelledMesh> mesh_;
   RenderConfig config_;
-  std::vector<Eigen::Vector3f> face_normals_W_;
-  std::vector<int32_t> face_instance_;
-  std::vector<int32_t> face_semantic_;
-  std::vector<Rgb8> face_color_;
+  std::vector<Eigen::Vector3f> face_normals_W_;  // empty without keep_face_normals
   std::vector<FaceRun> runs_;
 };
 
