@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include <gtest/gtest.h>
 
@@ -262,6 +263,49 @@ TEST(Renderer, AMeshWithoutLabelsOrColoursRendersGreyAndUnlabelled) {
     ASSERT_EQ(a.depth_m.data()[i], b.depth_m.data()[i]);
     ASSERT_EQ(a.color.data()[i].g, b.color.data()[i].g);
   }
+}
+
+// The overview's options: a shared mesh, faces above a height left out, normals computed per
+// pixel instead of kept; the image otherwise the same bits.
+TEST(Renderer, SharedMeshHeightCutAndPerPixelNormalsGiveTheSameImage) {
+  LabelledMesh mesh;
+  addQuad(&mesh, {4, -3, -2}, {4, 3, -2}, {4, 3, 4}, {4, -3, 4}, 1, 1);            // a wall x = 4
+  addQuad(&mesh, {3, -1, 1.5f}, {3, 1, 1.5f}, {3, 1, 1.8f}, {3, -1, 1.8f}, 2, 2);  // high panel
+  addBox(&mesh, {2.0f, -0.5f, -0.5f}, {2.5f, 0.5f, 0.5f}, 3, 3);
+  const auto shared = std::make_shared<const LabelledMesh>(mesh);
+  RenderConfig lean;
+  lean.keep_face_normals = false;
+  const MeshRenderer kept(mesh), computed(shared, lean);
+  EXPECT_EQ(&computed.mesh(), shared.get());
+  const Eigen::Isometry3d T_W_C = lookAlong({0.0, 0.3, 0.5}, {1.0, -0.1, 0.1});
+  const RenderedView a = kept.render(kCamera, T_W_C), b = computed.render(kCamera, T_W_C);
+  int panel = 0;
+  for (size_t i = 0; i < a.depth_m.size(); ++i) {
+    ASSERT_EQ(a.depth_m.data()[i], b.depth_m.data()[i]);
+    ASSERT_EQ(a.cos_incidence.data()[i], b.cos_incidence.data()[i]);
+    ASSERT_EQ(a.color.data()[i].r, b.color.data()[i].r);
+    ASSERT_EQ(a.instance.data()[i], b.instance.data()[i]);
+    panel += a.instance.data()[i] == 2;
+  }
+  ASSERT_GT(panel, 500);
+  // Cut above 1.4 m: the panel (1.5-1.8 m) goes, the wall behind it shows there instead; the
+  // wall's faces reach above the cut but have corners below it, so they stay.
+  RenderConfig cut;
+  cut.max_face_height_m = 1.4f;
+  const RenderedView c = MeshRenderer(shared, cut).render(kCamera, T_W_C);
+  int wall_where_panel = 0;
+  for (size_t i = 0; i < a.depth_m.size(); ++i) {
+    ASSERT_NE(c.instance.data()[i], 2);
+    if (a.instance.data()[i] == 2) wall_where_panel += c.instance.data()[i] == 1;
+    if (a.instance.data()[i] != 2) {
+      ASSERT_EQ(c.depth_m.data()[i], a.depth_m.data()[i]);
+    }
+  }
+  EXPECT_EQ(wall_where_panel, panel);
+  RenderConfig bad;
+  bad.max_face_height_m = std::nanf("");
+  EXPECT_THROW(MeshRenderer(shared, bad), Error);
+  EXPECT_THROW(MeshRenderer(std::shared_ptr<const LabelledMesh>(), RenderConfig()), Error);
 }
 
 TEST(Renderer, RejectsBadInput) {
