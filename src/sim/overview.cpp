@@ -33,7 +33,7 @@ std::vector<ColorImage> renderOverviews(const LabelledMesh& mesh,
   config.max_face_height_m = box.max().z() - 0.2f;
   // The mesh is shared, not copied, and no per-face array is kept: only the picture's faces
   // are shaded, by the colourings below.
-  config.keep_face_normals = false;
+  config.keep_face_data = false;
   const MeshRenderer renderer(
       std::shared_ptr<const LabelledMesh>(std::shared_ptr<const LabelledMesh>(), &mesh), config);
   const Eigen::Vector3d centre = box.center().cast<double>();

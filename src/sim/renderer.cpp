@@ -49,11 +49,20 @@ MeshRenderer::MeshRenderer(std::shared_ptr<const LabelledMesh> shared, const Ren
   const std::string problem = mesh.check();
   if (!problem.empty()) throw Error("renderer: mesh is inconsistent: " + problem);
   const size_t n = mesh.faces.size();
-  // Labels and colours are read through the mesh (a face takes its first vertex's): no per-face
-  // copies, a whole map's overview renders 14 M faces.
-  if (config_.keep_face_normals) {
+  // A face takes its first vertex's labels and colour: copied per face for speed (the simulator
+  // renders thousands of frames), or read through the mesh (an overview of a whole map, once).
+  if (config_.keep_face_data) {
     face_normals_W_.resize(n);
-    for (size_t f = 0; f < n; ++f) face_normals_W_[f] = faceNormal(static_cast<int32_t>(f));
+    if (!mesh.instance.empty()) face_instance_.resize(n);
+    if (!mesh.semantic.empty()) face_semantic_.resize(n);
+    if (!mesh.colors.empty()) face_color_.resize(n);
+    for (size_t f = 0; f < n; ++f) {
+      const int32_t first = mesh.faces[f][0];
+      face_normals_W_[f] = faceNormal(static_cast<int32_t>(f));
+      if (!mesh.instance.empty()) face_instance_[f] = mesh.instance[first];
+      if (!mesh.semantic.empty()) face_semantic_[f] = mesh.semantic[first];
+      if (!mesh.colors.empty()) face_color_[f] = mesh.colors[first];
+    }
   }
   for (size_t first = 0; first < n; first += kRunFaces) {
     FaceRun run;
@@ -176,14 +185,15 @@ void MeshRenderer::rasterise(const PinholeCamera& camera, const Eigen::Isometry3
   const Eigen::Isometry3f T_C_W = T_W_C.inverse().cast<float>();
   const std::vector<const FaceRun*> runs = visibleRuns(camera, T_C_W);
   // Transform the vertices the visible runs use: the union of their index ranges.
-  s->points_C.resize(mesh_->vertices.size());
+  const std::vector<Eigen::Vector3f>& vertices = mesh_->vertices;
+  s->points_C.resize(vertices.size());
   std::vector<std::pair<int32_t, int32_t>> ranges;
   for (const FaceRun* run : runs) ranges.push_back({run->first_vertex, run->end_vertex});
   std::sort(ranges.begin(), ranges.end());
   int32_t done = 0;
   for (const auto& [first, end] : ranges) {
     for (int32_t i = std::max(first, done); i < end; ++i)
-      s->points_C[i] = T_C_W * mesh_->vertices[i];
+      s->points_C[i] = T_C_W * vertices[i];
     done = std::max(done, end);
   }
   const float near = config_.near_m;
@@ -248,16 +258,6 @@ MeshRenderer::Scratch& MeshRenderer::rasteriseView(const PinholeCamera& camera,
   return scratch;
 }
 
-float MeshRenderer::cosIncidence(int32_t f, int u, int v, const PinholeCamera& camera,
-                                 const Eigen::Matrix3f& R_W_C) const {
-  const Eigen::Vector3f ray_C((u - static_cast<float>(camera.cx)) / static_cast<float>(camera.fx),
-                              (v - static_cast<float>(camera.cy)) / static_cast<float>(camera.fy),
-                              1.0f);
-  const Eigen::Vector3f ray_W = R_W_C * ray_C.normalized();
-  const Eigen::Vector3f n = face_normals_W_.empty() ? faceNormal(f) : face_normals_W_[f];
-  return std::abs(n.dot(ray_W));
-}
-
 void MeshRenderer::renderFaces(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
                                Image<int32_t>* face, Image<float>* cos_incidence) const {
   Scratch& scratch = rasteriseView(camera, T_W_C);
@@ -270,7 +270,14 @@ void MeshRenderer::renderFaces(const PinholeCamera& camera, const Eigen::Isometr
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const int32_t f = scratch.face(u, v);
-      (*cos_incidence)(u, v) = f < 0 ? 0.0f : cosIncidence(f, u, v, camera, R_W_C);
+      if (f < 0) {
+        (*cos_incidence)(u, v) = 0.0f;
+        continue;
+      }
+      const Eigen::Vector3f ray_C(
+          (u - static_cast<float>(camera.cx)) / static_cast<float>(camera.fx),
+          (v - static_cast<float>(camera.cy)) / static_cast<float>(camera.fy), 1.0f);
+      (*cos_incidence)(u, v) = cosIncidence(f, R_W_C * ray_C.normalized());
     }
   }
 }
@@ -305,12 +312,24 @@ void MeshRenderer::render(const PinholeCamera& camera, const Eigen::Isometry3d& 
       const Eigen::Vector3f ray_C(
           (u - static_cast<float>(camera.cx)) / static_cast<float>(camera.fx),
           (v - static_cast<float>(camera.cy)) / static_cast<float>(camera.fy), 1.0f);
-      const float cos_i = cosIncidence(f, u, v, camera, R_W_C);
+      const float cos_i = cosIncidence(f, R_W_C * ray_C.normalized());
       view->depth_m(u, v) = z;
-      const int32_t first = mesh_->faces[f][0];
-      const int32_t instance = mesh_->instance.empty() ? 0 : mesh_->instance[first];
+      // A face's labels and colour: its own copies, or its first vertex's in the mesh.
+      int32_t instance = 0, semantic = 0;
+      Rgb8 base{180, 180, 180};
+      if (config_.keep_face_data) {
+        if (!face_instance_.empty()) instance = face_instance_[f];
+        if (!face_semantic_.empty()) semantic = face_semantic_[f];
+        if (!face_color_.empty()) base = face_color_[f];
+      } else {
+        const LabelledMesh& mesh = *mesh_;
+        const int32_t first = mesh.faces[f][0];
+        if (!mesh.instance.empty()) instance = mesh.instance[first];
+        if (!mesh.semantic.empty()) semantic = mesh.semantic[first];
+        if (!mesh.colors.empty()) base = mesh.colors[first];
+      }
       view->instance(u, v) = instance;
-      view->semantic(u, v) = mesh_->semantic.empty() ? 0 : mesh_->semantic[first];
+      view->semantic(u, v) = semantic;
       view->cos_incidence(u, v) = cos_i;
       // Headlight shading times a 3D sine texture whose phase depends on the instance, so
       // colour carries surface information a network or a photometric term could use.
@@ -321,7 +340,6 @@ void MeshRenderer::render(const PinholeCamera& camera, const Eigen::Isometry3d& 
                             std::sin(two_pi_over_cell * p_W.z() + 3.0f * phase);
       const float shade = (config_.ambient + (1.0f - config_.ambient) * cos_i) *
                           (1.0f - config_.texture_contrast * (0.5f + 0.5f * pattern));
-      const Rgb8 base = mesh_->colors.empty() ? Rgb8{180, 180, 180} : mesh_->colors[first];
       view->color(u, v) = Rgb8{static_cast<uint8_t>(std::min(255.0f, base.r * shade + 0.5f)),
                                static_cast<uint8_t>(std::min(255.0f, base.g * shade + 0.5f)),
                                static_cast<uint8_t>(std::min(255.0f, base.b * shade + 0.5f))};

@@ -274,7 +274,7 @@ TEST(Renderer, SharedMeshHeightCutAndPerPixelNormalsGiveTheSameImage) {
   addBox(&mesh, {2.0f, -0.5f, -0.5f}, {2.5f, 0.5f, 0.5f}, 3, 3);
   const auto shared = std::make_shared<const LabelledMesh>(mesh);
   RenderConfig lean;
-  lean.keep_face_normals = false;
+  lean.keep_face_data = false;
   const MeshRenderer kept(mesh), computed(shared, lean);
   EXPECT_EQ(&computed.mesh(), shared.get());
   const Eigen::Isometry3d T_W_C = lookAlong({0.0, 0.3, 0.5}, {1.0, -0.1, 0.1});

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <limits>
 #include <memory>
 
@@ -37,9 +38,10 @@ struct RenderConfig {
   /// Faces whose three corners all lie higher than this (world z, metres) are not drawn: an
   /// overview's ceiling cut away. Infinite: every face.
   float max_face_height_m = std::numeric_limits<float>::infinity();
-  /// Keep every face's normal (12 bytes a face) for shading; off: each shaded pixel computes
-  /// its face's, bit for bit the same, for meshes too large to hold twice (a building's).
-  bool keep_face_normals = true;
+  /// Keep every face's normal, labels and colour (up to 23 bytes a face) for fast shading; off:
+  /// each shaded pixel reads them through the mesh (the normal computed bit for bit the same),
+  /// for meshes too large to hold twice (a building's).
+  bool keep_face_data = true;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -91,16 +93,21 @@ class MeshRenderer {
                  Scratch* scratch) const;
   /// Clears the scratch's buffers for `camera`, rasterises, and returns the scratch.
   Scratch& rasteriseView(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C) const;
-  /// |cos| of the angle between face f and the ray through pixel (u, v).
-  float cosIncidence(int32_t f, int u, int v, const PinholeCamera& camera,
-                     const Eigen::Matrix3f& R_W_C) const;
+  /// |cos| of the angle between face f and the unit ray ray_W (inline: once per shaded pixel).
+  float cosIncidence(int32_t f, const Eigen::Vector3f& ray_W) const {
+    return std::abs((face_normals_W_.empty() ? faceNormal(f) : face_normals_W_[f]).dot(ray_W));
+  }
 
   /// Face f's unit normal in the world frame.
   Eigen::Vector3f faceNormal(int32_t f) const;
 
   std::shared_ptr<const LabelledMesh> mesh_;
   RenderConfig config_;
-  std::vector<Eigen::Vector3f> face_normals_W_;  // empty without keep_face_normals
+  // Per face, with keep_face_data (else empty; labels and colours also when the mesh has none).
+  std::vector<Eigen::Vector3f> face_normals_W_;
+  std::vector<int32_t> face_instance_;
+  std::vector<int32_t> face_semantic_;
+  std::vector<Rgb8> face_color_;
   std::vector<FaceRun> runs_;
 };
 
