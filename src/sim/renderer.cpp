@@ -192,8 +192,7 @@ void MeshRenderer::rasterise(const PinholeCamera& camera, const Eigen::Isometry3
   std::sort(ranges.begin(), ranges.end());
   int32_t done = 0;
   for (const auto& [first, end] : ranges) {
-    for (int32_t i = std::max(first, done); i < end; ++i)
-      s->points_C[i] = T_C_W * vertices[i];
+    for (int32_t i = std::max(first, done); i < end; ++i) s->points_C[i] = T_C_W * vertices[i];
     done = std::max(done, end);
   }
   const float near = config_.near_m;
