@@ -13,10 +13,6 @@ OverviewColouring vertexColours(const LabelledMesh& mesh) {
   return [&mesh](size_t v) { return mesh.colors[v]; };
 }
 
-ColorImage renderOverview(const LabelledMesh& mesh, int width, int height) {
-  return renderOverviews(mesh, {vertexColours(mesh)}, width, height).front();
-}
-
 std::vector<ColorImage> renderOverviews(const LabelledMesh& mesh,
                                         const std::vector<OverviewColouring>& colourings, int width,
                                         int height) {
