@@ -64,10 +64,7 @@ std::vector<ColorImage> renderOverviews(const LabelledMesh& mesh,
       }
       // MeshRenderer's shading without texture: headlight plus ambient, rounded.
       const float shade = config.ambient + (1.0f - config.ambient) * cos_incidence.data()[i];
-      const Rgb8 base = colouring(static_cast<size_t>(faces[fi][0]));
-      picture.data()[i] = Rgb8{static_cast<uint8_t>(std::min(255.0f, base.r * shade + 0.5f)),
-                               static_cast<uint8_t>(std::min(255.0f, base.g * shade + 0.5f)),
-                               static_cast<uint8_t>(std::min(255.0f, base.b * shade + 0.5f))};
+      picture.data()[i] = shadedColour(colouring(static_cast<size_t>(faces[fi][0])), shade);
     }
     pictures.push_back(std::move(picture));
   }

@@ -339,9 +339,7 @@ void MeshRenderer::render(const PinholeCamera& camera, const Eigen::Isometry3d& 
                             std::sin(two_pi_over_cell * p_W.z() + 3.0f * phase);
       const float shade = (config_.ambient + (1.0f - config_.ambient) * cos_i) *
                           (1.0f - config_.texture_contrast * (0.5f + 0.5f * pattern));
-      view->color(u, v) = Rgb8{static_cast<uint8_t>(std::min(255.0f, base.r * shade + 0.5f)),
-                               static_cast<uint8_t>(std::min(255.0f, base.g * shade + 0.5f)),
-                               static_cast<uint8_t>(std::min(255.0f, base.b * shade + 0.5f))};
+      view->color(u, v) = shadedColour(base, shade);
     }
   }
 }

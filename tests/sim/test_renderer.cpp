@@ -308,6 +308,21 @@ TEST(Renderer, SharedMeshHeightCutAndPerPixelNormalsGiveTheSameImage) {
   EXPECT_THROW(MeshRenderer(std::shared_ptr<const LabelledMesh>(), RenderConfig()), Error);
 }
 
+TEST(Renderer, ShadedColourRoundsAndSaturates) {
+  const Rgb8 bright = shadedColour(Rgb8{200, 100, 0}, 1.5f);
+  EXPECT_EQ(bright.r, 255);
+  EXPECT_EQ(bright.g, 150);
+  EXPECT_EQ(bright.b, 0);
+  const Rgb8 dim = shadedColour(Rgb8{10, 11, 12}, 0.25f);  // 2.5, 2.75, 3.0 round to 3, 3, 3
+  EXPECT_EQ(dim.r, 3);
+  EXPECT_EQ(dim.g, 3);
+  EXPECT_EQ(dim.b, 3);
+  const Rgb8 half = shadedColour(Rgb8{1, 3, 255}, 0.5f);  // 0.5, 1.5, 127.5 round half up
+  EXPECT_EQ(half.r, 1);
+  EXPECT_EQ(half.g, 2);
+  EXPECT_EQ(half.b, 128);
+}
+
 TEST(Renderer, RejectsBadInput) {
   LabelledMesh bad;
   bad.vertices = {{0, 0, 0}};

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -45,6 +46,15 @@ struct RenderConfig {
   /// Throws Error naming the bad field.
   void check() const;
 };
+
+/// `base` shaded by `shade` (>= 0), as MeshRenderer colours a pixel: each channel rounded to
+/// the nearest value, saturating at 255.
+inline Rgb8 shadedColour(Rgb8 base, float shade) {
+  auto channel = [shade](uint8_t c) {
+    return static_cast<uint8_t>(std::min(255.0f, static_cast<float>(c) * shade + 0.5f));
+  };
+  return Rgb8{channel(base.r), channel(base.g), channel(base.b)};
+}
 
 /// Rasterises a labelled mesh with a z-buffer (perspective-correct depth, near-plane
 /// clipping, no back-face culling). A face takes the colour and labels of its first vertex.
