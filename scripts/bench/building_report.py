@@ -71,6 +71,18 @@ def fit_slope(samples):
     return slope, icept, dev
 
 
+def idle_scan(run):
+    """The surface-scan refreshes between frames (what the live mapper does while it waits):
+    median / p95 ms, or why there are none."""
+    every = run.get("idle_scan_every", 0)
+    times = sorted(run.get("idle_scan_ms", []))
+    if every <= 0 or not times:
+        return "none"
+    def q(p):
+        return times[min(len(times) - 1, int(p * len(times)))]
+    return f"{q(0.5):.1f} / {q(0.95):.1f} (every {every} frames)"
+
+
 def section(runs, commit, plot):
     cpu = "unknown CPU"
     try:
@@ -93,15 +105,22 @@ def section(runs, commit, plot):
         f"({platform.machine()}). `mapping resident` is the process's resident memory minus "
         "what it held before the first frame (the building, its renderer); `map` is TSDF "
         "blocks, occupancy and the super-point graph; observed surface counts the voxels the "
-        "surface passes through (observed, |sdf| < half a voxel) times a voxel's face.",
+        "surface passes through (observed, |sdf| < half a voxel) times a voxel's face. "
+        "`idle scan refresh`: as the live mapper's worker does while it waits for the next "
+        "frame (`panmap-mapper --idle-scan-every`, default 10 frames), the benchmark brings the "
+        "graph's surface scan up to date between frames, outside the frame's time; the final "
+        "optimisation then reads only the last frames' blocks. Offline mapping of a log has no "
+        "such wait: its final graph reads the blocks changed since the last periodic "
+        "forgetting, up to 100 frames (about 120 ms more on the 2 cm building, "
+        "docs/MAPPING.md).",
         "",
         f"![memory against observed surface]({plot.split('/')[-1]})",
         "",
         "| voxel | frames | frame ms median / p95 | peak mapping resident MiB | map MiB at the end "
         "| mapping / map | MiB per m2 (fit) | largest deviation from the fit | final graph "
-        "vertices / edges | final optimisation ms (graph + solve) | export s | export peak "
-        "resident MiB (before) |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "vertices / edges | idle scan refresh ms median / p95 | final optimisation ms (graph + "
+        "solve) | export s | export peak resident MiB (before) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in runs:
         last = r["samples"][-1]
@@ -112,6 +131,7 @@ def section(runs, commit, plot):
             f"{r['frame_ms_p95']:.1f} | {peak_mapping:.0f} | {last['map_bytes'] / MIB:.0f} | "
             f"{last['mapping_bytes'] / max(last['map_bytes'], 1):.2f} | {slope:.3f} | "
             f"{dev * 100:.0f} % | {r['graph_vertices']} / {r['graph_edges']} | "
+            f"{idle_scan(r)} | "
             f"{r['graph_ms']:.0f} + {r['solve_ms']:.0f} | {r['export_ms'] / 1000:.1f} | "
             f"{r['export_peak_resident_bytes'] / MIB:.0f} "
             f"({r['resident_before_export_bytes'] / MIB:.0f}) |")

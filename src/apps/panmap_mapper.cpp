@@ -247,6 +247,12 @@ int main(int argc, char** argv) {
       ->add_option("--queue-frames", live.max_queued_frames,
                    "frames waiting for the mapper at most; the oldest is dropped beyond")
       ->capture_default_str();
+  live_group
+      ->add_option("--idle-scan-every", live.idle_scan_every_frames,
+                   "while waiting for frames, refresh the graph's surface scan once this many "
+                   "frames came since the last time, so the final optimisation reads only the "
+                   "last few frames' blocks (0: never)")
+      ->capture_default_str();
   live_group->add_option("--channel-status", live.channel_status)->capture_default_str();
   live_group->add_option("--channel-objects", live.channel_objects)->capture_default_str();
   live_group->add_option("--channel-octomap", live.channel_octomap)->capture_default_str();

@@ -29,6 +29,7 @@ void LiveOptions::check() const {
   if (max_queued_frames < 1) throw Error("live: max_queued_frames must be at least 1");
   if (!(optimiser_timeout_s >= 0.0)) throw Error("live: optimiser_timeout_s must be >= 0");
   if (!(optimiser_retry_s > 0.0)) throw Error("live: optimiser_retry_s must be positive");
+  if (idle_scan_every_frames < 0) throw Error("live: idle_scan_every_frames must be >= 0");
 }
 
 LiveMapper::LiveMapper(lcm::LCM* lcm, const LiveOptions& options, Mapper* mapper,
@@ -191,8 +192,30 @@ void LiveMapper::workerLoop() {
     } else {
       session_.handle(item.channel, item.bytes.data(), item.bytes.size());
     }
+    refreshScanIfIdle();
   }
   session_.flush();
+}
+
+void LiveMapper::refreshScanIfIdle() {
+  if (options_.idle_scan_every_frames <= 0) return;
+  const int64_t frames = mapper_->framesIntegrated();
+  // A repair swapped in, or a map loaded, may have fewer frames: count from there.
+  if (frames < scanned_at_frame_) scanned_at_frame_ = frames;
+  if (frames - scanned_at_frame_ < options_.idle_scan_every_frames) return;
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    // Only time the worker would wait: a frame waiting, or the final drain, comes first.
+    if (!queue_.empty() || draining_ || stop_worker_) return;
+  }
+  scanned_at_frame_ = frames;
+  try {
+    mapper_->refreshSurfaceScan();
+    ++idle_scan_refreshes_;
+  } catch (const std::exception& e) {
+    // Only a cache: the final graph reads what this could not.
+    std::fprintf(stderr, "panmap-mapper: surface scan refresh failed: %s\n", e.what());
+  }
 }
 
 void LiveMapper::publishOutbox() {

@@ -187,6 +187,10 @@ void checkFrame(const MapperConfig& config, const RgbdFrame& frame, const Eigen:
   }
 }
 
+size_t Mapper::refreshSurfaceScan() const {
+  return graph_->surfaceScan(*map_, tracker_->labels()).blocksRead();
+}
+
 void Mapper::forgetUnvotedSuperpoints() {
   const LabelRegistry& registry = tracker_->labels();
   // Reads only the blocks changed since the last look: a whole-map read every

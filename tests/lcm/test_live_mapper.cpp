@@ -61,7 +61,11 @@ TEST(LiveMapper, MapsLikeTheSessionAndAnswersStatus) {
   StatusInbox inbox;
   lcm.subscribe("PANMAP_STATUS", &StatusInbox::onStatus, &inbox);
   Mapper mapper(test::streamMapperConfig());
-  LiveMapper live(&lcm, testOptions(), &mapper);
+  LiveOptions options = testOptions();
+  // The worker refreshes the surface scan whenever it waits (how often depends on timing):
+  // the map and the final graph must not depend on it.
+  options.idle_scan_every_frames = 1;
+  LiveMapper live(&lcm, options, &mapper);
   publishAll(&lcm, stream.messages());
   const uint8_t junk[3] = {9, 9, 9};
   lcm.publish("CAMERA_POSE", junk, sizeof(junk));
@@ -77,6 +81,16 @@ TEST(LiveMapper, MapsLikeTheSessionAndAnswersStatus) {
   EXPECT_EQ(live.framesDropped(), 0);
   EXPECT_EQ(stats.rejected.at("malformed CAMERA_POSE"), 1);
   EXPECT_EQ(test::mapBytes(mapper), test::mapBytes(reference));
+  const SuperpointGraph graph = mapper.graph(), expected = reference.graph();
+  ASSERT_EQ(graph.vertices.size(), expected.vertices.size());
+  ASSERT_EQ(graph.edges.size(), expected.edges.size());
+  for (size_t i = 0; i < graph.vertices.size(); ++i) {
+    EXPECT_EQ(graph.vertices[i].num_voxels, expected.vertices[i].num_voxels);
+  }
+  for (size_t i = 0; i < graph.edges.size(); ++i) {
+    EXPECT_EQ(std::tie(graph.edges[i].a, graph.edges[i].b),
+              std::tie(expected.edges[i].a, expected.edges[i].b));
+  }
 
   // drain() publishes a "finishing" status with the final counts.
   ASSERT_FALSE(inbox.received.empty());
@@ -233,6 +247,19 @@ TEST(LiveMapper, SaveCommandRunsOnTheWorkerAndMappingGoesOn) {
   EXPECT_LE(snapshot->framesIntegrated(), static_cast<int64_t>(half / 3));
   EXPECT_EQ(mapper.framesIntegrated(), static_cast<int64_t>(stream.frames.size()));
   EXPECT_EQ(live.status("done").frames_rejected, 1);
+}
+
+TEST(LiveMapper, RefusesBadOptionsNamingThem) {
+  LiveOptions options = testOptions();
+  options.idle_scan_every_frames = -1;
+  try {
+    options.check();
+    FAIL() << "a negative idle_scan_every_frames was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("idle_scan_every_frames"), std::string::npos) << e.what();
+  }
+  options.idle_scan_every_frames = 0;  // never: valid
+  EXPECT_NO_THROW(options.check());
 }
 
 }  // namespace

@@ -112,6 +112,43 @@ TEST_F(BoxScene, SameInputGivesBitIdenticalOutput) {
   EXPECT_LE(differing, 8u);
 }
 
+// The live mapper refreshes the surface scan between frames (LiveOptions::
+// idle_scan_every_frames): the final graph must be the one a mapper that never did gives.
+TEST_F(BoxScene, SurfaceScanRefreshesBetweenFramesChangeNoResult) {
+  auto plain = run(config(), 6);
+  auto refreshed = std::make_unique<Mapper>(config());
+  for (int k = 0; k < 6; ++k) {
+    RgbdFrame frame;
+    PanopticFrame panoptic;
+    frameAt(k, &frame, &panoptic);
+    refreshed->integrate(frame, pose(k), &panoptic);
+    const size_t read = refreshed->refreshSurfaceScan();
+    if (k == 0) {
+      EXPECT_EQ(refreshed->map().numBlocks(), read) << "the first reads every block";
+    }
+    EXPECT_GT(read, 0u) << "frame " << k << " changed blocks";
+    EXPECT_EQ(0u, refreshed->refreshSurfaceScan()) << "nothing changed since";
+  }
+  const SuperpointGraph a = plain->graph(), b = refreshed->graph();
+  ASSERT_EQ(a.vertices.size(), b.vertices.size());
+  ASSERT_GT(a.edges.size(), 0u);
+  ASSERT_EQ(a.edges.size(), b.edges.size());
+  for (size_t i = 0; i < a.vertices.size(); ++i) {
+    EXPECT_EQ(a.vertices[i].id, b.vertices[i].id);
+    EXPECT_EQ(a.vertices[i].num_voxels, b.vertices[i].num_voxels);
+    EXPECT_EQ(a.vertices[i].centroid, b.vertices[i].centroid);
+    EXPECT_EQ(a.vertices[i].scores, b.vertices[i].scores);
+  }
+  for (size_t i = 0; i < a.edges.size(); ++i) {
+    EXPECT_EQ(std::tie(a.edges[i].a, a.edges[i].b), std::tie(b.edges[i].a, b.edges[i].b));
+    EXPECT_EQ(a.edges[i].confidences, b.edges[i].confidences);
+  }
+  test::TempDir dir;
+  plain->save(dir.path("a.panmap"));
+  refreshed->save(dir.path("b.panmap"));
+  EXPECT_EQ(readFileBytes(dir.path("a.panmap")), readFileBytes(dir.path("b.panmap")));
+}
+
 TEST_F(BoxScene, LiveMeshUpdatesAddUpToTheExportedMesh) {
   Mapper mapper(config());
   // A viewer: one mesh per block, replaced when an update names the block.

@@ -187,6 +187,11 @@ class Mapper {
   const GraphAccumulator& graphAccumulator() const { return *graph_; }
   /// The super-point graph of the live super-points, ready for the final optimisation.
   SuperpointGraph graph() const { return graph_->graph(*map_, *tracker_); }
+  /// Brings the graph's surface scan up to date with the map (SurfaceScan::refresh): what
+  /// graph() would otherwise read first. Cheap when little changed since the last call; call it
+  /// when there is time to spare (the live mapper does, between frames), so the final graph
+  /// reads only the last few frames' blocks. Changes no result. Returns the blocks it read.
+  size_t refreshSurfaceScan() const;
   /// The configuration in use.
   const MapperConfig& config() const { return config_; }
   /// Frames integrated so far.
