@@ -374,6 +374,7 @@ int main(int argc, char** argv) {
       const panmap::GraphLabels labels = panmap::optimise(graph, optimiser);
       const double optimise_ms = msSince(optimise_start);
       output_options.utime = report.last_frame_utime;
+      output_options.final_export = true;  // nothing meshes this map after it
       const panmap::OutputSummary outputs =
           panmap::writeOutputs(out_dir, mapper.get(), &labels, optimiser, output_options);
       // After the outputs, which create OUT: OUT/graph.json is the natural place for it.
@@ -472,9 +473,11 @@ int main(int argc, char** argv) {
                    live.optimiser_timeout_s);
     }
     const panmap::SessionStats stats = node.stats();
-    output_options.utime = stats.last_frame_utime;
+    panmap::OutputOptions final_options = output_options;  // the export command keeps its own
+    final_options.utime = stats.last_frame_utime;
+    final_options.final_export = true;
     const panmap::OutputSummary outputs = panmap::writeOutputs(
-        out_dir, mapper.get(), labels ? &*labels : nullptr, optimiser, output_options);
+        out_dir, mapper.get(), labels ? &*labels : nullptr, optimiser, final_options);
     nlohmann::json json = sessionJson(stats);
     json["mode"] = "live";
     json["lcm_url"] = lcm_url;

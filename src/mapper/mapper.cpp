@@ -75,6 +75,8 @@ LabelledMesh Mapper::extractMesh(const GraphLabels* labels) {
   return mesher_->assemble(*map_, meshLabeller(labels, &cache));
 }
 
+void Mapper::releaseMeshCache() { mesher_->clear(); }
+
 MeshUpdate Mapper::updateMesh(const GraphLabels* labels) {
   // Every thread labels the blocks it has just meshed, while their voxels are in cache, with
   // its own cache of super-point labels; resolve() only reads once the registry is flattened.

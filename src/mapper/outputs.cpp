@@ -53,21 +53,31 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
     summary.step_seconds.emplace_back(name, std::chrono::duration<double>(now - last).count());
     last = now;
   };
-  const LabelledMesh mesh = mapper->extractMesh(labels);
-  summary.mesh_vertices = mesh.numVertices();
-  summary.mesh_faces = mesh.numFaces();
-  summary.mesh_area_m2 = mesh.surfaceArea();
-  std::set<int32_t> instances;
-  for (int32_t id : mesh.instance) {
-    if (id > 0) instances.insert(id);
-  }
-  summary.instances_in_mesh = instances.size();
-  step("mesh extraction");
+  {
+    // The welded mesh lives only while the meshes and snapshots are written: the later steps
+    // (the occupancy tree, the map file) would otherwise hold it on top of theirs (issue 23:
+    // the 2 cm building's export peaked during the occupancy tree, 0.4 GB of it this mesh).
+    const LabelledMesh mesh = mapper->extractMesh(labels);
+    if (options.final_export) mapper->releaseMeshCache();
+    summary.mesh_vertices = mesh.numVertices();
+    summary.mesh_faces = mesh.numFaces();
+    summary.mesh_area_m2 = mesh.surfaceArea();
+    std::set<int32_t> instances;
+    for (int32_t id : mesh.instance) {
+      if (id > 0) instances.insert(id);
+    }
+    summary.instances_in_mesh = instances.size();
+    step("mesh extraction");
 
-  writeLabelledMeshes(dir, mesh);
-  summary.files.insert(summary.files.end(),
-                       {kSemanticMeshFile, kInstanceMeshFile, kSuperpointMeshFile});
-  step("meshes");
+    writeLabelledMeshes(dir, mesh);
+    summary.files.insert(summary.files.end(),
+                         {kSemanticMeshFile, kInstanceMeshFile, kSuperpointMeshFile});
+    step("meshes");
+    if (options.snapshots && !mesh.faces.empty()) {
+      writeSnapshots(dir, mesh, &summary);
+      step("snapshots");
+    }
+  }
   const std::vector<MappedObject> objects = computeObjects(*mapper, labels);
   writeObjectsJson(dir + "/objects.json", objects, options.utime);
   summary.objects = objects.size();
@@ -92,10 +102,6 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
     summary.files.push_back("config.yaml");
   }
   step("config.yaml");
-  if (options.snapshots && !mesh.faces.empty()) {
-    writeSnapshots(dir, mesh, &summary);
-    step("snapshots");
-  }
   return summary;
 }
 

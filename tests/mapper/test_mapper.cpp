@@ -14,6 +14,7 @@
 #include "panmap/graph/optimiser.h"
 #include "panmap/io/image_codec.h"
 #include "panmap/mapper/mapper.h"
+#include "panmap/mapper/outputs.h"
 #include "panmap/mesh/marching_cubes.h"
 #include "panmap/sim/depth_noise.h"
 #include "panmap/sim/renderer.h"
@@ -147,6 +148,33 @@ TEST_F(BoxScene, SurfaceScanRefreshesBetweenFramesChangeNoResult) {
   plain->save(dir.path("a.panmap"));
   refreshed->save(dir.path("b.panmap"));
   EXPECT_EQ(readFileBytes(dir.path("a.panmap")), readFileBytes(dir.path("b.panmap")));
+}
+
+// A final export drops the block meshes kept for live updates (and the welded mesh before the
+// occupancy and map file steps): the files are those of an ordinary export, and a mesh
+// extracted afterwards (every block meshed again) is the same mesh.
+TEST_F(BoxScene, AFinalExportWritesTheSameFilesAndLeavesTheMeshIntact) {
+  auto mapper = run(config(), 6);
+  const GraphLabels labels = optimise(mapper->graph(), OptimiserConfig{});
+  const LabelledMesh before = mapper->extractMesh(&labels);
+  ASSERT_GT(before.numFaces(), 0u);
+  test::TempDir dir;
+  OutputOptions ordinary;
+  ordinary.snapshots = false;
+  const OutputSummary a = writeOutputs(dir.path("a"), mapper.get(), &labels, {}, ordinary);
+  OutputOptions last = ordinary;
+  last.final_export = true;
+  const OutputSummary b = writeOutputs(dir.path("b"), mapper.get(), &labels, {}, last);
+  ASSERT_EQ(a.files, b.files);
+  for (const std::string& name : a.files) {
+    EXPECT_EQ(readFileBytes(dir.path("a/" + name)), readFileBytes(dir.path("b/" + name))) << name;
+  }
+  const LabelledMesh after = mapper->extractMesh(&labels);
+  EXPECT_EQ(before.vertices, after.vertices);
+  EXPECT_EQ(before.faces, after.faces);
+  EXPECT_EQ(before.semantic, after.semantic);
+  EXPECT_EQ(before.instance, after.instance);
+  EXPECT_EQ(before.superpoint, after.superpoint);
 }
 
 TEST_F(BoxScene, LiveMeshUpdatesAddUpToTheExportedMesh) {

@@ -14,6 +14,10 @@ namespace panmap {
 struct OutputOptions {
   bool snapshots = true;  ///< overview PNGs of the meshes (semantic, instance, super-point, colour)
   int64_t utime = 0;      ///< time of the map state (newest frame), written into objects.json
+  /// The session's last export: the block meshes kept for live mesh updates are dropped once
+  /// the mesh is extracted (Mapper::releaseMeshCache), so the later steps (occupancy, map file)
+  /// run without them.
+  bool final_export = false;
 };
 
 /// What writeOutputs wrote.
@@ -24,8 +28,8 @@ struct OutputSummary {
   size_t instances_in_mesh = 0;    ///< distinct instance ids > 0 on mesh vertices
   size_t objects = 0;              ///< entries of objects.json
   std::vector<std::string> files;  ///< file names written, in order
-  /// Wall time of each step ("mesh extraction", "meshes", "objects.json", "occupancy.bt",
-  /// "trajectory.txt", "map.panmap", "config.yaml", "snapshots"), seconds, in order.
+  /// Wall time of each step ("mesh extraction", "meshes", "snapshots", "objects.json",
+  /// "occupancy.bt", "trajectory.txt", "map.panmap", "config.yaml"), seconds, in order.
   std::vector<std::pair<std::string, double>> step_seconds;
 };
 
