@@ -190,13 +190,13 @@ int main(int argc, char** argv) {
                  ("panmap-bench-building-" + std::to_string(::getpid())))
                     .string();
     }
-    panmap::OutputOptions final_export;  // as panmap-mapper's end of a session
-    final_export.final_export = true;
+    panmap::OutputOptions export_options;  // as panmap-mapper's end of a session
+    export_options.final_export = true;
     const size_t before_export = panmap::residentBytes();
     resetPeak();
     const auto export_start = std::chrono::steady_clock::now();
     const panmap::OutputSummary outputs =
-        panmap::writeOutputs(out_dir, mapper.get(), &labels, optimiser, final_export);
+        panmap::writeOutputs(out_dir, mapper.get(), &labels, optimiser, export_options);
     const double export_ms = msSince(export_start);
     const size_t export_peak = statusBytes("VmHWM");
     const size_t map_bytes = mapper->map().memoryBytes();

@@ -484,6 +484,7 @@ int main(int argc, char** argv) {
     json["autosave"] = autosaveJson(autosaver.get(), autosave_s);
     json["resumed"] = resumeJson(resumed);
     json["graph_requests_sent"] = node.graphRequestsSent();
+    json["idle_scan_refreshes"] = node.idleScanRefreshes();
     json["frames_received"] = node.framesReceived();
     json["frames_dropped_behind"] = node.framesDropped();
     json["wall_s"] = wall_s;
