@@ -78,8 +78,7 @@ int main(int argc, char** argv) {
       "cost."};
   int64_t seed = 1;
   int every = 250, threads = 2, frames = 0;
-  // LiveOptions::idle_scan_every_frames: the live mapper's default.
-  int idle_scan_every = 10;
+  int idle_scan_every = static_cast<int>(panmap::Mapper::kIdleScanEveryFrames);
   double voxel = 0.02;
   std::string json_path, out_dir;
   app.add_option("--building", seed, "building seed")->capture_default_str();

@@ -150,21 +150,25 @@ TEST_F(BoxScene, SurfaceScanRefreshesBetweenFramesChangeNoResult) {
   EXPECT_EQ(readFileBytes(dir.path("a.panmap")), readFileBytes(dir.path("b.panmap")));
 }
 
-// A final export drops the block meshes kept for live updates (and the welded mesh before the
-// occupancy and map file steps): the files are those of an ordinary export, and a mesh
-// extracted afterwards (every block meshed again) is the same mesh.
+// A final export drops the block meshes kept for live updates: the files are those of an
+// ordinary export, the next mesh update meshes every block again (an ordinary export leaves
+// nothing to re-mesh), and a mesh extracted afterwards is the same mesh.
 TEST_F(BoxScene, AFinalExportWritesTheSameFilesAndLeavesTheMeshIntact) {
   auto mapper = run(config(), 6);
   const GraphLabels labels = optimise(mapper->graph(), OptimiserConfig{});
   const LabelledMesh before = mapper->extractMesh(&labels);
   ASSERT_GT(before.numFaces(), 0u);
+  const size_t meshed = mapper->updateMesh(&labels).blocks.size();  // takes every changed block
+  ASSERT_GT(meshed, 0u);
   test::TempDir dir;
   OutputOptions ordinary;
   ordinary.snapshots = false;
   const OutputSummary a = writeOutputs(dir.path("a"), mapper.get(), &labels, {}, ordinary);
+  EXPECT_EQ(0u, mapper->updateMesh(&labels).blocks.size()) << "the block meshes were kept";
   OutputOptions last = ordinary;
   last.final_export = true;
   const OutputSummary b = writeOutputs(dir.path("b"), mapper.get(), &labels, {}, last);
+  EXPECT_EQ(meshed, mapper->updateMesh(&labels).blocks.size()) << "the block meshes were dropped";
   ASSERT_EQ(a.files, b.files);
   for (const std::string& name : a.files) {
     EXPECT_EQ(readFileBytes(dir.path("a/" + name)), readFileBytes(dir.path("b/" + name))) << name;

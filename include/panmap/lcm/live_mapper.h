@@ -18,6 +18,7 @@
 #include "panmap/graph/superpoint_graph.h"
 #include "panmap/lcm/channels.h"
 #include "panmap/lcm/mapping_session.h"
+#include "panmap/mapper/mapper.h"
 #include "panmap/status_t.hpp"
 
 namespace panmap {
@@ -45,7 +46,7 @@ struct LiveOptions {
   /// so that the final graph reads only the blocks of the last few frames instead of those of up
   /// to Mapper::kForgetEveryFrames frames (issue 23: 120 ms of the final optimisation on the
   /// 2 cm building). Uses time the worker would spend waiting; changes no result. 0: never.
-  int64_t idle_scan_every_frames = 10;
+  int64_t idle_scan_every_frames = Mapper::kIdleScanEveryFrames;
   /// Throws Error naming the bad field.
   void check() const;
 };

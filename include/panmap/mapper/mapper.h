@@ -205,6 +205,9 @@ class Mapper {
   uint64_t edgesPruned() const { return edges_pruned_; }
   /// Frames between checks for super-points without votes.
   static constexpr int64_t kForgetEveryFrames = 100;
+  /// Frames between refreshSurfaceScan() calls in idle time that the live mapper and the
+  /// building benchmark use by default (LiveOptions::idle_scan_every_frames).
+  static constexpr int64_t kIdleScanEveryFrames = 10;
   /// The occupancy map, or null when disabled.
   const OccupancyMap* occupancy() const { return occupancy_.get(); }
   /// Every integrated frame's pose as used (refined where tracking ran), in order.
