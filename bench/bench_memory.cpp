@@ -41,8 +41,8 @@ size_t superpointsWithVotes(const panmap::Mapper& mapper) {
   std::set<int32_t> labels;
   const panmap::LabelRegistry& registry = mapper.superpoints().labels();
   for (const auto& block : mapper.map().blocks()) {
-    for (const panmap::Voxel& v : block->voxels) {
-      for (const panmap::LabelVote& vote : v.votes) {
+    for (const panmap::VoxelVotes& votes : block->vote_sets) {
+      for (const panmap::LabelVote& vote : votes) {
         if (vote.count > 0) labels.insert(registry.resolve(vote.label));
       }
     }

@@ -89,7 +89,7 @@ SurfaceAdjacency SurfaceAdjacency::computeWith(const TsdfMap& map, const Resolve
         const Voxel& voxel = block.voxels[i];
         const bool on_surface = voxel.weight > 0.0f && std::fabs(voxel.sdf_m) <= band_m;
         if (!on_surface && !totals) continue;
-        const int32_t label = argmaxLabel(voxel, resolve);
+        const int32_t label = argmaxLabel(block.votes(i), resolve);
         if (label <= 0) continue;
         if (static_cast<size_t>(label) < num_totals) {
           ++scan.voxels[label];

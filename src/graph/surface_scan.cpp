@@ -253,9 +253,10 @@ void SurfaceScan::readBlocks(const TsdfMap& map, const std::vector<int32_t>& roo
       }
       for (int i = 0; i < kBlockVoxels; ++i) {
         const Voxel& voxel = block.voxels[i];
-        if (full) {
+        const VoxelVotes* votes = block.votes(i);
+        if (full && votes) {
           // A block's votes name a handful of roots: a search beats sorting thousands.
-          for (const LabelVote& vote : voxel.votes) {
+          for (const LabelVote& vote : *votes) {
             if (vote.count == 0) continue;
             const int32_t root = resolve(vote.label);
             if (std::find(s.roots.begin(), s.roots.end(), root) == s.roots.end()) {
@@ -266,10 +267,10 @@ void SurfaceScan::readBlocks(const TsdfMap& map, const std::vector<int32_t>& roo
         const bool on_surface = voxel.weight > 0.0f && std::fabs(voxel.sdf_m) <= band_m;
         if (!on_surface && !full) continue;
         bool tie = false;  // asked only of full reads: only their summaries keep it
-        const int32_t label = argmaxLabel(voxel, resolve, full ? &tie : nullptr);
+        const int32_t label = argmaxLabel(votes, resolve, full ? &tie : nullptr);
         if (label <= 0) continue;
         if (tie) {
-          for (const LabelVote& vote : voxel.votes) {
+          for (const LabelVote& vote : *votes) {
             const int32_t root = resolve(vote.label);
             if (vote.count > 0 && std::find(s.tied.begin(), s.tied.end(), root) == s.tied.end()) {
               s.tied.push_back(root);

@@ -49,10 +49,10 @@ BlockIndex unpackKey(uint64_t key) {
   return BlockIndex(field(key >> 42), field(key >> 21), field(key));
 }
 
-// The thread that applies votes to `voxel`: by 4 KiB region (voxels sharing a cache line
-// nearly always have the same owner), hashed so that regions spread evenly.
-uint32_t voteOwner(const Voxel* voxel, size_t owners) {
-  const uint64_t region = reinterpret_cast<uintptr_t>(voxel) >> 12;
+// The thread that applies votes to a block: one per block, since a voxel's first vote grows
+// the block's vote sets (Block::votesToWrite); hashed so that blocks spread evenly.
+uint32_t voteOwner(const Block* block, size_t owners) {
+  const uint64_t region = reinterpret_cast<uintptr_t>(block) >> 6;
   return static_cast<uint32_t>(((region * 0x9E3779B97F4A7C15ull) >> 32) * owners >> 32);
 }
 
@@ -63,7 +63,7 @@ uint32_t voteOwner(const Voxel* voxel, size_t owners) {
 // distances stretch at grazing angles and would miss the surface voxels there).
 // Two passes so both can run on every thread and still give the single-threaded result: first
 // each pixel's voxel is looked up (rows split between threads, the map is only read), and each
-// row's runs of votes are grouped by the thread that owns their voxel (by address); then every
+// row's runs of votes are grouped by the thread that owns their voxel's block; then every
 // thread applies its own runs row by row, so each voxel sees its votes in pixel order whatever
 // the thread count.
 void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isometry3f& T_W_C,
@@ -102,7 +102,7 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
       // Stable counting sort by owner: each owner's runs stay in pixel order.
       std::fill(begin, begin + owners + 1, size_t{0});
       for (size_t i = 0; i < n; ++i) {
-        owner[i] = voteOwner(found[i].voxel, owners);
+        owner[i] = voteOwner(found[i].block, owners);
         ++begin[owner[i] + 1];
       }
       for (size_t t = 0; t < owners; ++t) begin[t + 1] += begin[t];
@@ -119,7 +119,8 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
         const size_t* begin = &owner_begin_[r * (owners + 1)];
         for (size_t i = begin[t]; i < begin[t + 1]; ++i) {
           my_added += runs[i].count;
-          my_evicted += addVotes(runs[i].voxel, runs[i].label, runs[i].count);
+          my_evicted +=
+              addVotes(runs[i].block->votesToWrite(runs[i].voxel), runs[i].label, runs[i].count);
         }
       }
     }

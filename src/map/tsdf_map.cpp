@@ -87,6 +87,14 @@ const Voxel* TsdfMap::findVoxel(const Eigen::Vector3f& p_W) const {
   return &block->at(gx & 7, gy & 7, gz & 7);
 }
 
+const VoxelVotes* TsdfMap::findVotes(const Eigen::Vector3f& p_W) const {
+  const Voxel* voxel = findVoxel(p_W);
+  if (!voxel) return nullptr;
+  const BlockIndex b = blockIndexOf(p_W);
+  const Block* block = findBlock(b);
+  return block->votes(block->indexOf(*voxel));
+}
+
 Eigen::Vector3f TsdfMap::voxelCentre(const BlockIndex& block, int x, int y, int z) const {
   const float v = config_.voxel_size_m;
   return Eigen::Vector3f((block.x() * kBlockSide + x + 0.5f) * v,
@@ -95,7 +103,9 @@ Eigen::Vector3f TsdfMap::voxelCentre(const BlockIndex& block, int x, int y, int 
 }
 
 size_t TsdfMap::memoryBytes() const {
-  return blocks_.size() * sizeof(Block) +
+  size_t votes = 0;
+  for (const auto& block : blocks_) votes += block->vote_sets.capacity() * sizeof(VoxelVotes);
+  return blocks_.size() * sizeof(Block) + votes +
          index_.capacity() * (sizeof(uint64_t) + sizeof(Block*) + 1);
 }
 

@@ -11,13 +11,14 @@ namespace {
 
 // Appends n votes for (voxel, label) to the open run, or closes it and opens another: the
 // runs n calls with one vote each would give.
-inline void addToRun(Voxel* voxel, int32_t label, VoteRun* run, VoteRun** out, uint32_t n = 1) {
-  if (voxel == run->voxel && label == run->label) {
+inline void addToRun(Block* block, int32_t voxel, int32_t label, VoteRun* run, VoteRun** out,
+                     uint32_t n = 1) {
+  if (voxel == run->voxel && block == run->block && label == run->label) {
     run->count += n;
     return;
   }
   if (run->count > 0) *(*out)++ = *run;
-  *run = VoteRun{voxel, label, n};
+  *run = VoteRun{block, voxel, label, n};
 }
 
 // Pixel (u, v) one at a time through Eigen: its vote, if it casts one, joins the open run.
@@ -29,7 +30,10 @@ inline void votePixel(const Image<float>& depth_m, const LabelImage& labels, int
   if (label <= 0 || d <= 0.0f) return;
   Voxel* voxel = lookup->find(
       T_W_C * Eigen::Vector3f((u - cam.cx) * d / cam.fx, (v - cam.cy) * d / cam.fy, d));
-  if (voxel) addToRun(voxel, label, run, out);
+  if (voxel) {
+    Block* block = lookup->lastBlock();
+    addToRun(block, block->indexOf(*voxel), label, run, out);
+  }
 }
 
 #ifdef PANMAP_HAVE_AVX2_PATH
@@ -55,7 +59,7 @@ __attribute__((target("avx2"))) size_t findRowVotesAvx2(const Image<float>& dept
                                                         const RowCamera& cam,
                                                         MutableVoxelLookup* lookup, VoteRun* out) {
   VoteRun* const first = out;
-  VoteRun run{nullptr, 0, 0};
+  VoteRun run{nullptr, -1, 0, 0};
   const int width = depth_m.width();
   const float* depth_row = &depth_m(0, v);
   const int32_t* label_row = &labels(0, v);
@@ -139,7 +143,7 @@ __attribute__((target("avx2"))) size_t findRowVotesAvx2(const Image<float>& dept
       const int k = __builtin_ctz(static_cast<unsigned>(starts));
       last_block = lookup->findBlock(block_index[0][k], block_index[1][k], block_index[2][k]);
       if (last_block) {
-        addToRun(&last_block->voxels[voxel_offset[k]], label_row[u + k], &run, &out,
+        addToRun(last_block, voxel_offset[k], label_row[u + k], &run, &out,
                  static_cast<uint32_t>(stretchEnd(k) - k));
       }
     }
@@ -158,7 +162,7 @@ size_t findRowVotesScalar(const Image<float>& depth_m, const LabelImage& labels,
                           const Eigen::Isometry3f& T_W_C, const RowCamera& cam,
                           MutableVoxelLookup* lookup, VoteRun* out) {
   VoteRun* const first = out;
-  VoteRun run{nullptr, 0, 0};
+  VoteRun run{nullptr, -1, 0, 0};
   for (int u = 0; u < depth_m.width(); u += stride) {
     votePixel(depth_m, labels, u, v, T_W_C, cam, lookup, &run, &out);
   }

@@ -33,7 +33,19 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 //     to them on loading.
 // 12: the depth calibration (MapperConfig::depth_calibration); older files load without one,
 //     as they were built.
-constexpr uint32_t kVersion = 12;
+// 13: 8-byte voxels, then the votes of the voxels that hold any (Block::vote_sets): their
+//     count, then each one's index in the block and four 6-byte slots, by index. Older files'
+//     32-byte voxels are split on loading.
+constexpr uint32_t kVersion = 13;
+
+// Bytes of one voxel's votes in a file: four slots of a 4-byte label and a 2-byte count.
+constexpr size_t kVoteSetBytes = kVoteSlots * 6;
+static_assert(sizeof(VoxelVotes) == kVoteSetBytes, "vote sets are stored as they are in memory");
+
+// Gives voxel i of `block` the votes `votes` unless every count is 0.
+void keepVotes(const VoxelVotes& votes, int i, Block* block) {
+  if (votes.total() > 0) *block->votesToWrite(i) = votes;
+}
 
 // Reads a block's voxels as files before version 11 stored them: a 4-byte float distance and
 // weight, colour, flags, then four vote slots of a 4-byte label and a count of 4 bytes (before
@@ -41,7 +53,9 @@ constexpr uint32_t kVersion = 12;
 void getVoxelsBefore11(BinaryReader* r, uint32_t version, Block* block) {
   const size_t count_bytes = version >= 10 ? 2 : 4;
   const size_t slot_bytes = 4 + count_bytes;
-  for (Voxel& v : block->voxels) {
+  for (int i = 0; i < kBlockVoxels; ++i) {
+    Voxel& v = block->voxels[i];
+    VoxelVotes votes;
     uint8_t bytes[12 + kVoteSlots * 8];
     r->getBytes(bytes, 12 + kVoteSlots * slot_bytes);
     float sdf_m, weight;
@@ -54,7 +68,7 @@ void getVoxelsBefore11(BinaryReader* r, uint32_t version, Block* block) {
     uint32_t counts[kVoteSlots], most = 0;
     for (int k = 0; k < kVoteSlots; ++k) {
       const uint8_t* slot = bytes + 12 + slot_bytes * k;
-      std::memcpy(&v.votes[k].label, slot, 4);
+      std::memcpy(&votes.slots[k].label, slot, 4);
       uint16_t short_count = 0;
       if (count_bytes == 2) {
         std::memcpy(&short_count, slot + 4, 2);
@@ -68,14 +82,64 @@ void getVoxelsBefore11(BinaryReader* r, uint32_t version, Block* block) {
     // ratios survive and no slot empties.
     for (int k = 0; k < kVoteSlots; ++k) {
       const uint64_t c = counts[k];
-      v.votes[k].count =
+      votes.slots[k].count =
           static_cast<uint16_t>(most <= kMaxVoteCount ? c : (c * kMaxVoteCount + most - 1) / most);
     }
+    keepVotes(votes, i, block);
+  }
+}
+
+// Reads a block's voxels as versions 11 and 12 stored them: each voxel's 8 bytes of geometry
+// followed by its four vote slots.
+void getVoxels11(BinaryReader* r, Block* block) {
+  for (int i = 0; i < kBlockVoxels; ++i) {
+    r->getBytes(&block->voxels[i], sizeof(Voxel));
+    VoxelVotes votes;
+    r->getBytes(&votes, sizeof(votes));
+    keepVotes(votes, i, block);
+  }
+}
+
+// Writes a block's voxels and votes as version 13 stores them.
+void putVoxels(BinaryWriter* w, const Block& block) {
+  w->putBytes(block.voxels, sizeof(block.voxels));
+  uint16_t n = 0;
+  for (int i = 0; i < kBlockVoxels; ++i) {
+    const VoxelVotes* votes = block.votes(i);
+    n += votes && votes->total() > 0 ? 1 : 0;
+  }
+  w->put<uint16_t>(n);
+  for (int i = 0; i < kBlockVoxels; ++i) {
+    const VoxelVotes* votes = block.votes(i);
+    if (!votes || votes->total() == 0) continue;
+    w->put<uint16_t>(static_cast<uint16_t>(i));
+    w->putBytes(votes, sizeof(*votes));
+  }
+}
+
+// Reads what putVoxels wrote; throws Error naming `path` on an impossible vote list.
+void getVoxels(BinaryReader* r, const std::string& path, Block* block) {
+  r->getBytes(block->voxels, sizeof(block->voxels));
+  const uint16_t n = r->get<uint16_t>();
+  if (n > kBlockVoxels) throw Error(path + ": " + std::to_string(n) + " voted voxels in a block");
+  block->vote_sets.reserve(n);
+  int previous = -1;
+  for (uint16_t k = 0; k < n; ++k) {
+    const int i = r->get<uint16_t>();
+    if (i <= previous || i >= kBlockVoxels) {
+      throw Error(path + ": voted voxel " + std::to_string(i) + " out of order in a block");
+    }
+    previous = i;
+    VoxelVotes votes;
+    r->getBytes(&votes, sizeof(votes));
+    keepVotes(votes, i, block);
   }
 }
 // Bytes of a voxel in files of `version`.
+// (Version 13: the geometry alone; its votes follow, two bytes at least.)
 size_t voxelBytes(uint32_t version) {
-  return version >= 11 ? sizeof(Voxel) : 12 + kVoteSlots * (version >= 10 ? 6 : 8);
+  if (version >= 13) return sizeof(Voxel);
+  return version >= 11 ? sizeof(Voxel) + kVoteSetBytes : 12 + kVoteSlots * (version >= 10 ? 6 : 8);
 }
 constexpr uint32_t kOldestVersion = 5;
 // Magic, version, payload size.
@@ -419,7 +483,7 @@ void Mapper::serialize(ByteSink* sink) const {
     payload.put<int32_t>(block->index.y());
     payload.put<int32_t>(block->index.z());
     payload.put<uint8_t>(block->updated);
-    payload.putBytes(block->voxels, sizeof(block->voxels));
+    putVoxels(&payload, *block);
   }
   putSnapshot(&payload, tracker_->snapshot());
   putGraph(&payload, graph_->snapshot());
@@ -593,8 +657,10 @@ std::unique_ptr<Mapper> Mapper::parsePayload(BinaryReader* reader, uint32_t vers
     block->updated = r.get<uint8_t>() != 0;
     // The file does not say which faces changed: a changed block may have changed them all.
     block->lower_changed = block->updated ? 0xFE : 0;
-    if (version >= 11) {
-      r.getBytes(block->voxels, sizeof(block->voxels));
+    if (version >= 13) {
+      getVoxels(&r, path, block);
+    } else if (version >= 11) {
+      getVoxels11(&r, block);
     } else {
       getVoxelsBefore11(&r, version, block);
     }

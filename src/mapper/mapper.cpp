@@ -60,8 +60,8 @@ MeshLabeller Mapper::meshLabeller(const GraphLabels* labels,
     return it->second;
   };
   MeshLabeller labeller;
-  labeller.superpoint = [tracker](const Voxel& voxel) {
-    return argmaxLabel(voxel, [tracker](int32_t l) { return tracker->labels().resolve(l); });
+  labeller.superpoint = [tracker](const VoxelVotes& votes) {
+    return argmaxLabel(votes, [tracker](int32_t l) { return tracker->labels().resolve(l); });
   };
   labeller.semantic = [lookup](int32_t label) { return lookup(label).semantic; };
   labeller.instance = [lookup](int32_t label) { return lookup(label).instance; };

@@ -186,7 +186,7 @@ std::vector<MappedObject> computeObjects(const TsdfMap& map, const SuperpointTra
         for (int x = 0; x < kBlockSide; ++x) {
           const Voxel& voxel = block->at(x, y, z);
           if (voxel.weight <= 0.0f || std::abs(voxel.sdf_m) > band_m) continue;
-          const int32_t superpoint = argmaxLabel(voxel, resolve);
+          const int32_t superpoint = argmaxLabel(block->votes(Block::linear(x, y, z)), resolve);
           if (superpoint <= 0) continue;
           auto it = cache.find(superpoint);
           if (it == cache.end()) {

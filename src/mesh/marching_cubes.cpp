@@ -370,10 +370,11 @@ class VertexLabeller {
     e.votes = 0;
     const Block* b = blockAt(x, y, z);
     if (!b) return e;
-    const Voxel& v = b->at(x & 7, y & 7, z & 7);
-    for (const LabelVote& vote : v.votes) e.votes += vote.count;
-    // Most voxels around a surface hold no vote: their label is 0 without asking.
-    if (e.votes > 0) e.label = labeller_.superpoint(v);
+    const VoxelVotes* votes = b->votes(Block::linear(x & 7, y & 7, z & 7));
+    if (!votes) return e;
+    e.votes = votes->total();
+    // Voxels without a vote have label 0 without asking.
+    if (e.votes > 0) e.label = labeller_.superpoint(*votes);
     return e;
   }
 

@@ -11,17 +11,18 @@ namespace panmap {
 
 namespace {
 
-// Moves the votes of `from` (after resolving) in `voxel` to `to`; true when any moved.
-bool moveVotes(Voxel* voxel, int32_t from, int32_t to, const LabelRegistry& labels) {
+// Moves the votes of `from` (after resolving) in a voxel's `votes` to `to`; true when any
+// moved.
+bool moveVotes(VoxelVotes* votes, int32_t from, int32_t to, const LabelRegistry& labels) {
   uint64_t moved = 0;
-  for (LabelVote& vote : voxel->votes) {
+  for (LabelVote& vote : *votes) {
     if (vote.count == 0 || labels.resolve(vote.label) != from) continue;
     moved += vote.count;
     vote = LabelVote{};
   }
   if (moved == 0) return false;
   // The slot just emptied takes the new label, so nothing is evicted.
-  addVotes(voxel, to, moved > kMaxVoteCount ? kMaxVoteCount : static_cast<uint32_t>(moved));
+  addVotes(votes, to, moved > kMaxVoteCount ? kMaxVoteCount : static_cast<uint32_t>(moved));
   return true;
 }
 
@@ -91,8 +92,10 @@ size_t applySplits(FrameAssociation* association, const FrameSegmentation& segme
       const size_t i = split_of[sid] - 1;
       split_sum[i] += p_W.cast<double>();
       ++split_count[i];
-      Voxel* voxel = lookup.find(p_W);
-      if (voxel) changed += moveVotes(voxel, from[i], splits[i].to, labels);
+      const Voxel* voxel = lookup.find(p_W);
+      VoxelVotes* votes =
+          voxel ? lookup.lastBlock()->votes(lookup.lastBlock()->indexOf(*voxel)) : nullptr;
+      if (votes) changed += moveVotes(votes, from[i], splits[i].to, labels);
     }
   }
   for (size_t i = 0; i < splits.size(); ++i) {

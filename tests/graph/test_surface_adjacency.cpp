@@ -27,10 +27,11 @@ class HandMap {
     };
     int x, y, z;
     const BlockIndex index(split(gx, &x), split(gy, &y), split(gz, &z));
-    Voxel& v = map_.allocateBlock(index)->at(x, y, z);
+    Block* block = map_.allocateBlock(index);
+    Voxel& v = block->at(x, y, z);
     v.sdf_m = sdf_voxels * 0.1f;
     v.weight = weight;
-    v.votes[0] = LabelVote{label, 1};
+    block->votesToWrite(Block::linear(x, y, z))->slots[0] = LabelVote{label, 1};
   }
   const TsdfMap& map() const { return map_; }
 
@@ -165,7 +166,7 @@ TEST(SurfaceAdjacency, TwoThreadsFindWhatOneFinds) {
   for (int v : one.voxels) voxels += v;
   int distinct = 0;  // every set voxel counts once, however often it was drawn
   for (const auto& block : m.map().blocks()) {
-    for (const Voxel& v : block->voxels) distinct += v.votes[0].count > 0;
+    for (const VoxelVotes& v : block->vote_sets) distinct += v.slots[0].count > 0;
   }
   EXPECT_EQ(voxels, distinct);
 }

@@ -22,6 +22,12 @@ TsdfMap::Config config() {
 
 // Random voxel writes through a MutableVoxelLookup (so the blocks are stamped as every writer
 // of the mapper stamps them), in a box of about 10 x 6 x 4 blocks.
+// The votes of the voxel `lookup` found last, given empty slots when it had none.
+VoxelVotes* votesOf(const MutableVoxelLookup& lookup, const Voxel* voxel) {
+  Block* block = lookup.lastBlock();
+  return block->votesToWrite(block->indexOf(*voxel));
+}
+
 class RandomWriter {
  public:
   explicit RandomWriter(uint32_t seed) : state_(seed) {}
@@ -37,13 +43,14 @@ class RandomWriter {
       map->allocateBlock(BlockIndex(gx >> 3, gy >> 3, gz >> 3));
       MutableVoxelLookup lookup(*map);
       Voxel* v = lookup.findGrid(gx, gy, gz);
+      VoxelVotes* v_votes = votesOf(lookup, v);
       ASSERT_NE(v, nullptr);
       v->weight = below(5) == 0 ? 0.0f : 1.0f;
       v->sdf_m = below(3) == 0 ? 0.35f : 0.05f;  // 3.5 voxels: off a 2-voxel band
       const int votes = 1 + below(3);
-      for (int k = 0; k < kVoteSlots; ++k) v->votes[k] = LabelVote{};
+      for (int k = 0; k < kVoteSlots; ++k) v_votes->slots[k] = LabelVote{};
       for (int k = 0; k < votes; ++k) {
-        v->votes[k] = LabelVote{1 + below(kLabels), static_cast<uint16_t>(1 + below(4))};
+        v_votes->slots[k] = LabelVote{1 + below(kLabels), static_cast<uint16_t>(1 + below(4))};
       }
     }
   }
@@ -67,8 +74,8 @@ Full fullScan(const TsdfMap& map, const LabelRegistry& registry) {
   f.adjacency = SurfaceAdjacency::compute(map, registry.parents(), 2.0f, &f.totals);
   f.has_votes.assign(static_cast<size_t>(registry.size()) + 1, 0);
   for (const auto& block : map.blocks()) {
-    for (const Voxel& voxel : block->voxels) {
-      for (const LabelVote& vote : voxel.votes) {
+    for (const VoxelVotes& votes : block->vote_sets) {
+      for (const LabelVote& vote : votes) {
         if (vote.count > 0) f.has_votes[static_cast<size_t>(registry.resolve(vote.label))] = 1;
       }
     }
@@ -154,9 +161,11 @@ TEST(SurfaceScan, MergesThatOnlyRenameReadNoBlock) {
       map.allocateBlock(BlockIndex(gx >> 3, gy >> 3, gz >> 3));
       MutableVoxelLookup lookup(map);
       Voxel* v = lookup.findGrid(gx, gy, gz);
+      VoxelVotes* v_votes = votesOf(lookup, v);
       v->weight = rng.below(5) == 0 ? 0.0f : 1.0f;
       v->sdf_m = rng.below(3) == 0 ? 0.35f : 0.05f;
-      v->votes[0] = LabelVote{regionLabel(gx, gy, gz), static_cast<uint16_t>(1 + rng.below(4))};
+      v_votes->slots[0] =
+          LabelVote{regionLabel(gx, gy, gz), static_cast<uint16_t>(1 + rng.below(4))};
     }
     SurfaceScan scan;
     // Brings the scan up to date and compares it with a full scan.
@@ -187,15 +196,17 @@ TEST(SurfaceScan, MergesThatOnlyRenameReadNoBlock) {
     {
       MutableVoxelLookup lookup(map);
       Voxel* v = lookup.findGrid(20, 20, 20);
+      VoxelVotes* v_votes = votesOf(lookup, v);
       v->weight = 1.0f;
       v->sdf_m = 0.0f;
-      v->votes[0] = LabelVote{tied, 3};
-      v->votes[1] = LabelVote{rival, 3};
+      v_votes->slots[0] = LabelVote{tied, 3};
+      v_votes->slots[1] = LabelVote{rival, 3};
       Voxel* w = lookup.findGrid(21, 20, 20);
+      VoxelVotes* w_votes = votesOf(lookup, w);
       w->weight = 1.0f;
       w->sdf_m = 0.0f;
-      w->votes[0] = LabelVote{third, 2};
-      for (int k = 1; k < kVoteSlots; ++k) w->votes[k] = LabelVote{};
+      w_votes->slots[0] = LabelVote{third, 2};
+      for (int k = 1; k < kVoteSlots; ++k) w_votes->slots[k] = LabelVote{};
     }
     refreshAndCompare();
     registry.merge(third, survivor);
@@ -218,11 +229,12 @@ TEST(SurfaceScan, MergesThatOnlyRenameReadNoBlock) {
     {
       MutableVoxelLookup lookup(map);
       Voxel* v = lookup.findGrid(-20, -20, -20);
+      VoxelVotes* v_votes = votesOf(lookup, v);
       v->weight = 1.0f;
       v->sdf_m = 0.0f;
-      v->votes[0] = LabelVote{own, 3};
-      v->votes[1] = LabelVote{p, 2};
-      v->votes[2] = LabelVote{q, 2};
+      v_votes->slots[0] = LabelVote{own, 3};
+      v_votes->slots[1] = LabelVote{p, 2};
+      v_votes->slots[2] = LabelVote{q, 2};
     }
     refreshAndCompare();
     registry.merge(p, q);
@@ -245,7 +257,7 @@ TEST(SurfaceScan, AMarkedBlockIsReadAgain) {
   Voxel& v = block->voxels[0];
   v.weight = 1.0f;
   v.sdf_m = 0.0f;
-  v.votes[0] = LabelVote{kLabels, 50};
+  block->votesToWrite(0)->slots[0] = LabelVote{kLabels, 50};
   scan.refresh(map, registry, 2.0f);
   EXPECT_EQ(scan.blocksRead(), 0u);
   map.markChanged(block);

@@ -100,8 +100,11 @@ TEST(BlockUpdate, VectorPathMatchesScalarBitForBit) {
     const Eigen::Vector3f origin_C(lateral(rng), lateral(rng), range(rng));
     Block scalar, vector, before;
     seedBlock(&scalar, trial);
-    std::memcpy(static_cast<void*>(&vector), &scalar, sizeof(Block));
-    std::memcpy(static_cast<void*>(&before), &scalar, sizeof(Block));
+    for (Block* copy : {&vector, &before}) {
+      copy->index = scalar.index;
+      copy->lower_changed = scalar.lower_changed;
+      std::memcpy(copy->voxels, scalar.voxels, sizeof(Block::voxels));
+    }
     const size_t n_scalar = updateBlockScalar(p, origin_C, &scalar);
     const size_t n_vector = updateBlock(p, origin_C, &vector);
     ASSERT_EQ(n_scalar, n_vector) << "trial " << trial;

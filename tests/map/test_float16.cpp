@@ -53,7 +53,8 @@ TEST(Float16, ArithmeticIsFloatArithmetic) {
   EXPECT_EQ(v.sdf_m.bits(), Float16(mean).bits());
   v.weight += 0.5f;
   EXPECT_EQ(static_cast<float>(v.weight), 7.5f);
-  EXPECT_EQ(sizeof(Voxel), 32u);
+  EXPECT_EQ(sizeof(Voxel), 8u);
+  EXPECT_EQ(sizeof(VoxelVotes), 24u);
 }
 
 }  // namespace

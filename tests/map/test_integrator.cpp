@@ -144,21 +144,28 @@ TEST(Integrator, VotesGoToSurfaceVoxelsAndSameInputGivesSameMap) {
           std::memcmp(one->blocks()[b]->voxels, other->blocks()[b]->voxels, sizeof(Block::voxels)),
           0)
           << threads << " threads, block " << b;
+      for (int i = 0; i < kBlockVoxels; ++i) {
+        const VoxelVotes* a = one->blocks()[b]->votes(i);
+        const VoxelVotes* c = other->blocks()[b]->votes(i);
+        ASSERT_EQ(a == nullptr, c == nullptr) << threads << " threads, block " << b;
+        if (a) EXPECT_EQ(std::memcmp(a, c, sizeof(VoxelVotes)), 0) << threads << " threads";
+      }
     }
   }
   // The camera looks along +x with x_C = -y_W: image left (u < 320) is world +y.
-  const Voxel* left = one->findVoxel({2.0f, 0.5f, 0.1f});
-  const Voxel* right = one->findVoxel({2.0f, -0.5f, 0.1f});
+  const VoxelVotes* left = one->findVotes({2.0f, 0.5f, 0.1f});
+  const VoxelVotes* right = one->findVotes({2.0f, -0.5f, 0.1f});
   ASSERT_TRUE(left && right);
   auto identity = [](int32_t l) { return l; };
   EXPECT_EQ(argmaxLabel(*left, identity), 7);
   EXPECT_EQ(argmaxLabel(*right, identity), 9);
   // A vote per pixel whose point falls in the voxel, in each of the 3 frames.
-  EXPECT_GT(left->votes[0].count, 3u);
-  EXPECT_EQ(left->votes[0].count % 3, 0u);
-  const Voxel* free_space = one->findVoxel({1.95f, 0.5f, 0.1f});  // 5 cm in front: no vote
-  ASSERT_TRUE(free_space);
-  EXPECT_EQ(argmaxLabel(*free_space, identity), 0);
+  EXPECT_GT(left->slots[0].count, 3u);
+  EXPECT_EQ(left->slots[0].count % 3, 0u);
+  // 5 cm in front: an observed voxel without a vote.
+  ASSERT_TRUE(one->findVoxel({1.95f, 0.5f, 0.1f}));
+  EXPECT_EQ(one->findVotes({1.95f, 0.5f, 0.1f}), nullptr);
+  EXPECT_EQ(argmaxLabel(one->findVotes({1.95f, 0.5f, 0.1f}), identity), 0);
 }
 
 TEST(VoteStride, AutomaticIsTheLargestStrideHalfAVoxelApartAtMaxDepth) {
@@ -213,10 +220,10 @@ TEST(Integrator, AutomaticVoteStrideAtCoarseVoxelsLabelsTheSameVoxels) {
     const Block& other = *automatic->blocks()[b];
     ASSERT_EQ(one.index, other.index);
     for (int i = 0; i < kBlockVoxels; ++i) {
-      const int32_t label = argmaxLabel(one.voxels[i], identity);
+      const int32_t label = argmaxLabel(one.votes(i), identity);
       if (label == 0) continue;
       ++voted;
-      const int32_t sampled = argmaxLabel(other.voxels[i], identity);
+      const int32_t sampled = argmaxLabel(other.votes(i), identity);
       if (sampled == 0) continue;
       ++kept;
       EXPECT_EQ(sampled, label);
@@ -227,7 +234,7 @@ TEST(Integrator, AutomaticVoteStrideAtCoarseVoxelsLabelsTheSameVoxels) {
 }
 
 TEST(Votes, EvictionIsWeakestFirstAndCounted) {
-  Voxel v;
+  VoxelVotes v;
   for (int i = 0; i < 5; ++i) EXPECT_FALSE(addVote(&v, 1));
   for (int i = 0; i < 3; ++i) EXPECT_FALSE(addVote(&v, 2));
   EXPECT_FALSE(addVote(&v, 3));
@@ -235,7 +242,7 @@ TEST(Votes, EvictionIsWeakestFirstAndCounted) {
   // All four slots are full: label 5 evicts label 3 (count 1), the weakest.
   EXPECT_TRUE(addVote(&v, 5));
   int32_t labels[kVoteSlots];
-  for (int i = 0; i < kVoteSlots; ++i) labels[i] = v.votes[i].label;
+  for (int i = 0; i < kVoteSlots; ++i) labels[i] = v.slots[i].label;
   EXPECT_EQ(std::count(labels, labels + kVoteSlots, 3), 0);
   EXPECT_EQ(std::count(labels, labels + kVoteSlots, 5), 1);
   EXPECT_EQ(argmaxLabel(v, [](int32_t l) { return l; }), 1);
@@ -254,7 +261,10 @@ TEST(Votes, EvictionIsWeakestFirstAndCounted) {
   EXPECT_EQ(argmaxLabel(v, five_into_four, &tie), 1);
   EXPECT_FALSE(tie);  // 4 and 5 pooled: 3 ties with 2, below the winner's 5
   tie = true;
-  EXPECT_EQ(argmaxLabel(Voxel{}, same, &tie), 0);
+  EXPECT_EQ(argmaxLabel(VoxelVotes{}, same, &tie), 0);
+  tie = true;
+  EXPECT_EQ(argmaxLabel(static_cast<const VoxelVotes*>(nullptr), same, &tie), 0);
+  EXPECT_FALSE(tie);
   EXPECT_FALSE(tie);
 }
 

@@ -42,16 +42,20 @@ TEST(VoteRows, RunsOfOneRowByHand) {
                          : findRowVotesScalar(depth, labels, 0, 1, Eigen::Isometry3f::Identity(),
                                               cam, &lookup, runs.data());
     ASSERT_EQ(n, 4u) << (vector_path ? "vector" : "scalar");
-    EXPECT_EQ(runs[0].voxel, &block->at(0, 0, 2));
+    EXPECT_EQ(runs[0].block, block);
+    EXPECT_EQ(runs[0].voxel, Block::linear(0, 0, 2));
     EXPECT_EQ(runs[0].label, 1);
     EXPECT_EQ(runs[0].count, 2u);
-    EXPECT_EQ(runs[1].voxel, &block->at(0, 0, 2));
+    EXPECT_EQ(runs[1].block, block);
+    EXPECT_EQ(runs[1].voxel, Block::linear(0, 0, 2));
     EXPECT_EQ(runs[1].label, 2);
     EXPECT_EQ(runs[1].count, 2u);
-    EXPECT_EQ(runs[2].voxel, &block->at(1, 0, 2));
+    EXPECT_EQ(runs[2].block, block);
+    EXPECT_EQ(runs[2].voxel, Block::linear(1, 0, 2));
     EXPECT_EQ(runs[2].label, 3);
     EXPECT_EQ(runs[2].count, 4u);
-    EXPECT_EQ(runs[3].voxel, &block->at(2, 0, 2));  // pixels 9 and 11
+    EXPECT_EQ(runs[3].block, block);
+    EXPECT_EQ(runs[3].voxel, Block::linear(2, 0, 2));  // pixels 9 and 11
     EXPECT_EQ(runs[3].label, 7);
     EXPECT_EQ(runs[3].count, 2u);
   }
@@ -124,6 +128,7 @@ TEST(VoteRows, VectorPathMatchesScalarExactly) {
       const size_t nb = findRowVotesScalar(depth, labels, v, 1, T_W_C, cam, &lookup_b, b.data());
       ASSERT_EQ(na, nb) << "trial " << trial << " row " << v;
       for (size_t i = 0; i < na; ++i) {
+        ASSERT_EQ(a[i].block, b[i].block) << "trial " << trial << " row " << v << " run " << i;
         ASSERT_EQ(a[i].voxel, b[i].voxel) << "trial " << trial << " row " << v << " run " << i;
         ASSERT_EQ(a[i].label, b[i].label);
         ASSERT_EQ(a[i].count, b[i].count);
@@ -143,7 +148,7 @@ TEST(VoteRows, VectorPathMatchesScalarExactly) {
 TEST(VoteRows, AddVotesEqualsRepeatedAddVote) {
   std::mt19937 rng(5);
   for (int trial = 0; trial < 500; ++trial) {
-    Voxel bulk, single;
+    VoxelVotes bulk, single;
     bool evicted_bulk = false, evicted_single = false;
     for (int step = 0; step < 30; ++step) {
       const int32_t label = 1 + static_cast<int32_t>(rng() % 7);
@@ -151,27 +156,27 @@ TEST(VoteRows, AddVotesEqualsRepeatedAddVote) {
       evicted_bulk |= addVotes(&bulk, label, n);
       for (uint32_t i = 0; i < n; ++i) evicted_single |= addVote(&single, label);
       for (int s = 0; s < kVoteSlots; ++s) {
-        ASSERT_EQ(bulk.votes[s].label, single.votes[s].label) << "trial " << trial;
-        ASSERT_EQ(bulk.votes[s].count, single.votes[s].count) << "trial " << trial;
+        ASSERT_EQ(bulk.slots[s].label, single.slots[s].label) << "trial " << trial;
+        ASSERT_EQ(bulk.slots[s].count, single.slots[s].count) << "trial " << trial;
       }
     }
     EXPECT_EQ(evicted_bulk, evicted_single);
   }
   // A slot about to overflow halves the voxel's counts (rounding up) and then takes the votes:
   // the ratios Eq. 2 reads survive, and no slot empties.
-  Voxel full;
-  full.votes[0] = LabelVote{3, kMaxVoteCount - 2};
-  full.votes[1] = LabelVote{5, 40001};
-  full.votes[2] = LabelVote{6, 1};
+  VoxelVotes full;
+  full.slots[0] = LabelVote{3, kMaxVoteCount - 2};
+  full.slots[1] = LabelVote{5, 40001};
+  full.slots[2] = LabelVote{6, 1};
   addVotes(&full, 3, 10);
-  EXPECT_EQ(full.votes[0].count, 32767u + 10u);
-  EXPECT_EQ(full.votes[1].count, 20001u);
-  EXPECT_EQ(full.votes[2].count, 1u);
+  EXPECT_EQ(full.slots[0].count, 32767u + 10u);
+  EXPECT_EQ(full.slots[1].count, 20001u);
+  EXPECT_EQ(full.slots[2].count, 1u);
   EXPECT_EQ(argmaxLabel(full, [](int32_t l) { return l; }), 3);
   // A new slot takes at most the cap, however many votes arrive at once.
   addVotes(&full, 4, 100000);
-  EXPECT_EQ(full.votes[3].label, 4);
-  EXPECT_EQ(full.votes[3].count, kMaxVoteCount);
+  EXPECT_EQ(full.slots[3].label, 4);
+  EXPECT_EQ(full.slots[3].count, kMaxVoteCount);
 }
 
 // The lookups' floor must agree with std::floor everywhere a voxel index can be.

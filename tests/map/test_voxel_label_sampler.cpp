@@ -20,10 +20,10 @@ TEST(VoxelLabelSampler, RowOfSamplesMatchesOneByOne) {
     for (int by = -2; by <= 1; ++by) {
       if ((bx + by) % 3 == 0) continue;
       Block* block = map.allocateBlock(BlockIndex(bx, by, 2));
-      for (Voxel& voxel : block->voxels) {
+      for (int i = 0; i < kBlockVoxels; ++i) {
         if (rng() % 4 == 0) continue;  // no votes: label 0
         for (int k = 0; k < 1 + static_cast<int>(rng() % 3); ++k) {
-          addVotes(&voxel, 1 + static_cast<int32_t>(rng() % 6), 1 + rng() % 5);
+          addVotes(block->votesToWrite(i), 1 + static_cast<int32_t>(rng() % 6), 1 + rng() % 5);
         }
       }
     }

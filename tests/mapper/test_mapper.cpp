@@ -436,81 +436,100 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToTwelve) {
   EXPECT_FALSE(
       Mapper::deserialize(asVersion(bytes_b, offset, 11), "11.panmap")->config().depth_calibration);
 
-  // Versions outside 5-12 are refused by name.
+  // Versions outside 5-13 are refused by name.
   std::vector<uint8_t> future = Mapper(b).serialize();
-  future[8] = 13;
+  future[8] = 14;
   test::expectError([&] { Mapper::deserialize(future, "future.panmap"); },
-                    {"future.panmap", "version 13", "reads 5 to 12"});
+                    {"future.panmap", "version 14", "reads 5 to 13"});
 }
 
-// `file` (written by `mapper`) with its voxels as versions before 11 stored them: 4-byte
-// distance and weight, then vote counts of 4 bytes (version 9) or 2 (version 10). Voxel 0 of
-// block 0 gets the labels 77-80 with `first_counts`.
+// `file` (written by `mapper`) with its voxels as versions before 13 stored them, every voxel
+// with its four vote slots: 4-byte distance and weight and vote counts of 4 bytes (version 9)
+// or 2 (version 10); as today's 8 bytes, then the slots (versions 11 and 12). Voxel 0 of block
+// 0 gets the labels 77-80 with `first_counts`.
 std::vector<uint8_t> withLegacyVoxels(const std::vector<uint8_t>& file, const TsdfMap& map,
                                       uint32_t version, const uint32_t first_counts[kVoteSlots]) {
-  // Blocks are stored in allocation order, each as index, updated flag and voxels: the first
-  // block's record is found by its bytes.
+  // Blocks are stored in allocation order, each as index, updated flag, voxels and votes: the
+  // first block's record is found by its bytes.
   const Block& first = *map.blocks()[0];
   constexpr size_t kRecordHead = 3 * sizeof(int32_t) + 1;
-  std::vector<uint8_t> pattern(kRecordHead + sizeof(Voxel));
+  std::vector<uint8_t> pattern(kRecordHead + sizeof(Block::voxels));
   const int32_t index[3] = {first.index.x(), first.index.y(), first.index.z()};
   std::memcpy(pattern.data(), index, sizeof(index));
   pattern[12] = first.updated;
-  std::memcpy(pattern.data() + kRecordHead, &first.voxels[0], sizeof(Voxel));
+  std::memcpy(pattern.data() + kRecordHead, first.voxels, sizeof(Block::voxels));
   const auto found = std::search(file.begin(), file.end(), pattern.begin(), pattern.end());
   EXPECT_NE(found, file.end());
   if (found == file.end()) return {};
   const size_t begin = static_cast<size_t>(found - file.begin());
-  const size_t record = kRecordHead + sizeof(Block::voxels);
+  size_t end = begin;
+  for (const auto& block : map.blocks()) {
+    size_t voted = 0;
+    for (const VoxelVotes& votes : block->vote_sets) voted += votes.total() > 0 ? 1 : 0;
+    end += kRecordHead + sizeof(Block::voxels) + 2 + voted * (2 + sizeof(VoxelVotes));
+  }
   const size_t count_bytes = version >= 10 ? 2 : 4;
   std::vector<uint8_t> old(file.begin(), found);
   for (size_t b = 0; b < map.numBlocks(); ++b) {
-    const uint8_t* head = file.data() + begin + b * record;
-    old.insert(old.end(), head, head + kRecordHead);
+    const Block& block = *map.blocks()[b];
+    const int32_t block_index[3] = {block.index.x(), block.index.y(), block.index.z()};
+    std::vector<uint8_t> record(kRecordHead);
+    std::memcpy(record.data(), block_index, sizeof(block_index));
+    record[12] = block.updated;
+    old.insert(old.end(), record.begin(), record.end());
     for (int i = 0; i < kBlockVoxels; ++i) {
-      Voxel v;
-      std::memcpy(&v, head + kRecordHead + i * sizeof(Voxel), sizeof(Voxel));
-      std::vector<uint8_t> bytes(12 + kVoteSlots * (4 + count_bytes));
-      const float sdf_m = v.sdf_m, weight = v.weight;
-      std::memcpy(bytes.data(), &sdf_m, 4);
-      std::memcpy(bytes.data() + 4, &weight, 4);
-      bytes[8] = v.color.r;
-      bytes[9] = v.color.g;
-      bytes[10] = v.color.b;
-      bytes[11] = v.flags;
+      const Voxel& v = block.voxels[i];
+      const VoxelVotes none;
+      const VoxelVotes& votes = block.votes(i) ? *block.votes(i) : none;
+      std::vector<uint8_t> bytes;
+      if (version >= 11) {
+        bytes.resize(sizeof(Voxel) + kVoteSlots * 6);
+        std::memcpy(bytes.data(), &v, sizeof(Voxel));
+      } else {
+        bytes.resize(12 + kVoteSlots * (4 + count_bytes));
+        const float sdf_m = v.sdf_m, weight = v.weight;
+        std::memcpy(bytes.data(), &sdf_m, 4);
+        std::memcpy(bytes.data() + 4, &weight, 4);
+        bytes[8] = v.color.r;
+        bytes[9] = v.color.g;
+        bytes[10] = v.color.b;
+        bytes[11] = v.flags;
+      }
+      const size_t slots_at = version >= 11 ? sizeof(Voxel) : 12;
+      const size_t slot_bytes = version >= 11 ? 6 : 4 + count_bytes;
       for (int k = 0; k < kVoteSlots; ++k) {
-        int32_t label = v.votes[k].label;
-        uint32_t count = v.votes[k].count;
+        int32_t label = votes.slots[k].label;
+        uint32_t count = votes.slots[k].count;
         if (b == 0 && i == 0) {
           label = 77 + k;
           count = first_counts[k];
         }
-        uint8_t* slot = bytes.data() + 12 + (4 + count_bytes) * k;
+        uint8_t* slot = bytes.data() + slots_at + slot_bytes * k;
         std::memcpy(slot, &label, 4);
         const uint16_t short_count = static_cast<uint16_t>(count);
-        std::memcpy(slot + 4, count_bytes == 2 ? static_cast<const void*>(&short_count) : &count,
-                    count_bytes);
+        std::memcpy(slot + 4, slot_bytes == 6 ? static_cast<const void*>(&short_count) : &count,
+                    slot_bytes - 4);
       }
       old.insert(old.end(), bytes.begin(), bytes.end());
     }
   }
-  old.insert(old.end(),
-             file.begin() + static_cast<std::ptrdiff_t>(begin + map.numBlocks() * record),
-             file.end());
+  old.insert(old.end(), file.begin() + static_cast<std::ptrdiff_t>(end), file.end());
   return reseal(old, version);
 }
 
 // Files before version 11 hold 44-byte (version 9) or 36-byte (version 10) voxels with 4-byte
-// distances and weights: they load into today's 32-byte voxels with every value kept (the
-// 2-byte floats round-trip through 4-byte ones exactly); counts beyond 65,535 are scaled down.
-TEST_F(BoxScene, MapFilesBeforeVersionElevenLoadTheirVoxels) {
+// distances and weights, versions 11 and 12 32-byte ones with the four vote slots in every
+// voxel: they load into today's 8-byte voxels and vote sets with every value kept (the 2-byte
+// floats round-trip through 4-byte ones exactly); counts beyond 65,535 are scaled down; a
+// voxel without a vote gets no vote set.
+TEST_F(BoxScene, MapFilesBeforeVersionThirteenLoadTheirVoxels) {
   const auto mapper = run(config(), 3);
   const std::vector<uint8_t> file = withoutCalibrationFlag(mapper->serialize(), mapper->config());
   const TsdfMap& map = mapper->map();
   ASSERT_GT(map.numBlocks(), 10u);
   const uint32_t nine_counts[kVoteSlots] = {140000, 70000, 1, 0};
   const uint32_t ten_counts[kVoteSlots] = {65535, 1000, 1, 0};
-  for (const uint32_t version : {9u, 10u}) {
+  for (const uint32_t version : {9u, 10u, 11u}) {
     SCOPED_TRACE(version);
     const std::vector<uint8_t> old =
         withLegacyVoxels(file, map, version, version == 9 ? nine_counts : ten_counts);
@@ -523,22 +542,25 @@ TEST_F(BoxScene, MapFilesBeforeVersionElevenLoadTheirVoxels) {
       const Block& want = *map.blocks()[b];
       const Block& got = *back.blocks()[b];
       ASSERT_EQ(got.index, want.index);
-      for (int i = b == 0 ? 1 : 0; i < kBlockVoxels; ++i) {
+      for (int i = 0; i < kBlockVoxels; ++i) {
         ASSERT_EQ(0, std::memcmp(&got.voxels[i], &want.voxels[i], sizeof(Voxel))) << b << " " << i;
-        voted += want.voxels[i].votes[0].count > 0;
+        if (b == 0 && i == 0) continue;
+        ASSERT_EQ(got.votes(i) == nullptr, want.votes(i) == nullptr) << b << " " << i;
+        if (!want.votes(i)) continue;
+        ASSERT_EQ(0, std::memcmp(got.votes(i), want.votes(i), sizeof(VoxelVotes))) << b << " " << i;
+        ++voted;
       }
     }
     EXPECT_GT(voted, 100u);  // the votes were carried, not only empty slots
-    const Voxel& first = back.blocks()[0]->voxels[0];
-    EXPECT_EQ(first.votes[0].label, 77);
-    EXPECT_EQ(first.votes[0].count, kMaxVoteCount);
-    EXPECT_EQ(first.votes[1].label, 78);
-    // Version 9: half of 65,535, rounded up; version 10 kept its count.
-    EXPECT_EQ(first.votes[1].count, version == 9 ? 32768u : 1000u);
-    EXPECT_EQ(first.votes[2].count, 1u);  // a vote stays a vote
-    EXPECT_EQ(first.votes[3].count, 0u);
-    EXPECT_EQ(first.sdf_m.bits(), map.blocks()[0]->voxels[0].sdf_m.bits());
-    EXPECT_EQ(first.weight.bits(), map.blocks()[0]->voxels[0].weight.bits());
+    ASSERT_NE(back.blocks()[0]->votes(0), nullptr);
+    const VoxelVotes& first = *back.blocks()[0]->votes(0);
+    EXPECT_EQ(first.slots[0].label, 77);
+    EXPECT_EQ(first.slots[0].count, kMaxVoteCount);
+    EXPECT_EQ(first.slots[1].label, 78);
+    // Version 9: half of 65,535, rounded up; versions 10 and 11 kept their count.
+    EXPECT_EQ(first.slots[1].count, version == 9 ? 32768u : 1000u);
+    EXPECT_EQ(first.slots[2].count, 1u);  // a vote stays a vote
+    EXPECT_EQ(first.slots[3].count, 0u);
   }
 }
 

@@ -30,11 +30,14 @@ void setVoxel(TsdfMap* map, const Eigen::Vector3i& g, float sdf_m, float weight,
                      static_cast<int>(std::floor(g.y() / 8.0)),
                      static_cast<int>(std::floor(g.z() / 8.0)));
   const Eigen::Vector3i l = g - kBlockSide * b;
-  Voxel& v = map->allocateBlock(b)->at(l.x(), l.y(), l.z());
+  Block* block = map->allocateBlock(b);
+  Voxel& v = block->at(l.x(), l.y(), l.z());
   v.sdf_m = sdf_m;
   v.weight = weight;
+  if (votes.size() == 0) return;
+  VoxelVotes* slots = block->votesToWrite(Block::linear(l.x(), l.y(), l.z()));
   int k = 0;
-  for (const LabelVote& vote : votes) v.votes[k++] = vote;
+  for (const LabelVote& vote : votes) slots->slots[k++] = vote;
 }
 
 // Super-points 1..5; 4 was merged into 1. 1 and 2 form instance 7 (chair), 3 is instance 9

@@ -68,7 +68,7 @@ void fillMap(TsdfMap* map, const Eigen::Vector3f& lo_m, const Eigen::Vector3f& h
               v.weight = 1.0f;
               const Eigen::Vector3i g = globalVoxel(block->index, x, y, z);
               v.color = voxelColor(g);
-              v.votes[0] = LabelVote{voxelLabel(g), 3};
+              block->votesToWrite(Block::linear(x, y, z))->slots[0] = LabelVote{voxelLabel(g), 3};
             }
           }
         }
@@ -154,7 +154,9 @@ void expectSameMesh(const LabelledMesh& a, const LabelledMesh& b) {
 
 MeshLabeller identityLabeller() {
   MeshLabeller labeller;
-  labeller.superpoint = [](const Voxel& v) { return argmaxLabel(v, [](int32_t l) { return l; }); };
+  labeller.superpoint = [](const VoxelVotes& v) {
+    return argmaxLabel(v, [](int32_t l) { return l; });
+  };
   labeller.semantic = [](int32_t sp) { return sp == 0 ? 0 : sp + 2; };
   labeller.instance = [](int32_t sp) { return sp == 0 ? 0 : 1000 + sp; };
   return labeller;
@@ -387,20 +389,21 @@ TEST(MarchingCubes, VerticesOfUnvotedVoxelsTakeTheirNeighboursLabelWhenAsked) {
   fillSphere(&map, 0.15f);
   // Every 4th voxel along a diagonal pattern loses its votes (as voxels no pixel voted for).
   auto erased = [](const Eigen::Vector3i& g) { return ((g.x() + 2 * g.y() + 3 * g.z()) & 3) == 0; };
-  auto voxelAt = [&map](const Eigen::Vector3i& g) -> const Voxel* {
+  auto votesAt = [&map](const Eigen::Vector3i& g) -> const VoxelVotes* {
     const BlockIndex b(static_cast<int>(std::floor(g.x() / 8.0)),
                        static_cast<int>(std::floor(g.y() / 8.0)),
                        static_cast<int>(std::floor(g.z() / 8.0)));
     const Block* block = map.findBlock(b);
     if (!block) return nullptr;
     const Eigen::Vector3i l = g - b * kBlockSide;
-    return &block->at(l.x(), l.y(), l.z());
+    return block->votes(Block::linear(l.x(), l.y(), l.z()));
   };
   for (const auto& block : map.blocks()) {
     for (int z = 0; z < kBlockSide; ++z) {
       for (int y = 0; y < kBlockSide; ++y) {
         for (int x = 0; x < kBlockSide; ++x) {
-          if (erased(globalVoxel(block->index, x, y, z))) block->at(x, y, z).votes[0] = {};
+          VoxelVotes* votes = block->votes(Block::linear(x, y, z));
+          if (votes && erased(globalVoxel(block->index, x, y, z))) votes->slots[0] = {};
         }
       }
     }
@@ -413,8 +416,8 @@ TEST(MarchingCubes, VerticesOfUnvotedVoxelsTakeTheirNeighboursLabelWhenAsked) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           if (dx == 0 && dy == 0 && dz == 0) continue;
-          const Voxel* v = voxelAt(g + Eigen::Vector3i(dx, dy, dz));
-          if (v && v->votes[0].count > 0) ++counts[v->votes[0].label];
+          const VoxelVotes* v = votesAt(g + Eigen::Vector3i(dx, dy, dz));
+          if (v && v->slots[0].count > 0) ++counts[v->slots[0].label];
         }
       }
     }
@@ -484,7 +487,7 @@ TEST(MarchingCubes, VerticesOfUnvotedVoxelsTakeTheirNeighboursLabelWhenAsked) {
 
   // Nothing to copy from: no label is invented.
   for (const auto& block : map.blocks()) {
-    for (Voxel& v : block->voxels) v.votes[0] = {};
+    for (VoxelVotes& v : block->vote_sets) v.slots[0] = {};
   }
   for (int32_t label : marchingCubes(map, {}, filling).semantic) ASSERT_EQ(label, 0);
 }
@@ -588,7 +591,7 @@ TEST(IncrementalMesher, RelabelsAtAssembleTimeWithoutRemeshing) {
 
   // Super-points 2..7 merge into 1: every vertex becomes 1, no block is re-meshed.
   MeshLabeller merged = identityLabeller();
-  merged.superpoint = [](const Voxel& v) { return argmaxLabel(v, [](int32_t) { return 1; }); };
+  merged.superpoint = [](const VoxelVotes& v) { return argmaxLabel(v, [](int32_t) { return 1; }); };
   const LabelledMesh relabelled = mesher.assemble(map, merged);
   EXPECT_EQ(mesher.totalRemeshedBlocks(), meshed);
   EXPECT_EQ(relabelled.vertices, separate.vertices);
@@ -600,7 +603,7 @@ TEST(IncrementalMesher, RelabelsAtAssembleTimeWithoutRemeshing) {
   }
   // Votes changed in the map (no geometry change) show up at the next assembly too.
   for (const auto& block : map.blocks()) {
-    for (Voxel& v : block->voxels) v.votes[0].label = 9;
+    for (VoxelVotes& v : block->vote_sets) v.slots[0].label = 9;
   }
   const LabelledMesh revoted = mesher.assemble(map, identityLabeller());
   EXPECT_EQ(std::set<int32_t>(revoted.superpoint.begin(), revoted.superpoint.end()),

@@ -58,30 +58,51 @@ class Float16 {
 };
 static_assert(sizeof(Float16) == 2, "two bytes");
 
-/// A voxel of the label-TSDF: 32 bytes, two to a cache line. Distance and weight are 2-byte
-/// floats: the map is mostly voxels, and a building at 2 cm outgrew 4 GB with 4-byte ones.
+/// A voxel of the label-TSDF's geometry: 8 bytes, eight to a cache line. Distance and weight
+/// are 2-byte floats: the map is mostly voxels. Its super-point votes live beside it, in its
+/// block's vote sets (Block::votes), since about one voxel in seven ever holds one.
 struct Voxel {
   Float16 sdf_m;      ///< truncated signed distance to the surface, metres (+ in front)
   Float16 weight;     ///< integration weight, 0 = never observed
   Rgb8 color;         ///< running mean colour
   uint8_t flags = 0;  ///< reserved
-  LabelVote votes[kVoteSlots];
 };
-static_assert(sizeof(Voxel) == 32, "keep voxels lean");
+static_assert(sizeof(Voxel) == 8, "keep voxels lean");
+
+/// The super-point votes of one voxel: kVoteSlots slots, 24 bytes.
+struct VoxelVotes {
+  LabelVote slots[kVoteSlots];
+
+  /// The first slot, for range-for over the slots.
+  LabelVote* begin() { return slots; }
+  /// Past the last slot.
+  LabelVote* end() { return slots + kVoteSlots; }
+  /// The first slot, for range-for over the slots.
+  const LabelVote* begin() const { return slots; }
+  /// Past the last slot.
+  const LabelVote* end() const { return slots + kVoteSlots; }
+  /// Sum of the slots' counts.
+  uint32_t total() const {
+    uint32_t sum = 0;
+    for (const LabelVote& v : slots) sum += v.count;
+    return sum;
+  }
+};
+static_assert(sizeof(VoxelVotes) == 24, "vote sets are packed");
 
 /// Adds `n` votes for `label` (n >= 1), as n calls adding one vote each would (up to rounding
 /// where counts are halved): increments its slot, or fills an empty one, or evicts the weakest
 /// slot (lowest count, first on ties). A slot that would exceed kMaxVoteCount first halves
 /// every count of the voxel (rounding up, so no slot empties); what still does not fit
 /// saturates. Returns true when a vote was evicted.
-inline bool addVotes(Voxel* voxel, int32_t label, uint32_t n) {
+inline bool addVotes(VoxelVotes* votes, int32_t label, uint32_t n) {
   const uint16_t capped = static_cast<uint16_t>(n < kMaxVoteCount ? n : kMaxVoteCount);
   int empty = -1, weakest = 0;
   for (int i = 0; i < kVoteSlots; ++i) {
-    LabelVote& v = voxel->votes[i];
+    LabelVote& v = votes->slots[i];
     if (v.label == label && v.count > 0) {
       if (v.count > kMaxVoteCount - capped) {
-        for (LabelVote& other : voxel->votes) {
+        for (LabelVote& other : votes->slots) {
           other.count = static_cast<uint16_t>((other.count + 1u) / 2u);
         }
       }
@@ -91,20 +112,20 @@ inline bool addVotes(Voxel* voxel, int32_t label, uint32_t n) {
     }
     if (v.count == 0) {
       if (empty < 0) empty = i;
-    } else if (v.count < voxel->votes[weakest].count || voxel->votes[weakest].count == 0) {
+    } else if (v.count < votes->slots[weakest].count || votes->slots[weakest].count == 0) {
       weakest = i;
     }
   }
   if (empty >= 0) {
-    voxel->votes[empty] = LabelVote{label, capped};
+    votes->slots[empty] = LabelVote{label, capped};
     return false;
   }
-  voxel->votes[weakest] = LabelVote{label, capped};
+  votes->slots[weakest] = LabelVote{label, capped};
   return true;
 }
 
 /// Adds one vote for `label` (see addVotes). Returns true when a vote was evicted.
-inline bool addVote(Voxel* voxel, int32_t label) { return addVotes(voxel, label, 1); }
+inline bool addVote(VoxelVotes* votes, int32_t label) { return addVotes(votes, label, 1); }
 
 /// Eq. 2: the voxel's super-point label, argmax of its votes after mapping every stored label
 /// through `resolve` (merged super-points pool their votes). 0 when the voxel has no vote.
@@ -112,11 +133,11 @@ inline bool addVote(Voxel* voxel, int32_t label) { return addVotes(voxel, label,
 /// @param tie if given, set to whether another resolved label had the winner's count (a
 ///        renaming of the labels could then change the winner)
 template <typename Resolve>
-int32_t argmaxLabel(const Voxel& voxel, const Resolve& resolve, bool* tie = nullptr) {
+int32_t argmaxLabel(const VoxelVotes& votes, const Resolve& resolve, bool* tie = nullptr) {
   int32_t labels[kVoteSlots];
   uint64_t counts[kVoteSlots];
   int n = 0;
-  for (const LabelVote& v : voxel.votes) {
+  for (const LabelVote& v : votes.slots) {
     if (v.count == 0) continue;
     const int32_t label = resolve(v.label);
     int k = 0;
@@ -141,6 +162,16 @@ int32_t argmaxLabel(const Voxel& voxel, const Resolve& resolve, bool* tie = null
     *tie = winners > 1;
   }
   return best;
+}
+
+/// argmaxLabel of a voxel's votes, 0 (and no tie) when it has none (`votes` null).
+template <typename Resolve>
+int32_t argmaxLabel(const VoxelVotes* votes, const Resolve& resolve, bool* tie = nullptr) {
+  if (!votes) {
+    if (tie) *tie = false;
+    return 0;
+  }
+  return argmaxLabel(*votes, resolve, tie);
 }
 
 }  // namespace panmap

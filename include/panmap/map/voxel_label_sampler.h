@@ -38,7 +38,7 @@ class VoxelLabelSampler {
 
   /// The label of the voxel that pixel (u, v) at depth d_m (> 0) sees; 0 when that voxel's
   /// block is not allocated or it has no votes.
-  int32_t label(int u, int v, float d_m) { return labelOf(lookup_.find(point(u, v, d_m))); }
+  int32_t label(int u, int v, float d_m) { return labelOf(votesAt(point(u, v, d_m))); }
 
   /// Global integer coordinates of the voxel the last label() call found.
   const Eigen::Vector3i& lastVoxel() const { return lookup_.lastVoxel(); }
@@ -49,30 +49,38 @@ class VoxelLabelSampler {
   /// of a row overlap instead of waiting for one another.
   void labelRow(int v, const std::vector<RowSample>& samples, int32_t* labels,
                 Eigen::Vector3i* voxels) {
-    row_voxels_.resize(samples.size());
+    row_votes_.resize(samples.size());
     for (size_t k = 0; k < samples.size(); ++k) {
-      const Voxel* voxel = lookup_.find(point(samples[k].u, v, samples[k].d_m));
-      row_voxels_[k] = voxel;
+      const VoxelVotes* votes = votesAt(point(samples[k].u, v, samples[k].d_m));
+      row_votes_[k] = votes;
       if (voxels) voxels[k] = lookup_.lastVoxel();
-      if (voxel) {
-        // A voxel may straddle two cache lines.
-        __builtin_prefetch(voxel);
-        __builtin_prefetch(reinterpret_cast<const char*>(voxel + 1) - 1);
+      if (votes) {
+        // A vote set may straddle two cache lines.
+        __builtin_prefetch(votes);
+        __builtin_prefetch(reinterpret_cast<const char*>(votes + 1) - 1);
       }
     }
-    for (size_t k = 0; k < samples.size(); ++k) labels[k] = labelOf(row_voxels_[k]);
+    for (size_t k = 0; k < samples.size(); ++k) labels[k] = labelOf(row_votes_[k]);
   }
 
  private:
+  // The votes of the voxel p_W falls in; null when it has none or its block is not allocated.
+  const VoxelVotes* votesAt(const Eigen::Vector3f& p_W) {
+    const Voxel* voxel = lookup_.find(p_W);
+    if (!voxel) return nullptr;
+    const Block* block = lookup_.lastBlock();
+    return block->votes(block->indexOf(*voxel));
+  }
+
   Eigen::Vector3f point(int u, int v, float d_m) const {
     return T_W_C_ * Eigen::Vector3f((u - cx_) * d_m / fx_, (v - cy_) * d_m / fy_, d_m);
   }
 
-  int32_t labelOf(const Voxel* voxel) {
-    if (!voxel) return 0;
-    if (voxel != last_voxel_) {
-      last_voxel_ = voxel;
-      last_label_ = argmaxLabel(*voxel, resolve_);
+  int32_t labelOf(const VoxelVotes* votes) {
+    if (!votes) return 0;
+    if (votes != last_votes_) {
+      last_votes_ = votes;
+      last_label_ = argmaxLabel(*votes, resolve_);
     }
     return last_label_;
   }
@@ -81,9 +89,9 @@ class VoxelLabelSampler {
   Eigen::Isometry3f T_W_C_;
   float fx_, fy_, cx_, cy_;
   Resolve resolve_;
-  const Voxel* last_voxel_ = nullptr;
+  const VoxelVotes* last_votes_ = nullptr;
   int32_t last_label_ = 0;
-  std::vector<const Voxel*> row_voxels_;  // scratch of labelRow()
+  std::vector<const VoxelVotes*> row_votes_;  // scratch of labelRow()
 };
 
 }  // namespace panmap

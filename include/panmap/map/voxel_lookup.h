@@ -63,6 +63,9 @@ class VoxelLookupT {
   /// 1 / voxel size, as find() scales points by it.
   float inverseVoxelSize() const { return inv_voxel_; }
 
+  /// The block of the voxel of the last find() or findGrid(), null when it is not allocated.
+  BlockPtr lastBlock() const { return last_; }
+
   /// Global integer coordinates of the voxel of the last find().
   const Eigen::Vector3i& lastVoxel() const { return last_voxel_; }
 

@@ -35,10 +35,10 @@ struct MarchingCubesConfig {
 /// Per-vertex labels computed when a mesh is assembled, never stored with the geometry: they
 /// change (super-points merge, the optimiser relabels) without the surface changing.
 struct MeshLabeller {
-  /// Super-point label of a voxel (e.g. argmaxLabel with the current merges). Empty: the mesh
-  /// gets no label arrays. A vertex takes the label of the nearer voxel of its edge. Called
-  /// only for voxels with votes: a voxel without any has label 0.
-  std::function<int32_t(const Voxel&)> superpoint;
+  /// Super-point label of a voxel's votes (e.g. argmaxLabel with the current merges). Empty:
+  /// the mesh gets no label arrays. A vertex takes the label of the nearer voxel of its edge.
+  /// Called only for voxels with votes: a voxel without any has label 0.
+  std::function<int32_t(const VoxelVotes&)> superpoint;
   /// NYU40 class of a super-point label; empty: 0 (unlabelled).
   std::function<int32_t(int32_t)> semantic;
   /// Instance of a super-point label; empty: 0 (none).

@@ -12,7 +12,8 @@ namespace panmap {
 
 /// n consecutive votes of one image row for one voxel and label.
 struct VoteRun {
-  Voxel* voxel;
+  Block* block;   ///< the voxel's block
+  int32_t voxel;  ///< the voxel's index in block->voxels
   int32_t label;
   uint32_t count;
 };
