@@ -148,7 +148,9 @@ TEST(Integrator, VotesGoToSurfaceVoxelsAndSameInputGivesSameMap) {
         const VoxelVotes* a = one->blocks()[b]->votes(i);
         const VoxelVotes* c = other->blocks()[b]->votes(i);
         ASSERT_EQ(a == nullptr, c == nullptr) << threads << " threads, block " << b;
-        if (a) EXPECT_EQ(std::memcmp(a, c, sizeof(VoxelVotes)), 0) << threads << " threads";
+        if (a) {
+          EXPECT_EQ(std::memcmp(a, c, sizeof(VoxelVotes)), 0) << threads << " threads";
+        }
       }
     }
   }
@@ -231,6 +233,30 @@ TEST(Integrator, AutomaticVoteStrideAtCoarseVoxelsLabelsTheSameVoxels) {
   }
   ASSERT_GT(voted, 1000u);
   EXPECT_GE(kept, voted * 95 / 100) << kept << " of " << voted;
+}
+
+// A block keeps vote sets only for voxels that got a vote; the others have none (null), and
+// giving one voxel its set leaves every other voxel's alone.
+TEST(Votes, ABlockKeepsVoteSetsOnlyForVotedVoxels) {
+  Block block;
+  for (int i = 0; i < kBlockVoxels; ++i) ASSERT_EQ(block.votes(i), nullptr);
+  VoxelVotes* three = block.votesToWrite(3);
+  EXPECT_EQ(three->total(), 0u);
+  addVotes(three, 11, 4);
+  addVote(block.votesToWrite(200), 12);
+  EXPECT_EQ(block.votesToWrite(3)->slots[0].label, 11);  // the same set again, not a new one
+  ASSERT_EQ(block.vote_sets.size(), 2u);
+  ASSERT_NE(block.votes(3), nullptr);
+  EXPECT_EQ(block.votes(3)->slots[0].count, 4u);
+  EXPECT_EQ(block.votes(200)->slots[0].label, 12);
+  EXPECT_EQ(block.votes(200)->total(), 1u);
+  for (int i = 0; i < kBlockVoxels; ++i) {
+    if (i != 3 && i != 200) {
+      ASSERT_EQ(block.votes(i), nullptr) << i;
+    }
+  }
+  EXPECT_EQ(block.indexOf(block.at(1, 2, 3)), Block::linear(1, 2, 3));
+  EXPECT_EQ(Block::linear(1, 2, 3), 1 + 8 * 2 + 64 * 3);
 }
 
 TEST(Votes, EvictionIsWeakestFirstAndCounted) {

@@ -564,5 +564,59 @@ TEST_F(BoxScene, MapFilesBeforeVersionThirteenLoadTheirVoxels) {
   }
 }
 
+// Version 13 stores each block's votes as a list of the voted voxels: a reloaded map has the
+// same votes voxel by voxel and saves to the same bytes, and a list that is too long or out of
+// order is refused with the file's name.
+TEST_F(BoxScene, MapFileVotesRoundTripAndBadVoteListsAreRefused) {
+  const auto mapper = run(config(), 3);
+  const std::vector<uint8_t> file = mapper->serialize();
+  const auto loaded = Mapper::deserialize(file, "map.panmap");
+  const TsdfMap& map = mapper->map();
+  size_t voted = 0;
+  ASSERT_EQ(loaded->map().numBlocks(), map.numBlocks());
+  for (size_t b = 0; b < map.numBlocks(); ++b) {
+    const Block& want = *map.blocks()[b];
+    const Block& got = *loaded->map().blocks()[b];
+    for (int i = 0; i < kBlockVoxels; ++i) {
+      ASSERT_EQ(got.votes(i) == nullptr, want.votes(i) == nullptr) << b << " " << i;
+      if (!want.votes(i)) continue;
+      ASSERT_EQ(0, std::memcmp(got.votes(i), want.votes(i), sizeof(VoxelVotes)));
+      ++voted;
+    }
+  }
+  EXPECT_GT(voted, 100u);
+  EXPECT_LT(voted, map.numBlocks() * kBlockVoxels / 2);  // sparse: most voxels hold none
+  EXPECT_EQ(loaded->serialize(), file);
+
+  // The record of the first block with two voted voxels: head, voxels, count, then entries.
+  constexpr size_t kRecordHead = 3 * sizeof(int32_t) + 1;
+  const Block& first = *map.blocks()[0];
+  std::vector<uint8_t> pattern(kRecordHead + sizeof(Block::voxels));
+  const int32_t index[3] = {first.index.x(), first.index.y(), first.index.z()};
+  std::memcpy(pattern.data(), index, sizeof(index));
+  pattern[12] = first.updated;
+  std::memcpy(pattern.data() + kRecordHead, first.voxels, sizeof(Block::voxels));
+  const auto found = std::search(file.begin(), file.end(), pattern.begin(), pattern.end());
+  ASSERT_NE(found, file.end());
+  size_t at = static_cast<size_t>(found - file.begin());
+  for (const auto& block : map.blocks()) {
+    size_t n = 0;  // as stored: voxels whose votes count
+    for (const VoxelVotes& votes : block->vote_sets) n += votes.total() > 0 ? 1 : 0;
+    if (n >= 2) break;
+    at += kRecordHead + sizeof(Block::voxels) + 2 + n * (2 + sizeof(VoxelVotes));
+  }
+  const size_t count_at = at + kRecordHead + sizeof(Block::voxels);
+  const size_t second_at = count_at + 2 + 2 + sizeof(VoxelVotes);
+  std::vector<uint8_t> repeated = file;  // the second voted voxel's index made the first's
+  std::memcpy(&repeated[second_at], &file[count_at + 2], 2);
+  test::expectError([&] { Mapper::deserialize(reseal(repeated, 13), "repeated.panmap"); },
+                    {"repeated.panmap", "out of order"});
+  std::vector<uint8_t> too_many = file;
+  const uint16_t n = kBlockVoxels + 1;
+  std::memcpy(&too_many[count_at], &n, 2);
+  test::expectError([&] { Mapper::deserialize(reseal(too_many, 13), "many.panmap"); },
+                    {"many.panmap", "513 voted voxels"});
+}
+
 }  // namespace
 }  // namespace panmap

@@ -60,7 +60,7 @@ static_assert(sizeof(Float16) == 2, "two bytes");
 
 /// A voxel of the label-TSDF's geometry: 8 bytes, eight to a cache line. Distance and weight
 /// are 2-byte floats: the map is mostly voxels. Its super-point votes live beside it, in its
-/// block's vote sets (Block::votes), since about one voxel in seven ever holds one.
+/// block's vote sets (Block::votes), since only one voxel in seven to ten ever holds one.
 struct Voxel {
   Float16 sdf_m;      ///< truncated signed distance to the surface, metres (+ in front)
   Float16 weight;     ///< integration weight, 0 = never observed
