@@ -2,7 +2,7 @@
 # A building-sized map on this machine: panmap-bench-building maps the default procedural
 # building (seed 1: >= 20 rooms, >= 1000 m2) along its survey at 5 cm and 2 cm, and
 # scripts/bench/building_report.py writes the "Building" section of docs/PERFORMANCE.md and
-# the plot docs/building_memory.svg. About 25 minutes on 2 cores, 8 GB of memory at 2 cm.
+# the plot docs/building_memory.svg. About 15 minutes on 2 cores, 4 GB of memory at 2 cm.
 #   scripts/bench/building.sh [--voxel-sizes "0.05 0.02"] [--frames N]
 set -euo pipefail
 cd "$(dirname "$0")/../.."

@@ -40,6 +40,8 @@ namespace {
 
 // Image rows a thread takes at a time when finding votes.
 constexpr size_t kVoteRowsPerChunk = 16;
+// Runs ahead whose vote slot is prefetched while votes are applied.
+constexpr size_t kAhead = 16;
 
 BlockIndex unpackKey(uint64_t key) {
   auto field = [](uint64_t v) {
@@ -117,7 +119,18 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
       for (size_t r = 0; r < rows; ++r) {
         const VoteRun* runs = &vote_runs_[r * cols];
         const size_t* begin = &owner_begin_[r * (owners + 1)];
-        for (size_t i = begin[t]; i < begin[t + 1]; ++i) {
+        const size_t end = begin[t + 1];
+        for (size_t i = begin[t]; i < end; ++i) {
+          // A vote set is reached through its voxel's slot: both mostly miss the cache, so
+          // the slot is fetched kAhead runs ahead and the set half as far.
+          if (i + kAhead < end) {
+            __builtin_prefetch(&runs[i + kAhead].block->vote_slot[runs[i + kAhead].voxel]);
+          }
+          if (i + kAhead / 2 < end) {
+            const VoteRun& next = runs[i + kAhead / 2];
+            const VoxelVotes* votes = next.block->votes(next.voxel);
+            if (votes) __builtin_prefetch(votes, 1);
+          }
           my_added += runs[i].count;
           my_evicted +=
               addVotes(runs[i].block->votesToWrite(runs[i].voxel), runs[i].label, runs[i].count);

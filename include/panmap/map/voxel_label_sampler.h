@@ -44,23 +44,35 @@ class VoxelLabelSampler {
   const Eigen::Vector3i& lastVoxel() const { return lookup_.lastVoxel(); }
 
   /// label() of every sample of row v into labels[k], and lastVoxel() after it into
-  /// voxels[k] unless voxels is null. All voxels of the row are found and prefetched before
-  /// the first label is read: a voxel read mostly misses the cache, and this way the misses
-  /// of a row overlap instead of waiting for one another.
+  /// voxels[k] unless voxels is null. A label is read through two loads that mostly miss the
+  /// cache (the voxel's vote slot in its block, then its vote set), so the row goes in three
+  /// passes: every voxel found and its slot prefetched, every slot read and its vote set
+  /// prefetched, then the labels; the misses of a row overlap instead of waiting in turn.
   void labelRow(int v, const std::vector<RowSample>& samples, int32_t* labels,
                 Eigen::Vector3i* voxels) {
-    row_votes_.resize(samples.size());
-    for (size_t k = 0; k < samples.size(); ++k) {
-      const VoxelVotes* votes = votesAt(point(samples[k].u, v, samples[k].d_m));
-      row_votes_[k] = votes;
+    const size_t n = samples.size();
+    row_blocks_.resize(n);
+    row_index_.resize(n);
+    row_votes_.resize(n);
+    for (size_t k = 0; k < n; ++k) {
+      const Voxel* voxel = lookup_.find(point(samples[k].u, v, samples[k].d_m));
       if (voxels) voxels[k] = lookup_.lastVoxel();
+      const Block* block = voxel ? lookup_.lastBlock() : nullptr;
+      row_blocks_[k] = block;
+      if (!block) continue;
+      row_index_[k] = block->indexOf(*voxel);
+      __builtin_prefetch(&block->vote_slot[row_index_[k]]);
+    }
+    for (size_t k = 0; k < n; ++k) {
+      const VoxelVotes* votes = row_blocks_[k] ? row_blocks_[k]->votes(row_index_[k]) : nullptr;
+      row_votes_[k] = votes;
       if (votes) {
         // A vote set may straddle two cache lines.
         __builtin_prefetch(votes);
         __builtin_prefetch(reinterpret_cast<const char*>(votes + 1) - 1);
       }
     }
-    for (size_t k = 0; k < samples.size(); ++k) labels[k] = labelOf(row_votes_[k]);
+    for (size_t k = 0; k < n; ++k) labels[k] = labelOf(row_votes_[k]);
   }
 
  private:
@@ -91,7 +103,11 @@ class VoxelLabelSampler {
   Resolve resolve_;
   const VoxelVotes* last_votes_ = nullptr;
   int32_t last_label_ = 0;
-  std::vector<const VoxelVotes*> row_votes_;  // scratch of labelRow()
+  // Scratch of labelRow(): per sample, the voxel's block (null: not allocated), its index
+  // there and its votes.
+  std::vector<const Block*> row_blocks_;
+  std::vector<int> row_index_;
+  std::vector<const VoxelVotes*> row_votes_;
 };
 
 }  // namespace panmap
