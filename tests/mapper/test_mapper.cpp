@@ -443,30 +443,44 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToTwelve) {
                     {"future.panmap", "version 14", "reads 5 to 13"});
 }
 
+// Bytes before a block's voxels in a map file: its index and its updated flag.
+constexpr size_t kRecordHead = 3 * sizeof(int32_t) + 1;
+
+// Where the first block's record of `map` starts in `file` (blocks are stored in allocation
+// order, each as index, updated flag, voxels and votes: it is found by its bytes), or
+// file.size() when it is not there.
+size_t firstBlockRecord(const std::vector<uint8_t>& file, const TsdfMap& map) {
+  const Block& first = *map.blocks()[0];
+  std::vector<uint8_t> pattern(kRecordHead + sizeof(Block::voxels));
+  const int32_t index[3] = {first.index.x(), first.index.y(), first.index.z()};
+  std::memcpy(pattern.data(), index, sizeof(index));
+  pattern[12] = first.updated;
+  std::memcpy(pattern.data() + kRecordHead, first.voxels, sizeof(Block::voxels));
+  return static_cast<size_t>(std::search(file.begin(), file.end(), pattern.begin(), pattern.end()) -
+                             file.begin());
+}
+
+// Voxels of `block` whose votes a map file stores (those with a count).
+size_t storedVotedVoxels(const Block& block) {
+  size_t n = 0;
+  for (const VoxelVotes& votes : block.vote_sets) n += votes.total() > 0 ? 1 : 0;
+  return n;
+}
+
 // `file` (written by `mapper`) with its voxels as versions before 13 stored them, every voxel
 // with its four vote slots: 4-byte distance and weight and vote counts of 4 bytes (version 9)
 // or 2 (version 10); as today's 8 bytes, then the slots (versions 11 and 12). Voxel 0 of block
 // 0 gets the labels 77-80 with `first_counts`.
 std::vector<uint8_t> withLegacyVoxels(const std::vector<uint8_t>& file, const TsdfMap& map,
                                       uint32_t version, const uint32_t first_counts[kVoteSlots]) {
-  // Blocks are stored in allocation order, each as index, updated flag, voxels and votes: the
-  // first block's record is found by its bytes.
-  const Block& first = *map.blocks()[0];
-  constexpr size_t kRecordHead = 3 * sizeof(int32_t) + 1;
-  std::vector<uint8_t> pattern(kRecordHead + sizeof(Block::voxels));
-  const int32_t index[3] = {first.index.x(), first.index.y(), first.index.z()};
-  std::memcpy(pattern.data(), index, sizeof(index));
-  pattern[12] = first.updated;
-  std::memcpy(pattern.data() + kRecordHead, first.voxels, sizeof(Block::voxels));
-  const auto found = std::search(file.begin(), file.end(), pattern.begin(), pattern.end());
-  EXPECT_NE(found, file.end());
-  if (found == file.end()) return {};
-  const size_t begin = static_cast<size_t>(found - file.begin());
+  const size_t begin = firstBlockRecord(file, map);
+  EXPECT_NE(begin, file.size());
+  if (begin == file.size()) return {};
+  const auto found = file.begin() + static_cast<std::ptrdiff_t>(begin);
   size_t end = begin;
   for (const auto& block : map.blocks()) {
-    size_t voted = 0;
-    for (const VoxelVotes& votes : block->vote_sets) voted += votes.total() > 0 ? 1 : 0;
-    end += kRecordHead + sizeof(Block::voxels) + 2 + voted * (2 + sizeof(VoxelVotes));
+    end += kRecordHead + sizeof(Block::voxels) + 2 +
+           storedVotedVoxels(*block) * (2 + sizeof(VoxelVotes));
   }
   const size_t count_bytes = version >= 10 ? 2 : 4;
   std::vector<uint8_t> old(file.begin(), found);
@@ -589,19 +603,10 @@ TEST_F(BoxScene, MapFileVotesRoundTripAndBadVoteListsAreRefused) {
   EXPECT_EQ(loaded->serialize(), file);
 
   // The record of the first block with two voted voxels: head, voxels, count, then entries.
-  constexpr size_t kRecordHead = 3 * sizeof(int32_t) + 1;
-  const Block& first = *map.blocks()[0];
-  std::vector<uint8_t> pattern(kRecordHead + sizeof(Block::voxels));
-  const int32_t index[3] = {first.index.x(), first.index.y(), first.index.z()};
-  std::memcpy(pattern.data(), index, sizeof(index));
-  pattern[12] = first.updated;
-  std::memcpy(pattern.data() + kRecordHead, first.voxels, sizeof(Block::voxels));
-  const auto found = std::search(file.begin(), file.end(), pattern.begin(), pattern.end());
-  ASSERT_NE(found, file.end());
-  size_t at = static_cast<size_t>(found - file.begin());
+  size_t at = firstBlockRecord(file, map);
+  ASSERT_NE(at, file.size());
   for (const auto& block : map.blocks()) {
-    size_t n = 0;  // as stored: voxels whose votes count
-    for (const VoxelVotes& votes : block->vote_sets) n += votes.total() > 0 ? 1 : 0;
+    const size_t n = storedVotedVoxels(*block);
     if (n >= 2) break;
     at += kRecordHead + sizeof(Block::voxels) + 2 + n * (2 + sizeof(VoxelVotes));
   }
