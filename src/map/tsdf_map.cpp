@@ -74,25 +74,27 @@ Block* TsdfMap::allocateBlock(const BlockIndex& index) {
   return it->second;
 }
 
-const Voxel* TsdfMap::findVoxel(const Eigen::Vector3f& p_W) const {
+const Block* TsdfMap::findBlockOfPoint(const Eigen::Vector3f& p_W, int* voxel) const {
   const float inv = 1.0f / config_.voxel_size_m;
   const int gx = static_cast<int>(std::floor(p_W.x() * inv));
   const int gy = static_cast<int>(std::floor(p_W.y() * inv));
   const int gz = static_cast<int>(std::floor(p_W.z() * inv));
   // Floor division by the block side (works for negative coordinates).
-  const BlockIndex b(gx >> 3, gy >> 3, gz >> 3);
   static_assert(kBlockSide == 8, "shift by 3 assumes 8 voxels per block side");
-  const Block* block = findBlock(b);
-  if (!block) return nullptr;
-  return &block->at(gx & 7, gy & 7, gz & 7);
+  *voxel = Block::linear(gx & 7, gy & 7, gz & 7);
+  return findBlock(BlockIndex(gx >> 3, gy >> 3, gz >> 3));
+}
+
+const Voxel* TsdfMap::findVoxel(const Eigen::Vector3f& p_W) const {
+  int i = 0;
+  const Block* block = findBlockOfPoint(p_W, &i);
+  return block ? &block->voxels[i] : nullptr;
 }
 
 const VoxelVotes* TsdfMap::findVotes(const Eigen::Vector3f& p_W) const {
-  const Voxel* voxel = findVoxel(p_W);
-  if (!voxel) return nullptr;
-  const BlockIndex b = blockIndexOf(p_W);
-  const Block* block = findBlock(b);
-  return block->votes(block->indexOf(*voxel));
+  int i = 0;
+  const Block* block = findBlockOfPoint(p_W, &i);
+  return block ? block->votes(i) : nullptr;
 }
 
 Eigen::Vector3f TsdfMap::voxelCentre(const BlockIndex& block, int x, int y, int z) const {

@@ -144,6 +144,10 @@ class TsdfMap {
   }
 
  private:
+  // The block of the voxel containing p_W (null when not allocated) and, in *voxel, that
+  // voxel's index in it.
+  const Block* findBlockOfPoint(const Eigen::Vector3f& p_W, int* voxel) const;
+
   Config config_;
   uint64_t id_;
   std::atomic<uint64_t> change_stamp_{0};
