@@ -104,6 +104,12 @@ Eigen::Vector3f TsdfMap::voxelCentre(const BlockIndex& block, int x, int y, int 
                          (block.z() * kBlockSide + z + 0.5f) * v);
 }
 
+size_t TsdfMap::numVotedVoxels() const {
+  size_t n = 0;
+  for (const auto& block : blocks_) n += block->vote_sets.size();
+  return n;
+}
+
 size_t TsdfMap::memoryBytes() const {
   size_t votes = 0;
   for (const auto& block : blocks_) votes += block->vote_sets.capacity() * sizeof(VoxelVotes);

@@ -164,6 +164,12 @@ TEST(Integrator, VotesGoToSurfaceVoxelsAndSameInputGivesSameMap) {
   // A vote per pixel whose point falls in the voxel, in each of the 3 frames.
   EXPECT_GT(left->slots[0].count, 3u);
   EXPECT_EQ(left->slots[0].count % 3, 0u);
+  size_t voted = 0;
+  for (const auto& block : one->blocks()) {
+    for (int i = 0; i < kBlockVoxels; ++i) voted += block->votes(i) != nullptr ? 1 : 0;
+  }
+  EXPECT_GT(voted, 0u);
+  EXPECT_EQ(one->numVotedVoxels(), voted);
   // 5 cm in front: an observed voxel without a vote.
   ASSERT_TRUE(one->findVoxel({1.95f, 0.5f, 0.1f}));
   EXPECT_EQ(one->findVotes({1.95f, 0.5f, 0.1f}), nullptr);

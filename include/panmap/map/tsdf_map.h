@@ -124,6 +124,8 @@ class TsdfMap {
   std::vector<std::unique_ptr<Block>>& blocks() { return blocks_; }
   /// Bytes used by voxel storage and the index.
   size_t memoryBytes() const;
+  /// Voxels that hold votes (a vote set): those a measured point fell in.
+  size_t numVotedVoxels() const;
 
   /// Unique among the maps of this process: results kept per block (graph/surface_scan.h)
   /// belong to one map, and a map built in its place may reuse the old one's address.
