@@ -103,15 +103,10 @@ void getVoxels11(BinaryReader* r, Block* block) {
 // Writes a block's voxels and votes as version 13 stores them.
 void putVoxels(BinaryWriter* w, const Block& block) {
   w->putBytes(block.voxels, sizeof(block.voxels));
-  uint16_t n = 0;
+  w->put<uint16_t>(static_cast<uint16_t>(block.vote_sets.size()));
   for (int i = 0; i < kBlockVoxels; ++i) {
     const VoxelVotes* votes = block.votes(i);
-    n += votes && votes->total() > 0 ? 1 : 0;
-  }
-  w->put<uint16_t>(n);
-  for (int i = 0; i < kBlockVoxels; ++i) {
-    const VoxelVotes* votes = block.votes(i);
-    if (!votes || votes->total() == 0) continue;
+    if (!votes) continue;
     w->put<uint16_t>(static_cast<uint16_t>(i));
     w->putBytes(votes, sizeof(*votes));
   }

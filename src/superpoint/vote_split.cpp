@@ -92,9 +92,7 @@ size_t applySplits(FrameAssociation* association, const FrameSegmentation& segme
       const size_t i = split_of[sid] - 1;
       split_sum[i] += p_W.cast<double>();
       ++split_count[i];
-      const Voxel* voxel = lookup.find(p_W);
-      VoxelVotes* votes =
-          voxel ? lookup.lastBlock()->votes(lookup.lastBlock()->indexOf(*voxel)) : nullptr;
+      VoxelVotes* votes = lookup.findVotes(p_W);
       if (votes) changed += moveVotes(votes, from[i], splits[i].to, labels);
     }
   }

@@ -460,13 +460,6 @@ size_t firstBlockRecord(const std::vector<uint8_t>& file, const TsdfMap& map) {
                              file.begin());
 }
 
-// Voxels of `block` whose votes a map file stores (those with a count).
-size_t storedVotedVoxels(const Block& block) {
-  size_t n = 0;
-  for (const VoxelVotes& votes : block.vote_sets) n += votes.total() > 0 ? 1 : 0;
-  return n;
-}
-
 // `file` (written by `mapper`) with its voxels as versions before 13 stored them, every voxel
 // with its four vote slots: 4-byte distance and weight and vote counts of 4 bytes (version 9)
 // or 2 (version 10); as today's 8 bytes, then the slots (versions 11 and 12). Voxel 0 of block
@@ -480,7 +473,7 @@ std::vector<uint8_t> withLegacyVoxels(const std::vector<uint8_t>& file, const Ts
   size_t end = begin;
   for (const auto& block : map.blocks()) {
     end += kRecordHead + sizeof(Block::voxels) + 2 +
-           storedVotedVoxels(*block) * (2 + sizeof(VoxelVotes));
+           block->vote_sets.size() * (2 + sizeof(VoxelVotes));
   }
   const size_t count_bytes = version >= 10 ? 2 : 4;
   std::vector<uint8_t> old(file.begin(), found);
@@ -600,13 +593,16 @@ TEST_F(BoxScene, MapFileVotesRoundTripAndBadVoteListsAreRefused) {
   }
   EXPECT_GT(voted, 100u);
   EXPECT_LT(voted, map.numBlocks() * kBlockVoxels / 2);  // sparse: most voxels hold none
+  for (const auto& block : map.blocks()) {
+    for (const VoxelVotes& votes : block->vote_sets) ASSERT_GT(votes.total(), 0u);  // no empty set
+  }
   EXPECT_EQ(loaded->serialize(), file);
 
   // The record of the first block with two voted voxels: head, voxels, count, then entries.
   size_t at = firstBlockRecord(file, map);
   ASSERT_NE(at, file.size());
   for (const auto& block : map.blocks()) {
-    const size_t n = storedVotedVoxels(*block);
+    const size_t n = block->vote_sets.size();
     if (n >= 2) break;
     at += kRecordHead + sizeof(Block::voxels) + 2 + n * (2 + sizeof(VoxelVotes));
   }

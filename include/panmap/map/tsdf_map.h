@@ -36,10 +36,12 @@ struct Block {
   alignas(64) Voxel voxels[kBlockVoxels];
   /// Per voxel, 1 + the index of its votes in vote_sets, or 0 when it has none. Votes are kept
   /// apart from the geometry because most voxels never hold one: one in seven to ten on
-  /// rendered rooms and scene0470 at 2 cm (24 bytes each, against 24 bytes in every voxel when
-  /// each carried its slots).
+  /// rendered rooms and scene0470 at 2 cm, so 24 bytes for each of those costs far less than
+  /// the 24 bytes of slots every voxel carried before.
   uint16_t vote_slot[kBlockVoxels] = {};
   /// The vote sets of the voxels that hold votes, in the order they got their first vote.
+  /// Every set holds at least one vote: a set is only made for a vote (votesToWrite, then
+  /// addVotes), and moving votes away refills the slot it empties.
   std::vector<VoxelVotes> vote_sets;
 
   /// Voxel at local coordinates (x, y, z), each in [0, kBlockSide).

@@ -38,7 +38,7 @@ class VoxelLabelSampler {
 
   /// The label of the voxel that pixel (u, v) at depth d_m (> 0) sees; 0 when that voxel's
   /// block is not allocated or it has no votes.
-  int32_t label(int u, int v, float d_m) { return labelOf(votesAt(point(u, v, d_m))); }
+  int32_t label(int u, int v, float d_m) { return labelOf(lookup_.findVotes(point(u, v, d_m))); }
 
   /// Global integer coordinates of the voxel the last label() call found.
   const Eigen::Vector3i& lastVoxel() const { return lookup_.lastVoxel(); }
@@ -76,14 +76,6 @@ class VoxelLabelSampler {
   }
 
  private:
-  // The votes of the voxel p_W falls in; null when it has none or its block is not allocated.
-  const VoxelVotes* votesAt(const Eigen::Vector3f& p_W) {
-    const Voxel* voxel = lookup_.find(p_W);
-    if (!voxel) return nullptr;
-    const Block* block = lookup_.lastBlock();
-    return block->votes(block->indexOf(*voxel));
-  }
-
   Eigen::Vector3f point(int u, int v, float d_m) const {
     return T_W_C_ * Eigen::Vector3f((u - cx_) * d_m / fx_, (v - cy_) * d_m / fy_, d_m);
   }

@@ -18,6 +18,7 @@ template <typename Map>
 class VoxelLookupT {
   using BlockPtr = std::conditional_t<std::is_const<Map>::value, const Block*, Block*>;
   using VoxelPtr = std::conditional_t<std::is_const<Map>::value, const Voxel*, Voxel*>;
+  using VotesPtr = std::conditional_t<std::is_const<Map>::value, const VoxelVotes*, VoxelVotes*>;
 
  public:
   /// @param map the TsdfMap (const or not) looked up
@@ -29,6 +30,13 @@ class VoxelLookupT {
   VoxelPtr find(const Eigen::Vector3f& p_W) {
     return findGrid(floorToInt(p_W.x() * inv_voxel_), floorToInt(p_W.y() * inv_voxel_),
                     floorToInt(p_W.z() * inv_voxel_));
+  }
+
+  /// The votes of the voxel containing p_W, or null when it has none or its block is not
+  /// allocated.
+  VotesPtr findVotes(const Eigen::Vector3f& p_W) {
+    const VoxelPtr voxel = find(p_W);
+    return voxel ? last_->votes(last_->indexOf(*voxel)) : nullptr;
   }
 
   /// static_cast<int>(std::floor(x)) for |x| < 2^31, without the library call that baseline
