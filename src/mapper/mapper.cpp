@@ -77,6 +77,12 @@ LabelledMesh Mapper::extractMesh(const GraphLabels* labels) {
 
 void Mapper::releaseMeshCache() { mesher_->clear(); }
 
+LabelledMesh Mapper::extractFinalMesh(const GraphLabels* labels) {
+  releaseMeshCache();
+  absl::flat_hash_map<int32_t, SuperpointLabels> cache;
+  return marchingCubes(*map_, mesher_->config(), meshLabeller(labels, &cache), pool_.get());
+}
+
 MeshUpdate Mapper::updateMesh(const GraphLabels* labels) {
   // Every thread labels the blocks it has just meshed, while their voxels are in cache, with
   // its own cache of super-point labels; resolve() only reads once the registry is flattened.

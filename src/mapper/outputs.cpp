@@ -57,8 +57,8 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
     // The welded mesh lives only while the meshes and snapshots are written: the later steps
     // (the occupancy tree, the map file) would otherwise hold it on top of theirs (issue 23:
     // the 2 cm building's export peaked during the occupancy tree, 0.4 GB of it this mesh).
-    const LabelledMesh mesh = mapper->extractMesh(labels);
-    if (options.final_export) mapper->releaseMeshCache();
+    const LabelledMesh mesh =
+        options.final_export ? mapper->extractFinalMesh(labels) : mapper->extractMesh(labels);
     summary.mesh_vertices = mesh.numVertices();
     summary.mesh_faces = mesh.numFaces();
     summary.mesh_area_m2 = mesh.surfaceArea();

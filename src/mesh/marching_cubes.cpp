@@ -3,13 +3,15 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <memory>
+#include <numeric>
 #include <utility>
-
-#include <absl/container/flat_hash_map.h>
 
 #include "panmap/core/error.h"
 #include "panmap/mesh/internal/marching_cubes_tables.h"
+#include "panmap/mesh/internal/vertex_labeller.h"
+#include "panmap/mesh/mesh_welder.h"
 
 namespace panmap {
 
@@ -270,279 +272,38 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
   }
 }
 
+using internal::VertexLabeller;
+using internal::VertexLabels;
+
 namespace {
 
-// A grid edge anywhere in the map: its lower voxel's block and its id within that block.
-using EdgeKey = std::pair<uint64_t, uint16_t>;
-
-struct VertexLabels {
-  int32_t superpoint = 0, semantic = 0, instance = 0;
-};
+// Reserves `out`'s arrays for at most `vertices` vertices and exactly `faces` faces: growing
+// by doubling would briefly hold 1.5x a building's mesh. Pages reserved and never written
+// cost no memory, so the bound may be loose.
+void reserveMesh(size_t vertices, size_t faces, bool labelled, LabelledMesh* out) {
+  out->vertices.reserve(vertices);
+  out->colors.reserve(vertices);
+  out->faces.reserve(faces);
+  if (labelled) {
+    out->superpoint.reserve(vertices);
+    out->semantic.reserve(vertices);
+    out->instance.reserve(vertices);
+  }
+}
 
 }  // namespace
 
-namespace internal {
-
-// Labels vertices from their source voxels through a MeshLabeller, one block's vertices at a
-// time (setBlock). The labels of the voxels around the block are computed once each and kept
-// (a vertex without a label reads its 26 neighbours, which the next vertices mostly share),
-// and so are the last vertex's labels: neighbouring vertices mostly share their voxel, and
-// neighbouring voxels their super-point. The map must not change while it is in use.
-class VertexLabeller {
- public:
-  VertexLabeller(const TsdfMap& map, const MeshLabeller& labeller)
-      : map_(map), labeller_(labeller), region_(kRegionVoxels) {}
-
-  /// Makes `index` the block whose cubes made the next vertices.
-  void setBlock(const BlockIndex& index) {
-    index_ = index;
-    fetched_ = 0;
-    if (++stamp_ == 0) {  // wrapped: forget every entry explicitly once
-      for (Entry& e : region_) e.stamp = e.fill_stamp = 0;
-      stamp_ = 1;
-    }
-    last_voxel_ = nullptr;
-  }
-
-  /// @param source a BlockMesh source of the block last given to setBlock()
-  VertexLabels operator()(uint16_t source) {
-    const int slot = source >> 9, local = source & 511;
-    const int x = (slot & 1) * kBlockSide + (local & 7);
-    const int y = ((slot >> 1) & 1) * kBlockSide + ((local >> 3) & 7);
-    const int z = (slot >> 2) * kBlockSide + (local >> 6);
-    const Block* owner = blockAt(x, y, z);
-    if (!owner) return VertexLabels{};
-    const Voxel* voxel = &owner->voxels[local];
-    if (voxel == last_voxel_) return last_;
-    last_voxel_ = voxel;
-    const int r = regionIndex(x, y, z);
-    const int32_t superpoint = entry(r, x, y, z).label;
-    // A filled vertex takes its class and instance from the neighbours' super-point but keeps
-    // super-point 0: it belongs to none (super-point diagnostics measure them as voted).
-    int32_t source_label = superpoint;
-    if (superpoint == 0 && labeller_.fill_from_neighbours) source_label = filledLabel(r, x, y, z);
-    if (have_last_ && superpoint == last_.superpoint && source_label == last_source_) {
-      return last_;
-    }
-    have_last_ = true;
-    last_source_ = source_label;
-    last_.superpoint = superpoint;
-    last_.semantic = labeller_.semantic ? labeller_.semantic(source_label) : 0;
-    last_.instance = labeller_.instance ? labeller_.instance(source_label) : 0;
-    return last_;
-  }
-
- private:
-  // The region holds the voxels at block-local coordinates -1 .. 9: sources lie in 0 .. 8.
-  static constexpr int kRegionSide = kBlockSide + 3;
-  static constexpr int kRegionVoxels = kRegionSide * kRegionSide * kRegionSide;
-
-  struct Entry {
-    uint32_t stamp = 0;       // valid when equal to stamp_
-    int32_t label = 0;        // super-point, 0 for none or no block
-    uint64_t votes = 0;       // all votes of the voxel
-    uint32_t fill_stamp = 0;  // `fill` valid when equal to stamp_
-    int32_t fill = 0;         // neighbourhoodLabel() of the voxel
-  };
-
-  static int regionIndex(int x, int y, int z) {
-    return (x + 1) + kRegionSide * ((y + 1) + kRegionSide * (z + 1));
-  }
-
-  // The block holding block-local (x, y, z), looked up once per setBlock() (most vertices
-  // need only a few of the 27). Arithmetic shifts: -1 >> 3 is -1, so -1 .. 9 map to -1 .. 1.
-  const Block* blockAt(int x, int y, int z) {
-    const int dx = x >> 3, dy = y >> 3, dz = z >> 3;
-    const int slot = (dx + 1) + 3 * ((dy + 1) + 3 * (dz + 1));
-    if (!(fetched_ >> slot & 1u)) {
-      blocks_[slot] = map_.findBlock(index_ + BlockIndex(dx, dy, dz));
-      fetched_ |= 1u << slot;
-    }
-    return blocks_[slot];
-  }
-
-  // The labels of the voxel at block-local (x, y, z), region index r.
-  const Entry& entry(int r, int x, int y, int z) {
-    Entry& e = region_[r];
-    if (e.stamp == stamp_) return e;
-    e.stamp = stamp_;
-    e.label = 0;
-    e.votes = 0;
-    const Block* b = blockAt(x, y, z);
-    if (!b) return e;
-    const VoxelVotes* votes = b->votes(Block::linear(x & 7, y & 7, z & 7));
-    if (!votes) return e;
-    e.votes = votes->total();
-    // Voxels without a vote have label 0 without asking.
-    if (e.votes > 0) e.label = labeller_.superpoint(*votes);
-    return e;
-  }
-
-  // neighbourhoodLabel() of the voxel at block-local (x, y, z), region index r, computed once
-  // per block: the up to 6 vertices (one per grid edge at the voxel) that take their label from
-  // a voxel rarely come one after another.
-  int32_t filledLabel(int r, int x, int y, int z) {
-    Entry& e = region_[r];
-    if (e.fill_stamp != stamp_) {
-      e.fill = neighbourhoodLabel(x, y, z);
-      e.fill_stamp = stamp_;
-    }
-    return e.fill;
-  }
-
-  // The label most of the 26 neighbours of the voxel at block-local (x, y, z) carry (ties:
-  // more votes, then the smaller label); 0 when none carries one.
-  int32_t neighbourhoodLabel(int x, int y, int z) {
-    struct Tally {
-      int32_t label;
-      int voxels;
-      uint64_t votes;
-    };
-    Tally tally[26];
-    int n = 0;
-    for (int dz = -1; dz <= 1; ++dz) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          if (dx == 0 && dy == 0 && dz == 0) continue;
-          const int nx = x + dx, ny = y + dy, nz = z + dz;
-          const Entry& e = entry(regionIndex(nx, ny, nz), nx, ny, nz);
-          if (e.label == 0) continue;
-          int k = 0;
-          while (k < n && tally[k].label != e.label) ++k;
-          if (k == n) tally[n++] = Tally{e.label, 0, 0};
-          ++tally[k].voxels;
-          tally[k].votes += e.votes;
-        }
-      }
-    }
-    int32_t best = 0;
-    int best_voxels = 0;
-    uint64_t best_votes = 0;
-    for (int k = 0; k < n; ++k) {
-      const Tally& t = tally[k];
-      if (t.voxels > best_voxels || (t.voxels == best_voxels && t.votes > best_votes) ||
-          (t.voxels == best_voxels && t.votes == best_votes && t.label < best)) {
-        best = t.label, best_voxels = t.voxels, best_votes = t.votes;
-      }
-    }
-    return best;
-  }
-
-  const TsdfMap& map_;
-  const MeshLabeller& labeller_;
-  BlockIndex index_ = BlockIndex::Zero();  // the block of setBlock()
-  const Block* blocks_[27] = {};           // it and its 26 neighbours, where fetched_ says
-  uint32_t fetched_ = 0;
-  std::vector<Entry> region_;
-  uint32_t stamp_ = 0;
-  const Voxel* last_voxel_ = nullptr;
-  bool have_last_ = false;
-  int32_t last_source_ = 0;  // the label last_'s class and instance come from
-  VertexLabels last_;
-};
-
-}  // namespace internal
-
-using internal::VertexLabeller;
-
 LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const BlockMesh*>& blocks,
                                  const MeshLabeller& labeller) {
+  size_t vertices = 0, faces = 0;
+  for (const BlockMesh* mesh : blocks) {
+    vertices += mesh->vertices.size();
+    faces += mesh->faces.size();
+  }
   LabelledMesh out;
-  const bool labelled = static_cast<bool>(labeller.superpoint);
-  std::vector<size_t> offsets(blocks.size() + 1, 0);
-  size_t num_faces = 0, num_border = 0;
-  for (size_t b = 0; b < blocks.size(); ++b) {
-    offsets[b + 1] = offsets[b] + blocks[b]->vertices.size();
-    num_faces += blocks[b]->faces.size();
-  }
-  std::vector<int32_t> global(offsets.back(), -1);
-  out.vertices.reserve(offsets.back());
-  out.colors.reserve(offsets.back());
-  out.faces.reserve(num_faces);
-  if (labelled) {
-    // Reserved like the positions: growing by doubling would briefly hold 1.5x a building's
-    // labels on top of the rest of the mesh.
-    out.superpoint.reserve(offsets.back());
-    out.semantic.reserve(offsets.back());
-    out.instance.reserve(offsets.back());
-  }
-
-  VertexLabeller label_vertex(map, labeller);
-  auto findNeighbours = [&](const BlockIndex& index) {
-    if (labelled) label_vertex.setBlock(index);
-  };
-  auto emit = [&](const BlockMesh& mesh, size_t i) {
-    const int32_t index = static_cast<int32_t>(out.vertices.size());
-    out.vertices.push_back(mesh.vertices[i]);
-    out.colors.push_back(mesh.colors[i]);
-    if (labelled) {
-      const VertexLabels labels = label_vertex(mesh.sources[i]);
-      out.superpoint.push_back(labels.superpoint);
-      out.semantic.push_back(labels.semantic);
-      out.instance.push_back(labels.instance);
-    }
-    return index;
-  };
-  auto decode = [](uint16_t id, int* x, int* y, int* z) {
-    const int cell = id / 3;
-    *x = cell % kGrid;
-    *y = (cell / kGrid) % kGrid;
-    *z = cell / (kGrid * kGrid);
-  };
-
-  // Pass 1: every block's own vertices (lower voxel inside the block), in block order. Those
-  // on the block's lower faces may be shared with a lower neighbour's border vertices.
-  for (size_t b = 0; b < blocks.size(); ++b) {
-    for (uint16_t id : blocks[b]->edges) {
-      int x, y, z;
-      decode(id, &x, &y, &z);
-      num_border +=
-          (x == 0 || y == 0 || z == 0 || x == kBlockSide || y == kBlockSide || z == kBlockSide);
-    }
-  }
-  absl::flat_hash_map<EdgeKey, int32_t> border;
-  border.reserve(num_border);
-  for (size_t b = 0; b < blocks.size(); ++b) {
-    const BlockMesh& mesh = *blocks[b];
-    findNeighbours(mesh.index);
-    const uint64_t key = TsdfMap::key(mesh.index);
-    for (size_t i = 0; i < mesh.vertices.size(); ++i) {
-      int x, y, z;
-      decode(mesh.edges[i], &x, &y, &z);
-      if (x == kBlockSide || y == kBlockSide || z == kBlockSide) continue;
-      global[offsets[b] + i] = emit(mesh, i);
-      if (x == 0 || y == 0 || z == 0)
-        border.emplace(EdgeKey(key, mesh.edges[i]), global[offsets[b] + i]);
-    }
-  }
-  // Pass 2: border vertices owned by an upper neighbour: weld with the owner's vertex, or
-  // with the first lower block that produced it when the owner's cubes did not.
-  for (size_t b = 0; b < blocks.size(); ++b) {
-    const BlockMesh& mesh = *blocks[b];
-    bool have_neighbours = false;
-    for (size_t i = 0; i < mesh.vertices.size(); ++i) {
-      int x, y, z;
-      decode(mesh.edges[i], &x, &y, &z);
-      if (x < kBlockSide && y < kBlockSide && z < kBlockSide) continue;
-      const BlockIndex owner = mesh.index + BlockIndex(x >> 3, y >> 3, z >> 3);
-      const EdgeKey key(TsdfMap::key(owner), blockEdgeId(x & 7, y & 7, z & 7, mesh.edges[i] % 3));
-      auto [it, inserted] = border.try_emplace(key, -1);
-      if (inserted) {
-        if (!have_neighbours) {
-          findNeighbours(mesh.index);
-          have_neighbours = true;
-        }
-        it->second = emit(mesh, i);
-      }
-      global[offsets[b] + i] = it->second;
-    }
-  }
-  for (size_t b = 0; b < blocks.size(); ++b) {
-    const int32_t* map_to = global.data() + offsets[b];
-    for (const Eigen::Vector3i& f : blocks[b]->faces) {
-      out.faces.emplace_back(map_to[f[0]], map_to[f[1]], map_to[f[2]]);
-    }
-  }
+  reserveMesh(vertices, faces, static_cast<bool>(labeller.superpoint), &out);
+  MeshWelder welder(map, labeller, &out);
+  for (const BlockMesh* mesh : blocks) welder.add(*mesh);
   return out;
 }
 
@@ -577,21 +338,57 @@ LabelledMesh labelBlockMesh(const TsdfMap& map, const BlockMesh& mesh,
 }
 
 LabelledMesh marchingCubes(const TsdfMap& map, const MarchingCubesConfig& config,
-                           const MeshLabeller& labeller) {
+                           const MeshLabeller& labeller, ThreadPool* pool) {
   config.check();
   std::vector<const Block*> sorted;
   sorted.reserve(map.numBlocks());
   for (const auto& block : map.blocks()) sorted.push_back(block.get());
   std::sort(sorted.begin(), sorted.end(),
             [](const Block* a, const Block* b) { return blockIndexLess(a->index, b->index); });
-  std::vector<BlockMesh> meshes(sorted.size());
-  std::vector<const BlockMesh*> pointers;
-  pointers.reserve(sorted.size());
+  const int threads = pool ? pool->size() : 1;
+  auto forEach = [&](size_t n, const std::function<void(size_t, size_t, int)>& fn) {
+    // A few blocks at a time: blocks without surface cost a fraction of those with.
+    if (pool && n > 1) {
+      pool->parallelForDynamic(n, 16, fn);
+    } else {
+      fn(0, n, 0);
+    }
+  };
+  // Pass 1 only counts, so that the mesh is reserved once and no block mesh is kept: a
+  // building's block meshes are as large as its welded mesh (2 cm: 0.3 GB each). Marching
+  // cubes twice costs less than holding both.
+  std::vector<BlockMesh> scratch(threads);
+  std::vector<uint8_t> has_surface(sorted.size(), 0);
+  std::vector<size_t> vertices(threads, 0), faces(threads, 0);
+  forEach(sorted.size(), [&](size_t begin, size_t end, int thread) {
+    for (size_t i = begin; i < end; ++i) {
+      meshBlock(map, *sorted[i], config, &scratch[thread]);
+      vertices[thread] += scratch[thread].vertices.size();
+      faces[thread] += scratch[thread].faces.size();
+      has_surface[i] = !scratch[thread].vertices.empty();
+    }
+  });
+  std::vector<const Block*> surface;
   for (size_t i = 0; i < sorted.size(); ++i) {
-    meshBlock(map, *sorted[i], config, &meshes[i]);
-    if (!meshes[i].vertices.empty()) pointers.push_back(&meshes[i]);
+    if (has_surface[i]) surface.push_back(sorted[i]);
   }
-  return assembleBlockMeshes(map, pointers, labeller);
+  sorted = std::vector<const Block*>();
+  LabelledMesh out;
+  reserveMesh(std::accumulate(vertices.begin(), vertices.end(), size_t{0}),
+              std::accumulate(faces.begin(), faces.end(), size_t{0}),
+              static_cast<bool>(labeller.superpoint), &out);
+  // Pass 2: a batch of blocks meshed on every thread, then welded in order on this one.
+  constexpr size_t kBatch = 1024;
+  std::vector<BlockMesh> batch(std::min(kBatch, surface.size()));
+  MeshWelder welder(map, labeller, &out);
+  for (size_t first = 0; first < surface.size(); first += kBatch) {
+    const size_t n = std::min(kBatch, surface.size() - first);
+    forEach(n, [&](size_t begin, size_t end, int) {
+      for (size_t i = begin; i < end; ++i) meshBlock(map, *surface[first + i], config, &batch[i]);
+    });
+    for (size_t i = 0; i < n; ++i) welder.add(batch[i]);
+  }
+  return out;
 }
 
 }  // namespace panmap

@@ -23,6 +23,7 @@
 #include "panmap/mesh/internal/marching_cubes_tables.h"
 #include "panmap/mesh/marching_cubes.h"
 #include "panmap/mesh/mesh_export.h"
+#include "panmap/mesh/mesh_welder.h"
 #include "test_helpers.h"
 
 namespace panmap {
@@ -347,6 +348,69 @@ TEST(MarchingCubes, RandomFieldGivesAClosedConsistentSurface) {
   const LabelledMesh mesh = marchingCubes(map);
   ASSERT_GT(mesh.numFaces(), 10000u);
   expectWatertight(mesh);
+}
+
+// Every block's own mesh, in blockIndexLess order, those with surface only.
+std::vector<BlockMesh> sortedBlockMeshes(const TsdfMap& map) {
+  std::vector<const Block*> blocks;
+  for (const auto& block : map.blocks()) blocks.push_back(block.get());
+  std::sort(blocks.begin(), blocks.end(),
+            [](const Block* a, const Block* b) { return blockIndexLess(a->index, b->index); });
+  std::vector<BlockMesh> meshes;
+  for (const Block* block : blocks) {
+    BlockMesh mesh;
+    meshBlock(map, *block, MarchingCubesConfig(), &mesh);
+    if (!mesh.vertices.empty()) meshes.push_back(std::move(mesh));
+  }
+  return meshes;
+}
+
+TEST(MarchingCubes, BatchedOnThreadsItEqualsTheAssembledBlockMeshes) {
+  // A 3 mm sphere has more blocks with surface than one batch of marchingCubes (1,024).
+  TsdfMap map(TsdfMap::Config{0.003f});
+  fillSphere(&map);
+  const std::vector<BlockMesh> meshes = sortedBlockMeshes(map);
+  ASSERT_GT(meshes.size(), 2048u);
+  std::vector<const BlockMesh*> pointers;
+  for (const BlockMesh& mesh : meshes) pointers.push_back(&mesh);
+  const LabelledMesh assembled = assembleBlockMeshes(map, pointers, identityLabeller());
+  expectWatertight(assembled);
+  expectSameMesh(marchingCubes(map, {}, identityLabeller()), assembled);
+  ThreadPool pool(3);
+  expectSameMesh(marchingCubes(map, {}, identityLabeller(), &pool), assembled);
+}
+
+TEST(MeshWelder, WeldsEachSharedEdgeOnceAndRemembersOnlyTheSeam) {
+  TsdfMap map(TsdfMap::Config{0.01f});
+  fillSphere(&map);
+  const std::vector<BlockMesh> meshes = sortedBlockMeshes(map);
+  // Border vertices (on a block face) are the ones two or more blocks make.
+  size_t block_vertices = 0, border = 0;
+  for (const BlockMesh& mesh : meshes) {
+    block_vertices += mesh.vertices.size();
+    for (uint16_t edge : mesh.edges) {
+      const int cell = edge / 3, x = cell % 9, y = (cell / 9) % 9, z = cell / 81;
+      border += x % kBlockSide == 0 || y % kBlockSide == 0 || z % kBlockSide == 0;
+    }
+  }
+  LabelledMesh out;
+  MeshWelder welder(map, identityLabeller(), &out);
+  size_t largest_seam = 0;
+  for (const BlockMesh& mesh : meshes) {
+    welder.add(mesh);
+    largest_seam = std::max(largest_seam, welder.seamEdges());
+  }
+  expectWatertight(out);
+  // Every vertex a block shares with another is made once: the welded mesh has exactly the
+  // block vertices less the repeats, and the sphere's area (within 1 %).
+  EXPECT_LT(out.numVertices(), block_vertices);
+  EXPECT_NEAR(meshArea(out), 4.0 * M_PI * kRadius * kRadius, 0.01 * 4.0 * M_PI * kRadius * kRadius);
+  EXPECT_EQ(out.superpoint.size(), out.numVertices());
+  // The closed surface's every edge was made by its own block too, so nothing is left over,
+  // and the seam never held more than a part of the border.
+  EXPECT_EQ(welder.seamEdges(), 0u);
+  EXPECT_GT(largest_seam, 0u);
+  EXPECT_LT(largest_seam, border / 3);
 }
 
 TEST(MarchingCubes, ColoursInterpolateAndLabelsComeFromTheNearerVoxel) {

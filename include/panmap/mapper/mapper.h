@@ -287,10 +287,15 @@ class Mapper {
   /// @param labels as for extractMesh()
   MeshUpdate updateMesh(const GraphLabels* labels = nullptr);
   /// Drops the block meshes kept so that extractMesh() and updateMesh() re-run marching cubes
-  /// only on changed blocks (about 0.5 GB on the 2 cm building): for the last export of a
+  /// only on changed blocks (about 0.3 GB on the 2 cm building): for the last export of a
   /// session, which no live view follows. A later extractMesh() or updateMesh() meshes the
   /// whole map again, with the same result.
   void releaseMeshCache();
+  /// The same mesh as extractMesh(), for the last export of a session: drops the block
+  /// meshes first (releaseMeshCache) and meshes the map from scratch block by block
+  /// (marchingCubes), so the welded mesh is never held beside a copy of itself in pieces.
+  /// @param labels as for extractMesh()
+  LabelledMesh extractFinalMesh(const GraphLabels* labels = nullptr);
 
   /// Streams the whole state (config, TSDF, votes, super-points) as a map file into `sink`: a
   /// versioned header, the payload and its CRC-32, in chunks of 1 MiB (never whole in memory).

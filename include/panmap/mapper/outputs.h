@@ -14,9 +14,9 @@ namespace panmap {
 struct OutputOptions {
   bool snapshots = true;  ///< overview PNGs of the meshes (semantic, instance, super-point, colour)
   int64_t utime = 0;      ///< time of the map state (newest frame), written into objects.json
-  /// The session's last export: the block meshes kept for live mesh updates are dropped once
-  /// the mesh is extracted (Mapper::releaseMeshCache), so the later steps (occupancy, map file)
-  /// run without them.
+  /// The session's last export: the block meshes kept for live mesh updates are dropped and
+  /// the mesh is made from scratch block by block (Mapper::extractFinalMesh), so neither
+  /// they nor a copy of the mesh in pieces are held beside the welded mesh.
   bool final_export = false;
 };
 

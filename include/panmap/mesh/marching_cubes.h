@@ -10,6 +10,7 @@
 
 #include "panmap/core/image.h"
 #include "panmap/core/labelled_mesh.h"
+#include "panmap/core/thread_pool.h"
 #include "panmap/map/tsdf_map.h"
 
 namespace panmap {
@@ -126,8 +127,13 @@ inline bool blockIndexLess(const BlockIndex& a, const BlockIndex& b) {
 
 /// Marching cubes over every allocated block of `map`, from scratch: a watertight mesh for a
 /// closed, fully observed surface, with per-vertex colour and (through `labeller`) labels.
-/// Does not touch the blocks' `updated` flags (IncrementalMesher does).
+/// The same mesh as assembleBlockMeshes() of every block's meshBlock() in blockIndexLess
+/// order, but no block mesh is kept: blocks are meshed twice (a count, then a batch at a time
+/// welded into the reserved mesh), so the memory is the mesh's own. Does not touch the
+/// blocks' `updated` flags (IncrementalMesher does).
+/// @param pool threads to mesh blocks with (not owned), or null for the calling thread;
+/// the labeller is only called on the calling thread
 LabelledMesh marchingCubes(const TsdfMap& map, const MarchingCubesConfig& config = {},
-                           const MeshLabeller& labeller = {});
+                           const MeshLabeller& labeller = {}, ThreadPool* pool = nullptr);
 
 }  // namespace panmap
