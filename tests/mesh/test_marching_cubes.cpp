@@ -378,6 +378,10 @@ TEST(MarchingCubes, BatchedOnThreadsItEqualsTheAssembledBlockMeshes) {
   expectSameMesh(marchingCubes(map, {}, identityLabeller()), assembled);
   ThreadPool pool(3);
   expectSameMesh(marchingCubes(map, {}, identityLabeller(), &pool), assembled);
+  // A map without blocks meshes to nothing, threads or not.
+  const TsdfMap empty(TsdfMap::Config{0.003f});
+  EXPECT_EQ(marchingCubes(empty, {}, identityLabeller(), &pool).numVertices(), 0u);
+  EXPECT_EQ(marchingCubes(empty).numFaces(), 0u);
 }
 
 TEST(MeshWelder, WeldsEachSharedEdgeOnceAndRemembersOnlyTheSeam) {
