@@ -84,8 +84,8 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
 
 /// Concatenates block meshes into one mesh, welding the vertices they share on block
 /// borders (one vertex per edge of the voxel grid), and labels every vertex through
-/// `labeller` from the map's current voxels. Blocks are taken in the given order (sort them
-/// with blockIndexLess for a deterministic mesh). Blocks missing from `map` give label 0.
+/// `labeller` from the map's current voxels (MeshWelder). Blocks must come in blockIndexLess
+/// order, each once. Blocks missing from `map` give label 0.
 LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const BlockMesh*>& blocks,
                                  const MeshLabeller& labeller = {});
 

@@ -15,12 +15,15 @@ struct VertexLabels {
 };
 
 /// Labels vertices from their source voxels through a MeshLabeller, one block's vertices at a
-// time (setBlock). The labels of the voxels around the block are computed once each and kept
-// (a vertex without a label reads its 26 neighbours, which the next vertices mostly share),
-// and so are the last vertex's labels: neighbouring vertices mostly share their voxel, and
-// neighbouring voxels their super-point. The map must not change while it is in use.
+/// time (setBlock). The labels of the voxels around the block are computed once each and kept
+/// (a vertex without a label reads its 26 neighbours, which the next vertices mostly share),
+/// and so are the last vertex's labels: neighbouring vertices mostly share their voxel, and
+/// neighbouring voxels their super-point. The map must not change while it is in use. Used by
+/// MeshWelder and BlockMeshLabeller.
 class VertexLabeller {
  public:
+  /// @param map the map whose voxels label the vertices; must outlive this
+  /// @param labeller how voxels are labelled; must outlive this
   VertexLabeller(const TsdfMap& map, const MeshLabeller& labeller)
       : map_(map), labeller_(labeller), region_(kRegionVoxels) {}
 
