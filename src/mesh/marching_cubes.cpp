@@ -313,12 +313,19 @@ BlockMeshLabeller::BlockMeshLabeller(const TsdfMap& map, const MeshLabeller& lab
 BlockMeshLabeller::~BlockMeshLabeller() = default;
 
 LabelledMesh BlockMeshLabeller::label(const BlockMesh& mesh) {
+  if (vertex_) {
+    // As MeshWelder::add: the vote slots and sets, which marching cubes did not read, are
+    // fetched for the whole block before any label waits on them (here while the copies
+    // below run).
+    vertex_->setBlock(mesh.index);
+    for (uint16_t source : mesh.sources) vertex_->prefetchSlot(source);
+  }
   LabelledMesh out;
   out.vertices = mesh.vertices;
   out.colors = mesh.colors;
   out.faces = mesh.faces;
   if (!vertex_) return out;
-  vertex_->setBlock(mesh.index);
+  for (uint16_t source : mesh.sources) vertex_->prefetchVotes(source);
   const size_t n = mesh.vertices.size();
   out.superpoint.resize(n);
   out.semantic.resize(n);

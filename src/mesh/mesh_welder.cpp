@@ -32,7 +32,13 @@ int32_t MeshWelder::emit(const BlockMesh& mesh, size_t i) {
 
 void MeshWelder::add(const BlockMesh& mesh) {
   if (mesh.vertices.empty()) return;
-  if (label_vertex_) label_vertex_->setBlock(mesh.index);
+  if (label_vertex_) {
+    label_vertex_->setBlock(mesh.index);
+    // A vertex's labels wait on two loads the marching cubes never made (its voxel's vote
+    // slot, then its vote set): started for the whole block first, they overlap.
+    for (uint16_t source : mesh.sources) label_vertex_->prefetchSlot(source);
+    for (uint16_t source : mesh.sources) label_vertex_->prefetchVotes(source);
+  }
   const uint64_t own_key = TsdfMap::key(mesh.index);
   local_.resize(mesh.vertices.size());
   for (size_t i = 0; i < mesh.vertices.size(); ++i) {

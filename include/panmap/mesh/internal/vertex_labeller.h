@@ -38,6 +38,21 @@ class VertexLabeller {
     last_voxel_ = nullptr;
   }
 
+  /// Starts loading the vote slot of a source's voxel, the first of two loads each vertex's
+  /// labels wait for; call for a block's vertices before prefetchVotes() and the labels.
+  /// @param source a BlockMesh source of the block last given to setBlock()
+  void prefetchSlot(uint16_t source) {
+    const int local = source & 511;
+    if (const Block* b = sourceBlock(source)) __builtin_prefetch(&b->vote_slot[local]);
+  }
+  /// Starts loading the votes of a source's voxel (its slot should have arrived by now).
+  /// @param source a BlockMesh source of the block last given to setBlock()
+  void prefetchVotes(uint16_t source) {
+    const Block* b = sourceBlock(source);
+    if (!b) return;
+    if (const VoxelVotes* votes = b->votes(source & 511)) __builtin_prefetch(votes);
+  }
+
   /// @param source a BlockMesh source of the block last given to setBlock()
   VertexLabels operator()(uint16_t source) {
     const int slot = source >> 9, local = source & 511;
@@ -78,6 +93,14 @@ class VertexLabeller {
     uint32_t fill_stamp = 0;  // `fill` valid when equal to stamp_
     int32_t fill = 0;         // neighbourhoodLabel() of the voxel
   };
+
+  // The block holding a source's voxel.
+  const Block* sourceBlock(uint16_t source) {
+    const int slot = source >> 9, local = source & 511;
+    return blockAt((slot & 1) * kBlockSide + (local & 7),
+                   ((slot >> 1) & 1) * kBlockSide + ((local >> 3) & 7),
+                   (slot >> 2) * kBlockSide + (local >> 6));
+  }
 
   static int regionIndex(int x, int y, int z) {
     return (x + 1) + kRegionSide * ((y + 1) + kRegionSide * (z + 1));
