@@ -303,7 +303,10 @@ LabelledMesh assembleBlockMeshes(const TsdfMap& map, const std::vector<const Blo
   LabelledMesh out;
   reserveMesh(vertices, faces, static_cast<bool>(labeller.superpoint), &out);
   MeshWelder welder(map, labeller, &out);
-  for (const BlockMesh* mesh : blocks) welder.add(*mesh);
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    if (b + 1 < blocks.size()) welder.prefetch(*blocks[b + 1]);
+    welder.add(*blocks[b]);
+  }
   return out;
 }
 
@@ -393,7 +396,10 @@ LabelledMesh marchingCubes(const TsdfMap& map, const MarchingCubesConfig& config
     forEach(n, [&](size_t begin, size_t end, int) {
       for (size_t i = begin; i < end; ++i) meshBlock(map, *surface[first + i], config, &batch[i]);
     });
-    for (size_t i = 0; i < n; ++i) welder.add(batch[i]);
+    for (size_t i = 0; i < n; ++i) {
+      if (i + 1 < n) welder.prefetch(batch[i + 1]);
+      welder.add(batch[i]);
+    }
   }
   return out;
 }

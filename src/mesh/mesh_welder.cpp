@@ -8,7 +8,23 @@ namespace {
 
 constexpr int kGrid = kBlockSide + 1;
 
+// Every cache line of a vector's elements.
+template <typename T>
+void prefetchAll(const std::vector<T>& v) {
+  const char* p = reinterpret_cast<const char*>(v.data());
+  const size_t bytes = v.size() * sizeof(T);
+  for (size_t offset = 0; offset < bytes; offset += 64) __builtin_prefetch(p + offset);
+}
+
 }  // namespace
+
+void MeshWelder::prefetch(const BlockMesh& mesh) const {
+  prefetchAll(mesh.vertices);
+  prefetchAll(mesh.colors);
+  prefetchAll(mesh.edges);
+  prefetchAll(mesh.sources);
+  prefetchAll(mesh.faces);
+}
 
 MeshWelder::MeshWelder(const TsdfMap& map, const MeshLabeller& labeller, LabelledMesh* out)
     : out_(out),

@@ -37,6 +37,10 @@ class MeshWelder {
   /// a vertex shared with an earlier block reuses that block's vertex.
   void add(const BlockMesh& mesh);
 
+  /// Starts loading a block mesh that add() will take next, so that its arrays are in cache
+  /// by then (the block meshes kept for live updates are cold, each array its own allocation).
+  void prefetch(const BlockMesh& mesh) const;
+
   /// Grid edges on the seam remembered now (for tests: it stays a front, not the whole map).
   size_t seamEdges() const { return seam_.size(); }
 
