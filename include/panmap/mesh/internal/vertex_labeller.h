@@ -55,10 +55,9 @@ class VertexLabeller {
 
   /// @param source a BlockMesh source of the block last given to setBlock()
   VertexLabels operator()(uint16_t source) {
-    const int slot = source >> 9, local = source & 511;
-    const int x = (slot & 1) * kBlockSide + (local & 7);
-    const int y = ((slot >> 1) & 1) * kBlockSide + ((local >> 3) & 7);
-    const int z = (slot >> 2) * kBlockSide + (local >> 6);
+    const int local = source & 511;
+    int x, y, z;
+    decode(source, &x, &y, &z);
     const Block* owner = blockAt(x, y, z);
     if (!owner) return VertexLabels{};
     const Voxel* voxel = &owner->voxels[local];
@@ -94,12 +93,19 @@ class VertexLabeller {
     int32_t fill = 0;         // neighbourhoodLabel() of the voxel
   };
 
+  // A source's voxel in coordinates local to the block of setBlock() (0 .. 15).
+  static void decode(uint16_t source, int* x, int* y, int* z) {
+    const int slot = source >> 9, local = source & 511;
+    *x = (slot & 1) * kBlockSide + (local & 7);
+    *y = ((slot >> 1) & 1) * kBlockSide + ((local >> 3) & 7);
+    *z = (slot >> 2) * kBlockSide + (local >> 6);
+  }
+
   // The block holding a source's voxel.
   const Block* sourceBlock(uint16_t source) {
-    const int slot = source >> 9, local = source & 511;
-    return blockAt((slot & 1) * kBlockSide + (local & 7),
-                   ((slot >> 1) & 1) * kBlockSide + ((local >> 3) & 7),
-                   (slot >> 2) * kBlockSide + (local >> 6));
+    int x, y, z;
+    decode(source, &x, &y, &z);
+    return blockAt(x, y, z);
   }
 
   static int regionIndex(int x, int y, int z) {
