@@ -50,7 +50,11 @@ class VertexLabeller {
   void prefetchVotes(uint16_t source) {
     const Block* b = sourceBlock(source);
     if (!b) return;
-    if (const VoxelVotes* votes = b->votes(source & 511)) __builtin_prefetch(votes);
+    if (const VoxelVotes* votes = b->votes(source & 511)) {
+      // A vote set may straddle two cache lines (as VoxelLabelSampler::labelRow fetches them).
+      __builtin_prefetch(votes);
+      __builtin_prefetch(reinterpret_cast<const char*>(votes + 1) - 1);
+    }
   }
 
   /// @param source a BlockMesh source of the block last given to setBlock()
