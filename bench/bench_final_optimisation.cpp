@@ -2,8 +2,9 @@
 // the super-point graph of the live super-points (Mapper::graph), then the solve (optimise).
 // Prints each run, the median of each over --repeats runs, and a digest of the labels (a
 // fingerprint of every super-point's id, class and instance) so that a faster build can be checked
-// for equal output.
-//   panmap-bench-final MAP.panmap [--repeats 5]
+// for equal output. With --mesh, also the whole labelled mesh from the block meshes a live
+// session keeps (Mapper::extractMesh after a first call: welding and labelling, one thread).
+//   panmap-bench-final MAP.panmap [--repeats 5] [--mesh]
 
 #include <algorithm>
 #include <chrono>
@@ -51,6 +52,10 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats, "runs to take the median of")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
+  bool mesh = false;
+  app.add_flag("--mesh", mesh,
+               "also time the whole labelled mesh from the kept block meshes (welding and "
+               "labelling on one thread)");
   CLI11_PARSE(app, argc, argv);
   try {
     const auto mapper = panmap::Mapper::load(path);
@@ -76,6 +81,17 @@ int main(int argc, char** argv) {
         path.c_str(), mapper->map().numBlocks(), vertices, edges, repeats, median(graph_ms),
         median(solve_ms), median(graph_ms) + median(solve_ms),
         static_cast<unsigned long long>(digest));
+    if (mesh) {
+      size_t mesh_vertices = mapper->extractMesh().numVertices();  // meshes every block once
+      std::vector<double> mesh_ms;
+      for (int r = 0; r < repeats; ++r) {
+        const auto start = std::chrono::steady_clock::now();
+        mesh_vertices = mapper->extractMesh().numVertices();
+        mesh_ms.push_back(msSince(start));
+      }
+      std::printf("%s: whole mesh from the kept block meshes, %zu vertices: median of %d %.1f ms\n",
+                  path.c_str(), mesh_vertices, repeats, median(mesh_ms));
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-bench-final: error: %s\n", e.what());
     return 1;
