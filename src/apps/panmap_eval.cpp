@@ -192,15 +192,18 @@ json toJson(const panmap::TrajectoryError& e, const panmap::TrajectoryErrorConfi
   for (int r = 0; r < 4; ++r) {
     for (int c = 0; c < 4; ++c) T.push_back(e.T_gt_est.matrix()(r, c));
   }
-  return {{"num_estimated", e.num_estimated},
-          {"num_ground_truth", e.num_ground_truth},
-          {"num_associated", e.num_associated},
-          {"max_time_difference_s", config.max_time_difference_s},
-          {"rpe_delta_s", e.rpe_delta_s},
-          {"ate_m", toJson(e.ate_m)},
-          {"rpe_translation_m", toJson(e.rpe_m)},
-          {"rpe_rotation_deg", toJson(e.rpe_deg)},
-          {"T_gt_est_row_major", T}};
+  return {
+      {"num_estimated", e.num_estimated},
+      {"num_ground_truth", e.num_ground_truth},
+      {"num_associated", e.num_associated},
+      {"max_time_difference_s", config.max_time_difference_s},
+      {"rpe_delta_s", e.rpe_delta_s},
+      {"ate_m", toJson(e.ate_m)},
+      {"rpe_translation_m", toJson(e.rpe_m)},
+      {"rpe_rotation_deg", toJson(e.rpe_deg)},
+      {"T_gt_est_row_major", T},
+      {"scale", e.scale},
+      {"camera_offset_m", {e.camera_offset_m.x(), e.camera_offset_m.y(), e.camera_offset_m.z()}}};
 }
 
 /// The ground-truth mesh from --gt or --gt-scannet, with --gt-instances applied.
@@ -296,14 +299,22 @@ int main(int argc, char** argv) {
   gt_traj_option->needs(traj_option);
   bool align_pred = false;
   app.add_flag("--align-pred", align_pred,
-               "move the predicted mesh by the trajectory's rigid alignment (the ATE's T_gt_est) "
-               "before the label transfer: a map built from estimated poses lives in the "
-               "estimate's world frame, which differs from the ground truth's by a rigid "
-               "transform no mapper can observe")
+               "move the predicted mesh by the trajectory's alignment (the ATE's T_gt_est, and "
+               "its scale with --fit-scale) before the label transfer: a map built from "
+               "estimated poses lives in the estimate's world frame, which differs from the "
+               "ground truth's by a rigid transform no mapper can observe")
       ->needs(traj_option);
   app.add_option("--max-time-difference", traj_config.max_time_difference_s,
                  "largest stamp difference of associated poses, seconds")
       ->capture_default_str();
+  app.add_flag("--fit-camera-offset", traj_config.fit_camera_offset,
+               "ATE: also fit a constant offset of the camera centre in the estimate's camera "
+               "frame, for trajectories of two cameras on one rig (depth tracking against "
+               "colour-camera poses)")
+      ->needs(traj_option);
+  app.add_flag("--fit-scale", traj_config.fit_scale,
+               "ATE: align by a similarity (with scale), for trajectories without metric scale")
+      ->needs(traj_option);
   app.add_option("--rpe-delta", traj_config.rpe_delta_s,
                  "time between the poses of a relative pose error, seconds")
       ->capture_default_str();
@@ -336,7 +347,8 @@ int main(int argc, char** argv) {
       panmap::LabelledMesh pred = panmap::readPly(pred_path);
       if (align_pred) {
         const Eigen::Isometry3f T_gt_est = trajectory_error.T_gt_est.cast<float>();
-        for (Eigen::Vector3f& p : pred.vertices) p = T_gt_est * p;
+        const float scale = static_cast<float>(trajectory_error.scale);
+        for (Eigen::Vector3f& p : pred.vertices) p = T_gt_est * (scale * p);
       }
       const panmap::LabelledMesh gt =
           loadGroundTruth(gt_path, scannet_dir, scannet_labels, gt_instances_path);

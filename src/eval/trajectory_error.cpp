@@ -11,6 +11,15 @@
 #include "panmap/core/error.h"
 
 namespace panmap {
+namespace {
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
+}  // namespace
 
 void TrajectoryErrorConfig::check() const {
   if (!(max_time_difference_s >= 0.0 && max_time_difference_s < 1e6)) {
@@ -76,6 +85,44 @@ std::vector<std::pair<size_t, size_t>> associateByTime(const std::vector<Stamped
   return pairs;
 }
 
+TrajectoryAlignment fitAlignment(const std::vector<Eigen::Matrix3d>& R_est,
+                                 const Eigen::Matrix3Xd& p_est, const Eigen::Matrix3Xd& p_gt,
+                                 bool fit_scale, bool fit_camera_offset) {
+  const Eigen::Index n = p_est.cols();
+  const Eigen::Matrix4d similarity = Eigen::umeyama(p_est, p_gt, fit_scale);
+  TrajectoryAlignment a;
+  a.scale = fit_scale ? similarity.block<3, 1>(0, 0).norm() : 1.0;
+  a.T.linear() = similarity.block<3, 3>(0, 0) / a.scale;
+  a.T.translation() = similarity.block<3, 1>(0, 3);
+  if (!fit_camera_offset) return a;
+  // Gauss-Newton over (rotation as a left increment, translation, d, log scale):
+  // r_k = s R (p_k + R_k d) + t - q_k is linear in t and d, so the steps converge fast.
+  for (int iteration = 0; iteration < 100; ++iteration) {
+    Eigen::Matrix<double, 10, 10> JtJ = Eigen::Matrix<double, 10, 10>::Zero();
+    Eigen::Matrix<double, 10, 1> Jtr = Eigen::Matrix<double, 10, 1>::Zero();
+    for (Eigen::Index k = 0; k < n; ++k) {
+      const Eigen::Vector3d moved =
+          a.scale * (a.T.linear() * (p_est.col(k) + R_est[k] * a.camera_offset));
+      const Eigen::Vector3d r = moved + a.T.translation() - p_gt.col(k);
+      Eigen::Matrix<double, 3, 10> J;
+      J << -skew(moved), Eigen::Matrix3d::Identity(), a.scale * a.T.linear() * R_est[k],
+          fit_scale ? moved : Eigen::Vector3d::Zero();
+      JtJ += J.transpose() * J;
+      Jtr += J.transpose() * r;
+    }
+    const Eigen::Matrix<double, 10, 1> step = -JtJ.completeOrthogonalDecomposition().solve(Jtr);
+    const Eigen::Vector3d omega = step.head<3>();
+    if (omega.norm() > 0.0) {
+      a.T.linear() = Eigen::AngleAxisd(omega.norm(), omega.normalized()).matrix() * a.T.linear();
+    }
+    a.T.translation() += step.segment<3>(3);
+    a.camera_offset += step.segment<3>(6);
+    a.scale *= std::exp(step(9));
+    if (step.norm() < 1e-14) break;
+  }
+  return a;
+}
+
 TrajectoryError evaluateTrajectory(const std::vector<StampedPose>& estimate,
                                    const std::vector<StampedPose>& ground_truth,
                                    const TrajectoryErrorConfig& config) {
@@ -100,9 +147,18 @@ TrajectoryError evaluateTrajectory(const std::vector<StampedPose>& estimate,
     p_est.col(k) = estimate[pairs[k].first].T_W_C.translation();
     p_gt.col(k) = ground_truth[pairs[k].second].T_W_C.translation();
   }
-  out.T_gt_est.matrix() = Eigen::umeyama(p_est, p_gt, false);
+  std::vector<Eigen::Matrix3d> R_est(pairs.size());
+  for (Eigen::Index k = 0; k < n; ++k) R_est[k] = estimate[pairs[k].first].T_W_C.linear();
+  const TrajectoryAlignment alignment =
+      fitAlignment(R_est, p_est, p_gt, config.fit_scale, config.fit_camera_offset);
+  out.T_gt_est = alignment.T;
+  out.scale = alignment.scale;
+  out.camera_offset_m = alignment.camera_offset;
   std::vector<double> ate(pairs.size());
-  for (Eigen::Index k = 0; k < n; ++k) ate[k] = (out.T_gt_est * p_est.col(k) - p_gt.col(k)).norm();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const Eigen::Vector3d p = p_est.col(k) + R_est[k] * out.camera_offset_m;
+    ate[k] = (out.T_gt_est * (out.scale * p) - p_gt.col(k)).norm();
+  }
   out.ate_m = errorStats(std::move(ate));
 
   // RPE (Sturm et al. 2012, Eq. 1-2) over a fixed time delta.
@@ -152,6 +208,16 @@ std::string formatTrajectoryError(const TrajectoryError& e) {
     out += line;
   };
   row("ATE [m]", e.ate_m);
+  if (e.scale != 1.0) {
+    std::snprintf(line, sizeof(line), "scale             %.5f  (fitted)\n", e.scale);
+    out += line;
+  }
+  if (!e.camera_offset_m.isZero()) {
+    std::snprintf(line, sizeof(line), "camera offset [m] %.4f %.4f %.4f  (|d| %.4f, fitted)\n",
+                  e.camera_offset_m.x(), e.camera_offset_m.y(), e.camera_offset_m.z(),
+                  e.camera_offset_m.norm());
+    out += line;
+  }
   std::snprintf(line, sizeof(line), "RPE over %g s:\n", e.rpe_delta_s);
   out += line;
   row("  translation [m]", e.rpe_m);

@@ -106,6 +106,86 @@ TEST(TrajectoryError, ConstantDriftGivesTheAnalyticRelativeError) {
   EXPECT_NEAR(expected_m, 0.0998889, 1e-7);  // 10 cm per metre driven
 }
 
+TEST(TrajectoryError, CameraOffsetFitRemovesALeverArmThatTurnsWithTheRig) {
+  // The reference is a second camera on the same rig, 2.5 cm beside the estimate's and 1 cm
+  // behind it, in a world moved rigidly: p_gt = T (p_est + R_est d). A rigid fit alone
+  // cannot remove d, which turns with each pose; fitted together, both come out exactly.
+  const std::vector<StampedPose> estimate = twoLaps();
+  const Eigen::Vector3d d(0.025, 0.0, -0.01);
+  const Eigen::Isometry3d T = pose(Eigen::Vector3d(1.0, 2.0, -0.5), 0.7, -0.2);
+  std::vector<StampedPose> gt;
+  for (const StampedPose& p : estimate) {
+    Eigen::Isometry3d moved = p.T_W_C;
+    moved.translation() += p.T_W_C.linear() * d;
+    gt.push_back(stamped(p.utime, T * moved));
+  }
+  const TrajectoryError rigid = evaluateTrajectory(estimate, gt);
+  EXPECT_GT(rigid.ate_m.rmse, 0.005);
+  EXPECT_TRUE(rigid.camera_offset_m.isZero());
+  TrajectoryErrorConfig config;
+  config.fit_camera_offset = true;
+  const TrajectoryError fitted = evaluateTrajectory(estimate, gt, config);
+  EXPECT_NEAR(fitted.ate_m.max, 0.0, 1e-9);
+  EXPECT_NEAR((fitted.camera_offset_m - d).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((fitted.T_gt_est.matrix() - T.matrix()).norm(), 0.0, 1e-9);
+  EXPECT_NE(formatTrajectoryError(fitted).find("camera offset [m] 0.0250 "), std::string::npos)
+      << formatTrajectoryError(fitted);
+  EXPECT_NE(formatTrajectoryError(fitted).find(" -0.0100  (|d| 0.0269, fitted)"),
+            std::string::npos);
+  // Without an offset to find, the fit finds none and the ATE is the rigid one.
+  const TrajectoryError none = evaluateTrajectory(estimate, estimate, config);
+  EXPECT_NEAR(none.camera_offset_m.norm(), 0.0, 1e-9);
+  EXPECT_NEAR(none.ate_m.max, 0.0, 1e-9);
+}
+
+TEST(TrajectoryError, ScaleFitRecoversASimilarityWithAndWithoutAnOffset) {
+  // The reference is the estimate scaled by 1.07 (a depth scale error, or a monocular
+  // trajectory) and moved: p_gt = T (s (p_est + R_est d)). With d = 0 Umeyama's similarity
+  // finds s exactly; with d both come out of the joint fit.
+  const std::vector<StampedPose> estimate = twoLaps();
+  const Eigen::Isometry3d T = pose(Eigen::Vector3d(-1.0, 0.5, 2.0), -1.1, 0.3);
+  const double s = 1.07;
+  for (const Eigen::Vector3d& d :
+       {Eigen::Vector3d::Zero().eval(), Eigen::Vector3d(0.0, -0.03, 0.02)}) {
+    std::vector<StampedPose> gt;
+    for (const StampedPose& p : estimate) {
+      Eigen::Isometry3d moved = p.T_W_C;
+      moved.translation() = T * (s * (p.T_W_C.translation() + p.T_W_C.linear() * d));
+      moved.linear() = T.linear() * p.T_W_C.linear();
+      gt.push_back(stamped(p.utime, moved));
+    }
+    TrajectoryErrorConfig config;
+    config.fit_scale = true;
+    config.fit_camera_offset = !d.isZero();
+    const TrajectoryError e = evaluateTrajectory(estimate, gt, config);
+    EXPECT_NEAR(e.scale, s, 1e-9);
+    EXPECT_NEAR(e.ate_m.max, 0.0, 1e-9);
+    EXPECT_NEAR((e.camera_offset_m - d).norm(), 0.0, 1e-9);
+    EXPECT_NEAR((e.T_gt_est.matrix() - T.matrix()).norm(), 0.0, 1e-9);
+    EXPECT_NE(formatTrajectoryError(e).find("scale             1.07000  (fitted)"),
+              std::string::npos);
+    // A rigid fit leaves the 7 % scale as error.
+    EXPECT_GT(evaluateTrajectory(estimate, gt).ate_m.rmse, 0.02);
+  }
+}
+
+TEST(TrajectoryError, CameraOffsetFitTakesTheLeastNormOffsetWhenTheRigNeverTurns) {
+  // Every pose has the same rotation: R_est d is one constant vector, indistinguishable from
+  // the alignment's translation. The fit must not invent an offset.
+  std::vector<StampedPose> estimate, gt;
+  for (int k = 0; k < 10; ++k) {
+    const Eigen::Vector3d p(0.1 * k, 0.05 * k * k, 0.0);
+    estimate.push_back(stamped(k * 100000, pose(p, 0.3)));
+    gt.push_back(stamped(k * 100000, pose(p + Eigen::Vector3d(0.02, 0.0, 0.0), 0.3)));
+  }
+  TrajectoryErrorConfig config;
+  config.fit_camera_offset = true;
+  const TrajectoryError e = evaluateTrajectory(estimate, gt, config);
+  EXPECT_NEAR(e.ate_m.max, 0.0, 1e-9);
+  EXPECT_TRUE(e.camera_offset_m.allFinite());
+  EXPECT_LT(e.camera_offset_m.norm(), 0.02 + 1e-9);
+}
+
 TEST(TrajectoryError, AssociationIsGreedyByTimeDifference) {
   std::vector<StampedPose> estimate, gt;
   for (int64_t t : {0, 100000, 110000, 500000}) estimate.push_back(stamped(t, pose({0, 0, 0}, 0)));
