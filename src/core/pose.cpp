@@ -30,6 +30,12 @@ bool isRigidTransform(const Eigen::Matrix4d& T, double tolerance, std::string* w
   return false;
 }
 
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d S;
+  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return S;
+}
+
 Eigen::Isometry3d nearestIsometry(const Eigen::Matrix4d& T) {
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);

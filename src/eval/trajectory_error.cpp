@@ -11,15 +11,6 @@
 #include "panmap/core/error.h"
 
 namespace panmap {
-namespace {
-
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
-
-}  // namespace
 
 void TrajectoryErrorConfig::check() const {
   if (!(max_time_difference_s >= 0.0 && max_time_difference_s < 1e6)) {

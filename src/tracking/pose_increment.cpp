@@ -2,16 +2,9 @@
 
 #include <cmath>
 
+#include "panmap/core/pose.h"
+
 namespace panmap {
-namespace {
-
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d S;
-  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return S;
-}
-
-}  // namespace
 
 Eigen::Matrix3d expSo3(const Eigen::Vector3d& theta_rad) {
   const double angle = theta_rad.norm();

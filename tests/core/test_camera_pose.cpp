@@ -78,6 +78,14 @@ TEST(Pose, NearestIsometryIsOrthonormalAndClose) {
   EXPECT_LT((iso.matrix() - T).cwiseAbs().maxCoeff(), 2e-4);
 }
 
+TEST(Pose, SkewIsTheCrossProduct) {
+  const Eigen::Vector3d v(1.0, -2.0, 3.0), w(0.5, 4.0, -1.5);
+  EXPECT_NEAR((skew(v) * w - v.cross(w)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR((skew(v) + skew(v).transpose()).norm(), 0.0, 0.0);  // antisymmetric
+  EXPECT_DOUBLE_EQ(skew(v)(0, 1), -3.0);
+  EXPECT_DOUBLE_EQ(skew(v)(2, 0), 2.0);
+}
+
 TEST(Pose, InterpolateMidway) {
   Eigen::Isometry3d a = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d b = Eigen::Isometry3d::Identity();

@@ -35,6 +35,9 @@ Eigen::Isometry3d nearestIsometry(const Eigen::Matrix4d& T);
 /// @param t in [0, 1]: 0 gives a, 1 gives b.
 Eigen::Isometry3d interpolatePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double t);
 
+/// The cross-product matrix [v]x: skew(v) * w = v.cross(w).
+Eigen::Matrix3d skew(const Eigen::Vector3d& v);
+
 /// Name of a pose source ("ground_truth", "slam", ...).
 const char* poseSourceName(PoseSource source);
 
