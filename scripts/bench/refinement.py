@@ -275,19 +275,25 @@ def render(rows, skipped, layouts, seconds):
                "the colour camera the reference poses. The same trajectories, aligned each way "
                "(`panmap-eval --fit-scale`, `--fit-camera-offset`): ATE recorded / input / "
                "refined, cm. Counts in the order of the columns below:"]
+        def independent(r, name, which):
+            """ATE of the row's recorded (0), input (1) or refined (2) trajectory, metres."""
+            if name == "rigid":
+                return r[("independent_recorded_m", "independent_input_m",
+                          "independent_refined_m")[which]]
+            return r["independent_fits"][name][which][0]
+
         for correction in sorted({r["correction"] for r in fitted}):
-            counts = []
+            rows_of = [r for r in fitted if r["correction"] == correction]
+            counts, drifted = [], []
             for name, _ in ALIGNMENTS:
-                pairs = [(r["independent_recorded_m"], r["independent_refined_m"]) if name == "rigid"
-                         else (r["independent_fits"][name][0][0], r["independent_fits"][name][2][0])
-                         for r in fitted if r["correction"] == correction and r["drift"] == "none"]
-                counts.append("%s %d of %d" % (name, sum(1 for a, b in pairs if b < a), len(pairs)))
-            drifted = []
-            for name, _ in ALIGNMENTS:
-                pairs = [(r["independent_input_m"], r["independent_refined_m"]) if name == "rigid"
-                         else (r["independent_fits"][name][1][0], r["independent_fits"][name][2][0])
-                         for r in fitted if r["correction"] == correction and r["drift"] != "none"]
-                drifted.append("%d of %d" % (sum(1 for a, b in pairs if b < a), len(pairs)))
+                still = [r for r in rows_of if r["drift"] == "none"]
+                moved = [r for r in rows_of if r["drift"] != "none"]
+                counts.append("%s %d of %d" % (name, sum(
+                    1 for r in still if independent(r, name, 2) < independent(r, name, 0)),
+                    len(still)))
+                drifted.append("%d of %d" % (sum(
+                    1 for r in moved if independent(r, name, 2) < independent(r, name, 1)),
+                    len(moved)))
             md.append("- `%s`: no drift, refined closer than recorded: %s; drift injected, refined "
                       "closer than its input: %s;" % (correction, ", ".join(counts),
                                                       ", ".join(drifted)))
@@ -307,12 +313,8 @@ def render(rows, skipped, layouts, seconds):
                " | ".join(name for name, _ in ALIGNMENTS) + " |",
                "|---|---|---|---|---|" + "---:|" * len(ALIGNMENTS)]
         for r in fitted:
-            cells = ["%.2f / %.2f / %.2f" % (r["independent_recorded_m"] * 100,
-                                             r["independent_input_m"] * 100,
-                                             r["independent_refined_m"] * 100)]
-            for name, _ in ALIGNMENTS[1:]:
-                v = r["independent_fits"][name]
-                cells.append("%.2f / %.2f / %.2f" % (v[0][0] * 100, v[1][0] * 100, v[2][0] * 100))
+            cells = ["%.2f / %.2f / %.2f" % tuple(independent(r, name, w) * 100 for w in range(3))
+                     for name, _ in ALIGNMENTS]
             md.append("| %s | %g cm | %s | %s | %s | %s |" % (
                 r["sequence"], r["voxel_m"] * 100, r["drift"],
                 "-" if r["drift"] == "none" else r["seed"], r["correction"], " | ".join(cells)))

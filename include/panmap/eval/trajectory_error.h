@@ -103,7 +103,7 @@ TrajectoryAlignment fitAlignment(const std::vector<Eigen::Matrix3d>& R_est,
                                  bool fit_scale, bool fit_camera_offset);
 
 /// A few lines: associated poses, ATE and RPE statistics ('-' where there were no pairs), and
-/// the fitted camera offset when there is one.
+/// what the alignment fitted besides the rigid motion (scale, camera offset).
 std::string formatTrajectoryError(const TrajectoryError& error);
 
 }  // namespace panmap
