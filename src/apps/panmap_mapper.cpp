@@ -48,6 +48,16 @@ nlohmann::json sessionJson(const panmap::SessionStats& s) {
           {"geometry_only_frames", s.sync.geometry_only},
           {"unmatched_panoptic", s.sync.unmatched_panoptic},
           {"timings", timings},
+          {"pose_refinement",
+           {{"frames", s.refinement.frames},
+            {"moved_m",
+             {{"median", s.refinement.median_m},
+              {"p95", s.refinement.p95_m},
+              {"max", s.refinement.max_m}}},
+            {"turned_deg",
+             {{"median", s.refinement.median_deg},
+              {"p95", s.refinement.p95_deg},
+              {"max", s.refinement.max_deg}}}}},
           {"corrections",
            {{"received", s.corrections_received},
             {"applied", s.corrections_applied},
@@ -147,6 +157,17 @@ void printRejected(const std::map<std::string, int64_t>& rejected) {
   for (const auto& [reason, count] : rejected) {
     std::printf("  rejected %lld: %s\n", static_cast<long long>(count), reason.c_str());
   }
+}
+
+// What refinement did to the given poses, when it tracked any: a trusted SLAM system's poses
+// moved by centimetres point at the depth sensor (docs/MAPPING.md, "Depth calibration").
+void printRefinement(const panmap::PoseRefinementStats& r) {
+  if (r.frames == 0) return;
+  std::printf(
+      "  pose refinement moved %lld tracked poses by %.1f cm median (p95 %.1f, max %.1f) and "
+      "%.2f deg median (max %.2f)\n",
+      static_cast<long long>(r.frames), 100.0 * r.median_m, 100.0 * r.p95_m, 100.0 * r.max_m,
+      r.median_deg, r.max_deg);
 }
 
 double msSince(std::chrono::steady_clock::time_point start) {
@@ -408,6 +429,7 @@ int main(int argc, char** argv) {
           mapper->superpoints().states().size(), outputs.instances_in_mesh, outputs.mesh_vertices,
           out_dir.c_str());
       printRejected(report.rejected);
+      printRefinement(report.refinement);
       return 0;
     }
 
@@ -506,6 +528,7 @@ int main(int argc, char** argv) {
         wall_s, mapper->superpoints().states().size(), outputs.instances_in_mesh,
         labels ? " after optimisation" : " (unoptimised)", outputs.mesh_vertices, out_dir.c_str());
     printRejected(stats.rejected);
+    printRefinement(stats.refinement);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-mapper: error: %s\n", e.what());

@@ -1,8 +1,13 @@
 #include "panmap/lcm/mapping_session.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <optional>
+#include <tuple>
+
+#include <Eigen/Geometry>
 
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
@@ -21,6 +26,18 @@ StageTiming summariseTimes(std::vector<double> times_ms) {
   t.p95_ms = times_ms[std::min(times_ms.size() - 1, times_ms.size() * 95 / 100)];
   return t;
 }
+
+namespace {
+
+// Median, 95th percentile and largest value (the same ranks as summariseTimes).
+std::array<double, 3> spread(std::vector<double> values) {
+  if (values.empty()) return {0.0, 0.0, 0.0};
+  std::sort(values.begin(), values.end());
+  return {values[values.size() / 2], values[std::min(values.size() - 1, values.size() * 95 / 100)],
+          values.back()};
+}
+
+}  // namespace
 
 std::string reasonOf(const std::string& what) {
   const auto colon = what.find(':');
@@ -237,6 +254,12 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
       const FrameStats s =
           mapper_->integrate(f.frame, f.T_W_C, f.panoptic ? &*f.panoptic : nullptr, f.pose_source);
       for (const auto& [stage, ms] : s.stageTimes()) times_ms_[stage].push_back(ms);
+      if (s.tracked) {
+        refinement_moved_m_.push_back((s.T_W_C.translation() - f.T_W_C.translation()).norm());
+        refinement_turned_deg_.push_back(
+            Eigen::AngleAxisd(f.T_W_C.linear().transpose() * s.T_W_C.linear()).angle() * 180.0 /
+            M_PI);
+      }
       ++stats_.frames_integrated;
       stats_.last_frame_utime = std::max(stats_.last_frame_utime, f.frame.utime);
       if (writer_) {
@@ -290,6 +313,13 @@ SessionStats MappingSession::stats() const {
     if (n) out.rejected[reason] += n;
   }
   for (const auto& [stage, list] : times_ms_) out.timings[stage] = summariseTimes(list);
+  out.refinement.frames = static_cast<int64_t>(refinement_moved_m_.size());
+  const std::array<double, 3> moved = spread(refinement_moved_m_);
+  const std::array<double, 3> turned = spread(refinement_turned_deg_);
+  std::tie(out.refinement.median_m, out.refinement.p95_m, out.refinement.max_m) =
+      std::tie(moved[0], moved[1], moved[2]);
+  std::tie(out.refinement.median_deg, out.refinement.p95_deg, out.refinement.max_deg) =
+      std::tie(turned[0], turned[1], turned[2]);
   if (background_ && background_->running()) {
     out.repair_running = true;
     out.repair_frames_done = background_->framesDone();

@@ -44,6 +44,36 @@ TEST_F(MappingSessionTest, CleanStreamMapsEveryFrame) {
   EXPECT_TRUE(clean_stats_.rejected.empty());
   EXPECT_EQ(clean_stats_.sync.geometry_only, 0);
   EXPECT_EQ(clean_stats_.timings.count("total"), 1u);
+  // Ground-truth poses are never tracked, so refinement moved none.
+  EXPECT_EQ(clean_stats_.refinement.frames, 0);
+  EXPECT_EQ(clean_stats_.refinement.max_m, 0.0);
+}
+
+TEST_F(MappingSessionTest, RefinementReportsHowFarItMovedTheGivenPoses) {
+  // The same frames with their poses flagged as SLAM, one of them 3 cm off along x: tracking
+  // refines every frame after the warm-up and pulls that one back by about its error.
+  test::SyntheticStream slam = stream_;
+  for (StampedPose& p : slam.poses) p.source = PoseSource::kSlam;
+  const size_t off = slam.poses.size() - 3;
+  slam.poses[off].T_W_C.translation().x() += 0.03;
+  MapperConfig config = test::streamMapperConfig();
+  // 160 x 120 frames: every other pixel, or too few points reach the map to align.
+  config.tracking.level_strides_px = {4, 2};
+  Mapper mapper(config);
+  MappingSession session(SessionOptions{}, &mapper);
+  feed(&session, slam.messages());
+  const PoseRefinementStats& r = session.stats().refinement;
+  EXPECT_EQ(mapper.trackingCounts()[static_cast<size_t>(AlignmentStatus::kAccepted)] +
+                mapper.trackingCounts()[static_cast<size_t>(AlignmentStatus::kAcceptedPartially)],
+            r.frames);
+  EXPECT_EQ(r.frames, static_cast<int64_t>(slam.frames.size()) - config.tracking_warmup_frames);
+  EXPECT_GT(r.max_m, 0.02);
+  EXPECT_LT(r.max_m, 0.04);
+  EXPECT_LT(r.median_m, 0.01);
+  EXPECT_LE(r.median_m, r.p95_m);
+  EXPECT_LE(r.p95_m, r.max_m);
+  EXPECT_GE(r.median_deg, 0.0);
+  EXPECT_LE(r.median_deg, r.max_deg);
 }
 
 TEST_F(MappingSessionTest, MalformedAndTruncatedMessagesAreCounted) {

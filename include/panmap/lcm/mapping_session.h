@@ -47,6 +47,18 @@ struct StageTiming {
   double last_ms = 0.0;  ///< the most recent frame
 };
 
+/// How far pose refinement moved the poses it was given, over the frames it tracked: the
+/// camera centre's displacement and the rotation angle between given and refined pose.
+struct PoseRefinementStats {
+  int64_t frames = 0;  ///< frames tracked against the map
+  double median_m = 0.0;
+  double p95_m = 0.0;
+  double max_m = 0.0;
+  double median_deg = 0.0;
+  double p95_deg = 0.0;
+  double max_deg = 0.0;
+};
+
 /// What a session has done so far.
 struct SessionStats {
   int64_t messages = 0;                     ///< messages on the three input channels
@@ -56,16 +68,20 @@ struct SessionStats {
   std::map<std::string, int64_t> rejected;  ///< reason -> frames (or messages) refused
   SyncStats sync;
   std::map<std::string, StageTiming> timings;  ///< by stage name
-  int64_t corrections_received = 0;            ///< pose_correction_t messages that decoded
-  int64_t corrections_applied = 0;             ///< of those, repairs that completed
-  int64_t last_correction_id = 0;              ///< correction_id of the newest repair
-  int64_t frames_reintegrated = 0;             ///< frames re-integrated by all repairs
-  int64_t repair_frames_done = 0;              ///< progress of the repair running or last run
-  int64_t repair_frames_total = 0;             ///< frames it re-integrates
-  double last_repair_s = 0.0;                  ///< wall time of the last completed repair
-  bool repair_running = false;                 ///< a background repair is under way
-  int64_t corrections_superseded = 0;          ///< background repairs a newer one abandoned
-  std::vector<std::string> repairs;            ///< describe() of every repair, in order
+  /// What tracking did to the given poses (MapperConfig::tracking_mode): a good SLAM system's
+  /// poses moved by centimetres are a sign that refinement hurts (an uncalibrated depth sensor,
+  /// docs/MAPPING.md).
+  PoseRefinementStats refinement;
+  int64_t corrections_received = 0;    ///< pose_correction_t messages that decoded
+  int64_t corrections_applied = 0;     ///< of those, repairs that completed
+  int64_t last_correction_id = 0;      ///< correction_id of the newest repair
+  int64_t frames_reintegrated = 0;     ///< frames re-integrated by all repairs
+  int64_t repair_frames_done = 0;      ///< progress of the repair running or last run
+  int64_t repair_frames_total = 0;     ///< frames it re-integrates
+  double last_repair_s = 0.0;          ///< wall time of the last completed repair
+  bool repair_running = false;         ///< a background repair is under way
+  int64_t corrections_superseded = 0;  ///< background repairs a newer one abandoned
+  std::vector<std::string> repairs;    ///< describe() of every repair, in order
 };
 
 /// One mapping run over a stream of LCM messages, the same for the offline reader and the
@@ -124,6 +140,8 @@ class MappingSession {
   std::function<void(int64_t, int64_t)> repair_hook_;
   SessionStats stats_;
   std::map<std::string, std::vector<double>> times_ms_;
+  // Per tracked frame: how far refinement moved the given pose (metres, degrees).
+  std::vector<double> refinement_moved_m_, refinement_turned_deg_;
   int64_t newest_utime_ = INT64_MIN;
   bool done_ = false;
   std::unique_ptr<FrameStoreWriter> writer_;      // with a frame store: writes it off this thread
