@@ -6,6 +6,7 @@
 #include <cmath>
 #include <optional>
 #include <tuple>
+#include <utility>
 
 #include <Eigen/Geometry>
 
@@ -17,19 +18,9 @@
 
 namespace panmap {
 
-StageTiming summariseTimes(std::vector<double> times_ms) {
-  StageTiming t;
-  if (times_ms.empty()) return t;
-  t.last_ms = times_ms.back();
-  std::sort(times_ms.begin(), times_ms.end());
-  t.median_ms = times_ms[times_ms.size() / 2];
-  t.p95_ms = times_ms[std::min(times_ms.size() - 1, times_ms.size() * 95 / 100)];
-  return t;
-}
-
 namespace {
 
-// Median, 95th percentile and largest value (the same ranks as summariseTimes).
+// Median, 95th percentile and largest value.
 std::array<double, 3> spread(std::vector<double> values) {
   if (values.empty()) return {0.0, 0.0, 0.0};
   std::sort(values.begin(), values.end());
@@ -38,6 +29,16 @@ std::array<double, 3> spread(std::vector<double> values) {
 }
 
 }  // namespace
+
+StageTiming summariseTimes(std::vector<double> times_ms) {
+  StageTiming t;
+  if (times_ms.empty()) return t;
+  t.last_ms = times_ms.back();
+  const std::array<double, 3> s = spread(std::move(times_ms));
+  t.median_ms = s[0];
+  t.p95_ms = s[1];
+  return t;
+}
 
 std::string reasonOf(const std::string& what) {
   const auto colon = what.find(':');
