@@ -37,6 +37,10 @@ namespace {
 std::atomic<bool> g_stop{false};
 void onSignal(int) { g_stop = true; }
 
+nlohmann::json spreadJson(const panmap::ValueSpread& s) {
+  return {{"median", s.median}, {"p95", s.p95}, {"max", s.max}};
+}
+
 nlohmann::json sessionJson(const panmap::SessionStats& s) {
   nlohmann::json timings;
   for (const auto& [stage, t] : s.timings)
@@ -50,14 +54,8 @@ nlohmann::json sessionJson(const panmap::SessionStats& s) {
           {"timings", timings},
           {"pose_refinement",
            {{"frames", s.refinement.frames},
-            {"moved_m",
-             {{"median", s.refinement.median_m},
-              {"p95", s.refinement.p95_m},
-              {"max", s.refinement.max_m}}},
-            {"turned_deg",
-             {{"median", s.refinement.median_deg},
-              {"p95", s.refinement.p95_deg},
-              {"max", s.refinement.max_deg}}}}},
+            {"moved_m", spreadJson(s.refinement.moved_m)},
+            {"turned_deg", spreadJson(s.refinement.turned_deg)}}},
           {"corrections",
            {{"received", s.corrections_received},
             {"applied", s.corrections_applied},
@@ -166,8 +164,8 @@ void printRefinement(const panmap::PoseRefinementStats& r) {
   std::printf(
       "  pose refinement moved %lld tracked poses by %.1f cm median (p95 %.1f, max %.1f) and "
       "%.2f deg median (max %.2f)\n",
-      static_cast<long long>(r.frames), 100.0 * r.median_m, 100.0 * r.p95_m, 100.0 * r.max_m,
-      r.median_deg, r.max_deg);
+      static_cast<long long>(r.frames), 100.0 * r.moved_m.median, 100.0 * r.moved_m.p95,
+      100.0 * r.moved_m.max, r.turned_deg.median, r.turned_deg.max);
 }
 
 double msSince(std::chrono::steady_clock::time_point start) {

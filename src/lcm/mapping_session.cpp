@@ -1,11 +1,9 @@
 #include "panmap/lcm/mapping_session.h"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <optional>
-#include <tuple>
 #include <utility>
 
 #include <Eigen/Geometry>
@@ -18,25 +16,23 @@
 
 namespace panmap {
 
-namespace {
-
-// Median, 95th percentile and largest value.
-std::array<double, 3> spread(std::vector<double> values) {
-  if (values.empty()) return {0.0, 0.0, 0.0};
+ValueSpread spreadOf(std::vector<double> values) {
+  ValueSpread s;
+  if (values.empty()) return s;
   std::sort(values.begin(), values.end());
-  return {values[values.size() / 2], values[std::min(values.size() - 1, values.size() * 95 / 100)],
-          values.back()};
+  s.median = values[values.size() / 2];
+  s.p95 = values[std::min(values.size() - 1, values.size() * 95 / 100)];
+  s.max = values.back();
+  return s;
 }
-
-}  // namespace
 
 StageTiming summariseTimes(std::vector<double> times_ms) {
   StageTiming t;
   if (times_ms.empty()) return t;
   t.last_ms = times_ms.back();
-  const std::array<double, 3> s = spread(std::move(times_ms));
-  t.median_ms = s[0];
-  t.p95_ms = s[1];
+  const ValueSpread s = spreadOf(std::move(times_ms));
+  t.median_ms = s.median;
+  t.p95_ms = s.p95;
   return t;
 }
 
@@ -315,12 +311,8 @@ SessionStats MappingSession::stats() const {
   }
   for (const auto& [stage, list] : times_ms_) out.timings[stage] = summariseTimes(list);
   out.refinement.frames = static_cast<int64_t>(refinement_moved_m_.size());
-  const std::array<double, 3> moved = spread(refinement_moved_m_);
-  const std::array<double, 3> turned = spread(refinement_turned_deg_);
-  std::tie(out.refinement.median_m, out.refinement.p95_m, out.refinement.max_m) =
-      std::tie(moved[0], moved[1], moved[2]);
-  std::tie(out.refinement.median_deg, out.refinement.p95_deg, out.refinement.max_deg) =
-      std::tie(turned[0], turned[1], turned[2]);
+  out.refinement.moved_m = spreadOf(refinement_moved_m_);
+  out.refinement.turned_deg = spreadOf(refinement_turned_deg_);
   if (background_ && background_->running()) {
     out.repair_running = true;
     out.repair_frames_done = background_->framesDone();

@@ -46,7 +46,7 @@ TEST_F(MappingSessionTest, CleanStreamMapsEveryFrame) {
   EXPECT_EQ(clean_stats_.timings.count("total"), 1u);
   // Ground-truth poses are never tracked, so refinement moved none.
   EXPECT_EQ(clean_stats_.refinement.frames, 0);
-  EXPECT_EQ(clean_stats_.refinement.max_m, 0.0);
+  EXPECT_EQ(clean_stats_.refinement.moved_m.max, 0.0);
 }
 
 TEST_F(MappingSessionTest, RefinementReportsHowFarItMovedTheGivenPoses) {
@@ -67,13 +67,13 @@ TEST_F(MappingSessionTest, RefinementReportsHowFarItMovedTheGivenPoses) {
                 mapper.trackingCounts()[static_cast<size_t>(AlignmentStatus::kAcceptedPartially)],
             r.frames);
   EXPECT_EQ(r.frames, static_cast<int64_t>(slam.frames.size()) - config.tracking_warmup_frames);
-  EXPECT_GT(r.max_m, 0.02);
-  EXPECT_LT(r.max_m, 0.04);
-  EXPECT_LT(r.median_m, 0.01);
-  EXPECT_LE(r.median_m, r.p95_m);
-  EXPECT_LE(r.p95_m, r.max_m);
-  EXPECT_GE(r.median_deg, 0.0);
-  EXPECT_LE(r.median_deg, r.max_deg);
+  EXPECT_GT(r.moved_m.max, 0.02);
+  EXPECT_LT(r.moved_m.max, 0.04);
+  EXPECT_LT(r.moved_m.median, 0.01);
+  EXPECT_LE(r.moved_m.median, r.moved_m.p95);
+  EXPECT_LE(r.moved_m.p95, r.moved_m.max);
+  EXPECT_GE(r.turned_deg.median, 0.0);
+  EXPECT_LE(r.turned_deg.median, r.turned_deg.max);
 }
 
 TEST_F(MappingSessionTest, MalformedAndTruncatedMessagesAreCounted) {

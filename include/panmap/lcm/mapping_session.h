@@ -47,16 +47,22 @@ struct StageTiming {
   double last_ms = 0.0;  ///< the most recent frame
 };
 
+/// Median, 95th percentile and largest of a list of values (all 0 for none).
+struct ValueSpread {
+  double median = 0.0;
+  double p95 = 0.0;
+  double max = 0.0;
+};
+
+/// Spread of the values (the ranks StageTiming uses).
+ValueSpread spreadOf(std::vector<double> values);
+
 /// How far pose refinement moved the poses it was given, over the frames it tracked: the
 /// camera centre's displacement and the rotation angle between given and refined pose.
 struct PoseRefinementStats {
   int64_t frames = 0;  ///< frames tracked against the map
-  double median_m = 0.0;
-  double p95_m = 0.0;
-  double max_m = 0.0;
-  double median_deg = 0.0;
-  double p95_deg = 0.0;
-  double max_deg = 0.0;
+  ValueSpread moved_m;
+  ValueSpread turned_deg;
 };
 
 /// What a session has done so far.
