@@ -76,18 +76,21 @@ class Spec:
     runs: "all" (every variant with the poses as given, plus the full method with pose
     refinement when poses drift), "tracked" (every variant, each with the default tracking:
     drifting poses refined against the map) or "full" (the full method only, default
-    tracking).
+    tracking). join_parts (scannet): `panmap-synth --join-parts`, the scene named
+    SCENE_joined.
     """
 
     def __init__(self, kind, source, seed, poses, masks, annotation="annotated", runs="all",
-                 frames=450, rate_hz=5.0):
+                 frames=450, rate_hz=5.0, join_parts=False):
         self.kind, self.source, self.seed = kind, source, seed
         self.poses, self.masks, self.annotation, self.runs = poses, masks, annotation, runs
         self.frames, self.rate_hz = frames, rate_hz
+        self.join_parts = join_parts and kind == "scannet"
 
     def scene(self):
         if self.kind == "scannet":
-            return os.path.basename(os.path.normpath(self.source))
+            name = os.path.basename(os.path.normpath(self.source))
+            return name + "_joined" if self.join_parts else name
         return "%s%d" % ("sl" if self.kind == "scannetlike" else "room", self.source)
 
     def name(self):
@@ -102,6 +105,8 @@ class Spec:
         if self.kind == "scannet":
             args += ["--scannet", self.source, "--scannet-labels", SCANNET_LABELS]
             args += dict(ANNOTATIONS)[self.annotation]
+            if self.join_parts:
+                args.append("--join-parts")
         else:
             args += ["--room", str(self.source)]
             if self.kind == "scannetlike":

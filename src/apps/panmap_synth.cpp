@@ -21,6 +21,7 @@
 #include "panmap/lcm/conversions.h"
 #include "panmap/lcm/correction_conversions.h"
 #include "panmap/lcm/log_writer.h"
+#include "panmap/sim/instance_parts.h"
 #include "panmap/sim/procedural_room.h"
 #include "panmap/sim/sequence.h"
 #include "panmap/sim/unannotation.h"
@@ -135,6 +136,7 @@ int main(int argc, char** argv) {
   int preview_every = 0;
   panmap::UnannotateConfig unannotate_config;
   std::string unannotated_masks = "painted";
+  bool join_parts = false;
   auto* source = app.add_option_group("source", "ground-truth mesh (one of)");
   source->add_option("--room", room_seed, "procedural room with this seed");
   int64_t building_seed = -1;
@@ -213,6 +215,10 @@ int main(int argc, char** argv) {
                  "rates) or empty (no mask on anything unannotated)")
       ->capture_default_str()
       ->check(CLI::IsMember({"painted", "empty"}));
+  app.add_flag("--join-parts", join_parts,
+               "with --scannet: join same-class thing instances stacked above each other (a "
+               "chair's seat and its star base) into one, where a derived annotation split one "
+               "object into connected components (docs/SIMULATION.md)");
   app.add_option("--out", out_dir, "output folder")->required();
   app.add_option(
       "--preview-every", preview_every,
@@ -221,6 +227,9 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
+    if (join_parts && scannet_dir.empty()) {
+      throw panmap::Error("--join-parts needs --scannet (procedural rooms have whole objects)");
+    }
     const auto start = std::chrono::steady_clock::now();
     panmap::LabelledMesh mesh;
     json source_json;
@@ -256,6 +265,19 @@ int main(int argc, char** argv) {
       mesh = gt.mesh;
       source_json = {
           {"type", "scannet"}, {"dir", scannet_dir}, {"unknown_labels", gt.unknown_labels}};
+      if (join_parts) {
+        const std::vector<panmap::PartJoin> joins =
+            panmap::joinStackedParts(&mesh, panmap::PartJoinConfig());
+        json joined = json::array();
+        for (const panmap::PartJoin& join : joins) {
+          joined.push_back({{"part", join.part},
+                            {"into", join.into},
+                            {"class", join.class_id},
+                            {"share", join.share}});
+        }
+        source_json["joined_parts"] = joined;
+        if (!quiet) std::printf("joined %zu instance parts into larger ones\n", joins.size());
+      }
     }
 
     // The world the network sees and the annotation evaluation sees (docs/SIMULATION.md).

@@ -67,6 +67,11 @@ TEST(SynthCli, RoomOutputsAreCompleteAndDeterministic) {
             readFileBytes(dir.path("c/sequence.lcmlog")));
 }
 
+nlohmann::json readJson(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
 TEST(SynthCli, ScanNetGroundTruthWithAGivenTrajectory) {
   test::TempDir dir;
   // The tiny fixture scene has no room to walk in: the planner says so in one line...
@@ -88,6 +93,17 @@ TEST(SynthCli, ScanNetGroundTruthWithAGivenTrajectory) {
                  dir.path("traj.txt") + " --poses gt --out " + dir.path("s"));
   ASSERT_EQ(ok.exit_code, 0) << ok.output;
   EXPECT_EQ(inspectLog(dir.path("s/sequence.lcmlog"), true).channels[0].count, 2u);
+  EXPECT_FALSE(readJson(dir.path("s/info.json"))["source"].contains("joined_parts"));
+  // --join-parts lists its joins (the fixture's instances are not stacked: none).
+  const auto joined =
+      runCommand(binPath("panmap-synth") + " --quiet --frames 5 --scannet " +
+                 test::fixtureDir("scannet_gt_tiny") + " --scannet-labels " +
+                 test::dataDir("scannet-meta/scannetv2-labels.combined.tsv") + " --trajectory " +
+                 dir.path("traj.txt") + " --poses gt --join-parts --out " + dir.path("j"));
+  ASSERT_EQ(joined.exit_code, 0) << joined.output;
+  const auto parts = readJson(dir.path("j/info.json"))["source"]["joined_parts"];
+  EXPECT_TRUE(parts.is_array());
+  EXPECT_TRUE(parts.empty());
 }
 
 TEST(SynthCli, BadArgumentsFailClearly) {
@@ -101,6 +117,11 @@ TEST(SynthCli, BadArgumentsFailClearly) {
                                dir.path("none.txt") + " --out " + dir.path("x"));
   EXPECT_EQ(traj.exit_code, 1);
   EXPECT_NE(traj.output.find("none.txt"), std::string::npos) << traj.output;
+  const auto join =
+      runCommand(binPath("panmap-synth") + " --room 1 --join-parts --out " + dir.path("x"));
+  EXPECT_EQ(join.exit_code, 1);
+  EXPECT_EQ(test::countLines(join.output), 1) << join.output;
+  EXPECT_NE(join.output.find("--join-parts needs --scannet"), std::string::npos) << join.output;
 }
 
 }  // namespace
