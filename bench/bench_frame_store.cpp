@@ -21,6 +21,7 @@
 #include "panmap/core/fingerprint.h"
 #include "panmap/core/progress.h"
 #include "panmap/core/thread_pool.h"
+#include "panmap/core/value_spread.h"
 #include "panmap/io/dataset_reader.h"
 #include "panmap/io/image_codec.h"
 #include "panmap/io/plane_codec.h"
@@ -36,21 +37,6 @@ using Clock = std::chrono::steady_clock;
 
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-// Median, 95th percentile and maximum (nearest rank).
-struct Summary {
-  double median = 0.0, p95 = 0.0, max = 0.0;
-};
-
-Summary summarise(std::vector<double> values) {
-  Summary s;
-  if (values.empty()) return s;
-  std::sort(values.begin(), values.end());
-  s.median = values[values.size() / 2];
-  s.p95 = values[std::min(values.size() - 1, values.size() * 95 / 100)];
-  s.max = values.back();
-  return s;
 }
 
 // FNV-1a over an image's pixels: load() must give back exactly what add() got, and keeping
@@ -227,7 +213,7 @@ int main(int argc, char** argv) {
         voxel_size_m * 100.0, config.compression_level,
         config.store_color ? ("JPEG q" + std::to_string(config.color_quality)).c_str() : "off");
     const auto row = [](const char* what, const std::vector<double>& v, const char* unit) {
-      const Summary s = summarise(v);
+      const panmap::ValueSpread s = panmap::spreadOf(v);
       std::printf("  %-18s median %7.1f  p95 %7.1f  max %7.1f %s\n", what, s.median, s.p95, s.max,
                   unit);
     };
@@ -251,7 +237,7 @@ int main(int argc, char** argv) {
     row("  decoding", png_decode_ms, "ms");
     std::printf("  open()             %.1f ms for %zu frames (CRC-32 of every file)\n", open_ms,
                 utimes.size());
-    const Summary total = summarise(total_kb);
+    const panmap::ValueSpread total = panmap::spreadOf(total_kb);
     std::printf("  budget 150 kB per frame: %s (max %.1f kB)\n",
                 total.max <= 150.0 ? "met by every frame" : "EXCEEDED", total.max);
   } catch (const std::exception& e) {

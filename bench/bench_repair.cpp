@@ -27,6 +27,7 @@
 
 #include "panmap/core/error.h"
 #include "panmap/core/progress.h"
+#include "panmap/core/value_spread.h"
 #include "panmap/io/dataset_reader.h"
 #include "panmap/loop/background_repair.h"
 #include "panmap/loop/frame_store.h"
@@ -41,18 +42,6 @@ using Clock = std::chrono::steady_clock;
 
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-double p95(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, v.size() * 95 / 100)];
 }
 
 // Frame i of a replay of `reader` back and forth (0 1 .. n-1 n-2 .. 1 0 1 ..), at 5 Hz.
@@ -200,7 +189,7 @@ int main(int argc, char** argv) {
       progress.update(mapper.trajectory().size(), frames);
     }
     progress.finish();
-    const double map_median_ms = median(map_ms);
+    const double map_median_ms = panmap::spreadOf(map_ms).median;
     const size_t n = mapper.trajectory().size();
 
     // What loading the frames alone costs (from the page cache, as right after mapping).
@@ -216,7 +205,7 @@ int main(int argc, char** argv) {
     const panmap::MapRepairResult blocking = panmap::repairMap(&mapper, &store, first);
     std::printf("blocking repair:   %s\n", panmap::describe(blocking).c_str());
     std::printf("  loading frames   %.2f s alone (%.1f ms median per frame)\n",
-                load_total_ms / 1000.0, median(load_ms));
+                load_total_ms / 1000.0, panmap::spreadOf(load_ms).median);
     std::printf("  per frame        %.1f ms (mapping a frame before: %.1f ms median)\n",
                 1000.0 * blocking.reintegration.seconds / static_cast<double>(n), map_median_ms);
 
@@ -251,7 +240,8 @@ int main(int argc, char** argv) {
     std::printf(
         "  %d frames mapped meanwhile at %.1f Hz: %.1f ms median, %.1f ms p95 each "
         "(before: %.1f ms median); swapped in %.2f s after the correction\n",
-        offered, rate_hz, median(map_ms), p95(map_ms), map_median_ms, wall_s);
+        offered, rate_hz, panmap::spreadOf(map_ms).median, panmap::spreadOf(map_ms).p95,
+        map_median_ms, wall_s);
     std::printf("machine: %u hardware threads; %zu frames of %s at %.0f cm, mapping threads %d\n",
                 std::thread::hardware_concurrency(), n, data.c_str(), voxel_size_m * 100.0,
                 threads);

@@ -16,16 +16,6 @@
 
 namespace panmap {
 
-ValueSpread spreadOf(std::vector<double> values) {
-  ValueSpread s;
-  if (values.empty()) return s;
-  std::sort(values.begin(), values.end());
-  s.median = values[values.size() / 2];
-  s.p95 = values[std::min(values.size() - 1, values.size() * 95 / 100)];
-  s.max = values.back();
-  return s;
-}
-
 StageTiming summariseTimes(std::vector<double> times_ms) {
   StageTiming t;
   if (times_ms.empty()) return t;

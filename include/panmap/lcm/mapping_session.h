@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "panmap/core/value_spread.h"
 #include "panmap/lcm/channels.h"
 #include "panmap/loop/background_repair.h"
 #include "panmap/loop/frame_store.h"
@@ -46,16 +47,6 @@ struct StageTiming {
   double p95_ms = 0.0;
   double last_ms = 0.0;  ///< the most recent frame
 };
-
-/// Median, 95th percentile and largest of a list of values (all 0 for none).
-struct ValueSpread {
-  double median = 0.0;
-  double p95 = 0.0;
-  double max = 0.0;
-};
-
-/// Spread of the values (the ranks StageTiming uses).
-ValueSpread spreadOf(std::vector<double> values);
 
 /// How far pose refinement moved the poses it was given, over the frames it tracked: the
 /// camera centre's displacement and the rotation angle between given and refined pose.
