@@ -1,6 +1,5 @@
 #include "panmap/sim/instance_parts.h"
 
-#include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
@@ -25,7 +24,7 @@ namespace {
 struct Instance {
   int32_t class_id = 0;
   size_t vertices = 0;
-  std::set<std::pair<int64_t, int64_t>> cells;  // footprint, ordered for a fixed intersection
+  std::set<std::pair<int64_t, int64_t>> cells;  // footprint: (x, y) cell indices
 };
 
 // The strict order in which an instance is "larger": more footprint cells, then more
