@@ -39,8 +39,8 @@ struct PartJoin {
 /// chairs joins one of them; the chairs join each other only if one covers the other so. Stuff
 /// (wall, floor, ceiling) and class-0 vertices are left alone. Meant for derived annotations only:
 /// in a human annotation a pile of books is several instances on purpose. Deterministic; returns
-/// the joins in ascending part id. Throws Error when the mesh lacks labels or the config is
-/// invalid.
+/// the joins in ascending part id. Throws Error when the mesh lacks labels, an instance holds
+/// two classes, or the config is invalid.
 std::vector<PartJoin> joinStackedParts(LabelledMesh* mesh, const PartJoinConfig& config);
 
 }  // namespace panmap
