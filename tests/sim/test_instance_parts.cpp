@@ -106,6 +106,11 @@ TEST(JoinStackedParts, RefusesAMeshWithoutLabelsAndABadConfig) {
   config.cell_m = -1.0f;
   EXPECT_THROW(joinStackedParts(&mesh, config), Error);
   EXPECT_TRUE(joinStackedParts(&mesh, PartJoinConfig()).empty());
+  // One instance id on a chair vertex and a table vertex: not a segGroup's instance.
+  mesh.vertices.emplace_back(1.0f, 0.0f, 0.0f);
+  mesh.semantic.push_back(7);
+  mesh.instance.push_back(1);
+  EXPECT_THROW(joinStackedParts(&mesh, PartJoinConfig()), Error);
 }
 
 }  // namespace
