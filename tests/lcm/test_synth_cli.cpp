@@ -18,6 +18,11 @@ namespace {
 using test::binPath;
 using test::runCommand;
 
+nlohmann::json readJson(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
 TEST(SynthCli, RoomOutputsAreCompleteAndDeterministic) {
   test::TempDir dir;
   const std::string args = " --room 3 --frames 24 --masks m2f --poses slam --seed 9 --quiet --out ";
@@ -51,8 +56,7 @@ TEST(SynthCli, RoomOutputsAreCompleteAndDeterministic) {
   EXPECT_EQ(gt_traj[0].T_W_C.translation(), in_traj[0].T_W_C.translation());
   EXPECT_GE(minClearance(gt_traj, mesh), 0.3 - 0.03);
 
-  std::ifstream in(dir.path("a/info.json"));
-  const auto json = nlohmann::json::parse(in);
+  const auto json = readJson(dir.path("a/info.json"));
   EXPECT_EQ(json["seed"], 9);
   EXPECT_EQ(json["frames"], 24);
   EXPECT_EQ(json["masks"]["preset"], "m2f");
@@ -67,18 +71,14 @@ TEST(SynthCli, RoomOutputsAreCompleteAndDeterministic) {
             readFileBytes(dir.path("c/sequence.lcmlog")));
 }
 
-nlohmann::json readJson(const std::string& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
-
 TEST(SynthCli, ScanNetGroundTruthWithAGivenTrajectory) {
   test::TempDir dir;
-  // The tiny fixture scene has no room to walk in: the planner says so in one line...
-  const auto no_room = runCommand(binPath("panmap-synth") + " --quiet --frames 5 --scannet " +
-                                  test::fixtureDir("scannet_gt_tiny") + " --scannet-labels " +
-                                  test::dataDir("scannet-meta/scannetv2-labels.combined.tsv") +
-                                  " --out " + dir.path("s"));
+  // The tiny fixture scene, its labels and a quiet 5-frame run: what every command shares.
+  const std::string synth = binPath("panmap-synth") + " --quiet --frames 5 --scannet " +
+                            test::fixtureDir("scannet_gt_tiny") + " --scannet-labels " +
+                            test::dataDir("scannet-meta/scannetv2-labels.combined.tsv");
+  // The scene has no room to walk in: the planner says so in one line...
+  const auto no_room = runCommand(synth + " --out " + dir.path("s"));
   if (!std::filesystem::is_directory(test::dataDir("scannet-meta")))
     GTEST_SKIP() << "no scannet-meta";
   EXPECT_EQ(no_room.exit_code, 1) << no_room.output;
@@ -86,20 +86,13 @@ TEST(SynthCli, ScanNetGroundTruthWithAGivenTrajectory) {
   EXPECT_NE(no_room.output.find("survey"), std::string::npos) << no_room.output;
   // ... and a given TUM trajectory renders it.
   std::ofstream(dir.path("traj.txt")) << "0.0 0 0 3 0 0 0 1\n0.033333 0 0 3.01 0 0 0 1\n";
-  const auto ok =
-      runCommand(binPath("panmap-synth") + " --quiet --frames 5 --scannet " +
-                 test::fixtureDir("scannet_gt_tiny") + " --scannet-labels " +
-                 test::dataDir("scannet-meta/scannetv2-labels.combined.tsv") + " --trajectory " +
-                 dir.path("traj.txt") + " --poses gt --out " + dir.path("s"));
+  const std::string along = synth + " --trajectory " + dir.path("traj.txt") + " --poses gt";
+  const auto ok = runCommand(along + " --out " + dir.path("s"));
   ASSERT_EQ(ok.exit_code, 0) << ok.output;
   EXPECT_EQ(inspectLog(dir.path("s/sequence.lcmlog"), true).channels[0].count, 2u);
   EXPECT_FALSE(readJson(dir.path("s/info.json"))["source"].contains("joined_parts"));
   // --join-parts lists its joins (the fixture's instances are not stacked: none).
-  const auto joined =
-      runCommand(binPath("panmap-synth") + " --quiet --frames 5 --scannet " +
-                 test::fixtureDir("scannet_gt_tiny") + " --scannet-labels " +
-                 test::dataDir("scannet-meta/scannetv2-labels.combined.tsv") + " --trajectory " +
-                 dir.path("traj.txt") + " --poses gt --join-parts --out " + dir.path("j"));
+  const auto joined = runCommand(along + " --join-parts --out " + dir.path("j"));
   ASSERT_EQ(joined.exit_code, 0) << joined.output;
   const auto parts = readJson(dir.path("j/info.json"))["source"]["joined_parts"];
   EXPECT_TRUE(parts.is_array());
