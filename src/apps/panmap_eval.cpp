@@ -73,7 +73,9 @@ json toJson(const panmap::EvalResult& r) {
                        {"rq75", number(c.rq75)},
                        {"iou_ls", number(c.iou_ls)},
                        {"iou_ls_best", number(c.iou_ls_best)},
-                       {"semantic_iou", number(c.semantic_iou)}});
+                       {"semantic_iou", number(c.semantic_iou)},
+                       {"semantic_gt_vertices", c.semantic_gt_vertices},
+                       {"semantic_false_vertices", c.semantic_false_vertices}});
   }
   return {{"protocol", r.paper_compatible ? "paper-compatible (matched predictions scored at "
                                             "confidence 1)"
@@ -97,6 +99,9 @@ json toJson(const panmap::EvalResult& r) {
           {"iou_ls_instances", number(r.iou_ls_instances)},
           {"iou_ls_best", number(r.iou_ls_best)},
           {"miou", number(r.miou)},
+          {"miou_gt_classes", number(r.miou_gt_classes)},
+          {"spurious_classes", r.spurious_classes},
+          {"spurious_vertices", r.spurious_vertices},
           {"classes", classes}};
 }
 

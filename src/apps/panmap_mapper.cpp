@@ -240,6 +240,13 @@ int main(int argc, char** argv) {
                "repair by re-integrating the stored frames with the super-points they had, "
                "never by mapping them again with their masks (faster; objects formed under "
                "large drift stay as they were)");
+  std::vector<double> grid_shift;
+  app.add_option("--grid-shift", grid_shift,
+                 "X,Y,Z metres: move every pose by this before mapping, so the voxel grid falls "
+                 "elsewhere on the same surfaces (a diagnostic: outputs are in the moved frame; "
+                 "scripts/bench/noise_floor.py)")
+      ->expected(3)
+      ->delimiter(',');
   app.add_flag("--no-snapshots", no_snapshots, "skip the overview PNGs");
   std::string graph_json;
   app.add_option("--graph-json", graph_json,
@@ -301,6 +308,12 @@ int main(int argc, char** argv) {
       config = file_config.mapper;
       config.map.voxel_size_m = voxel;
       config.num_threads = threads;
+    }
+    if (!grid_shift.empty()) {
+      options.grid_shift_m = Eigen::Vector3d(grid_shift[0], grid_shift[1], grid_shift[2]);
+      if (!frame_store_dir.empty()) {
+        throw panmap::Error("--grid-shift is a diagnostic of offline maps: not with --frame-store");
+      }
     }
     if (geometry_only) config.fusion.geometry_only = true;
     if (!depth_calibration.empty()) {

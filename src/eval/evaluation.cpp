@@ -25,19 +25,27 @@ double nanMean(const std::vector<double>& values) {
 
 /// Per-vertex class IoU as ScanNet's evaluate_semantic_label.py: vertices whose GT class is not
 /// evaluated are ignored; FP = predicted c on vertices of another evaluated class.
-double semanticIoU(const std::vector<int32_t>& gt, const std::vector<int32_t>& pred,
-                   const std::vector<int32_t>& classes, int32_t c) {
+// Per-vertex IoU of class c over the GT vertices of an evaluated class, with its counts.
+struct SemanticCounts {
   int64_t tp = 0, fp = 0, fn = 0;
+  double iou() const {
+    const int64_t denominator = tp + fp + fn;
+    return denominator > 0 ? static_cast<double>(tp) / static_cast<double>(denominator) : kNaN;
+  }
+};
+
+SemanticCounts semanticCounts(const std::vector<int32_t>& gt, const std::vector<int32_t>& pred,
+                              const std::vector<int32_t>& classes, int32_t c) {
+  SemanticCounts n;
   for (size_t v = 0; v < gt.size(); ++v) {
     if (std::find(classes.begin(), classes.end(), gt[v]) == classes.end()) continue;
     if (gt[v] == c) {
-      (pred[v] == c ? tp : fn) += 1;
+      (pred[v] == c ? n.tp : n.fn) += 1;
     } else if (pred[v] == c) {
-      ++fp;
+      ++n.fp;
     }
   }
-  const int64_t denominator = tp + fp + fn;
-  return denominator > 0 ? static_cast<double>(tp) / static_cast<double>(denominator) : kNaN;
+  return n;
 }
 
 std::string fmt(double v) {
@@ -152,7 +160,11 @@ EvalResult evaluateTransferred(const LabelledMesh& gt, const TransferredLabels& 
     for (const PredInstance& p : matches.pred) cm.num_pred += p.class_id == cm.class_id;
     cm.iou_ls = nanMean(sp_sum);
     cm.iou_ls_best = nanMean(sp_best);
-    cm.semantic_iou = semanticIoU(gt.semantic, pred.semantic, classes, cm.class_id);
+    const SemanticCounts semantic =
+        semanticCounts(gt.semantic, pred.semantic, classes, cm.class_id);
+    cm.semantic_iou = semantic.iou();
+    cm.semantic_gt_vertices = semantic.tp + semantic.fn;
+    cm.semantic_false_vertices = semantic.fp;
     result.classes.push_back(cm);
   }
 
@@ -184,6 +196,16 @@ EvalResult evaluateTransferred(const LabelledMesh& gt, const TransferredLabels& 
   result.iou_ls_best = average(&ClassMetrics::iou_ls_best);
   result.iou_ls_instances = nanMean(sp_all);
   result.miou = average(&ClassMetrics::semantic_iou);
+  std::vector<double> present;
+  for (const ClassMetrics& cm : result.classes) {
+    if (cm.semantic_gt_vertices > 0) {
+      present.push_back(cm.semantic_iou);
+    } else if (cm.semantic_false_vertices > 0) {
+      ++result.spurious_classes;
+      result.spurious_vertices += cm.semantic_false_vertices;
+    }
+  }
+  result.miou_gt_classes = nanMean(present);
   return result;
 }
 
@@ -227,6 +249,12 @@ std::string formatEvalTable(const EvalResult& r) {
                 fmt(r.sq50).c_str(), fmt(r.rq50).c_str(), fmt(r.sq75).c_str(), fmt(r.rq75).c_str(),
                 fmt(r.iou_ls_instances).c_str(), fmt(r.iou_ls_best).c_str(), r.num_transferred,
                 r.num_gt_vertices);
+  out += line;
+  std::snprintf(line, sizeof(line),
+                "mIoU over the GT's classes %s | spurious classes (predicted, absent in GT) %d "
+                "on %lld GT vertices\n",
+                fmt(r.miou_gt_classes).c_str(), r.spurious_classes,
+                static_cast<long long>(r.spurious_vertices));
   out += line;
   if (r.paper_compatible) {
     out +=

@@ -34,6 +34,11 @@ std::string reasonOf(const std::string& what) {
 MappingSession::MappingSession(const SessionOptions& options, Mapper* mapper)
     : options_(options), mapper_(mapper), sync_(options.sync) {
   if (!mapper_) throw Error("MappingSession: no mapper");
+  if (!options_.grid_shift_m.allFinite()) throw Error("grid shift: not a finite translation");
+  if (!options_.grid_shift_m.isZero(0.0) && options_.frame_store) {
+    // Corrections come in the SLAM's frame, the stored poses would be in the moved one.
+    throw Error("grid shift: a diagnostic of offline maps, not combined with a frame store");
+  }
   if (options_.frame_store) writer_ = std::make_unique<FrameStoreWriter>(options_.frame_store);
 }
 
@@ -238,6 +243,9 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
   for (SyncedFrame& f : ready) {
     if (done_) return;
     try {
+      if (!options_.grid_shift_m.isZero(0.0)) {
+        f.T_W_C = Eigen::Translation3d(options_.grid_shift_m) * f.T_W_C;
+      }
       const FrameStats s =
           mapper_->integrate(f.frame, f.T_W_C, f.panoptic ? &*f.panoptic : nullptr, f.pose_source);
       for (const auto& [stage, ms] : s.stageTimes()) times_ms_[stage].push_back(ms);

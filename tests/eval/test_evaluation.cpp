@@ -222,6 +222,38 @@ TEST(EvalSemantic, MeanIoUIgnoresUnevaluatedGt) {
   EXPECT_TRUE(std::isnan(r.map));
 }
 
+// GT [cabinet x4, bed x4], predicted [cabinet x3 + chair, bed x4]: cabinet 3/4, bed 1, chair (no
+// GT vertex) 0. ScanNet's per-scene mean counts the chair: (3/4 + 1 + 0) / 3 = 7/12; over the
+// GT's classes it is (3/4 + 1) / 2 = 7/8, the chair counted apart as 1 spurious class on 1
+// vertex (its vertex still costs the cabinet).
+TEST(EvalSemantic, SpuriousClassesAreCountedApartFromTheMeanOverGtClasses) {
+  Scene s;
+  s.add(3, 3, 0, 3, 0);
+  s.add(1, 3, 0, 5, 0);
+  s.add(4, 4, 0, 4, 0);
+  const EvalResult r = evaluateTransferred(s.gt, s.pred, {});
+  EXPECT_NEAR(classOf(r, 3).semantic_iou, 0.75, 1e-12);
+  EXPECT_EQ(classOf(r, 3).semantic_gt_vertices, 4);
+  EXPECT_EQ(classOf(r, 3).semantic_false_vertices, 0);
+  EXPECT_NEAR(classOf(r, 5).semantic_iou, 0.0, 1e-12);
+  EXPECT_EQ(classOf(r, 5).semantic_gt_vertices, 0);
+  EXPECT_EQ(classOf(r, 5).semantic_false_vertices, 1);
+  EXPECT_NEAR(r.miou, 7.0 / 12.0, 1e-12);
+  EXPECT_NEAR(r.miou_gt_classes, 7.0 / 8.0, 1e-12);
+  EXPECT_EQ(r.spurious_classes, 1);
+  EXPECT_EQ(r.spurious_vertices, 1);
+
+  // Without the stray vertex there is nothing spurious and both means agree.
+  Scene t;
+  t.add(4, 3, 0, 3, 0);
+  t.add(4, 4, 0, 4, 0);
+  const EvalResult clean = evaluateTransferred(t.gt, t.pred, {});
+  EXPECT_DOUBLE_EQ(clean.miou, 1.0);
+  EXPECT_DOUBLE_EQ(clean.miou_gt_classes, 1.0);
+  EXPECT_EQ(clean.spurious_classes, 0);
+  EXPECT_EQ(clean.spurious_vertices, 0);
+}
+
 TEST(EvalAp, RejectsMismatchedLengths) {
   Scene s;
   s.add(3, 3, 1, 3, 1);

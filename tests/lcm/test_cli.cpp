@@ -32,6 +32,17 @@ TEST(Cli, ImportOfAMissingFolderFailsWithOneLine) {
   EXPECT_FALSE(std::filesystem::exists(dir.path("x.lcmlog")));
 }
 
+TEST(Cli, MapperRefusesAGridShiftWithAFrameStoreInOneLine) {
+  test::TempDir dir;
+  const auto r = runCommand(binPath("panmap-mapper") + " --grid-shift 0.01,0,0 --frame-store " +
+                            dir.path("store") + " --log " + dir.path("absent.lcmlog") +
+                            " --out " + dir.path("out"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(test::countLines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("--grid-shift"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path("store")));
+}
+
 TEST(Cli, ImportThenLogInfoJson) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   test::TempDir dir;

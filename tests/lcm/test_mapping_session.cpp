@@ -180,6 +180,45 @@ TEST_F(MappingSessionTest, MaxFramesStopsIntegration) {
 
 // A loop-closure correction in the stream repairs the map from the frame store: the result is
 // the map the same frames give at the corrected poses; without a store it is refused, counted.
+TEST_F(MappingSessionTest, AGridShiftMovesEveryPoseItMaps) {
+  Mapper unshifted(test::streamMapperConfig());
+  MappingSession plain(SessionOptions{}, &unshifted);
+  feed(&plain, stream_.messages());
+  SessionOptions options;
+  options.grid_shift_m = Eigen::Vector3d(0.013, -0.007, 0.005);
+  Mapper mapper(test::streamMapperConfig());
+  MappingSession session(options, &mapper);
+  feed(&session, stream_.messages());
+  EXPECT_EQ(session.stats().frames_integrated, static_cast<int64_t>(stream_.frames.size()));
+  ASSERT_EQ(mapper.trajectory().size(), unshifted.trajectory().size());
+  for (size_t i = 0; i < mapper.trajectory().size(); ++i) {
+    const Eigen::Isometry3d& given = unshifted.trajectory()[i].T_W_C;
+    const Eigen::Isometry3d& mapped = mapper.trajectory()[i].T_W_C;
+    EXPECT_EQ(mapped.linear(), given.linear());
+    EXPECT_EQ(mapped.translation(), given.translation() + options.grid_shift_m);
+  }
+  // The surfaces fall elsewhere in the voxel grid: another map.
+  EXPECT_NE(test::mapBytes(mapper), clean_);
+}
+
+TEST_F(MappingSessionTest, AGridShiftIsRefusedWithAFrameStoreOrWhenNotFinite) {
+  Mapper mapper(test::streamMapperConfig());
+  test::TempDir dir;
+  FrameStoreConfig store_config;
+  store_config.folder = dir.path("store");
+  FrameStore store(store_config);
+  SessionOptions options;
+  options.grid_shift_m = Eigen::Vector3d(0.01, 0.0, 0.0);
+  options.frame_store = &store;
+  EXPECT_THROW(MappingSession(options, &mapper), Error);
+  options.frame_store = nullptr;
+  options.grid_shift_m.y() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(MappingSession(options, &mapper), Error);
+  options.grid_shift_m = Eigen::Vector3d::Zero();
+  options.frame_store = &store;
+  EXPECT_NO_THROW(MappingSession(options, &mapper));
+}
+
 TEST_F(MappingSessionTest, ACorrectionRepairsTheMapFromTheFrameStore) {
   std::vector<test::Encoded> messages = stream_.messages();
   // The back-end moves keyframe 6 by D; every frame follows (one keyframe corrected).

@@ -38,6 +38,10 @@ struct ClassMetrics {
   double iou_ls = 0.0;        ///< super-point IoU_LS averaged over the class's GT instances
   double iou_ls_best = 0.0;   ///< best single super-point IoU averaged likewise
   double semantic_iou = 0.0;  ///< per-vertex class IoU
+  /// Evaluated GT vertices of the class (its IoU's true positives and false negatives).
+  int64_t semantic_gt_vertices = 0;
+  /// Evaluated GT vertices of another class that carry this one (its false positives).
+  int64_t semantic_false_vertices = 0;
 };
 
 /// Scene metrics: class averages skip NaN classes (numpy nanmean), counts are class sums.
@@ -54,6 +58,13 @@ struct EvalResult {
   double iou_ls_instances = 0.0;  ///< the paper's formula: mean over all GT instances
   double iou_ls_best = 0.0;       ///< class-averaged best single super-point IoU
   double miou = 0.0;              ///< semantic mIoU over the evaluated classes
+  /// Semantic mIoU over the classes the scene's ground truth has. A class predicted where
+  /// the GT has none is left out of it (its vertices still count against the GT's class) and
+  /// counted in spurious_classes: in `miou` one such vertex costs a scene of n classes
+  /// 1/(n + 1) of its mean, which makes a per-scene figure jump with a handful of vertices.
+  double miou_gt_classes = 0.0;
+  int spurious_classes = 0;       ///< evaluated classes predicted on GT vertices, absent in GT
+  int64_t spurious_vertices = 0;  ///< GT vertices carrying one of those classes
 };
 
 /// Super-point accuracy of one GT instance o (our reading of the paper's

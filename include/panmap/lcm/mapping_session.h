@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "panmap/core/value_spread.h"
 #include "panmap/lcm/channels.h"
 #include "panmap/loop/background_repair.h"
@@ -39,6 +41,11 @@ struct SessionOptions {
   int64_t max_frames = 0;  ///< stop integrating after this many frames (0 = all)
   /// Frames at or before this utime are refused (counted): a resumed map already holds them.
   int64_t resume_after_utime = INT64_MIN;
+  /// A diagnostic: every pose is moved by this translation, metres, before it is mapped, so
+  /// the voxel grid falls elsewhere on the same surfaces (outputs are in the moved frame). A
+  /// method whose outputs change with it depends on where voxel boundaries fall: the noise
+  /// floor of a comparison (scripts/bench/noise_floor.py). Not with a frame store.
+  Eigen::Vector3d grid_shift_m = Eigen::Vector3d::Zero();
 };
 
 /// Median and 95th percentile of a stage's per-frame time.
