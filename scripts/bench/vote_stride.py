@@ -178,8 +178,8 @@ def main():
         run_diffs = [score(b["results"][r], "full") - score(a["results"][r], "full")
                      for r in mine]
         worst = max(run_diffs, key=abs)
-        miou_a = mean([score(a["results"][r], "full", "miou") for r in mine])
-        miou_b = mean([score(b["results"][r], "full", "miou") for r in mine])
+        miou_a = mean([score(a["results"][r], "full", "miou_gt_classes") for r in mine])
+        miou_b = mean([score(b["results"][r], "full", "miou_gt_classes") for r in mine])
         verdicts.append((scene, full_b - full_a))
         lines.append("| %s | %d | %s / %s | %+.1f | %+.1f | %+.1f | %s / %s |" % (
             scene, len(mine), fmt(full_a), fmt(full_b), full_b - full_a, mean(diffs), worst,
