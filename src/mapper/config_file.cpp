@@ -173,6 +173,8 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("min_surface_px", &m.fusion.min_surface_px);
     s.read("stuff_confidence", &m.fusion.stuff_confidence);
     s.read("geometry_only", &m.fusion.geometry_only);
+    s.read("fill_mask_edges", &m.mask_edge_fill.enabled);
+    s.read("fill_max_depth_step", &m.mask_edge_fill.max_depth_step);
     s.finish();
   }
   {
@@ -407,7 +409,12 @@ std::string configToYaml(const PanmapConfig& c) {
   y << "fusion:\n"
     << "   min_surface_px: " << m.fusion.min_surface_px << "   # smaller surfaces are dropped\n"
     << "   stuff_confidence: " << m.fusion.stuff_confidence << "   # P_o of stuff (Eq. 1)\n"
-    << "   geometry_only: " << m.fusion.geometry_only << "   # ignore panoptic masks (0/1)\n";
+    << "   geometry_only: " << m.fusion.geometry_only << "   # ignore panoptic masks (0/1)\n"
+    << "   fill_mask_edges: " << m.mask_edge_fill.enabled
+    << "   # a mask's pixels outside every surface (edges, thin parts) vote with its surfaces "
+       "(0/1)\n"
+    << "   fill_max_depth_step: " << m.mask_edge_fill.max_depth_step
+    << "   # ... across depth steps up to this share of the depth\n";
   y << "superpoints:\n"
     << "   association_min_overlap: " << m.superpoints.association_min_overlap << "\n"
     << "   significant_overlap: " << m.superpoints.significant_overlap << "   # L_N(s_i) share\n"

@@ -36,7 +36,9 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 // 13: 8-byte voxels, then the votes of the voxels that hold any (Block::vote_sets): their
 //     count, then each one's index in the block and four 6-byte slots, by index. Older files'
 //     32-byte voxels are split on loading.
-constexpr uint32_t kVersion = 13;
+// 14: fusion's mask edge fill (MaskEdgeFillConfig); older files load with it off, as they were
+//     built.
+constexpr uint32_t kVersion = 14;
 
 // Bytes of one voxel's votes in a file: four slots of a 4-byte label and a 2-byte count.
 constexpr size_t kVoteSetBytes = kVoteSlots * 6;
@@ -235,6 +237,8 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
     w->putBytes(k.offsetsM().data(), k.offsetsM().size() * sizeof(float));
     w->putString(c.depth_calibration_file);
   }
+  w->put<uint8_t>(c.mask_edge_fill.enabled);
+  w->put(c.mask_edge_fill.max_depth_step);
 }
 
 MapperConfig getConfig(BinaryReader* r, uint32_t version) {
@@ -313,6 +317,12 @@ MapperConfig getConfig(BinaryReader* r, uint32_t version) {
     c.depth_calibration = std::make_shared<const DepthCalibration>(v[0], v[1], v[2], v[3], v[4],
                                                                    spacing_m, std::move(offsets));
     c.depth_calibration_file = r->getString();
+  }
+  if (version >= 14) {
+    c.mask_edge_fill.enabled = r->get<uint8_t>() != 0;
+    c.mask_edge_fill.max_depth_step = r->get<double>();
+  } else {
+    c.mask_edge_fill.enabled = false;
   }
   return c;
 }

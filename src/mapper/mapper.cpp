@@ -22,6 +22,7 @@ void MapperConfig::check() const {
   integrator.check();
   depth_segmentation.check();
   fusion.check();
+  mask_edge_fill.check();
   superpoints.check();
   graph.check();
   occupancy.check();
@@ -282,6 +283,10 @@ FrameStats Mapper::integrate(const RgbdFrame& raw_frame, const Eigen::Isometry3d
     if (failure) std::rethrow_exception(failure);
   }
   applySplits(&association, segmentation, frame, T_W_C, tracker_->labels(), map_.get());
+  if (panoptic && !config_.fusion.geometry_only) {
+    stats.mask_filled_pixels =
+        fillMaskEdges(frame.depth, *panoptic, config_.mask_edge_fill, &association.pixel_labels);
+  }
   const auto t2 = Clock::now();
   stats.integration = integrator_->integrate(frame, T_W_C, &association.pixel_labels, map_.get());
   const auto t3 = Clock::now();

@@ -333,20 +333,36 @@ std::vector<uint8_t> reseal(std::vector<uint8_t> file, uint32_t version) {
   return file;
 }
 
-// A file of today's `config` without the byte that version 12 added at the end of the config
-// (whether a depth calibration follows): its layout before version 12. The byte follows the
-// thread count, found where two files that differ only in it differ.
-std::vector<uint8_t> withoutCalibrationFlag(std::vector<uint8_t> file, const MapperConfig& config) {
+// Where the byte that version 12 added at the end of the config (whether a depth calibration
+// follows) sits in a file of today's `config`: after the thread count, found where two files
+// that differ only in it differ.
+size_t calibrationFlagAt(const MapperConfig& config) {
   MapperConfig one = config, three = config;
   one.num_threads = 1;
   three.num_threads = 3;
   const std::vector<uint8_t> a = Mapper(one).serialize(), b = Mapper(three).serialize();
   size_t threads = 0;
   while (threads < a.size() && a[threads] == b[threads]) ++threads;
-  const size_t flag = threads + sizeof(int32_t);
-  EXPECT_LT(flag, file.size());
+  return threads + sizeof(int32_t);
+}
+
+// A file of today's `config` (without a calibration) without the mask edge fill that version
+// 14 added after the calibration flag (a flag and a double): its layout of versions 12 and 13.
+std::vector<uint8_t> withoutMaskFill(std::vector<uint8_t> file, const MapperConfig& config) {
+  const size_t flag = calibrationFlagAt(config);
+  EXPECT_LT(flag + 9, file.size());
   EXPECT_EQ(file[flag], 0);  // no calibration
-  file.erase(file.begin() + static_cast<std::ptrdiff_t>(flag));
+  EXPECT_EQ(file[flag + 1], config.mask_edge_fill.enabled ? 1 : 0);
+  file.erase(file.begin() + static_cast<std::ptrdiff_t>(flag + 1),
+             file.begin() + static_cast<std::ptrdiff_t>(flag + 1 + 1 + sizeof(double)));
+  return file;
+}
+
+// A file of today's `config` without the bytes that versions 12 and 14 added at the end of the
+// config: its layout before version 12.
+std::vector<uint8_t> withoutCalibrationFlag(std::vector<uint8_t> file, const MapperConfig& config) {
+  file = withoutMaskFill(std::move(file), config);
+  file.erase(file.begin() + static_cast<std::ptrdiff_t>(calibrationFlagAt(config)));
   return file;
 }
 
@@ -372,7 +388,7 @@ std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, u
   return reseal(std::move(file), version);
 }
 
-TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToTwelve) {
+TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToFourteen) {
   MapperConfig a;
   a.map.voxel_size_m = 0.05f;
   a.graph.prune_edges = false;
@@ -436,11 +452,22 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToTwelve) {
   EXPECT_FALSE(
       Mapper::deserialize(asVersion(bytes_b, offset, 11), "11.panmap")->config().depth_calibration);
 
-  // Versions outside 5-13 are refused by name.
+  // A version 13 file was built without the mask edge fill; a version 14 file keeps it.
+  MapperConfig fill = b;
+  fill.mask_edge_fill.max_depth_step = 0.02;
+  EXPECT_FALSE(Mapper::deserialize(reseal(withoutMaskFill(Mapper(fill).serialize(), fill), 13),
+                                   "13.panmap")
+                   ->config()
+                   .mask_edge_fill.enabled);
+  const auto fourteen = Mapper::deserialize(Mapper(fill).serialize(), "14.panmap");
+  EXPECT_TRUE(fourteen->config().mask_edge_fill.enabled);
+  EXPECT_EQ(fourteen->config().mask_edge_fill.max_depth_step, 0.02);
+
+  // Versions outside 5-14 are refused by name.
   std::vector<uint8_t> future = Mapper(b).serialize();
-  future[8] = 14;
+  future[8] = 15;
   test::expectError([&] { Mapper::deserialize(future, "future.panmap"); },
-                    {"future.panmap", "version 14", "reads 5 to 13"});
+                    {"future.panmap", "version 15", "reads 5 to 14"});
 }
 
 // Bytes before a block's voxels in a map file: its index and its updated flag.
@@ -610,12 +637,12 @@ TEST_F(BoxScene, MapFileVotesRoundTripAndBadVoteListsAreRefused) {
   const size_t second_at = count_at + 2 + 2 + sizeof(VoxelVotes);
   std::vector<uint8_t> repeated = file;  // the second voted voxel's index made the first's
   std::memcpy(&repeated[second_at], &file[count_at + 2], 2);
-  test::expectError([&] { Mapper::deserialize(reseal(repeated, 13), "repeated.panmap"); },
+  test::expectError([&] { Mapper::deserialize(reseal(repeated, 14), "repeated.panmap"); },
                     {"repeated.panmap", "out of order"});
   std::vector<uint8_t> too_many = file;
   const uint16_t n = kBlockVoxels + 1;
   std::memcpy(&too_many[count_at], &n, 2);
-  test::expectError([&] { Mapper::deserialize(reseal(too_many, 13), "many.panmap"); },
+  test::expectError([&] { Mapper::deserialize(reseal(too_many, 14), "many.panmap"); },
                     {"many.panmap", "513 voted voxels"});
 }
 

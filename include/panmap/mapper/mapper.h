@@ -23,6 +23,7 @@
 #include "panmap/mapper/map_rebuild.h"
 #include "panmap/mesh/incremental_mesher.h"
 #include "panmap/occupancy/occupancy_map.h"
+#include "panmap/segmentation/mask_edge_fill.h"
 #include "panmap/segmentation/panoptic_geometric.h"
 #include "panmap/superpoint/superpoint_tracker.h"
 #include "panmap/tracking/drift_filter.h"
@@ -44,6 +45,8 @@ struct MapperConfig {
   IntegratorConfig integrator;
   DepthSegmentationConfig depth_segmentation;
   SurfaceFusionConfig fusion;
+  /// Pixels of a mask that no surface holds vote with the mask's surfaces (fillMaskEdges).
+  MaskEdgeFillConfig mask_edge_fill;
   SuperpointConfig superpoints;
   GraphConfig graph;
   /// The occupancy tree for planners (OctoMap cells, 5 cm by default).
@@ -107,6 +110,8 @@ struct FrameStats {
   int surfaces = 0;
   int new_superpoints = 0;
   int merges = 0;
+  /// Pixels of a mask outside every surface that took a super-point from it (fillMaskEdges).
+  int64_t mask_filled_pixels = 0;
   IntegrationStats integration;
 
   /// The stage times by name, as reports and benchmarks list them ("tracking" only when the

@@ -1,0 +1,37 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "panmap/core/frame.h"
+#include "panmap/core/image.h"
+
+namespace panmap {
+
+/// Which unlabelled pixels of a panoptic mask take a super-point label from the mask's
+/// labelled pixels (fillMaskEdges).
+struct MaskEdgeFillConfig {
+  /// Off: pixels that no surface holds (geometric edges, dropped small surfaces) cast no vote.
+  bool enabled = true;
+  /// A step between 4-neighbours is followed when their depths differ by at most this share
+  /// of the nearer one (as depth_segmentation.depth_discontinuity_ratio marks a jump).
+  double max_depth_step = 0.01;
+  /// Throws Error naming the bad field.
+  void check() const;
+};
+
+/// Gives each pixel without a label (0) that lies inside a panoptic mask of a known class, and
+/// has depth, the label of the nearest labelled pixel of the same mask it reaches through
+/// 4-neighbour steps without a depth jump (breadth first from every labelled pixel of a mask,
+/// in pixel order: deterministic). Why: the geometric segmentation leaves the pixels near
+/// depth edges, concave joints and thin parts out of every surface (a band of about half its
+/// normal window), so a chair's legs, or the strip of its seat seen under a desk, would never
+/// vote and stay unlabelled in the map however often they are seen; the mask says whose they
+/// are, the depth says where that stops. Returns the number of pixels labelled.
+/// @param depth the frame's depth image (0 = none), in units of depth_scale_m
+/// @param masks the frame's panoptic segmentation, same size
+/// @param labels super-point label per pixel, same size; filled in place
+int64_t fillMaskEdges(const DepthImage& depth, const PanopticFrame& masks,
+                      const MaskEdgeFillConfig& config, LabelImage* labels);
+
+}  // namespace panmap

@@ -1,0 +1,104 @@
+// fillMaskEdges: the pixels of a mask that no surface holds take the label of the mask's
+// labelled pixels they reach without crossing a depth jump; exact values on tiny images.
+#include <limits>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "panmap/core/error.h"
+#include "panmap/segmentation/mask_edge_fill.h"
+
+namespace panmap {
+namespace {
+
+// A frame of `rows` (one string per image row): a digit is the pixel's super-point label
+// (0: none), every pixel has depth 1000 (1 m in mm) unless `depth` says otherwise, and mask
+// ids come from `mask_rows` ('.' = no mask, 'a' = mask 1 chair, 'b' = mask 2 table, 'u' =
+// mask 3 of an unknown class).
+struct Tiny {
+  DepthImage depth;
+  PanopticFrame masks;
+  LabelImage labels;
+
+  Tiny(const std::vector<const char*>& rows, const std::vector<const char*>& mask_rows) {
+    const int w = static_cast<int>(std::char_traits<char>::length(rows[0]));
+    const int h = static_cast<int>(rows.size());
+    depth = DepthImage(w, h, 1000);
+    labels = LabelImage(w, h, 0);
+    masks.segment_ids = LabelImage(w, h, 0);
+    masks.segments = {{1, 5, 5, true, 0.9f}, {2, 7, 7, true, 0.9f}, {3, 0, 99, true, 0.9f}};
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        labels(u, v) = rows[v][u] - '0';
+        const char m = mask_rows[v][u];
+        masks.segment_ids(u, v) = m == 'a' ? 1 : m == 'b' ? 2 : m == 'u' ? 3 : 0;
+      }
+    }
+  }
+  std::vector<int32_t> row(int v) const {
+    std::vector<int32_t> out;
+    for (int u = 0; u < labels.width(); ++u) out.push_back(labels(u, v));
+    return out;
+  }
+};
+
+TEST(MaskEdgeFill, EdgePixelsOfAMaskTakeItsNearestLabel) {
+  // Mask a over everything, labels 7 and 9 with edge pixels (0) between and around them:
+  // each takes the label nearest in steps; column 1 is one step from both, and breadth first
+  // from the sources in pixel order gives it 7, the first.
+  Tiny t({"70900", "00000"}, {"aaaaa", "aaaaa"});
+  const int64_t filled = fillMaskEdges(t.depth, t.masks, MaskEdgeFillConfig{}, &t.labels);
+  EXPECT_EQ(filled, 8);
+  EXPECT_EQ(t.row(0), (std::vector<int32_t>{7, 7, 9, 9, 9}));
+  EXPECT_EQ(t.row(1), (std::vector<int32_t>{7, 7, 9, 9, 9}));
+}
+
+TEST(MaskEdgeFill, StopsAtOtherMasksUnknownClassesNoMaskAndNoDepth) {
+  Tiny t({"5000000", "0000000"}, {"aaab.uu", "aaab.uu"});
+  t.depth(2, 1) = 0;  // no depth: never filled, and the fill does not pass through it
+  const int64_t filled = fillMaskEdges(t.depth, t.masks, MaskEdgeFillConfig{}, &t.labels);
+  EXPECT_EQ(filled, 4);
+  EXPECT_EQ(t.row(0), (std::vector<int32_t>{5, 5, 5, 0, 0, 0, 0}));
+  EXPECT_EQ(t.row(1), (std::vector<int32_t>{5, 5, 0, 0, 0, 0, 0}));
+}
+
+TEST(MaskEdgeFill, StopsAtADepthJumpButFollowsASlope) {
+  // 1 m with steps of 9 mm (0.9 %: followed), then a 2 cm jump (2 %: not crossed).
+  Tiny t({"30000"}, {"aaaaa"});
+  const uint16_t depth_mm[] = {1000, 1009, 1018, 1038, 1047};
+  for (int u = 0; u < 5; ++u) t.depth(u, 0) = depth_mm[u];
+  const int64_t filled = fillMaskEdges(t.depth, t.masks, MaskEdgeFillConfig{}, &t.labels);
+  EXPECT_EQ(filled, 2);
+  EXPECT_EQ(t.row(0), (std::vector<int32_t>{3, 3, 3, 0, 0}));
+  // A looser step crosses it.
+  Tiny loose({"30000"}, {"aaaaa"});
+  for (int u = 0; u < 5; ++u) loose.depth(u, 0) = depth_mm[u];
+  MaskEdgeFillConfig config;
+  config.max_depth_step = 0.025;
+  EXPECT_EQ(fillMaskEdges(loose.depth, loose.masks, config, &loose.labels), 4);
+}
+
+TEST(MaskEdgeFill, OffOrWithoutMasksChangesNothing) {
+  Tiny t({"40000"}, {"aaaaa"});
+  MaskEdgeFillConfig off;
+  off.enabled = false;
+  EXPECT_EQ(fillMaskEdges(t.depth, t.masks, off, &t.labels), 0);
+  EXPECT_EQ(t.row(0), (std::vector<int32_t>{4, 0, 0, 0, 0}));
+  Tiny bare({"40000"}, {"....."});
+  EXPECT_EQ(fillMaskEdges(bare.depth, bare.masks, MaskEdgeFillConfig{}, &bare.labels), 0);
+}
+
+TEST(MaskEdgeFill, RefusesBadConfigAndMismatchedSizes) {
+  Tiny t({"40000"}, {"aaaaa"});
+  MaskEdgeFillConfig bad;
+  bad.max_depth_step = -0.1;
+  EXPECT_THROW(fillMaskEdges(t.depth, t.masks, bad, &t.labels), Error);
+  bad.max_depth_step = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(bad.check(), Error);
+  LabelImage small(4, 1, 0);
+  EXPECT_THROW(fillMaskEdges(t.depth, t.masks, MaskEdgeFillConfig{}, &small), Error);
+  EXPECT_EQ(t.row(0), (std::vector<int32_t>{4, 0, 0, 0, 0}));
+}
+
+}  // namespace
+}  // namespace panmap
