@@ -24,14 +24,16 @@ SCANNET_LABELS = os.path.join(ROOT, "..", "shared", "data", "scannet-meta",
                               "scannetv2-labels.combined.tsv")
 
 # Method variants: (name, map, optimiser flags). Map A: semantically consistent super-points
-# (III-B); map B: spatial-only merging. Both run the same per-frame pipeline otherwise.
+# (III-B); map B: spatial-only merging, the same per-frame pipeline otherwise; map V: as B, and
+# without the mask edge fill (not in Voxblox++, and it joins objects through their contacts
+# when super-points merge by overlap alone: a baseline should not carry it).
 VARIANTS = [
     ("full", "A", []),
     ("w/o III-B", "B", []),
     ("w/o III-C", "A", ["--no-regularise"]),
     ("w/o III-D", "A", ["--no-refine"]),
     ("w/o III-C & III-D", "A", ["--no-regularise", "--no-refine"]),
-    ("Voxblox++-like", "B", ["--no-regularise", "--no-refine"]),
+    ("Voxblox++-like", "V", ["--no-regularise", "--no-refine"]),
 ]
 REFINED = "full + pose refinement"
 # The full method on drifting poses mapped as given (`--tracking off`), beside a "tracked" spec's
@@ -218,6 +220,9 @@ def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
         if any(v[1] == "B" for v in wanted):
             run(fixed + ["--spatial-only", "--no-regularise", "--no-refine",
                          "--out", os.path.join(out, "B")], log)
+        if any(v[1] == "V" for v in wanted):
+            run(fixed + ["--spatial-only", "--no-mask-edge-fill", "--no-regularise",
+                         "--no-refine", "--out", os.path.join(out, "V")], log)
         if drifting and spec.runs == "tracked":
             ate["refined"] = trajectory_ate(seq_dir, os.path.join(out, "A", "trajectory.txt"),
                                             os.path.join(out, "ate_refined.json"), log)
@@ -230,15 +235,16 @@ def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
                                   .replace("&", "and").replace("+", "p"))
             if source == "A" and not flags:
                 folder = os.path.join(out, "A")
-            elif source == "B" and flags:
-                folder = os.path.join(out, "B")
+            elif source == "V":
+                folder = os.path.join(out, "V")
             else:
                 run([tool("panmap-mapper"), "-q", "--no-snapshots", "--export-only", "--load",
                      os.path.join(out, source, "map.panmap"), "--out", folder] + flags + extra,
                     log)
             results[variant] = evaluate(folder, seq_dir, voxel_m,
                                         built_with(os.path.join(out, source)))
-            if folder not in (os.path.join(out, "A"), os.path.join(out, "B")):
+            if folder not in (os.path.join(out, "A"), os.path.join(out, "B"),
+                              os.path.join(out, "V")):
                 drop_map(folder)
     if drifting:
         ate["input"] = trajectory_ate(seq_dir, os.path.join(seq_dir, "gt", "trajectory_input.txt"),

@@ -187,6 +187,7 @@ int main(int argc, char** argv) {
   panmap::LiveOptions live;
   panmap::SessionOptions& options = live.session;
   bool quiet = false, geometry_only = false, spatial_only = false, no_snapshots = false;
+  bool no_mask_edge_fill = false;
   bool no_regularise = false, no_refine = false, print_config = false, export_only = false;
   app.add_option("--log", log_path, "LCM log to map offline (omit for the live LCM mode)");
   app.add_option("--out", out_dir, "output folder")->required(false);
@@ -198,6 +199,9 @@ int main(int argc, char** argv) {
   app.add_option("--threads", config.num_threads, "integration threads")->capture_default_str();
   app.add_option("--max-frames", options.max_frames, "stop after N integrated frames (0 = all)");
   app.add_flag("--geometry-only", geometry_only, "ignore panoptic masks (ablation)");
+  app.add_flag("--no-mask-edge-fill", no_mask_edge_fill,
+               "pixels of a mask outside every surface cast no vote (fusion.fill_mask_edges 0; "
+               "as Voxblox++)");
   app.add_flag("--spatial-only", spatial_only,
                "merge super-points without the semantic consistency check (ablation, Voxblox++)");
   app.add_flag("--no-regularise", no_regularise,
@@ -322,6 +326,7 @@ int main(int argc, char** argv) {
       config.depth_calibration_file = depth_calibration;
     }
     config.superpoints.semantic_consistency = !spatial_only;
+    if (no_mask_edge_fill) config.mask_edge_fill.enabled = false;
     if (tracking == "off") config.tracking_mode = panmap::MapperConfig::TrackingMode::kOff;
     if (tracking == "auto") config.tracking_mode = panmap::MapperConfig::TrackingMode::kAuto;
     if (tracking == "on") config.tracking_mode = panmap::MapperConfig::TrackingMode::kOn;
