@@ -25,26 +25,51 @@ int64_t fillMaskEdges(const DepthImage& depth, const PanopticFrame& masks,
       masks.segment_ids.height() != h) {
     throw Error("mask edge fill: depth, mask and label images differ in size");
   }
-  // Masks of a known class: a category-0 segment names no class to vote for.
-  std::unordered_set<int32_t> known;
+  // Masks of a known class (a category-0 segment names no class to vote for), as a flag per
+  // id: the loops below test every pixel. Ids are a network's segments of one frame, small in
+  // practice; a larger one is looked up in the set.
+  constexpr int32_t kDenseIds = 1 << 16;
+  std::vector<uint8_t> known_dense(kDenseIds, 0);
+  std::unordered_set<int32_t> known_sparse;
   for (const PanopticSegment& s : masks.segments) {
-    if (s.category > 0) known.insert(s.id);
+    if (s.category <= 0 || s.id <= 0) continue;
+    if (s.id < kDenseIds) {
+      known_dense[static_cast<size_t>(s.id)] = 1;
+    } else {
+      known_sparse.insert(s.id);
+    }
   }
-  if (known.empty()) return 0;
+  auto known = [&](int32_t id) {
+    return id > 0 && (id < kDenseIds ? known_dense[static_cast<size_t>(id)] != 0
+                                     : known_sparse.count(id) != 0);
+  };
   const int32_t* mask = masks.segment_ids.data();
   const uint16_t* d = depth.data();
   int32_t* label = labels->data();
   const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
-  // Pixels a fill may reach: in a known mask, with depth, without a label. Sources: labelled
-  // pixels of a known mask. Both found once, so the loop below reads no set.
+  // Pixels a fill may reach: in a known mask, with depth, without a label.
   std::vector<uint8_t> open(n, 0);
-  std::vector<int32_t> queue;
+  bool any_open = false;
   for (size_t i = 0; i < n; ++i) {
-    if (mask[i] <= 0 || known.count(mask[i]) == 0) continue;
-    if (label[i] > 0) {
-      queue.push_back(static_cast<int32_t>(i));
-    } else if (d[i] > 0) {
-      open[i] = 1;
+    if (label[i] == 0 && d[i] > 0 && known(mask[i])) open[i] = 1, any_open = true;
+  }
+  if (!any_open) return 0;
+  // Sources, in pixel order: labelled pixels of a known mask next to an open pixel of the same
+  // mask (one with none can give nothing: the fill moves through open pixels only).
+  std::vector<int32_t> queue;
+  for (int v = 0; v < h; ++v) {
+    const size_t row = static_cast<size_t>(v) * static_cast<size_t>(w);
+    for (int u = 0; u < w; ++u) {
+      const size_t k = row + static_cast<size_t>(u);
+      if (label[k] <= 0) continue;
+      const int32_t m = mask[k];
+      auto opens = [&](size_t j) { return open[j] && mask[j] == m; };
+      if (((u > 0 && opens(k - 1)) || (u + 1 < w && opens(k + 1)) ||
+           (v > 0 && opens(k - static_cast<size_t>(w))) ||
+           (v + 1 < h && opens(k + static_cast<size_t>(w)))) &&
+          known(m)) {
+        queue.push_back(static_cast<int32_t>(k));
+      }
     }
   }
   const float step = static_cast<float>(config.max_depth_step);
@@ -56,7 +81,6 @@ int64_t fillMaskEdges(const DepthImage& depth, const PanopticFrame& masks,
     auto reach = [&](int32_t j) {
       if (!open[j] || mask[j] != mask[i]) return;
       const float dj = static_cast<float>(d[j]);
-      // The source may lack depth (a labelled pixel always has it, a filled one too).
       if (std::fabs(dj - di) > step * std::min(di, dj)) return;
       open[j] = 0;
       label[j] = label[i];
