@@ -175,6 +175,7 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("geometry_only", &m.fusion.geometry_only);
     s.read("fill_mask_edges", &m.mask_edge_fill.enabled);
     s.read("fill_max_depth_step", &m.mask_edge_fill.max_depth_step);
+    s.read("fill_max_distance_px", &m.mask_edge_fill.max_distance_px);
     s.finish();
   }
   {
@@ -414,7 +415,9 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   # a mask's pixels outside every surface (edges, thin parts) vote with its surfaces "
        "(0/1)\n"
     << "   fill_max_depth_step: " << m.mask_edge_fill.max_depth_step
-    << "   # ... across depth steps up to this share of the depth\n";
+    << "   # ... across depth steps up to this share of the depth\n"
+    << "   fill_max_distance_px: " << m.mask_edge_fill.max_distance_px
+    << "   # ... at most this many pixels from a labelled one (0: no limit)\n";
   y << "superpoints:\n"
     << "   association_min_overlap: " << m.superpoints.association_min_overlap << "\n"
     << "   significant_overlap: " << m.superpoints.significant_overlap << "   # L_N(s_i) share\n"

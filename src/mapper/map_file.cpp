@@ -239,6 +239,7 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   }
   w->put<uint8_t>(c.mask_edge_fill.enabled);
   w->put(c.mask_edge_fill.max_depth_step);
+  w->put<int32_t>(c.mask_edge_fill.max_distance_px);
 }
 
 MapperConfig getConfig(BinaryReader* r, uint32_t version) {
@@ -321,6 +322,7 @@ MapperConfig getConfig(BinaryReader* r, uint32_t version) {
   if (version >= 14) {
     c.mask_edge_fill.enabled = r->get<uint8_t>() != 0;
     c.mask_edge_fill.max_depth_step = r->get<double>();
+    c.mask_edge_fill.max_distance_px = r->get<int32_t>();
   } else {
     c.mask_edge_fill.enabled = false;
   }

@@ -10,6 +10,10 @@
 namespace panmap {
 
 void MaskEdgeFillConfig::check() const {
+  if (max_distance_px < 0) {
+    throw Error("mask_edge_fill.max_distance_px must be >= 0, got " +
+                std::to_string(max_distance_px));
+  }
   if (!(max_depth_step >= 0.0) || !std::isfinite(max_depth_step)) {
     throw Error("mask_edge_fill.max_depth_step must be finite and >= 0, got " +
                 std::to_string(max_depth_step));
@@ -73,11 +77,15 @@ int64_t fillMaskEdges(const DepthImage& depth, const PanopticFrame& masks,
     }
   }
   const float step = static_cast<float>(config.max_depth_step);
+  // Steps from the source of each queued pixel (sources 0), for max_distance_px.
+  std::vector<int32_t> steps(queue.size(), 0);
   int64_t filled = 0;
   for (size_t head = 0; head < queue.size(); ++head) {
     const int32_t i = queue[head];
     const int u = i % w, v = i / w;
     const float di = static_cast<float>(d[i]);
+    const int32_t next_steps = steps[head] + 1;
+    if (config.max_distance_px > 0 && next_steps > config.max_distance_px) continue;
     auto reach = [&](int32_t j) {
       if (!open[j] || mask[j] != mask[i]) return;
       const float dj = static_cast<float>(d[j]);
@@ -86,6 +94,7 @@ int64_t fillMaskEdges(const DepthImage& depth, const PanopticFrame& masks,
       label[j] = label[i];
       ++filled;
       queue.push_back(j);
+      steps.push_back(next_steps);
     };
     if (u > 0) reach(i - 1);
     if (u + 1 < w) reach(i + 1);

@@ -347,14 +347,16 @@ size_t calibrationFlagAt(const MapperConfig& config) {
 }
 
 // A file of today's `config` (without a calibration) without the mask edge fill that version
-// 14 added after the calibration flag (a flag and a double): its layout of versions 12 and 13.
+// 14 added after the calibration flag (a flag, a double and an int32): its layout of versions
+// 12 and 13.
 std::vector<uint8_t> withoutMaskFill(std::vector<uint8_t> file, const MapperConfig& config) {
   const size_t flag = calibrationFlagAt(config);
-  EXPECT_LT(flag + 9, file.size());
+  constexpr size_t kFillBytes = 1 + sizeof(double) + sizeof(int32_t);
+  EXPECT_LT(flag + kFillBytes, file.size());
   EXPECT_EQ(file[flag], 0);  // no calibration
   EXPECT_EQ(file[flag + 1], config.mask_edge_fill.enabled ? 1 : 0);
   file.erase(file.begin() + static_cast<std::ptrdiff_t>(flag + 1),
-             file.begin() + static_cast<std::ptrdiff_t>(flag + 1 + 1 + sizeof(double)));
+             file.begin() + static_cast<std::ptrdiff_t>(flag + 1 + kFillBytes));
   return file;
 }
 
@@ -455,13 +457,15 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToFourteen) {
   // A version 13 file was built without the mask edge fill; a version 14 file keeps it.
   MapperConfig fill = b;
   fill.mask_edge_fill.max_depth_step = 0.02;
-  EXPECT_FALSE(Mapper::deserialize(reseal(withoutMaskFill(Mapper(fill).serialize(), fill), 13),
-                                   "13.panmap")
-                   ->config()
-                   .mask_edge_fill.enabled);
+  fill.mask_edge_fill.max_distance_px = 9;
+  EXPECT_FALSE(
+      Mapper::deserialize(reseal(withoutMaskFill(Mapper(fill).serialize(), fill), 13), "13.panmap")
+          ->config()
+          .mask_edge_fill.enabled);
   const auto fourteen = Mapper::deserialize(Mapper(fill).serialize(), "14.panmap");
   EXPECT_TRUE(fourteen->config().mask_edge_fill.enabled);
   EXPECT_EQ(fourteen->config().mask_edge_fill.max_depth_step, 0.02);
+  EXPECT_EQ(fourteen->config().mask_edge_fill.max_distance_px, 9);
 
   // Versions outside 5-14 are refused by name.
   std::vector<uint8_t> future = Mapper(b).serialize();

@@ -78,6 +78,22 @@ TEST(MaskEdgeFill, StopsAtADepthJumpButFollowsASlope) {
   EXPECT_EQ(fillMaskEdges(loose.depth, loose.masks, config, &loose.labels), 4);
 }
 
+TEST(MaskEdgeFill, ReachesAtMostMaxDistanceSteps) {
+  // A label at each end of a 16-pixel mask: the default (6) leaves the two middle pixels, 7
+  // steps from both, unlabelled; no limit fills them from the nearer end (the left one first).
+  Tiny t({"5000000000000008"}, {"aaaaaaaaaaaaaaaa"});
+  EXPECT_EQ(fillMaskEdges(t.depth, t.masks, MaskEdgeFillConfig{}, &t.labels), 12);
+  EXPECT_EQ(t.row(0), (std::vector<int32_t>{5, 5, 5, 5, 5, 5, 5, 0, 0, 8, 8, 8, 8, 8, 8, 8}));
+  Tiny unlimited({"5000000000000008"}, {"aaaaaaaaaaaaaaaa"});
+  MaskEdgeFillConfig config;
+  config.max_distance_px = 0;
+  EXPECT_EQ(fillMaskEdges(unlimited.depth, unlimited.masks, config, &unlimited.labels), 14);
+  EXPECT_EQ(unlimited.row(0),
+            (std::vector<int32_t>{5, 5, 5, 5, 5, 5, 5, 5, 8, 8, 8, 8, 8, 8, 8, 8}));
+  config.max_distance_px = -1;
+  EXPECT_THROW(config.check(), Error);
+}
+
 TEST(MaskEdgeFill, OffOrWithoutMasksChangesNothing) {
   Tiny t({"40000"}, {"aaaaa"});
   MaskEdgeFillConfig off;

@@ -16,6 +16,11 @@ struct MaskEdgeFillConfig {
   /// A step between 4-neighbours is followed when their depths differ by at most this share
   /// of the nearer one (as depth_segmentation.depth_discontinuity_ratio marks a jump).
   double max_depth_step = 0.01;
+  /// Steps at most from a labelled pixel (0: no limit). 6, half the depth segmentation's
+  /// normal window: the band it leaves out of every surface along an edge. Farther, a fill
+  /// would cross whole dropped segments, and the gap between two objects one mask covers
+  /// (a `hard` network's merged masks: two touching chairs joined through it).
+  int max_distance_px = 6;
   /// Throws Error naming the bad field.
   void check() const;
 };
