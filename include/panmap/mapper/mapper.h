@@ -110,8 +110,6 @@ struct FrameStats {
   int surfaces = 0;
   int new_superpoints = 0;
   int merges = 0;
-  /// Pixels of a mask outside every surface that took a super-point from it (fillMaskEdges).
-  int64_t mask_filled_pixels = 0;
   IntegrationStats integration;
 
   /// The stage times by name, as reports and benchmarks list them ("tracking" only when the

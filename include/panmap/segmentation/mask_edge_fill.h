@@ -26,13 +26,13 @@ struct MaskEdgeFillConfig {
 };
 
 /// Gives each pixel without a label (0) that lies inside a panoptic mask of a known class, and
-/// has depth, the label of the nearest labelled pixel of the same mask it reaches through
-/// 4-neighbour steps without a depth jump (breadth first from every labelled pixel of a mask,
-/// in pixel order: deterministic). Why: the geometric segmentation leaves the pixels near
-/// depth edges, concave joints and thin parts out of every surface (a band of about half its
-/// normal window), so a chair's legs, or the strip of its seat seen under a desk, would never
-/// vote and stay unlabelled in the map however often they are seen; the mask says whose they
-/// are, the depth says where that stops. Returns the number of pixels labelled.
+/// has depth, the label of the nearest labelled pixel of the same mask it reaches through at
+/// most max_distance_px 4-neighbour steps without a depth jump (breadth first from the
+/// labelled pixels of the masks, in pixel order: deterministic). Why: the geometric segmentation
+/// leaves the pixels near depth edges, concave joints and thin parts out of every surface (a band
+/// of about half its normal window), so a chair's legs, or the strip of its seat seen under a desk,
+/// would never vote and stay unlabelled in the map however often they are seen; the mask says whose
+/// they are, the depth says where that stops. Returns the number of pixels labelled.
 /// @param depth the frame's depth image (0 = none), in units of depth_scale_m
 /// @param masks the frame's panoptic segmentation, same size
 /// @param labels super-point label per pixel, same size; filled in place
