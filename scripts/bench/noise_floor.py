@@ -25,6 +25,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import accuracy  # noqa: E402  (same folder)
+from accuracy import pct  # noqa: E402
 import suite  # noqa: E402
 
 
@@ -65,10 +66,6 @@ def changed_things(a, b):
             rows.append((t["instance_id"], t["class_id"], t["vertices"], outcome(old),
                          outcome(t)))
     return rows
-
-
-def pct(v):
-    return "-" if v is None or v != v else "%.1f" % (100 * v)
 
 
 def main():
