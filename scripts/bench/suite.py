@@ -221,8 +221,8 @@ def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
             run(fixed + ["--spatial-only", "--no-regularise", "--no-refine",
                          "--out", os.path.join(out, "B")], log)
         if any(v[1] == "V" for v in wanted):
-            run(fixed + ["--spatial-only", "--no-mask-edge-fill", "--no-regularise",
-                         "--no-refine", "--out", os.path.join(out, "V")], log)
+            run(fixed + ["--spatial-only", "--no-mask-edge-fill", "--pair-interior-px", "0",
+                         "--no-regularise", "--no-refine", "--out", os.path.join(out, "V")], log)
         if drifting and spec.runs == "tracked":
             ate["refined"] = trajectory_ate(seq_dir, os.path.join(out, "A", "trajectory.txt"),
                                             os.path.join(out, "ate_refined.json"), log)

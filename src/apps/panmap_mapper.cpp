@@ -202,6 +202,10 @@ int main(int argc, char** argv) {
   app.add_flag("--no-mask-edge-fill", no_mask_edge_fill,
                "pixels of a mask outside every surface cast no vote (fusion.fill_mask_edges 0; "
                "as Voxblox++)");
+  int pair_interior_px = -1;
+  app.add_option("--pair-interior-px", pair_interior_px,
+                 "co-observation (Eq. 6) counts only pixels this far inside their mask's outline "
+                 "(graph.pair_interior_px, default 2; 0: every pixel, as the paper and Voxblox++)");
   app.add_flag("--spatial-only", spatial_only,
                "merge super-points without the semantic consistency check (ablation, Voxblox++)");
   app.add_flag("--no-regularise", no_regularise,
@@ -327,6 +331,7 @@ int main(int argc, char** argv) {
     }
     config.superpoints.semantic_consistency = !spatial_only;
     if (no_mask_edge_fill) config.mask_edge_fill.enabled = false;
+    if (app.count("--pair-interior-px") > 0) config.graph.pair_interior_px = pair_interior_px;
     if (tracking == "off") config.tracking_mode = panmap::MapperConfig::TrackingMode::kOff;
     if (tracking == "auto") config.tracking_mode = panmap::MapperConfig::TrackingMode::kAuto;
     if (tracking == "on") config.tracking_mode = panmap::MapperConfig::TrackingMode::kOn;

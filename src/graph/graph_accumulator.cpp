@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iterator>
 #include <memory>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -33,6 +34,7 @@ void GraphConfig::check() const {
     throw Error("graph edge_min_share must be in [0, 1]");
   }
   if (!(surface_band_voxels > 0.0f)) throw Error("graph surface_band_voxels must be > 0");
+  if (pair_interior_px < 0) throw Error("graph pair_interior_px must be >= 0");
 }
 
 GraphAccumulator::GraphAccumulator(const GraphConfig& config, ThreadPool* pool)
@@ -135,6 +137,10 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   std::map<int32_t, int> things_per_class;
   for (const PanopticSegment& s : panoptic.segments) {
     if (s.category <= 0) continue;
+    if (s.id > internal::kMaxMaskHitId) {
+      throw Error("graph update: panoptic segment id " + std::to_string(s.id) + " is above " +
+                  std::to_string(internal::kMaxMaskHitId));
+    }
     masks[s.id] = {s.category, s.is_thing ? s.score : stuff_confidence};
     if (s.is_thing) ++things_per_class[s.category];
   }
@@ -163,6 +169,9 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   auto resolve = [&registry](int32_t l) { return registry.resolve(l); };
   const int stride = config_.sample_stride_px;
   const size_t rows = static_cast<size_t>((cam.height + stride - 1) / stride);
+  const bool all_interior = config_.pair_interior_px == 0;
+  if (!all_interior)
+    internal::maskInterior(panoptic.segment_ids, config_.pair_interior_px, &interior_);
   // Rows go to whichever thread is free (rows with masks cost far more than rows without).
   // Each thread sorts and dedupes its own hits; merged, they are what one sort of all hits
   // would give, whichever rows each thread took (equal hits are identical: one voxel has one
@@ -192,9 +201,13 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
         const int32_t id = scratch->masks[k];
         const Eigen::Vector3i& g = scratch->voxels[k];
         const uint64_t key = internal::maskHitVoxelKey(g.x(), g.y(), g.z());
+        // A pixel near its mask's outline is a boundary hit (even key), any other an interior
+        // one (odd key): a mask's two kinds sort next to each other.
+        const bool inside = all_interior || interior_(scratch->samples[k].u, v) != 0;
+        const int32_t hit_mask = internal::maskHitKey(id, inside);
         // Neighbouring pixels often repeat the last hit: keep the sort below small.
-        if (!out.empty() && out.back().mask == id && out.back().voxel == key) continue;
-        out.push_back({key, id, label});
+        if (!out.empty() && out.back().mask == hit_mask && out.back().voxel == key) continue;
+        out.push_back({key, hit_mask, label});
       }
     }
   };
@@ -237,18 +250,31 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
                            (field(key) + 0.5) * voxel);
   };
   for (size_t begin = 0; begin < hits.size();) {
-    size_t end = begin;
-    while (end < hits.size() && hits[end].mask == hits[begin].mask) ++end;
-    const auto [cls, p_o] = masks.at(hits[begin].mask);
-    // N^S_o and the centroid of those voxels, per super-point, in label order.
+    const int32_t mask = internal::maskOfHitKey(hits[begin].mask);
+    size_t mid = begin;  // [begin, mid): boundary hits, [mid, end): interior hits
+    while (mid < hits.size() && hits[mid].mask == internal::maskHitKey(mask, false)) ++mid;
+    size_t end = mid;
+    while (end < hits.size() && hits[end].mask == internal::maskHitKey(mask, true)) ++end;
+    const auto [cls, p_o] = masks.at(mask);
+    // N^S_o (unique voxels, either kind), its interior part and the centroid of those voxels,
+    // per super-point, in label order. Both kinds are sorted by voxel: one merge walk.
     groups_.clear();
     group_index_.clear();
-    for (size_t i = begin; i < end; ++i) {
-      const auto [it, added] = group_index_.try_emplace(hits[i].label, groups_.size());
-      if (added) groups_.push_back({hits[i].label, 0, Eigen::Vector3d::Zero(), {}});
+    auto count = [&](const Hit& h, bool interior) {
+      const auto [it, added] = group_index_.try_emplace(h.label, groups_.size());
+      if (added) groups_.push_back({h.label, 0, 0, Eigen::Vector3d::Zero(), {}});
       Group& g = groups_[it->second];
       ++g.count;
-      g.sum += centre(hits[i].voxel);
+      if (interior) ++g.interior;
+      g.sum += centre(h.voxel);
+    };
+    for (size_t b = begin, i = mid; b < mid || i < end;) {
+      if (i == end || (b < mid && hits[b].voxel < hits[i].voxel)) {
+        count(hits[b++], false);
+      } else {
+        if (b < mid && hits[b].voxel == hits[i].voxel) ++b;
+        count(hits[i++], true);
+      }
     }
     std::sort(groups_.begin(), groups_.end(),
               [](const Group& x, const Group& y) { return x.label < y.label; });
@@ -269,10 +295,11 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
         const Group& gj = groups_[j];
         const double distance = (gi.centroid - gj.centroid).norm();
         const double p_s = 1.0 / (1.0 + distance / config_.spatial_scale_m);
-        edges_.add(gi.label, gj.label, cls, p_o * p_s * std::min(gi.count, gj.count));
+        const int n_pair = std::min(gi.interior, gj.interior);
+        if (n_pair > 0) edges_.add(gi.label, gj.label, cls, p_o * p_s * n_pair);
       }
     }
-    mask_groups_.push_back({cls, p_o, is_thing_mask.count(hits[begin].mask) > 0, groups_});
+    mask_groups_.push_back({cls, p_o, is_thing_mask.count(mask) > 0, groups_});
     begin = end;
   }
 
@@ -293,7 +320,8 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
         for (const Group& g2 : o2.groups) {
           if (g1.label == g2.label) continue;
           const auto [lo, hi] = std::minmax(g1.label, g2.label);
-          const double n = std::min(g1.count, g2.count);
+          const double n = std::min(g1.interior, g2.interior);
+          if (n <= 0.0) continue;
           if (same_thing_class) {
             const double distance = (g1.centroid - g2.centroid).norm();
             if (distance <= config_.separation_radius_m) {

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <array>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
 #include "panmap/core/radix_sort.h"
 
 namespace panmap::internal {
@@ -73,6 +76,41 @@ void sortUniqueHits(std::vector<MaskHit>* hits, std::vector<MaskHit>* scratch) {
               (((key >> shift_y) & mask_y) + lo[1]) << kFieldBits | ((key & mask_z) + lo[2]);
   }
   hits->erase(std::unique(hits->begin(), hits->end()), hits->end());
+}
+
+void maskInterior(const Image<int32_t>& segment_ids, int radius_px, Image<uint8_t>* interior) {
+  const int w = segment_ids.width(), h = segment_ids.height();
+  if (interior->width() != w || interior->height() != h) *interior = Image<uint8_t>(w, h);
+  // 255 where a pixel and its right and lower neighbours agree (and it has a segment): a pixel
+  // at an outline marks both sides of it. Eroding that by the radius leaves the interior.
+  cv::Mat same(h, w, CV_8U, cv::Scalar(255));
+  for (int v = 0; v < h; ++v) {
+    const int32_t* ids = segment_ids.row(v);
+    const int32_t* below = v + 1 < h ? segment_ids.row(v + 1) : nullptr;
+    uint8_t* out = same.ptr<uint8_t>(v);
+    uint8_t* out_below = v + 1 < h ? same.ptr<uint8_t>(v + 1) : nullptr;
+    for (int u = 0; u < w; ++u) {
+      if (ids[u] == 0) out[u] = 0;
+      if (u + 1 < w && ids[u + 1] != ids[u]) out[u] = out[u + 1] = 0;
+      if (below && below[u] != ids[u]) out[u] = out_below[u] = 0;
+    }
+  }
+  cv::Mat eroded(h, w, CV_8U, interior->data());
+  if (radius_px <= 0) {
+    for (int v = 0; v < h; ++v) {
+      const int32_t* ids = segment_ids.row(v);
+      uint8_t* out = eroded.ptr<uint8_t>(v);
+      for (int u = 0; u < w; ++u) out[u] = ids[u] != 0 ? 1 : 0;
+    }
+    return;
+  }
+  const int k = 2 * radius_px - 1;  // the outline pixels themselves are already 0
+  if (k > 1) {
+    cv::erode(same, eroded, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)));
+  } else {
+    same.copyTo(eroded);
+  }
+  eroded /= 255;
 }
 
 }  // namespace panmap::internal

@@ -197,6 +197,7 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("prune_edges", &m.graph.prune_edges);
     s.read("edge_min_share", &m.graph.edge_min_share);
     s.read("surface_band_voxels", &m.graph.surface_band_voxels);
+    s.read("pair_interior_px", &m.graph.pair_interior_px);
     s.finish();
   }
   {
@@ -438,7 +439,9 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   edge_min_share: " << m.graph.edge_min_share
     << "   # strong: P_eps or P_sep >= share x the smaller sum of P_nu\n"
     << "   surface_band_voxels: " << m.graph.surface_band_voxels
-    << "   # |sdf| band of the surface\n";
+    << "   # |sdf| band of the surface\n"
+    << "   pair_interior_px: " << m.graph.pair_interior_px
+    << "   # co-observation counts pixels this far inside a mask's outline (0: all)\n";
   const OccupancyMap::Config& oc = m.occupancy;
   y << "occupancy:\n"
     << "   enabled: " << m.occupancy_enabled << "   # OctoMap tree for planners (0/1)\n"

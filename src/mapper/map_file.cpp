@@ -38,7 +38,7 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 //     32-byte voxels are split on loading.
 // 14: fusion's mask edge fill (MaskEdgeFillConfig); older files load with it off, as they were
 //     built.
-constexpr uint32_t kVersion = 14;
+constexpr uint32_t kVersion = 15;
 
 // Bytes of one voxel's votes in a file: four slots of a 4-byte label and a 2-byte count.
 constexpr size_t kVoteSetBytes = kVoteSlots * 6;
@@ -240,6 +240,7 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put<uint8_t>(c.mask_edge_fill.enabled);
   w->put(c.mask_edge_fill.max_depth_step);
   w->put<int32_t>(c.mask_edge_fill.max_distance_px);
+  w->put<int32_t>(c.graph.pair_interior_px);
 }
 
 MapperConfig getConfig(BinaryReader* r, uint32_t version) {
@@ -326,6 +327,8 @@ MapperConfig getConfig(BinaryReader* r, uint32_t version) {
   } else {
     c.mask_edge_fill.enabled = false;
   }
+  // Older maps counted every pixel of a mask as co-observation: they go on as they began.
+  c.graph.pair_interior_px = version >= 15 ? r->get<int32_t>() : 0;
   return c;
 }
 

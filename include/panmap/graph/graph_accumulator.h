@@ -46,6 +46,12 @@ struct GraphConfig {
   /// Half-width of the surface band, voxels: observed voxels with |sdf| at most this count as
   /// surface (as objects and meshes do: mapper/objects.h kObjectSurfaceBandVoxels).
   float surface_band_voxels = 2.0f;
+  /// Eq. 6 and the separation evidence count only voxels reached by pixels at least this many
+  /// pixels (Chebyshev) inside their mask's outline; Eq. 5 counts every pixel. A network's
+  /// outline errors put a band of each mask on its neighbours: counted as co-observation,
+  /// they tie every small piece at an object's rim to the floor or wall around it as strongly
+  /// as if one mask had covered both (not in the paper; 0 = every pixel, as the paper).
+  int pair_interior_px = 2;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -160,6 +166,7 @@ class GraphAccumulator {
   struct Group {
     int32_t label;
     int count;
+    int interior;  ///< of count, the voxels reached by a pixel inside the mask's outline
     Eigen::Vector3d sum;
     Eigen::Vector3d centroid;
   };
@@ -177,7 +184,8 @@ class GraphAccumulator {
     bool thing;  ///< a thing mask of a class with two or more things in the frame
     std::vector<Group> groups;
   };
-  std::vector<MaskGroups> mask_groups_;                  // scratch
+  std::vector<MaskGroups> mask_groups_;  // scratch
+  Image<uint8_t> interior_;              // per pixel: inside its mask by pair_interior_px, scratch
   absl::flat_hash_map<int32_t, size_t> group_index_;     // label -> groups_ index, scratch
   std::map<int32_t, std::map<int32_t, double>> scores_;  // label -> class -> P_nu
   EdgeTable edges_;  // (a<b) -> class C -> P_eps^C, -C -> P_sep^C, 0 -> P_apart

@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "panmap/core/image.h"
+
 namespace panmap::internal {
 
 /// A sampled pixel's mask, the voxel its ray reaches and that voxel's super-point. The voxel is
@@ -16,6 +18,21 @@ struct MaskHit {
   }
   bool operator==(const MaskHit& o) const { return mask == o.mask && voxel == o.voxel; }
 };
+
+/// The largest mask id a MaskHit can carry (its key is twice the id, plus one when interior).
+constexpr int32_t kMaxMaskHitId = (int32_t{1} << 30) - 1;
+
+/// MaskHit::mask for a pixel of mask `id` (1..kMaxMaskHitId): even near the mask's outline,
+/// odd inside it, so that both kinds of one mask sort next to each other.
+inline int32_t maskHitKey(int32_t id, bool interior) { return 2 * id + (interior ? 1 : 0); }
+
+/// The mask id of a MaskHit::mask key.
+inline int32_t maskOfHitKey(int32_t key) { return key >> 1; }
+
+/// Per pixel 1 where every pixel within `radius_px` (Chebyshev) has the same segment id,
+/// else 0: the pixels at least radius_px inside their segment's outline (pixels outside the
+/// image count as the same). Pixels of id 0 get 0 when radius_px > 0.
+void maskInterior(const Image<int32_t>& segment_ids, int radius_px, Image<uint8_t>* interior);
 
 /// The voxel key of a MaskHit for global voxel coordinates (x, y, z).
 inline uint64_t maskHitVoxelKey(int x, int y, int z) {
