@@ -8,6 +8,7 @@
 #include <memory>
 #include <set>
 #include <sstream>
+#include <string>
 #include <tuple>
 
 #include "panmap/core/error.h"
@@ -188,8 +189,10 @@ void checkFrame(const MapperConfig& config, const RgbdFrame& frame, const Eigen:
     }
     std::set<int32_t> ids;
     for (const PanopticSegment& seg : panoptic->segments) {
-      if (seg.id <= 0 || !ids.insert(seg.id).second) {
-        throw Error("panoptic segment ids must be positive and unique");
+      if (seg.id <= 0 || seg.id > kMaxPanopticSegmentId || !ids.insert(seg.id).second) {
+        throw Error("panoptic segment ids must be unique and in 1.." +
+                    std::to_string(kMaxPanopticSegmentId) + " (got " + std::to_string(seg.id) +
+                    ")");
       }
       if (!(seg.score >= 0.0f && seg.score <= 1.0f)) throw Error("panoptic score outside [0, 1]");
     }

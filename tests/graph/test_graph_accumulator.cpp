@@ -209,10 +209,52 @@ TEST_F(WallGraph, TwoMasksGiveSeparationAndApartEvidence) {
   EXPECT_EQ(g.edges[0].confidences.count(0), 0u);  // the keys below 1 stay out of P_eps
 }
 
+// A network's outline errors put a band of each mask on its neighbour: those pixels vote
+// (Eq. 5) but tie nothing (Eq. 6) unless they lie pair_interior_px inside the mask.
+TEST_F(WallGraph, CoObservationLeavesOutTheBandAlongAMasksOutline) {
+  TsdfMap map(TsdfMap::Config{0.05f});
+  SuperpointTracker tracker(SuperpointConfig{});
+  step(&tracker, &map, columns(384, 640, 5, 1, 0));  // a chair part (1) and a wall part (2)
+  // The chair mask reaches 16 px onto the wall part; the wall mask has the rest.
+  PanopticFrame bleed;
+  bleed.segment_ids = LabelImage(640, 480, 0);
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 640; ++u) bleed.segment_ids(u, v) = u < 400 ? 1 : 2;
+  }
+  bleed.segments = {PanopticSegment{1, 5, 5, true, 0.8f}, PanopticSegment{2, 1, 1, false, 1.0f}};
+  GraphConfig every, inside;
+  every.pair_interior_px = 0;
+  inside.pair_interior_px = 20;
+  GraphAccumulator a(every), b(inside);
+  a.update(frame_, T_W_C_, bleed, map, tracker);
+  b.update(frame_, T_W_C_, bleed, map, tracker);
+  // Every pixel (the paper): the band ties the wall part to the chair as if one mask held both.
+  ASSERT_EQ(a.confidences(1, 2).count(5), 1u);
+  EXPECT_GT(a.confidences(1, 2).at(5), 0.0);
+  // 20 px inside the outline: no tie, and the same votes.
+  EXPECT_TRUE(b.confidences(1, 2).empty());
+  ASSERT_GT(a.scores(2).count(5), 0u);
+  EXPECT_EQ(b.scores(1), a.scores(1));
+  EXPECT_EQ(b.scores(2), a.scores(2));
+  // A mask over both parts, far from its outline, still ties them.
+  b.update(frame_, T_W_C_, wholeMask(), map, tracker);
+  ASSERT_EQ(b.confidences(1, 2).count(5), 1u);
+  EXPECT_GT(b.confidences(1, 2).at(5), 0.0);
+  // A segment id beyond what a hit key holds is named, and nothing is added.
+  PanopticFrame huge = wholeMask();
+  huge.segments[0].id = internal::kMaxMaskHitId + 1;
+  const auto before = b.scores(1);
+  EXPECT_THROW(b.update(frame_, T_W_C_, huge, map, tracker), Error);
+  EXPECT_EQ(b.scores(1), before);
+}
+
 TEST(GraphAccumulator, RejectsBadInput) {
   GraphConfig bad;
   bad.spatial_scale_m = 0.0;
   EXPECT_THROW(GraphAccumulator{bad}, Error);
+  GraphConfig band;
+  band.pair_interior_px = -1;
+  EXPECT_THROW(GraphAccumulator{band}, Error);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The graph update's sort of (mask, voxel) hits against std::sort + std::unique.
 #include <algorithm>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -76,6 +77,68 @@ TEST(MaskHits, EdgeCases) {
     corners.push_back({maskHitVoxelKey(i & 1 ? -1 : 0, i & 2 ? -1 : 0, i & 4 ? -1 : 0), i % 3, 1});
   }
   expectSameAsReference(corners);
+}
+
+// Rows of a small id image, one character per pixel ('0'-'9' the id), and back.
+Image<int32_t> ids(const std::vector<std::string>& rows) {
+  Image<int32_t> image(static_cast<int>(rows[0].size()), static_cast<int>(rows.size()));
+  for (size_t v = 0; v < rows.size(); ++v) {
+    for (size_t u = 0; u < rows[v].size(); ++u) {
+      image(static_cast<int>(u), static_cast<int>(v)) = rows[v][u] - '0';
+    }
+  }
+  return image;
+}
+
+std::vector<std::string> rowsOf(const Image<uint8_t>& image) {
+  std::vector<std::string> rows;
+  for (int v = 0; v < image.height(); ++v) {
+    std::string row;
+    for (int u = 0; u < image.width(); ++u) row += static_cast<char>('0' + image(u, v));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+TEST(MaskHits, InteriorLeavesOutTheBandAlongEveryOutline) {
+  // Mask 1 left, mask 2 right, no mask (0) in a corner; the image's own border is no outline.
+  const Image<int32_t> image = ids({"11111122",  //
+                                    "11111122",  //
+                                    "11111122",  //
+                                    "11111122",  //
+                                    "00111122"});
+  Image<uint8_t> interior;
+  internal::maskInterior(image, 1, &interior);
+  // Radius 1: the pixels on either side of an outline (4-neighbours differ) and no-mask pixels.
+  EXPECT_EQ(rowsOf(interior), (std::vector<std::string>{"11111001",  //
+                                                        "11111001",  //
+                                                        "11111001",  //
+                                                        "00111001",  //
+                                                        "00011001"}));
+  internal::maskInterior(image, 2, &interior);
+  // Radius 2: also every pixel whose 3 x 3 neighbourhood holds one of those.
+  EXPECT_EQ(rowsOf(interior), (std::vector<std::string>{"11110000",  //
+                                                        "11110000",  //
+                                                        "00010000",  //
+                                                        "00000000",  //
+                                                        "00000000"}));
+  // Along one row: radius r leaves out r pixels on each side of the outline.
+  internal::maskInterior(ids({"111111111222"}), 2, &interior);
+  EXPECT_EQ(rowsOf(interior), (std::vector<std::string>{"111111100001"}));
+  internal::maskInterior(ids({"111111111222"}), 3, &interior);
+  EXPECT_EQ(rowsOf(interior), (std::vector<std::string>{"111111000000"}));
+}
+
+TEST(MaskHits, KeysKeepTheMaskAndSortItsTwoKindsTogether) {
+  for (const int32_t id : {1, 7, internal::kMaxMaskHitId}) {
+    for (const bool interior : {false, true}) {
+      const int32_t key = internal::maskHitKey(id, interior);
+      EXPECT_EQ(internal::maskOfHitKey(key), id);
+      EXPECT_EQ(key % 2 == 1, interior);
+    }
+    EXPECT_EQ(internal::maskHitKey(id, true), internal::maskHitKey(id, false) + 1);
+  }
+  EXPECT_LT(internal::maskHitKey(7, true), internal::maskHitKey(8, false));
 }
 
 }  // namespace

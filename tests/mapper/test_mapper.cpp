@@ -301,6 +301,10 @@ TEST_F(BoxScene, BadInputIsRefusedAndTheMapIsUnharmed) {
   if (!duplicate.segments.empty()) {
     duplicate.segments.push_back(duplicate.segments.front());
     EXPECT_THROW(mapper->integrate(frame, pose(3), &duplicate), Error);
+    PanopticFrame huge = panoptic;
+    huge.segments.front().id = kMaxPanopticSegmentId + 1;
+    test::expectError([&] { mapper->integrate(frame, pose(3), &huge); },
+                      {"panoptic segment ids", "1073741823", "got 1073741824"});
   }
   mapper->save(dir.path("after.panmap"));
   EXPECT_EQ(readFileBytes(dir.path("before.panmap")), readFileBytes(dir.path("after.panmap")));
@@ -346,12 +350,27 @@ size_t calibrationFlagAt(const MapperConfig& config) {
   return threads + sizeof(int32_t);
 }
 
+constexpr size_t kFillBytes = 1 + sizeof(double) + sizeof(int32_t);
+
+// A file of today's `config` (without a calibration) without the co-observation band that
+// version 15 added after the mask edge fill (an int32): its layout of version 14.
+std::vector<uint8_t> withoutPairInterior(std::vector<uint8_t> file, const MapperConfig& config) {
+  const size_t at = calibrationFlagAt(config) + 1 + kFillBytes;
+  EXPECT_LT(at + sizeof(int32_t), file.size());
+  int32_t stored = -1;
+  std::memcpy(&stored, &file[at], sizeof(stored));
+  EXPECT_EQ(stored, config.graph.pair_interior_px);
+  file.erase(file.begin() + static_cast<std::ptrdiff_t>(at),
+             file.begin() + static_cast<std::ptrdiff_t>(at + sizeof(int32_t)));
+  return file;
+}
+
 // A file of today's `config` (without a calibration) without the mask edge fill that version
-// 14 added after the calibration flag (a flag, a double and an int32): its layout of versions
-// 12 and 13.
+// 14 added after the calibration flag (a flag, a double and an int32) and what came after it:
+// its layout of versions 12 and 13.
 std::vector<uint8_t> withoutMaskFill(std::vector<uint8_t> file, const MapperConfig& config) {
+  file = withoutPairInterior(std::move(file), config);
   const size_t flag = calibrationFlagAt(config);
-  constexpr size_t kFillBytes = 1 + sizeof(double) + sizeof(int32_t);
   EXPECT_LT(flag + kFillBytes, file.size());
   EXPECT_EQ(file[flag], 0);  // no calibration
   EXPECT_EQ(file[flag + 1], config.mask_edge_fill.enabled ? 1 : 0);
@@ -390,7 +409,7 @@ std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, u
   return reseal(std::move(file), version);
 }
 
-TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToFourteen) {
+TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToFifteen) {
   MapperConfig a;
   a.map.voxel_size_m = 0.05f;
   a.graph.prune_edges = false;
@@ -462,16 +481,23 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToFourteen) {
       Mapper::deserialize(reseal(withoutMaskFill(Mapper(fill).serialize(), fill), 13), "13.panmap")
           ->config()
           .mask_edge_fill.enabled);
-  const auto fourteen = Mapper::deserialize(Mapper(fill).serialize(), "14.panmap");
+  fill.graph.pair_interior_px = 3;
+  const auto fourteen = Mapper::deserialize(
+      reseal(withoutPairInterior(Mapper(fill).serialize(), fill), 14), "14.panmap");
   EXPECT_TRUE(fourteen->config().mask_edge_fill.enabled);
   EXPECT_EQ(fourteen->config().mask_edge_fill.max_depth_step, 0.02);
   EXPECT_EQ(fourteen->config().mask_edge_fill.max_distance_px, 9);
+  // A version 14 file counted every pixel of a mask as co-observation; version 15 keeps its band.
+  EXPECT_EQ(fourteen->config().graph.pair_interior_px, 0);
+  EXPECT_EQ(
+      Mapper::deserialize(Mapper(fill).serialize(), "15.panmap")->config().graph.pair_interior_px,
+      3);
 
-  // Versions outside 5-14 are refused by name.
+  // Versions outside 5-15 are refused by name.
   std::vector<uint8_t> future = Mapper(b).serialize();
-  future[8] = 15;
+  future[8] = 16;
   test::expectError([&] { Mapper::deserialize(future, "future.panmap"); },
-                    {"future.panmap", "version 15", "reads 5 to 14"});
+                    {"future.panmap", "version 16", "reads 5 to 15"});
 }
 
 // Bytes before a block's voxels in a map file: its index and its updated flag.
@@ -641,12 +667,12 @@ TEST_F(BoxScene, MapFileVotesRoundTripAndBadVoteListsAreRefused) {
   const size_t second_at = count_at + 2 + 2 + sizeof(VoxelVotes);
   std::vector<uint8_t> repeated = file;  // the second voted voxel's index made the first's
   std::memcpy(&repeated[second_at], &file[count_at + 2], 2);
-  test::expectError([&] { Mapper::deserialize(reseal(repeated, 14), "repeated.panmap"); },
+  test::expectError([&] { Mapper::deserialize(reseal(repeated, 15), "repeated.panmap"); },
                     {"repeated.panmap", "out of order"});
   std::vector<uint8_t> too_many = file;
   const uint16_t n = kBlockVoxels + 1;
   std::memcpy(&too_many[count_at], &n, 2);
-  test::expectError([&] { Mapper::deserialize(reseal(too_many, 14), "many.panmap"); },
+  test::expectError([&] { Mapper::deserialize(reseal(too_many, 15), "many.panmap"); },
                     {"many.panmap", "513 voted voxels"});
 }
 

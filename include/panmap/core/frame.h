@@ -20,10 +20,14 @@ struct RgbdFrame {
   ColorImage color;              ///< same size as depth, or empty when the source has no colour
 };
 
+/// The largest panoptic segment id the mapper takes (the graph update keys a mask's pixels by
+/// twice its id; network ids, COCO's category * 1000 + instance included, are far below).
+constexpr int32_t kMaxPanopticSegmentId = (int32_t{1} << 30) - 1;
+
 /// One segment of a 2D panoptic segmentation.
 struct PanopticSegment {
-  int32_t id = 0;               ///< pixel value in PanopticFrame::segment_ids (> 0)
-  int32_t category = 0;         ///< panmap class (NYU40 id); 0 = unknown
+  int32_t id = 0;        ///< pixel value in PanopticFrame::segment_ids (1..kMaxPanopticSegmentId)
+  int32_t category = 0;  ///< panmap class (NYU40 id); 0 = unknown
   int32_t source_category = 0;  ///< the segmenter's own category id
   bool is_thing = false;        ///< countable object (has an instance) vs stuff
   float score = 1.0f;           ///< segmenter confidence in [0, 1]

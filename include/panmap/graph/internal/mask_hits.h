@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "panmap/core/frame.h"
 #include "panmap/core/image.h"
 
 namespace panmap::internal {
@@ -20,7 +21,7 @@ struct MaskHit {
 };
 
 /// The largest mask id a MaskHit can carry (its key is twice the id, plus one when interior).
-constexpr int32_t kMaxMaskHitId = (int32_t{1} << 30) - 1;
+constexpr int32_t kMaxMaskHitId = kMaxPanopticSegmentId;
 
 /// MaskHit::mask for a pixel of mask `id` (1..kMaxMaskHitId): even near the mask's outline,
 /// odd inside it, so that both kinds of one mask sort next to each other.
