@@ -348,6 +348,7 @@ size_t GraphAccumulator::memoryBytes() const {
              vectorBytes(scratch.samples) + vectorBytes(scratch.masks) +
              vectorBytes(scratch.labels) + vectorBytes(scratch.voxels);
   }
+  bytes += static_cast<size_t>(interior_.width()) * interior_.height();
   bytes += vectorBytes(groups_) +
            group_index_.capacity() * (sizeof(std::pair<const int32_t, size_t>) + 1);
   return bytes + vectorBytes(hits_) + vectorBytes(merged_);

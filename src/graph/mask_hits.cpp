@@ -96,14 +96,6 @@ void maskInterior(const Image<int32_t>& segment_ids, int radius_px, Image<uint8_
     }
   }
   cv::Mat eroded(h, w, CV_8U, interior->data());
-  if (radius_px <= 0) {
-    for (int v = 0; v < h; ++v) {
-      const int32_t* ids = segment_ids.row(v);
-      uint8_t* out = eroded.ptr<uint8_t>(v);
-      for (int u = 0; u < w; ++u) out[u] = ids[u] != 0 ? 1 : 0;
-    }
-    return;
-  }
   const int k = 2 * radius_px - 1;  // the outline pixels themselves are already 0
   if (k > 1) {
     cv::erode(same, eroded, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)));

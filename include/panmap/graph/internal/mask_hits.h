@@ -30,9 +30,9 @@ inline int32_t maskHitKey(int32_t id, bool interior) { return 2 * id + (interior
 /// The mask id of a MaskHit::mask key.
 inline int32_t maskOfHitKey(int32_t key) { return key >> 1; }
 
-/// Per pixel 1 where every pixel within `radius_px` (Chebyshev) has the same segment id,
-/// else 0: the pixels at least radius_px inside their segment's outline (pixels outside the
-/// image count as the same). Pixels of id 0 get 0 when radius_px > 0.
+/// Per pixel 1 for the pixels at least `radius_px` (>= 1) inside their segment's outline, else
+/// 0: no pixel within radius_px - 1 (Chebyshev) is an outline pixel, one with a 4-neighbour of
+/// another id (pixels outside the image count as the same id). Pixels of id 0 get 0.
 void maskInterior(const Image<int32_t>& segment_ids, int radius_px, Image<uint8_t>* interior);
 
 /// The voxel key of a MaskHit for global voxel coordinates (x, y, z).
