@@ -11,6 +11,7 @@
 #include "panmap/core/classes.h"
 #include "panmap/core/container_memory.h"
 #include "panmap/core/error.h"
+#include "panmap/core/known_segments.h"
 #include "panmap/map/voxel.h"
 
 namespace panmap {
@@ -151,14 +152,9 @@ void GraphAccumulator::update(const RgbdFrame& frame, const Eigen::Isometry3d& T
   }
   mask_groups_.clear();
   if (masks.empty()) return;
-  // Per-pixel membership test without a tree lookup: ids are small in practice (a network's
-  // segments of one frame); larger ones fall back to the map.
-  constexpr int32_t kDenseIds = 4096;
-  std::vector<uint8_t> known(kDenseIds, 0);
-  for (const auto& [id, unused] : masks) {
-    if (id < kDenseIds) known[id] = 1;
-  }
-  auto isKnown = [&](int32_t id) { return id < kDenseIds ? known[id] != 0 : masks.count(id) != 0; };
+  // The same segments as `masks`, tested per pixel without a tree lookup.
+  const KnownSegments known(panoptic);
+  auto isKnown = [&known](int32_t id) { return known.contains(id); };
 
   // Voxels reached by each mask's rays: (mask, voxel key, super-point) per sampled pixel. Rows
   // are split between threads; concatenated in row order they are what one thread would find.

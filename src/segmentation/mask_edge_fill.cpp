@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
-#include <unordered_set>
 
 #include "panmap/core/error.h"
+#include "panmap/core/known_segments.h"
 
 namespace panmap {
 
@@ -29,24 +29,9 @@ int64_t fillMaskEdges(const DepthImage& depth, const PanopticFrame& masks,
       masks.segment_ids.height() != h) {
     throw Error("mask edge fill: depth, mask and label images differ in size");
   }
-  // Masks of a known class (a category-0 segment names no class to vote for), as a flag per
-  // id: the loops below test every pixel. Ids are a network's segments of one frame, small in
-  // practice; a larger one is looked up in the set.
-  constexpr int32_t kDenseIds = 1 << 16;
-  std::vector<uint8_t> known_dense(kDenseIds, 0);
-  std::unordered_set<int32_t> known_sparse;
-  for (const PanopticSegment& s : masks.segments) {
-    if (s.category <= 0 || s.id <= 0) continue;
-    if (s.id < kDenseIds) {
-      known_dense[static_cast<size_t>(s.id)] = 1;
-    } else {
-      known_sparse.insert(s.id);
-    }
-  }
-  auto known = [&](int32_t id) {
-    return id > 0 && (id < kDenseIds ? known_dense[static_cast<size_t>(id)] != 0
-                                     : known_sparse.count(id) != 0);
-  };
+  // Masks of a known class: a category-0 segment names no class to vote for.
+  const KnownSegments known_segments(masks);
+  auto known = [&known_segments](int32_t id) { return known_segments.contains(id); };
   const int32_t* mask = masks.segment_ids.data();
   const uint16_t* d = depth.data();
   int32_t* label = labels->data();
