@@ -383,6 +383,8 @@ void lcmSeeds() {
   status.stage_names = {"integration"};
   status.stage_median_ms = {2.5f};
   status.stage_last_ms = {3.0f};
+  status.depth_check = "pending";
+  status.depth_pattern_mm = -1.0f;
   seed("lcm_messages", "status", selected(3, status));
   panmap::MappedObject o;
   o.id = 2;

@@ -62,7 +62,11 @@ nlohmann::json statusJson(const panmap::status_t& s) {
           {"last_correction_id", s.last_correction_id},
           {"repair_frames_done", s.repair_frames_done},
           {"repair_frames_total", s.repair_frames_total},
-          {"last_repair_s", s.last_repair_s}};
+          {"last_repair_s", s.last_repair_s},
+          {"poses_corrected", s.poses_corrected},
+          {"poses_kept_as_given", s.poses_kept_as_given},
+          {"depth_check", s.depth_check},
+          {"depth_pattern_mm", s.depth_pattern_mm}};
 }
 
 struct StatusCatcher {

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -76,6 +77,43 @@ nlohmann::json trackingJson(const panmap::Mapper& mapper) {
   return out;
 }
 
+// Auto tracking's depth check (MapperConfig::depth_check) and what became of the poses.
+nlohmann::json depthCheckJson(const panmap::Mapper& mapper) {
+  const panmap::DepthPatternMonitor& check = mapper.depthCheck();
+  const double pattern_m = check.patternRmsM();
+  return {{"verdict", panmap::DepthPatternMonitor::name(check.verdict())},
+          {"frames", check.frames()},
+          {"pattern_mm",
+           std::isfinite(pattern_m) ? nlohmann::json(1000.0 * pattern_m) : nlohmann::json(nullptr)},
+          {"limit_mm", 1000.0 * mapper.config().depth_check.max_pattern_m},
+          {"poses_corrected", mapper.posesCorrected()},
+          {"poses_kept_as_given", mapper.posesKeptAsGiven()}};
+}
+
+// When the depth check kept poses as given, why, and what to do about it.
+void printDepthCheck(const panmap::Mapper& mapper) {
+  const panmap::DepthPatternMonitor& check = mapper.depthCheck();
+  if (mapper.posesKeptAsGiven() == 0) return;
+  if (check.verdict() == panmap::DepthPatternMonitor::Verdict::kUncalibrated) {
+    std::printf(
+        "  pose refinement withheld: over %d aligned frames the depth disagreed with the map in a "
+        "fixed pattern of %.1f mm RMS (limit %.1f mm), the mark of an uncalibrated sensor that "
+        "would pull good poses away; %lld poses kept as given. Calibrate the sensor "
+        "(panmap-calibrate-depth, then --depth-calibration FILE) or force refinement with "
+        "--tracking on\n",
+        check.frames(), 1000.0 * check.patternRmsM(),
+        1000.0 * mapper.config().depth_check.max_pattern_m,
+        static_cast<long long>(mapper.posesKeptAsGiven()));
+  } else {
+    std::printf(
+        "  pose refinement: %lld poses kept as given while the depth check (%s after %d "
+        "frames) judged the sensor, %lld corrected\n",
+        static_cast<long long>(mapper.posesKeptAsGiven()),
+        panmap::DepthPatternMonitor::name(check.verdict()), check.frames(),
+        static_cast<long long>(mapper.posesCorrected()));
+  }
+}
+
 // Seconds each export step took, by step name.
 nlohmann::json exportSeconds(const panmap::OutputSummary& outputs) {
   nlohmann::json out = nlohmann::json::object();
@@ -98,6 +136,7 @@ nlohmann::json mapJson(const panmap::Mapper& mapper, const panmap::OutputSummary
           {"objects", outputs.objects},
           {"vote_evictions", mapper.voteEvictions()},
           {"tracking", trackingJson(mapper)},
+          {"depth_check", depthCheckJson(mapper)},
           {"mesh",
            {{"vertices", outputs.mesh_vertices},
             {"faces", outputs.mesh_faces},
@@ -451,6 +490,7 @@ int main(int argc, char** argv) {
           out_dir.c_str());
       printRejected(report.rejected);
       printRefinement(report.refinement);
+      printDepthCheck(*mapper);
       return 0;
     }
 
@@ -550,6 +590,7 @@ int main(int argc, char** argv) {
         labels ? " after optimisation" : " (unoptimised)", outputs.mesh_vertices, out_dir.c_str());
     printRejected(stats.rejected);
     printRefinement(stats.refinement);
+    printDepthCheck(*mapper);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-mapper: error: %s\n", e.what());

@@ -1,6 +1,7 @@
 #include "panmap/lcm/live_mapper.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "panmap/command_t.hpp"
@@ -266,6 +267,12 @@ status_t LiveMapper::status(const std::string& state) const {
   msg.repair_frames_done = s.repair_frames_done;
   msg.repair_frames_total = s.repair_frames_total;
   msg.last_repair_s = static_cast<float>(s.last_repair_s);
+  msg.poses_corrected = mapper_->posesCorrected();
+  msg.poses_kept_as_given = mapper_->posesKeptAsGiven();
+  const DepthPatternMonitor& check = mapper_->depthCheck();
+  msg.depth_check = DepthPatternMonitor::name(check.verdict());
+  const double pattern_m = check.patternRmsM();
+  msg.depth_pattern_mm = std::isfinite(pattern_m) ? static_cast<float>(1000.0 * pattern_m) : -1.0f;
   return msg;
 }
 

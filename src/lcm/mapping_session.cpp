@@ -249,7 +249,7 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
       const FrameStats s =
           mapper_->integrate(f.frame, f.T_W_C, f.panoptic ? &*f.panoptic : nullptr, f.pose_source);
       for (const auto& [stage, ms] : s.stageTimes()) times_ms_[stage].push_back(ms);
-      if (s.tracked) {
+      if (s.tracked && !s.pose_kept) {
         refinement_moved_m_.push_back((s.T_W_C.translation() - f.T_W_C.translation()).norm());
         refinement_turned_deg_.push_back(
             Eigen::AngleAxisd(f.T_W_C.linear().transpose() * s.T_W_C.linear()).angle() * 180.0 /

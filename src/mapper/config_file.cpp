@@ -249,6 +249,8 @@ PanmapConfig loadConfig(const std::string& path) {
       s.fail("tracking.correction must be per_frame or filter, not \"" + correction + "\"");
     }
     s.read("warmup_frames", &m.tracking_warmup_frames);
+    s.read("depth_check_frames", &m.depth_check.frames);
+    s.read("max_depth_pattern_m", &m.depth_check.max_pattern_m);
     s.read("max_iterations", &t.max_iterations);
     s.read("robust_scale_m", &t.robust_scale_m);
     s.read("point_sigma_m", &t.point_sigma_m);
@@ -462,6 +464,10 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   mode: \"" << mode
     << "\"   # refine poses against the map - off, auto (SLAM or odometry poses) or on\n"
     << "   warmup_frames: " << m.tracking_warmup_frames << "   # frames mapped before refining\n"
+    << "   depth_check_frames: " << m.depth_check.frames
+    << "   # auto: aligned frames that judge the depth before poses are corrected (0: trust it)\n"
+    << "   max_depth_pattern_m: " << m.depth_check.max_pattern_m
+    << "   # auto: a fixed depth error pattern above this keeps every pose as given\n"
     << "   correction: \""
     << (m.tracking_correction == MapperConfig::PoseCorrection::kFilter ? "filter" : "per_frame")
     << "\"   # per_frame (aligned pose used as is) or filter (smooth drift estimate, "

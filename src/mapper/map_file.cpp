@@ -38,7 +38,11 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 //     32-byte voxels are split on loading.
 // 14: fusion's mask edge fill (MaskEdgeFillConfig); older files load with it off, as they were
 //     built.
-constexpr uint32_t kVersion = 15;
+// 15: the graph's outline band (GraphConfig::pair_interior_px); older files load with 0.
+// 16: the depth check of auto tracking (MapperConfig::depth_check) and its state, and the
+//     counts of poses kept as given and corrected; older files load with the check off
+//     (frames 0), as they were built.
+constexpr uint32_t kVersion = 16;
 
 // Bytes of one voxel's votes in a file: four slots of a 4-byte label and a 2-byte count.
 constexpr size_t kVoteSetBytes = kVoteSlots * 6;
@@ -241,6 +245,9 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put(c.mask_edge_fill.max_depth_step);
   w->put<int32_t>(c.mask_edge_fill.max_distance_px);
   w->put<int32_t>(c.graph.pair_interior_px);
+  const DepthPatternMonitor::Config& k = c.depth_check;
+  for (int v : {k.frames, k.min_cell_points, k.min_cell_frames, k.min_cells}) w->put<int32_t>(v);
+  w->put(k.max_pattern_m);
 }
 
 MapperConfig getConfig(BinaryReader* r, uint32_t version) {
@@ -329,6 +336,15 @@ MapperConfig getConfig(BinaryReader* r, uint32_t version) {
   }
   // Older maps counted every pixel of a mask as co-observation: they go on as they began.
   c.graph.pair_interior_px = version >= 15 ? r->get<int32_t>() : 0;
+  DepthPatternMonitor::Config& k = c.depth_check;
+  if (version >= 16) {
+    for (int* v : {&k.frames, &k.min_cell_points, &k.min_cell_frames, &k.min_cells}) {
+      *v = r->get<int32_t>();
+    }
+    k.max_pattern_m = r->get<double>();
+  } else {
+    k.frames = 0;
+  }
   return c;
 }
 
@@ -503,6 +519,18 @@ void Mapper::serialize(ByteSink* sink) const {
   putPose(&payload, drift.correction);
   for (int i = 0; i < 36; ++i) payload.put(drift.covariance.data()[i]);
   for (int64_t n : tracking_counts_) payload.put(n);
+  const DepthPatternMonitor::State check = depth_check_.state();
+  payload.put<int8_t>(static_cast<int8_t>(check.verdict));
+  payload.put<int32_t>(check.frames);
+  for (int h = 0; h < 2; ++h) {
+    payload.put<uint64_t>(check.cell_frames[h].size());
+    for (size_t i = 0; i < check.cell_frames[h].size(); ++i) {
+      payload.put(check.cell_mean_sum_m[h][i]);
+      payload.put<int32_t>(check.cell_frames[h][i]);
+    }
+  }
+  payload.put(poses_kept_);
+  payload.put(poses_corrected_);
   payload.put<uint64_t>(trajectory_.size());
   for (const StampedPose& p : trajectory_) {
     payload.put(p.utime);
@@ -684,6 +712,25 @@ std::unique_ptr<Mapper> Mapper::parsePayload(BinaryReader* reader, uint32_t vers
   for (int i = 0; i < 36; ++i) drift.covariance.data()[i] = r.get<double>();
   mapper->drift_.restore(drift);
   for (int64_t& n : mapper->tracking_counts_) n = r.get<int64_t>();
+  if (version >= 16) {
+    DepthPatternMonitor::State check;
+    const int8_t verdict = r.get<int8_t>();
+    if (verdict < 0 || verdict > 2) throw Error(path + ": unknown depth check verdict");
+    check.verdict = static_cast<DepthPatternMonitor::Verdict>(verdict);
+    check.frames = r.get<int32_t>();
+    for (int h = 0; h < 2; ++h) {
+      const size_t cells = r.getCount(sizeof(double) + sizeof(int32_t));
+      check.cell_mean_sum_m[h].resize(cells);
+      check.cell_frames[h].resize(cells);
+      for (size_t i = 0; i < cells; ++i) {
+        check.cell_mean_sum_m[h][i] = r.get<double>();
+        check.cell_frames[h][i] = r.get<int32_t>();
+      }
+    }
+    mapper->depth_check_.restore(check);
+    mapper->poses_kept_ = r.get<int64_t>();
+    mapper->poses_corrected_ = r.get<int64_t>();
+  }
   mapper->trajectory_.resize(r.getCount(17 + 12 * sizeof(double)));
   for (StampedPose& p : mapper->trajectory_) {
     p.utime = r.get<int64_t>();

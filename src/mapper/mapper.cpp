@@ -29,11 +29,15 @@ void MapperConfig::check() const {
   occupancy.check();
   tracking.check();
   drift.check();
+  depth_check.check();
   if (tracking_warmup_frames < 0) throw Error("mapper tracking_warmup_frames must be >= 0");
   if (num_threads < 1 || num_threads > 256) throw Error("mapper num_threads must be in [1, 256]");
 }
 
-Mapper::Mapper(const MapperConfig& config) : config_(config), drift_(config.drift) {
+Mapper::Mapper(const MapperConfig& config)
+    : config_(config),
+      drift_(config.drift),
+      depth_check_(config.depth_check, kResidualCellsX * kResidualCellsY) {
   config_.check();
   pool_ = std::make_unique<ThreadPool>(config_.num_threads);
   map_ = std::make_unique<TsdfMap>(config_.map);
@@ -232,10 +236,17 @@ FrameStats Mapper::integrate(const RgbdFrame& raw_frame, const Eigen::Isometry3d
   const auto t_start = Clock::now();
   // Refine the pose against the map first: every later stage then sees the refined pose.
   Eigen::Isometry3d T_W_C = T_W_C_given;
-  const bool track = config_.tracking_mode == MapperConfig::TrackingMode::kOn ||
-                     (config_.tracking_mode == MapperConfig::TrackingMode::kAuto &&
-                      (source == PoseSource::kSlam || source == PoseSource::kOdometry));
-  if (track) {
+  const bool forced = config_.tracking_mode == MapperConfig::TrackingMode::kOn;
+  const bool track = forced || (config_.tracking_mode == MapperConfig::TrackingMode::kAuto &&
+                                (source == PoseSource::kSlam || source == PoseSource::kOdometry));
+  // Auto mode corrects poses only with depth it can trust (MapperConfig::depth_check): the
+  // first frames are aligned to judge the depth but integrated as given.
+  const DepthPatternMonitor::Verdict verdict =
+      forced || calibrated ? DepthPatternMonitor::Verdict::kTrusted : depth_check_.verdict();
+  if (track && verdict == DepthPatternMonitor::Verdict::kUncalibrated) {
+    stats.pose_kept = true;
+    ++poses_kept_;
+  } else if (track) {
     // The drift estimate follows every tracked frame (its uncertainty grows with the motion),
     // the map corrects it once it has a model to align against.
     const Eigen::Isometry3d prior = drift_.predict(T_W_C_given);
@@ -245,9 +256,15 @@ FrameStats Mapper::integrate(const RgbdFrame& raw_frame, const Eigen::Isometry3d
       stats.tracked = true;
       stats.tracking_status = result.status;
       ++tracking_counts_[static_cast<size_t>(result.status)];
-      // A refused frame keeps the predicted correction rather than jumping back to the raw
-      // pose, which would tear the map where it joins the corrected part.
-      if (result.accepted) {
+      if (verdict == DepthPatternMonitor::Verdict::kPending) {
+        // Judging the depth: the pose stays as given whatever the alignment says.
+        if (result.accepted) depth_check_.add(result.cell_sum_m, result.cell_count);
+        stats.pose_kept = true;
+        ++poses_kept_;
+      } else if (result.accepted) {
+        // A refused frame keeps the predicted correction rather than jumping back to the raw
+        // pose, which would tear the map where it joins the corrected part.
+        ++poses_corrected_;
         T_W_C = config_.tracking_correction == MapperConfig::PoseCorrection::kFilter
                     ? drift_.update(result.delta, result.information)
                     : drift_.adopt(result.T_W_C);

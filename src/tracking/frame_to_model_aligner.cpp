@@ -1,5 +1,6 @@
 #include "panmap/tracking/frame_to_model_aligner.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -111,6 +112,25 @@ std::vector<Eigen::Vector3f> selectPoints(const DepthImage& depth, const Pinhole
     }
   }
   return points_C;
+}
+
+// AlignmentResult::cell_sum_m and cell_count at `delta`.
+void cellResiduals(SdfResiduals* residuals, const Vector6d& delta, const PinholeCamera& camera,
+                   double inlier_distance_m, AlignmentResult* result) {
+  constexpr int kCells = kResidualCellsX * kResidualCellsY;
+  result->cell_sum_m.assign(kCells, 0.0);
+  result->cell_count.assign(kCells, 0);
+  for (const SdfResiduals::RayDistance& d : residuals->rayDistances(delta)) {
+    if (!(std::abs(d.along_ray_m) <= inlier_distance_m) || !(d.p_C.z() > 0.0f)) continue;
+    const double u = camera.fx * d.p_C.x() / d.p_C.z() + camera.cx;
+    const double v = camera.fy * d.p_C.y() / d.p_C.z() + camera.cy;
+    const int cx =
+        std::clamp(static_cast<int>(u * kResidualCellsX / camera.width), 0, kResidualCellsX - 1);
+    const int cy =
+        std::clamp(static_cast<int>(v * kResidualCellsY / camera.height), 0, kResidualCellsY - 1);
+    result->cell_sum_m[cy * kResidualCellsX + cx] += d.along_ray_m;
+    ++result->cell_count[cy * kResidualCellsX + cx];
+  }
 }
 
 // Runs Ceres on one level from *delta; returns false (with a message) when Ceres fails.
@@ -369,6 +389,7 @@ AlignmentResult FrameToModelAligner::align(const TsdfMap& map, const DepthImage&
   }
   result.solved_delta = delta;
   result.delta = delta;
+  cellResiduals(&residuals, delta, camera, config_.inlier_distance_m, &result);
   {
     Vector6d prior_information;
     prior_information << Eigen::Vector3d::Constant(

@@ -28,7 +28,10 @@ void robustLoss(RobustLoss loss, double scale_m, double s, double* rho, double* 
 SdfResiduals::SdfResiduals(const TsdfMap& map, const Eigen::Isometry3d& T_W_C_prior,
                            const std::vector<Eigen::Vector3f>& points_C,
                            const SdfResidualOptions& options)
-    : sampler_(map), t_W_C_prior_(T_W_C_prior.translation()), options_(options) {
+    : sampler_(map),
+      t_W_C_prior_(T_W_C_prior.translation()),
+      R_W_C_prior_(T_W_C_prior.linear()),
+      options_(options) {
   rays_W_.reserve(points_C.size());
   inv_scales_.reserve(points_C.size());
   const double relative = options.depth_noise_at_1m_m / options.point_sigma_m;
@@ -143,6 +146,24 @@ SdfFitStats SdfResiduals::statistics(const Vector6d& delta, double inlier_distan
     stats.weight_sum = weight_sum;
   }
   return stats;
+}
+
+std::vector<SdfResiduals::RayDistance> SdfResiduals::rayDistances(const Vector6d& delta) {
+  update(delta);
+  const Eigen::Matrix3d R = expSo3(delta.tail<3>());
+  std::vector<RayDistance> out;
+  out.reserve(static_cast<size_t>(in_map_));
+  for (size_t i = 0; i < rays_W_.size(); ++i) {
+    const Sample& sample = samples_[i];
+    if (!sample.in_map) continue;
+    const Eigen::Vector3d a_W = R * rays_W_[i];
+    const double norm = a_W.norm() * sample.gradient_W.cast<double>().norm();
+    const double cosine =
+        norm > 0.0 ? std::abs(a_W.dot(sample.gradient_W.cast<double>())) / norm : 1.0;
+    out.push_back({(R_W_C_prior_.transpose() * rays_W_[i]).cast<float>(),
+                   static_cast<float>(sample.sdf_m / std::max(cosine, 0.3))});
+  }
+  return out;
 }
 
 }  // namespace panmap

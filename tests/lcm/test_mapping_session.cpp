@@ -59,6 +59,7 @@ TEST_F(MappingSessionTest, RefinementReportsHowFarItMovedTheGivenPoses) {
   MapperConfig config = test::streamMapperConfig();
   // 160 x 120 frames: every other pixel, or too few points reach the map to align.
   config.tracking.level_strides_px = {4, 2};
+  config.depth_check.frames = 0;  // rendered depth: trusted without auto's check
   Mapper mapper(config);
   MappingSession session(SessionOptions{}, &mapper);
   feed(&session, slam.messages());

@@ -352,9 +352,41 @@ size_t calibrationFlagAt(const MapperConfig& config) {
 
 constexpr size_t kFillBytes = 1 + sizeof(double) + sizeof(int32_t);
 
+// Bytes of auto tracking's depth check in the config (version 16): four int32 and a double.
+constexpr size_t kDepthCheckConfigBytes = 4 * sizeof(int32_t) + sizeof(double);
+
+// A file of today's `config` (without a calibration) whose mapper never tracked a frame,
+// without what version 16 added: the depth check's config after the co-observation band, and
+// its state (a verdict byte, a frame count, two halves of per-cell sums and counts, the counts
+// of poses kept and corrected) after the tracking counts, found by its bytes. Its layout of
+// version 15.
+std::vector<uint8_t> withoutDepthCheck(std::vector<uint8_t> file, const MapperConfig& config) {
+  const size_t at = calibrationFlagAt(config) + 1 + kFillBytes + sizeof(int32_t);
+  EXPECT_LT(at + kDepthCheckConfigBytes, file.size());
+  int32_t frames = -1;
+  std::memcpy(&frames, &file[at], sizeof(frames));
+  EXPECT_EQ(frames, config.depth_check.frames);
+  file.erase(file.begin() + static_cast<std::ptrdiff_t>(at),
+             file.begin() + static_cast<std::ptrdiff_t>(at + kDepthCheckConfigBytes));
+  const uint64_t cells = kResidualCellsX * kResidualCellsY;
+  std::vector<uint8_t> state(1 + sizeof(int32_t), 0);
+  state[0] = config.depth_check.frames == 0 ? 1 : 0;  // trusted, or pending
+  for (int half = 0; half < 2; ++half) {
+    const size_t count_at = state.size();
+    state.resize(count_at + sizeof(uint64_t) + cells * (sizeof(double) + sizeof(int32_t)), 0);
+    std::memcpy(&state[count_at], &cells, sizeof(cells));
+  }
+  state.resize(state.size() + 2 * sizeof(int64_t), 0);
+  const auto found = std::search(file.begin(), file.end(), state.begin(), state.end());
+  EXPECT_NE(found, file.end());
+  if (found != file.end()) file.erase(found, found + static_cast<std::ptrdiff_t>(state.size()));
+  return file;
+}
+
 // A file of today's `config` (without a calibration) without the co-observation band that
 // version 15 added after the mask edge fill (an int32): its layout of version 14.
 std::vector<uint8_t> withoutPairInterior(std::vector<uint8_t> file, const MapperConfig& config) {
+  file = withoutDepthCheck(std::move(file), config);
   const size_t at = calibrationFlagAt(config) + 1 + kFillBytes;
   EXPECT_LT(at + sizeof(int32_t), file.size());
   int32_t stored = -1;
@@ -409,7 +441,7 @@ std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, u
   return reseal(std::move(file), version);
 }
 
-TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToFifteen) {
+TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToSixteen) {
   MapperConfig a;
   a.map.voxel_size_m = 0.05f;
   a.graph.prune_edges = false;
@@ -489,15 +521,25 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToFifteen) {
   EXPECT_EQ(fourteen->config().mask_edge_fill.max_distance_px, 9);
   // A version 14 file counted every pixel of a mask as co-observation; version 15 keeps its band.
   EXPECT_EQ(fourteen->config().graph.pair_interior_px, 0);
-  EXPECT_EQ(
-      Mapper::deserialize(Mapper(fill).serialize(), "15.panmap")->config().graph.pair_interior_px,
-      3);
+  fill.depth_check.frames = 12;
+  fill.depth_check.max_pattern_m = 0.002;
+  const auto fifteen = Mapper::deserialize(
+      reseal(withoutDepthCheck(Mapper(fill).serialize(), fill), 15), "15.panmap");
+  EXPECT_EQ(fifteen->config().graph.pair_interior_px, 3);
+  // A version 15 file refined poses with no depth check: it goes on trusting the depth.
+  EXPECT_EQ(fifteen->config().depth_check.frames, 0);
+  EXPECT_EQ(fifteen->depthCheck().verdict(), DepthPatternMonitor::Verdict::kTrusted);
+  // Version 16 keeps the check's settings and its state.
+  const auto sixteen = Mapper::deserialize(Mapper(fill).serialize(), "16.panmap");
+  EXPECT_EQ(sixteen->config().depth_check.frames, 12);
+  EXPECT_EQ(sixteen->config().depth_check.max_pattern_m, 0.002);
+  EXPECT_EQ(sixteen->depthCheck().verdict(), DepthPatternMonitor::Verdict::kPending);
 
-  // Versions outside 5-15 are refused by name.
+  // Versions outside 5-16 are refused by name.
   std::vector<uint8_t> future = Mapper(b).serialize();
-  future[8] = 16;
+  future[8] = 17;
   test::expectError([&] { Mapper::deserialize(future, "future.panmap"); },
-                    {"future.panmap", "version 16", "reads 5 to 15"});
+                    {"future.panmap", "version 17", "reads 5 to 16"});
 }
 
 // Bytes before a block's voxels in a map file: its index and its updated flag.
@@ -667,12 +709,12 @@ TEST_F(BoxScene, MapFileVotesRoundTripAndBadVoteListsAreRefused) {
   const size_t second_at = count_at + 2 + 2 + sizeof(VoxelVotes);
   std::vector<uint8_t> repeated = file;  // the second voted voxel's index made the first's
   std::memcpy(&repeated[second_at], &file[count_at + 2], 2);
-  test::expectError([&] { Mapper::deserialize(reseal(repeated, 15), "repeated.panmap"); },
+  test::expectError([&] { Mapper::deserialize(reseal(repeated, 16), "repeated.panmap"); },
                     {"repeated.panmap", "out of order"});
   std::vector<uint8_t> too_many = file;
   const uint16_t n = kBlockVoxels + 1;
   std::memcpy(&too_many[count_at], &n, 2);
-  test::expectError([&] { Mapper::deserialize(reseal(too_many, 15), "many.panmap"); },
+  test::expectError([&] { Mapper::deserialize(reseal(too_many, 16), "many.panmap"); },
                     {"many.panmap", "513 voted voxels"});
 }
 

@@ -98,6 +98,48 @@ TEST(Aligner, RecoversAKnownOffsetInTheRoom) {
   EXPECT_EQ(aligner.counts()[static_cast<int>(AlignmentStatus::kAccepted)], 3);
 }
 
+// The per-cell residuals after the fit (AlignmentResult::cell_sum_m, cell_count), which the
+// mapper's depth check reads: exact depth at the true pose agrees with the map everywhere;
+// depth whose left half reads 8 mm long leaves the left cells behind the surface and the right
+// ones in front: the fit turns the view to absorb part of the step (3.5 mm of 8 remain).
+TEST(Aligner, CellResidualsShowADepthPatternTheFitCannotRemove) {
+  const RoomScene& scene = roomScene();
+  FrameToModelAligner aligner(Config{});
+  const PinholeCamera camera = test::kinectCamera();
+  const Eigen::Isometry3d T_true = scene.trajectory[75].T_W_C;
+  auto halves = [&](const DepthImage& depth, double* left_m, double* right_m) {
+    const AlignmentResult r = aligner.align(scene.map, depth, camera, T_true);
+    ASSERT_TRUE(r.accepted) << r.reason;
+    ASSERT_EQ(r.cell_sum_m.size(), static_cast<size_t>(kResidualCellsX * kResidualCellsY));
+    ASSERT_EQ(r.cell_count.size(), r.cell_sum_m.size());
+    double sum[2] = {0.0, 0.0};
+    int count[2] = {0, 0};
+    for (int c = 0; c < kResidualCellsX * kResidualCellsY; ++c) {
+      const int half = c % kResidualCellsX < kResidualCellsX / 2 ? 0 : 1;
+      sum[half] += r.cell_sum_m[c];
+      count[half] += r.cell_count[c];
+    }
+    ASSERT_GT(count[0], 500);
+    ASSERT_GT(count[1], 500);
+    *left_m = sum[0] / count[0];
+    *right_m = sum[1] / count[1];
+  };
+  const DepthImage exact = renderDepth(scene.renderer, T_true, false, 0);
+  double left = 0.0, right = 0.0;
+  halves(exact, &left, &right);
+  EXPECT_LT(std::abs(left), 0.001);
+  EXPECT_LT(std::abs(right), 0.001);
+  DepthImage patterned = exact;
+  for (int v = 0; v < patterned.height(); ++v) {
+    for (int u = 0; u < patterned.width() / 2; ++u) {
+      if (patterned(u, v) > 0) patterned(u, v) += 8;  // millimetres
+    }
+  }
+  halves(patterned, &left, &right);
+  EXPECT_LT(left - right, -0.0025);
+  RecordProperty("left_minus_right_mm", std::to_string(1000.0 * (left - right)));
+}
+
 // Depth with the simulator's sensor model (Nguyen's axial noise, 2 to 6 mm at 1 to 3 m, 80 %
 // of it correlated over 8-pixel windows, edge jitter and dropouts): a few millimetres.
 TEST(Aligner, RecoversAKnownOffsetFromNoisyDepth) {

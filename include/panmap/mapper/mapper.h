@@ -26,6 +26,7 @@
 #include "panmap/segmentation/mask_edge_fill.h"
 #include "panmap/segmentation/panoptic_geometric.h"
 #include "panmap/superpoint/superpoint_tracker.h"
+#include "panmap/tracking/depth_pattern_monitor.h"
 #include "panmap/tracking/drift_filter.h"
 #include "panmap/tracking/frame_to_model_aligner.h"
 
@@ -75,6 +76,11 @@ struct MapperConfig {
   FrameToModelAligner::Config tracking = FrameToModelAligner::Config::forSequences();
   /// The smooth drift estimate (kFilter).
   DriftFilter::Config drift;
+  /// kAuto without a depth calibration: the first frames' alignments decide whether the depth
+  /// can be trusted to correct poses (DepthPatternMonitor). Until then every pose is integrated
+  /// as given; after a fixed error pattern is found, every pose stays as given. kOn skips the
+  /// check; a depth calibration is trusted.
+  DepthPatternMonitor::Config depth_check;
   int num_threads = 2;  ///< threads for segmentation and integration (association uses one)
   /// The depth sensor's calibration (panmap-calibrate-depth, docs/MAPPING.md), added to every
   /// frame's depth before anything else reads it; null: the depth as the sensor read it. Kept in
@@ -105,7 +111,10 @@ struct FrameStats {
   double total_ms = 0.0;
   /// The pose the frame was integrated with (the given one, or refined against the map).
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
-  bool tracked = false;                                          ///< pose refinement ran
+  bool tracked = false;  ///< pose refinement ran
+  /// The pose was aligned but integrated as given: the depth check is pending or found the
+  /// depth uncalibrated (MapperConfig::depth_check), or refinement was skipped for that reason.
+  bool pose_kept = false;
   AlignmentStatus tracking_status = AlignmentStatus::kAccepted;  ///< when tracked
   int surfaces = 0;
   int new_superpoints = 0;
@@ -221,6 +230,13 @@ class Mapper {
   const std::array<int64_t, kAlignmentStatusCount>& trackingCounts() const {
     return tracking_counts_;
   }
+  /// Whether this mapper's depth may correct poses (MapperConfig::depth_check).
+  const DepthPatternMonitor& depthCheck() const { return depth_check_; }
+  /// Frames that tracking would have refined but that were integrated at their given pose
+  /// because of the depth check (FrameStats::pose_kept).
+  int64_t posesKeptAsGiven() const { return poses_kept_; }
+  /// Frames integrated at a pose corrected by tracking.
+  int64_t posesCorrected() const { return poses_corrected_; }
 
   /// The super-point label each pixel of the last integrated frame voted for (0 = none): what
   /// a frame store keeps so that the frame can be re-integrated at a corrected pose.
@@ -354,6 +370,9 @@ class Mapper {
   /// (kPerFrame) or a smooth estimate of the input's drift (kFilter).
   DriftFilter drift_;
   std::array<int64_t, kAlignmentStatusCount> tracking_counts_{};
+  DepthPatternMonitor depth_check_;
+  int64_t poses_kept_ = 0;
+  int64_t poses_corrected_ = 0;
   std::vector<StampedPose> trajectory_;
   int64_t frames_ = 0;
   uint64_t vote_evictions_ = 0;

@@ -29,6 +29,10 @@ enum class AlignmentStatus : int8_t {
 /// Number of AlignmentStatus values.
 constexpr int kAlignmentStatusCount = 7;
 
+/// Image cells across and down of AlignmentResult's per-cell residuals.
+constexpr int kResidualCellsX = 8;
+constexpr int kResidualCellsY = 6;
+
 /// Short name of a status ("accepted", "too_few_points", ...).
 const char* alignmentStatusName(AlignmentStatus status);
 
@@ -61,6 +65,12 @@ struct AlignmentResult {
   /// independent (on real depth they are not: DriftFilter adds a floor). Zero when refused
   /// before the fit.
   Matrix6d information = Matrix6d::Zero();
+  /// Where the frame's depth disagrees with the map after the fit, per image cell (row-major,
+  /// kResidualCellsX x kResidualCellsY): sum and count of the inliers' distances along their
+  /// rays (SdfResiduals::rayDistances). A fixed pattern across frames is the sensor's depth
+  /// error, which the fit cannot remove (DepthPatternMonitor). Empty when refused before the fit.
+  std::vector<double> cell_sum_m;
+  std::vector<int> cell_count;
   int iterations = 0;    ///< Ceres iterations over all levels
   double time_ms = 0.0;  ///< wall time of align()
 };

@@ -83,6 +83,16 @@ class SdfResiduals {
   /// @param inlier_distance_m an in-map point with |sdf| at most this is an inlier
   SdfFitStats statistics(const Vector6d& delta, double inlier_distance_m);
 
+  /// One in-map point at an increment: where it is in the prior's camera frame, and its
+  /// distance to the surface along its ray (signed distance over the cosine between ray and
+  /// normal, clamped at 0.3: positive when the point reads short, in front of the surface).
+  struct RayDistance {
+    Eigen::Vector3f p_C;
+    float along_ray_m;
+  };
+  /// The in-map points' distances along their rays at `delta`.
+  std::vector<RayDistance> rayDistances(const Vector6d& delta);
+
  private:
   struct Sample {
     bool in_map = false;
@@ -93,6 +103,7 @@ class SdfResiduals {
 
   SdfSampler sampler_;
   Eigen::Vector3d t_W_C_prior_;
+  Eigen::Matrix3d R_W_C_prior_;
   std::vector<Eigen::Vector3d> rays_W_;  // R_W_C_prior p_C: the points about the camera centre
   std::vector<double> inv_scales_;       // point_sigma / the point's sigma (depth noise)
   SdfResidualOptions options_;
