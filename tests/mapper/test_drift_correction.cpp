@@ -294,7 +294,7 @@ TEST(DriftCorrection, SevenScenesAutoKeepsTheRecordedPosesOfTheUncalibratedKinec
   }
   const DepthPatternMonitor& check = mapper.depthCheck();
   EXPECT_EQ(check.verdict(), DepthPatternMonitor::Verdict::kUncalibrated);
-  EXPECT_GT(check.patternRmsM(), 0.0018);  // 2.3 mm at 2 cm; the limit is 1.2 mm
+  EXPECT_GT(check.patternRmsM(), 0.0018);  // 2.3 mm at 2 cm; the limit is 1 mm
   EXPECT_EQ(mapper.posesKeptAsGiven(), static_cast<int64_t>(frames.size()) - 5);
   EXPECT_EQ(mapper.posesCorrected(), 0);
   EXPECT_LT(ateRmse(mapper.trajectory(), stamped(recorded, utimes)), 1e-12);
