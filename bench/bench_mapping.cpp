@@ -155,8 +155,8 @@ int main(int argc, char** argv) {
                  "own (0 = none)")
       ->capture_default_str();
   app.add_flag("--slam-poses", slam,
-               "flag the dataset's poses as SLAM poses, so that tracking (auto) refines each "
-               "against the map and its stage is timed");
+               "flag the dataset's poses as SLAM poses and skip auto's depth check, so that "
+               "tracking refines each against the map and its stage is timed");
   app.add_flag("--mesh-change", mesh_change,
                "report how far the blocks each mesh update re-meshes moved since their previous "
                "mesh (slower: keeps every block's mesh)");
@@ -171,6 +171,9 @@ int main(int argc, char** argv) {
       if (app.count("--voxel-size")) config.map.voxel_size_m = voxel_m;
       if (app.count("--threads")) config.num_threads = threads;
     }
+    // Timing refinement means refining every frame: auto's depth check would stop it on an
+    // uncalibrated sensor after its 30 frames.
+    if (slam) config.depth_check.frames = 0;
     panmap::Mapper mapper(config);
     Recorder recorder(&mapper, outputs_every, mesh_change);
     if (!log_path.empty()) {

@@ -82,12 +82,18 @@ ALIGNMENTS = [("rigid", []), ("similarity", ["--fit-scale"]),
               ("similarity + camera offset", ["--fit-scale", "--fit-camera-offset"])]
 
 
-# Pose correction models (tracking.correction): name -> extra panmap-mapper arguments.
-# `calibrated` is per_frame with the depth calibration panmap-calibrate-depth learns from the
-# same log (calibration_path()).
-CORRECTIONS = {"per_frame": [],
-               "filter": ["--config", os.path.join(suite.ROOT, "configs", "drift_filter.yaml")],
-               "calibrated": []}
+# Pose refinement settings: name -> (--tracking, extra panmap-mapper arguments). `auto` is the
+# default: the depth check decides whether the poses are corrected. `per_frame` and `filter`
+# force refinement past it (tracking on; tracking.correction per_frame or filter).
+# `calibrated` is the default with the depth calibration panmap-calibrate-depth learns from
+# the same log (calibration_path()), which auto trusts.
+CORRECTIONS = {"auto": ("auto", []),
+               "per_frame": ("on", []),
+               "filter": ("on", ["--config",
+                                 os.path.join(suite.ROOT, "configs", "drift_filter.yaml")]),
+               "calibrated": ("auto", [])}
+# Frames mapped at their given pose before tracking starts (tracking.warmup_frames).
+WARMUP_FRAMES = 5
 
 
 def calibration_path(work, tag):
@@ -129,14 +135,15 @@ def one(work, name, folder, drift, seed, voxel, correction):
     log = os.path.join(work, tag + ".lcmlog")  # written by one_import()
     reference = os.path.join(work, tag + ".reference.txt")
     base = os.path.join(work, "%s_%gcm_%s" % (tag, voxel * 100, correction))
-    extra = list(CORRECTIONS[correction])
+    mode, extra = CORRECTIONS[correction]
+    extra = list(extra)
     if correction == "calibrated":
         extra += ["--depth-calibration", calibration_path(work, tag)]
-    refined = map_run(log, base + "_auto", voxel, "auto", extra)
+    refined = map_run(log, base + "_auto", voxel, mode, extra)
     raw = map_run(log, base + "_off", voxel, "off")
-    tracking = refined.get("tracking", {})
-    corrected = tracking.get("accepted", 0) + tracking.get("accepted_partially", 0)
-    kept = sum(tracking.values()) - corrected
+    check = refined["depth_check"]
+    corrected = check["poses_corrected"]
+    kept = refined["frames_integrated"] - WARMUP_FRAMES - corrected
     photo = photometric(folder, [reference, os.path.join(work, tag + ".input.txt"),
                                  os.path.join(base + "_auto", "trajectory.txt")])
     return {
@@ -146,6 +153,9 @@ def one(work, name, folder, drift, seed, voxel, correction):
         "refined_ate_m": ate(os.path.join(base + "_auto", "trajectory.txt"), reference),
         "input_area_m2": raw["mesh"]["area_m2"], "refined_area_m2": refined["mesh"]["area_m2"],
         "corrected": corrected, "kept": kept,
+        "depth_check": ("calibration" if correction == "calibrated" else
+                        "-" if mode == "on" else
+                        "%s, %.1f mm" % (check["verdict"], check["pattern_mm"] or 0.0)),
         "photometric_reference": photo[0], "photometric_input": photo[1],
         "photometric_refined": photo[2],
         "tracking_ms": refined["timings"].get("tracking", {}).get("median_ms", 0.0),
@@ -188,16 +198,19 @@ def render(rows, skipped, layouts, seconds):
           "`python3 scripts/bench/refinement.py` (%.1f min on this machine): every real sequence "
           "in `../shared/data` with at least %d frames, its recorded poses replaced by "
           "`panmap-import --drift LEVEL --seed N` (none; light: 1 %%/m, 0.5 deg/m; heavy: 3x), "
-          "mapped geometry-only with tracking `auto` (the poses are flagged SLAM), each "
-          "correction model (`per_frame`: the default, each aligned pose used as it is; "
-          "`filter`: `configs/drift_filter.yaml`, a smooth drift estimate, docs/MAPPING.md; "
-          "`calibrated`: `per_frame` with the depth sensor's calibration that "
-          "`panmap-calibrate-depth --first N/2` learnt from the same drifted log, its second half "
-          "only, with no poses but the log's own refined by tracking, docs/MAPPING.md), "
-          "and with `--tracking off`. ATE is against the recorded poses, **which are themselves "
-          "estimates**: %s.%s Corrected / kept: frames whose alignment was fused into the "
-          "drift estimate / refused (kept at the prediction). ms: median of the tracking stage "
-          "per frame, runs two at a time on 2 cores." % (
+          "mapped geometry-only (the poses are flagged SLAM) four ways: `auto`, the default "
+          "(`tracking: auto`: the first 30 aligned frames judge the depth, integrated as given; "
+          "a fixed depth error pattern above 1 mm keeps every pose as given, column *depth "
+          "check*, docs/MAPPING.md); `per_frame`, refinement forced past that check (`--tracking "
+          "on`), each aligned pose used as it is; `filter`, forced with "
+          "`configs/drift_filter.yaml`, a smooth drift estimate; `calibrated`, the default with "
+          "the depth sensor's calibration that `panmap-calibrate-depth --first N/2` learnt from "
+          "the same drifted log, its second half only, with no poses but the log's own refined "
+          "by tracking (auto trusts a calibrated sensor), docs/MAPPING.md; and with `--tracking "
+          "off`. ATE is against the recorded poses, **which are themselves "
+          "estimates**: %s.%s Corrected / kept: frames integrated at a corrected pose / at the "
+          "given or predicted one (after the 5 warm-up frames). ms: median of the tracking "
+          "stage per frame, runs two at a time on 2 cores." % (
               seconds / 60.0, MIN_FRAMES,
               "; ".join("%s: %s" % (n, REFERENCES.get(l, l)) for n, l in layouts),
               SEVEN_SCENES_NOTE if any(l == "7scenes" for _, l in layouts) else ""), "",
@@ -242,8 +255,9 @@ def render(rows, skipped, layouts, seconds):
                "refined, cm.", ""]
     md += ["| sequence | voxel | drift | seed | correction | input ATE cm | refined ATE cm | "
            "target | %sarea m2: reference map / input / refined | photometric: recorded / input "
-           "/ refined | corrected / kept | ms |" % ("vs independent | " if independent else ""),
-           "|---|---|---|---|---|---|---|---|---|---|---|---|" + ("---|" if independent else "")]
+           "/ refined | depth check | corrected / kept | ms |" % (
+               "vs independent | " if independent else ""),
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|" + ("---|" if independent else "")]
     reference_area = {(r["sequence"], r["voxel_m"]): r["input_area_m2"]
                       for r in rows if r["drift"] == "none"}
     for r in rows:
@@ -255,7 +269,7 @@ def render(rows, skipped, layouts, seconds):
                                                 r["independent_refined_m"] * 100)
                      if "independent_refined_m" in r else "- | ")
         md.append("| %s | %g cm | %s | %s | %s | %.2f | %.2f | %s %s | %s%.2f / %.2f / %.2f | "
-                  "%.2f / %.2f / %.2f | %d / %d | %.1f |" % (
+                  "%.2f / %.2f / %.2f | %s | %d / %d | %.1f |" % (
                       r["sequence"], r["voxel_m"] * 100, r["drift"],
                       "-" if r["drift"] == "none" else r["seed"], r["correction"],
                       r["input_ate_m"] * 100,
@@ -264,7 +278,8 @@ def render(rows, skipped, layouts, seconds):
                       r["input_area_m2"], r["refined_area_m2"],
                       r.get("photometric_reference", float("nan")),
                       r.get("photometric_input", float("nan")),
-                      r.get("photometric_refined", float("nan")), r["corrected"], r["kept"],
+                      r.get("photometric_refined", float("nan")), r.get("depth_check", "-"),
+                      r["corrected"], r["kept"],
                       r["tracking_ms"]))
     fitted = [r for r in rows if "independent_fits" in r]
     if fitted:
@@ -350,7 +365,7 @@ def main():
     parser.add_argument("--seeds", default="1,2,3")
     parser.add_argument("--voxels", default="0.01,0.02")
     parser.add_argument("--drifts", default="none,light,heavy")
-    parser.add_argument("--corrections", default="per_frame,filter,calibrated")
+    parser.add_argument("--corrections", default="auto,per_frame,filter,calibrated")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--work", default=os.path.join(suite.BUILD, "refinement"))
     parser.add_argument("--out", default=os.path.join(suite.ROOT, "docs", "RESULTS.md"))

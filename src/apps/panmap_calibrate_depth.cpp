@@ -35,9 +35,9 @@ Round mapOnce(const std::string& log, const panmap::MapperConfig& config, int64_
   auto hook = [&](const panmap::SyncedFrame& f, const panmap::FrameStats& stats) {
     ++round.integrated;
     round.tracked += stats.tracked;
-    round.corrected +=
-        stats.tracked && (stats.tracking_status == panmap::AlignmentStatus::kAccepted ||
-                          stats.tracking_status == panmap::AlignmentStatus::kAcceptedPartially);
+    round.corrected += stats.tracked && !stats.pose_kept &&
+                       (stats.tracking_status == panmap::AlignmentStatus::kAccepted ||
+                        stats.tracking_status == panmap::AlignmentStatus::kAcceptedPartially);
     panmap::StampedPose pose;
     pose.utime = f.frame.utime;
     pose.T_W_C = stats.T_W_C;
@@ -131,6 +131,9 @@ int main(int argc, char** argv) {
     if (tracking == "off") config.tracking_mode = panmap::MapperConfig::TrackingMode::kOff;
     if (tracking == "auto") config.tracking_mode = panmap::MapperConfig::TrackingMode::kAuto;
     if (tracking == "on") config.tracking_mode = panmap::MapperConfig::TrackingMode::kOn;
+    // The depth check of auto tracking would keep every pose of an uncalibrated sensor as
+    // given; the rounds refine poses and calibration together, which is the remedy it asks for.
+    config.depth_check.frames = 0;
     config.check();
     panmap::ThreadPool pool(threads);
     std::shared_ptr<const panmap::DepthCalibration> calibration;

@@ -249,6 +249,13 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
       const FrameStats s =
           mapper_->integrate(f.frame, f.T_W_C, f.panoptic ? &*f.panoptic : nullptr, f.pose_source);
       for (const auto& [stage, ms] : s.stageTimes()) times_ms_[stage].push_back(ms);
+      if (s.reverted_frames > 0) {
+        // The depth check found the sensor uncalibrated: the refined frames went back to their
+        // given poses (the frame store keeps the poses they were first stored with; repairs
+        // start from the mapper's trajectory).
+        refinement_moved_m_.clear();
+        refinement_turned_deg_.clear();
+      }
       if (s.tracked && !s.pose_kept) {
         refinement_moved_m_.push_back((s.T_W_C.translation() - f.T_W_C.translation()).norm());
         refinement_turned_deg_.push_back(

@@ -739,6 +739,8 @@ std::unique_ptr<Mapper> Mapper::parsePayload(BinaryReader* reader, uint32_t vers
     p.T_W_C = getPose(&r);
   }
   if (mapper->occupancy_) mapper->occupancy_->readState(&r);
+  // The frames a pending depth check would revert are not in the file.
+  mapper->probation_complete_ = mapper->trajectory_.empty();
   if (r.remaining() != 0) throw Error(path + ": unexpected bytes after the map state");
   return mapper;
 }

@@ -240,10 +240,15 @@ FrameStats Mapper::integrate(const RgbdFrame& raw_frame, const Eigen::Isometry3d
   const bool track = forced || (config_.tracking_mode == MapperConfig::TrackingMode::kAuto &&
                                 (source == PoseSource::kSlam || source == PoseSource::kOdometry));
   // Auto mode corrects poses only with depth it can trust (MapperConfig::depth_check): the
-  // first frames are aligned to judge the depth but integrated as given.
-  const DepthPatternMonitor::Verdict verdict =
+  // first frames are refined and kept while their alignments judge the depth.
+  DepthPatternMonitor::Verdict verdict =
       forced || calibrated ? DepthPatternMonitor::Verdict::kTrusted : depth_check_.verdict();
+  const bool judging = track && verdict == DepthPatternMonitor::Verdict::kPending;
+  if (frames_ == 0) probation_complete_ = judging;
   if (track && verdict == DepthPatternMonitor::Verdict::kUncalibrated) {
+    // No alignment any more. The correction held when the check decided without the frames
+    // to revert (an overflowed probation) keeps the map from tearing; after a revert it is none.
+    T_W_C = drift_.predict(T_W_C_given);
     stats.pose_kept = true;
     ++poses_kept_;
   } else if (track) {
@@ -256,9 +261,13 @@ FrameStats Mapper::integrate(const RgbdFrame& raw_frame, const Eigen::Isometry3d
       stats.tracked = true;
       stats.tracking_status = result.status;
       ++tracking_counts_[static_cast<size_t>(result.status)];
-      if (verdict == DepthPatternMonitor::Verdict::kPending) {
-        // Judging the depth: the pose stays as given whatever the alignment says.
-        if (result.accepted) depth_check_.add(result.cell_sum_m, result.cell_count);
+      if (judging && result.accepted) {
+        verdict = depth_check_.add(result.cell_sum_m, result.cell_count);
+      }
+      if (verdict == DepthPatternMonitor::Verdict::kUncalibrated) {
+        // This alignment decided: the frame goes in as given, and the refined ones before it
+        // are integrated again as given once it is in (revertProbation).
+        if (probation_complete_) T_W_C = T_W_C_given;
         stats.pose_kept = true;
         ++poses_kept_;
       } else if (result.accepted) {
@@ -330,7 +339,37 @@ FrameStats Mapper::integrate(const RgbdFrame& raw_frame, const Eigen::Isometry3d
   used.source = source;
   trajectory_.push_back(used);
   ++frames_;
+  if (judging && probation_complete_ && probation_.size() < kMaxProbationFrames) {
+    probation_.push_back({frame, T_W_C_given, association.pixel_labels});
+  } else if (probation_complete_) {
+    // Overflowed, tracking no longer applies (a pose not flagged SLAM or odometry), or the
+    // check trusted the depth: nothing will be reverted.
+    probation_complete_ = false;
+    probation_ = std::vector<ProbationFrame>();
+  }
+  if (judging && verdict == DepthPatternMonitor::Verdict::kUncalibrated) {
+    stats.reverted_frames = revertProbation();
+  }
   return stats;
+}
+
+int Mapper::revertProbation() {
+  const bool complete = probation_complete_ && probation_.size() == trajectory_.size();
+  probation_complete_ = false;
+  std::vector<ProbationFrame> frames = std::move(probation_);
+  probation_ = std::vector<ProbationFrame>();
+  if (!complete) return 0;
+  std::unique_ptr<MapRebuild> rebuild = beginRebuild(nullptr, false);
+  int64_t refined = 0;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    refined += !trajectory_[i].T_W_C.isApprox(frames[i].T_W_C_given, 0.0);
+    rebuild->add(frames[i].frame, frames[i].T_W_C_given, &frames[i].pixel_labels);
+  }
+  // Sets the trajectory to the given poses and the drift estimate back to none.
+  commitRebuild(std::move(rebuild));
+  poses_kept_ += refined;
+  poses_corrected_ = 0;
+  return static_cast<int>(frames.size());
 }
 
 }  // namespace panmap

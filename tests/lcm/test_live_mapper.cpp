@@ -104,6 +104,11 @@ TEST(LiveMapper, MapsLikeTheSessionAndAnswersStatus) {
   EXPECT_GT(last.num_blocks, 0);
   EXPECT_GT(last.memory_bytes, 0);
   EXPECT_GE(last.num_stages, 5);
+  // Ground-truth poses: tracking never ran, so the depth check has nothing to judge.
+  EXPECT_EQ(last.depth_check, "pending");
+  EXPECT_EQ(last.depth_pattern_mm, -1.0f);
+  EXPECT_EQ(last.poses_corrected, 0);
+  EXPECT_EQ(last.poses_kept_as_given, 0);
 }
 
 // A loop-closure correction over LCM repairs the live map from its frame store, and the

@@ -68,6 +68,8 @@ TEST_F(MappingSessionTest, RefinementReportsHowFarItMovedTheGivenPoses) {
                 mapper.trackingCounts()[static_cast<size_t>(AlignmentStatus::kAcceptedPartially)],
             r.frames);
   EXPECT_EQ(r.frames, static_cast<int64_t>(slam.frames.size()) - config.tracking_warmup_frames);
+  EXPECT_EQ(mapper.posesCorrected(), r.frames);
+  EXPECT_EQ(mapper.posesKeptAsGiven(), 0);
   EXPECT_GT(r.moved_m.max, 0.02);
   EXPECT_LT(r.moved_m.max, 0.04);
   EXPECT_LT(r.moved_m.median, 0.01);

@@ -103,49 +103,73 @@ TEST(DriftCorrection, SyntheticRoomWithSlamPoses) {
                 counts[static_cast<size_t>(AlignmentStatus::kAcceptedPartially)],
             100);
   // Rendered depth has random noise only: the depth check trusts it after its 30 frames, which
-  // (after the 5 warm-up frames) were integrated exactly as given.
+  // were refined like the rest; only the 5 warm-up frames are as given.
   const DepthPatternMonitor& check = refined.depthCheck();
   EXPECT_EQ(check.verdict(), DepthPatternMonitor::Verdict::kTrusted);
   EXPECT_EQ(check.frames(), 30);
   EXPECT_LT(check.patternRmsM(), 0.001);
-  EXPECT_EQ(refined.posesKeptAsGiven(), 30);
+  EXPECT_EQ(refined.posesKeptAsGiven(), 0);
   EXPECT_GT(refined.posesCorrected(), 100);
-  for (size_t k = 0; k < 35; ++k) {
+  for (size_t k = 0; k < 5; ++k) {
     EXPECT_TRUE(refined.trajectory()[k].T_W_C.isApprox(synth.inputTrajectory()[k].T_W_C, 0.0)) << k;
   }
+  EXPECT_FALSE(refined.trajectory()[20].T_W_C.isApprox(synth.inputTrajectory()[20].T_W_C, 0.0));
   RecordProperty("pattern_mm", std::to_string(1000.0 * check.patternRmsM()));
   RecordProperty("input_ate_m", std::to_string(input_ate));
   RecordProperty("refined_ate_m", std::to_string(refined_ate));
 }
 
-// The same survey through a sensor with a fixed depth error pattern: auto tracking finds the
-// pattern in its first aligned frames and integrates every pose exactly as given, a map file
-// keeps that verdict, and `tracking: on` still refines (the check is auto's alone).
+// The same survey through a sensor with a fixed depth error pattern: auto tracking refines the
+// first frames while their alignments find the pattern, then integrates those frames again at
+// their given poses, and every later pose as given: the map is the one of the given poses. A
+// map file keeps that verdict, and `tracking: on` still refines (the check is auto's alone).
 TEST(DriftCorrection, AutoKeepsThePosesOfDepthWithAFixedErrorPattern) {
   const ProceduralRoom room = generateRoom(8);
   SequenceSynthesizer synth = slamRoomSurvey(room);
   Mapper kept(driftConfig());
+  MapperConfig off = driftConfig();
+  off.tracking_mode = MapperConfig::TrackingMode::kOff;
+  Mapper as_given(off);
   MapperConfig on = driftConfig();
   on.tracking_mode = MapperConfig::TrackingMode::kOn;
   Mapper forced(on);
+  int reverts = 0, reverted_at = -1;
   for (size_t k = 0; k < 60; ++k) {
     SynthFrame f = synth.frame(k);
     addDepthPattern(&f.rgbd.depth);
     const FrameStats stats = kept.integrate(f.rgbd, f.input_pose.T_W_C, nullptr, PoseSource::kSlam);
-    EXPECT_TRUE(stats.T_W_C.isApprox(f.input_pose.T_W_C, 0.0)) << k;
-    EXPECT_EQ(stats.pose_kept, k >= 5) << k;
+    if (stats.reverted_frames > 0) {
+      ++reverts;
+      reverted_at = static_cast<int>(k);
+      EXPECT_EQ(stats.reverted_frames, static_cast<int>(k) + 1);
+    }
+    if (reverted_at >= 0) {
+      EXPECT_TRUE(stats.pose_kept) << k;
+      EXPECT_TRUE(stats.T_W_C.isApprox(f.input_pose.T_W_C, 0.0)) << k;
+    }
+    as_given.integrate(f.rgbd, f.input_pose.T_W_C, nullptr, PoseSource::kSlam);
     forced.integrate(f.rgbd, f.input_pose.T_W_C, nullptr, PoseSource::kSlam);
   }
+  EXPECT_EQ(reverts, 1);
+  EXPECT_GE(reverted_at, 34);  // after the 5 warm-up frames and 30 accepted alignments
+  for (size_t k = 0; k < 60; ++k) {
+    EXPECT_TRUE(kept.trajectory()[k].T_W_C.isApprox(synth.inputTrajectory()[k].T_W_C, 0.0)) << k;
+  }
+  // The map of the given poses.
+  EXPECT_NEAR(kept.extractMesh(nullptr).surfaceArea(), as_given.extractMesh(nullptr).surfaceArea(),
+              1e-3);
   const DepthPatternMonitor& check = kept.depthCheck();
   EXPECT_EQ(check.verdict(), DepthPatternMonitor::Verdict::kUncalibrated);
   EXPECT_EQ(check.frames(), 30);
   EXPECT_GT(check.patternRmsM(), 0.003);
-  EXPECT_EQ(kept.posesKeptAsGiven(), 55);
+  // The frames after the verdict, the verdict's own, and the refined ones it reverted.
+  EXPECT_GT(kept.posesKeptAsGiven(), 60 - reverted_at);
+  EXPECT_LE(kept.posesKeptAsGiven(), 55);
   EXPECT_EQ(kept.posesCorrected(), 0);
   // After the verdict, frames are not even aligned.
   int64_t aligned = 0;
   for (int64_t n : kept.trackingCounts()) aligned += n;
-  EXPECT_EQ(aligned, 30);
+  EXPECT_EQ(aligned, reverted_at + 1 - 5);
   EXPECT_GT(forced.posesCorrected(), 40);
   EXPECT_EQ(forced.posesKeptAsGiven(), 0);
 
@@ -155,7 +179,7 @@ TEST(DriftCorrection, AutoKeepsThePosesOfDepthWithAFixedErrorPattern) {
   const std::unique_ptr<Mapper> loaded = Mapper::load(path);
   EXPECT_EQ(loaded->depthCheck().verdict(), DepthPatternMonitor::Verdict::kUncalibrated);
   EXPECT_EQ(loaded->depthCheck().patternRmsM(), check.patternRmsM());
-  EXPECT_EQ(loaded->posesKeptAsGiven(), 55);
+  EXPECT_EQ(loaded->posesKeptAsGiven(), kept.posesKeptAsGiven());
   SynthFrame f = synth.frame(60);
   addDepthPattern(&f.rgbd.depth);
   const FrameStats next = loaded->integrate(f.rgbd, f.input_pose.T_W_C, nullptr, PoseSource::kSlam);
@@ -287,14 +311,18 @@ TEST(DriftCorrection, SevenScenesAutoKeepsTheRecordedPosesOfTheUncalibratedKinec
   MapperConfig config = driftConfig();
   config.fusion.geometry_only = true;
   Mapper mapper(config);
+  int reverted = 0;
   for (size_t i = 0; i < frames.size(); ++i) {
-    const FrameStats stats =
-        mapper.integrate(frames[i].rgbd, recorded[i], nullptr, PoseSource::kSlam);
-    ASSERT_TRUE(stats.T_W_C.isApprox(recorded[i], 0.0)) << i;
+    reverted +=
+        mapper.integrate(frames[i].rgbd, recorded[i], nullptr, PoseSource::kSlam).reverted_frames;
+  }
+  for (size_t i = 0; i < frames.size(); ++i) {
+    ASSERT_TRUE(mapper.trajectory()[i].T_W_C.isApprox(recorded[i], 0.0)) << i;
   }
   const DepthPatternMonitor& check = mapper.depthCheck();
   EXPECT_EQ(check.verdict(), DepthPatternMonitor::Verdict::kUncalibrated);
   EXPECT_GT(check.patternRmsM(), 0.0018);  // 2.3 mm at 2 cm; the limit is 1 mm
+  EXPECT_GE(reverted, 35);                 // the frames refined while the check decided
   EXPECT_EQ(mapper.posesKeptAsGiven(), static_cast<int64_t>(frames.size()) - 5);
   EXPECT_EQ(mapper.posesCorrected(), 0);
   EXPECT_LT(ateRmse(mapper.trajectory(), stamped(recorded, utimes)), 1e-12);

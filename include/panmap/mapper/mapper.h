@@ -77,8 +77,9 @@ struct MapperConfig {
   /// The smooth drift estimate (kFilter).
   DriftFilter::Config drift;
   /// kAuto without a depth calibration: the first frames' alignments decide whether the depth
-  /// can be trusted to correct poses (DepthPatternMonitor). Until then every pose is integrated
-  /// as given; after a fixed error pattern is found, every pose stays as given. kOn skips the
+  /// can be trusted to correct poses (DepthPatternMonitor). Meanwhile poses are refined as
+  /// usual and the frames are kept; when a fixed error pattern is found, those frames are
+  /// integrated again at their given poses and every later pose stays as given. kOn skips the
   /// check; a depth calibration is trusted.
   DepthPatternMonitor::Config depth_check;
   int num_threads = 2;  ///< threads for segmentation and integration (association uses one)
@@ -112,9 +113,13 @@ struct FrameStats {
   /// The pose the frame was integrated with (the given one, or refined against the map).
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
   bool tracked = false;  ///< pose refinement ran
-  /// The pose was aligned but integrated as given: the depth check is pending or found the
-  /// depth uncalibrated (MapperConfig::depth_check), or refinement was skipped for that reason.
+  /// Tracking would have refined the pose, but the depth check found the depth uncalibrated
+  /// (MapperConfig::depth_check): the frame was integrated at its given pose.
   bool pose_kept = false;
+  /// Frames integrated again at their given poses because this frame's alignment completed a
+  /// depth check that found the depth uncalibrated (0 otherwise): the map and trajectory() of
+  /// those frames changed.
+  int reverted_frames = 0;
   AlignmentStatus tracking_status = AlignmentStatus::kAccepted;  ///< when tracked
   int surfaces = 0;
   int new_superpoints = 0;
@@ -232,9 +237,13 @@ class Mapper {
   }
   /// Whether this mapper's depth may correct poses (MapperConfig::depth_check).
   const DepthPatternMonitor& depthCheck() const { return depth_check_; }
-  /// Frames that tracking would have refined but that were integrated at their given pose
-  /// because of the depth check (FrameStats::pose_kept).
+  /// Frames that tracking would have refined but that are integrated at their given pose
+  /// because the depth check found the depth uncalibrated (FrameStats::pose_kept, and the
+  /// frames refined before the verdict and integrated again as given).
   int64_t posesKeptAsGiven() const { return poses_kept_; }
+  /// Most frames kept while the depth check decides (about 2.7 MB each at 640x480); a check
+  /// still pending after them can no longer revert the refined frames.
+  static constexpr size_t kMaxProbationFrames = 60;
   /// Frames integrated at a pose corrected by tracking.
   int64_t posesCorrected() const { return poses_corrected_; }
 
@@ -371,6 +380,19 @@ class Mapper {
   DriftFilter drift_;
   std::array<int64_t, kAlignmentStatusCount> tracking_counts_{};
   DepthPatternMonitor depth_check_;
+  /// While the depth check is pending: every frame integrated so far, its given pose and the
+  /// super-point label each pixel voted for, to integrate them again at their given poses.
+  struct ProbationFrame {
+    RgbdFrame frame;
+    Eigen::Isometry3d T_W_C_given;
+    LabelImage pixel_labels;
+  };
+  std::vector<ProbationFrame> probation_;
+  /// probation_ holds every frame integrated (false once it overflowed, for a loaded map, or
+  /// when tracking did not apply to the first frame).
+  bool probation_complete_ = true;
+  /// Integrates the frames of probation_ again at their given poses (depth check: uncalibrated).
+  int revertProbation();
   int64_t poses_kept_ = 0;
   int64_t poses_corrected_ = 0;
   std::vector<StampedPose> trajectory_;
