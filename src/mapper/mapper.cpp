@@ -267,7 +267,7 @@ FrameStats Mapper::integrate(const RgbdFrame& raw_frame, const Eigen::Isometry3d
       if (verdict == DepthPatternMonitor::Verdict::kUncalibrated) {
         // This alignment decided: the frame goes in as given, and the refined ones before it
         // are integrated again as given once it is in (revertProbation).
-        if (probation_complete_) T_W_C = T_W_C_given;
+        if (probation_complete_ && probation_.size() < kMaxProbationFrames) T_W_C = T_W_C_given;
         stats.pose_kept = true;
         ++poses_kept_;
       } else if (result.accepted) {
