@@ -435,6 +435,37 @@ def room_section(results, specs):
     return md
 
 
+def depth_check_note(work, specs):
+    """What auto tracking's depth check decided on every sequence with drifting poses, read
+    from each full run's report.json (empty when none has one)."""
+    checks = []
+    for spec in specs:
+        if spec.poses == "gt":
+            continue
+        for folder in ("A_refined", "A"):  # box rooms: A maps the poses as given
+            path = os.path.join(work, "runs", spec.name(), folder, "report.json")
+            if os.path.exists(path):
+                with open(path) as f:
+                    check = json.load(f).get("depth_check")
+                if check:
+                    checks.append(check)
+                break
+    if not checks:
+        return []
+    verdicts = {}
+    for c in checks:
+        verdicts[c["verdict"]] = verdicts.get(c["verdict"], 0) + 1
+    patterns = [c["pattern_mm"] for c in checks if c.get("pattern_mm") is not None]
+    return ["Depth check of the default tracking (docs/MAPPING.md, \"Depth check\": the fixed "
+            "depth error pattern measured over the first 30 alignments, limit %.1f mm), on the "
+            "%d sequences with SLAM-like poses: %s; pattern %.2f-%.2f mm." % (
+                checks[0]["limit_mm"], len(checks),
+                ", ".join("%s %d" % (v, n) for v, n in sorted(verdicts.items())),
+                min(patterns), max(patterns)) if patterns else
+            "Depth check of the default tracking: %d sequences, no pattern measured." % len(checks),
+            ""]
+
+
 def code_version():
     """The commit the maps are made with, and whether tracked files other than the reports
     differed from it."""
@@ -542,7 +573,9 @@ def main():
           "(`--tracking off`); **full, `slam` poses** maps SLAM-like poses with the default "
           "tracking (`auto`: each pose refined against the map); **full, poses as given** maps "
           "the same SLAM-like poses with `--tracking off`, so that the two show what the pose "
-          "refinement adds (issue 20: never less than without it).", "",
+          "refinement adds (issue 20: never less than without it).", ""] + depth_check_note(
+              args.work, real + likes + boxes + weaker) + [
+
           "A map built from drifting poses lives in the world frame of its trajectory, which "
           "differs from the ground truth's by a rigid transform no mapper can observe (the "
           "drift of the first poses fixes it). Before scoring, such a mesh is moved by the "

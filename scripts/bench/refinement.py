@@ -155,7 +155,7 @@ def one(work, name, folder, drift, seed, voxel, correction):
         "corrected": corrected, "kept": kept,
         "depth_check": ("calibration" if correction == "calibrated" else
                         "-" if mode == "on" else
-                        "%s, %.1f mm" % (check["verdict"], check["pattern_mm"] or 0.0)),
+                        "%s, %.2f mm" % (check["verdict"], check["pattern_mm"] or 0.0)),
         "photometric_reference": photo[0], "photometric_input": photo[1],
         "photometric_refined": photo[2],
         "tracking_ms": refined["timings"].get("tracking", {}).get("median_ms", 0.0),

@@ -17,7 +17,7 @@ namespace panmap {
 /// halves' cell means, whose square root is the RMS of a pattern fixed to the image, while
 /// random noise and the disagreements that change with the viewpoint (a drifting map seen from
 /// elsewhere) fall out of it. Measured after 30 frames refined as usual (MapperConfig::
-/// depth_check): 2.28-2.36 mm on 7-Scenes' Kinect at 1 and 2 cm, with or without injected
+/// depth_check): 2.28-2.41 mm on 7-Scenes' Kinect at 1 and 2 cm, with or without injected
 /// drift, and 0.00-0.29 mm on the 18 rendered sequences with SLAM-like poses of the accuracy
 /// suite. The limit sits between them, nearer the rendered side: mistaking a real sensor for a
 /// clean one is what makes good poses worse.
