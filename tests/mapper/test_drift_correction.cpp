@@ -188,6 +188,51 @@ TEST(DriftCorrection, AutoKeepsThePosesOfDepthWithAFixedErrorPattern) {
   RecordProperty("pattern_mm", std::to_string(1000.0 * check.patternRmsM()));
 }
 
+// A map saved while the depth check is pending does not hold the frames it would revert: loaded
+// and mapped on to an uncalibrated verdict, it keeps the poses refined so far and holds the
+// correction it has at the verdict for every later frame, so the map does not tear there.
+TEST(DriftCorrection, ALoadedMapWithThePendingCheckHoldsItsCorrectionAtTheVerdict) {
+  const ProceduralRoom room = generateRoom(8);
+  SequenceSynthesizer synth = slamRoomSurvey(room);
+  Mapper first(driftConfig());
+  for (size_t k = 0; k < 20; ++k) {
+    SynthFrame f = synth.frame(k);
+    addDepthPattern(&f.rgbd.depth);
+    first.integrate(f.rgbd, f.input_pose.T_W_C, nullptr, PoseSource::kSlam);
+  }
+  ASSERT_EQ(first.depthCheck().verdict(), DepthPatternMonitor::Verdict::kPending);
+  test::TempDir dir;
+  first.save(dir.path("pending.panmap"));
+  const std::unique_ptr<Mapper> loaded = Mapper::load(dir.path("pending.panmap"));
+  EXPECT_EQ(loaded->depthCheck().frames(), first.depthCheck().frames());
+  const std::vector<StampedPose> before(loaded->trajectory().begin(), loaded->trajectory().end());
+  int reverted = 0;
+  Eigen::Isometry3d held = Eigen::Isometry3d::Identity();
+  bool decided = false;
+  for (size_t k = 20; k < 60; ++k) {
+    SynthFrame f = synth.frame(k);
+    addDepthPattern(&f.rgbd.depth);
+    const FrameStats stats =
+        loaded->integrate(f.rgbd, f.input_pose.T_W_C, nullptr, PoseSource::kSlam);
+    reverted += stats.reverted_frames;
+    if (decided) {
+      EXPECT_TRUE(stats.pose_kept) << k;
+      EXPECT_TRUE(stats.T_W_C.isApprox(held * f.input_pose.T_W_C, 1e-12)) << k;
+    } else if (loaded->depthCheck().verdict() == DepthPatternMonitor::Verdict::kUncalibrated) {
+      decided = true;
+      held = loaded->poseCorrection();
+      // The verdict's own frame keeps the correction too.
+      EXPECT_TRUE(stats.T_W_C.isApprox(held * f.input_pose.T_W_C, 1e-12)) << k;
+    }
+  }
+  EXPECT_TRUE(decided);
+  EXPECT_EQ(reverted, 0);
+  EXPECT_FALSE(held.isApprox(Eigen::Isometry3d::Identity(), 1e-9));  // refined before
+  for (size_t k = 0; k < before.size(); ++k) {
+    EXPECT_TRUE(loaded->trajectory()[k].T_W_C.isApprox(before[k].T_W_C, 0.0)) << k;
+  }
+}
+
 TEST(DriftCorrection, GroundTruthPosesAreNotTouched) {
   const ProceduralRoom room = generateRoom(8);
   SurveyConfig survey;
