@@ -90,28 +90,20 @@ nlohmann::json depthCheckJson(const panmap::Mapper& mapper) {
           {"poses_kept_as_given", mapper.posesKeptAsGiven()}};
 }
 
-// When the depth check kept poses as given, why, and what to do about it.
+// When the depth check found the sensor uncalibrated (the only way poses are kept as given):
+// why, and what to do about it.
 void printDepthCheck(const panmap::Mapper& mapper) {
   const panmap::DepthPatternMonitor& check = mapper.depthCheck();
-  if (mapper.posesKeptAsGiven() == 0) return;
-  if (check.verdict() == panmap::DepthPatternMonitor::Verdict::kUncalibrated) {
-    std::printf(
-        "  pose refinement withheld: over %d aligned frames the depth disagreed with the map in a "
-        "fixed pattern of %.1f mm RMS (limit %.1f mm), the mark of an uncalibrated sensor that "
-        "would pull good poses away; %lld poses kept as given. Calibrate the sensor "
-        "(panmap-calibrate-depth, then --depth-calibration FILE) or force refinement with "
-        "--tracking on\n",
-        check.frames(), 1000.0 * check.patternRmsM(),
-        1000.0 * mapper.config().depth_check.max_pattern_m,
-        static_cast<long long>(mapper.posesKeptAsGiven()));
-  } else {
-    std::printf(
-        "  pose refinement: %lld poses kept as given while the depth check (%s after %d "
-        "frames) judged the sensor, %lld corrected\n",
-        static_cast<long long>(mapper.posesKeptAsGiven()),
-        panmap::DepthPatternMonitor::name(check.verdict()), check.frames(),
-        static_cast<long long>(mapper.posesCorrected()));
-  }
+  if (check.verdict() != panmap::DepthPatternMonitor::Verdict::kUncalibrated) return;
+  std::printf(
+      "  pose refinement withheld: over %d aligned frames the depth disagreed with the map in a "
+      "fixed pattern of %.1f mm RMS (limit %.1f mm), the mark of an uncalibrated sensor that "
+      "would pull good poses away; %lld poses kept as given. Calibrate the sensor "
+      "(panmap-calibrate-depth, then --depth-calibration FILE) or force refinement with "
+      "--tracking on\n",
+      check.frames(), 1000.0 * check.patternRmsM(),
+      1000.0 * mapper.config().depth_check.max_pattern_m,
+      static_cast<long long>(mapper.posesKeptAsGiven()));
 }
 
 // Seconds each export step took, by step name.
