@@ -153,6 +153,7 @@ def one(work, name, folder, drift, seed, voxel, correction):
         "refined_ate_m": ate(os.path.join(base + "_auto", "trajectory.txt"), reference),
         "input_area_m2": raw["mesh"]["area_m2"], "refined_area_m2": refined["mesh"]["area_m2"],
         "corrected": corrected, "kept": kept,
+        "limit_mm": check["limit_mm"],
         "depth_check": ("calibration" if correction == "calibrated" else
                         "-" if mode == "on" else
                         "%s, %.2f mm" % (check["verdict"], check["pattern_mm"] or 0.0)),
@@ -193,15 +194,22 @@ def verdict(row):
     return r <= 0.4 * i, "<= 0.4 x input"
 
 
+def limits(rows):
+    """The depth check's limit the rows were mapped with (rows of before it was recorded: the
+    1 mm it was then)."""
+    values = sorted({r.get("limit_mm", 1.0) for r in rows if r["correction"] == "auto"})
+    return " / ".join("%g mm" % v for v in values) or "its limit"
+
+
 def render(rows, skipped, layouts, seconds):
     md = [BEGIN, "## Pose refinement on real depth", "",
           "`python3 scripts/bench/refinement.py` (%.1f min on this machine): every real sequence "
           "in `../shared/data` with at least %d frames, its recorded poses replaced by "
           "`panmap-import --drift LEVEL --seed N` (none; light: 1 %%/m, 0.5 deg/m; heavy: 3x), "
           "mapped geometry-only (the poses are flagged SLAM) four ways: `auto`, the default "
-          "(`tracking: auto`: the first 30 aligned frames judge the depth, integrated as given; "
-          "a fixed depth error pattern above 1 mm keeps every pose as given, column *depth "
-          "check*, docs/MAPPING.md); `per_frame`, refinement forced past that check (`--tracking "
+          "(`tracking: auto`: the first 30 aligned frames judge the depth; a fixed depth error "
+          "pattern above %s integrates them again at their given poses and keeps every later "
+          "pose as given, column *depth check*, docs/MAPPING.md); `per_frame`, refinement forced past that check (`--tracking "
           "on`), each aligned pose used as it is; `filter`, forced with "
           "`configs/drift_filter.yaml`, a smooth drift estimate; `calibrated`, the default with "
           "the depth sensor's calibration that `panmap-calibrate-depth --first N/2` learnt from "
@@ -211,7 +219,7 @@ def render(rows, skipped, layouts, seconds):
           "estimates**: %s.%s Corrected / kept: frames integrated at a corrected pose / at the "
           "given or predicted one (after the 5 warm-up frames). ms: median of the tracking "
           "stage per frame, runs two at a time on 2 cores." % (
-              seconds / 60.0, MIN_FRAMES,
+              seconds / 60.0, MIN_FRAMES, limits(rows),
               "; ".join("%s: %s" % (n, REFERENCES.get(l, l)) for n, l in layouts),
               SEVEN_SCENES_NOTE if any(l == "7scenes" for _, l in layouts) else ""), "",
           "Two reference-free figures judge a trajectory without trusting the recorded one. "

@@ -188,6 +188,17 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "seed of trajectory, noise, masks and drift")
       ->capture_default_str();
   app.add_flag("--no-depth-noise", no_depth_noise, "exact depth (quantised to 1 mm)");
+  std::string depth_pattern_file;
+  double depth_pattern_scale = 1.0;
+  app.add_option("--depth-pattern", depth_pattern_file,
+                 "add the fixed-pattern depth error of a real sensor to every frame: the sensor's "
+                 "calibration as panmap-calibrate-depth writes it (the error is its negative; "
+                 "docs/SIMULATION.md)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--depth-pattern-scale", depth_pattern_scale,
+                 "multiply that error by this (0.5: a sensor with half the Kinect's pattern)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
   size_t correction_every = 0;
   panmap::CorrectionResidual residual;
   double residual_cm = 0.0, residual_deg = 0.0;
@@ -290,6 +301,10 @@ int main(int argc, char** argv) {
     config.masks = panmap::SegmenterNoiseConfig::fromPreset(masks);
     config.poses = panmap::PoseDriftConfig::fromPreset(poses);
     config.depth.enabled = !no_depth_noise;
+    if (!depth_pattern_file.empty()) {
+      config.depth_pattern = panmap::sensorDepthPattern(
+          panmap::DepthCalibration::load(depth_pattern_file), depth_pattern_scale);
+    }
     std::vector<panmap::StampedPose> trajectory;
     panmap::SurveyConfig survey;
     if (!building_stops.empty()) {
@@ -401,6 +416,10 @@ int main(int argc, char** argv) {
           {"residual_cm", residual_cm},
           {"residual_deg", residual_deg}}},
         {"depth_noise", depthJson(config.depth)},
+        {"depth_pattern",
+         {{"file", depth_pattern_file},
+          {"scale", depth_pattern_file.empty() ? 0.0 : depth_pattern_scale},
+          {"rms_mm", config.depth_pattern.rmsOffsetM() * 1000.0}}},
         {"coverage",
          {{"thing_instances", cov.thing_instances},
           {"seen_once", cov.seen_once},

@@ -18,6 +18,23 @@ void SynthConfig::check() const {
   poses.check();
   if (min_view_px < 1) throw Error("synth min_view_px must be >= 1");
   if (!(distinct_view_deg > 0)) throw Error("synth distinct_view_deg must be > 0");
+  if (!depth_pattern.empty() &&
+      (depth_pattern.width() != camera.width || depth_pattern.height() != camera.height)) {
+    throw Error("synth depth pattern is for " + std::to_string(depth_pattern.width()) + "x" +
+                std::to_string(depth_pattern.height()) + " images, the camera's are " +
+                std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  }
+}
+
+DepthCalibration sensorDepthPattern(const DepthCalibration& calibration, double scale) {
+  if (!(scale >= 0) || !std::isfinite(scale))
+    throw Error("depth pattern scale must be finite and >= 0");
+  if (calibration.empty()) return {};
+  std::vector<float> offsets_m = calibration.offsetsM();
+  for (float& o : offsets_m) o = static_cast<float>(-scale * o);
+  return DepthCalibration(calibration.width(), calibration.height(), calibration.cellsX(),
+                          calibration.cellsY(), calibration.knots(), calibration.knotSpacingM(),
+                          std::move(offsets_m));
 }
 
 namespace {
@@ -85,6 +102,11 @@ SynthFrame SequenceSynthesizer::frame(size_t k) {
   out.rgbd.depth_scale_m = config_.depth_scale_m;
   out.rgbd.depth =
       simulateDepth(view_, config_.depth, hashSeed(config_.seed, k, 0xDE9u), config_.depth_scale_m);
+  if (!config_.depth_pattern.empty()) {
+    DepthImage with_pattern;
+    config_.depth_pattern.apply(out.rgbd.depth, config_.depth_scale_m, &with_pattern);
+    out.rgbd.depth = std::move(with_pattern);
+  }
   out.rgbd.color = view_.color;
   out.gt_instance = view_.instance;
   out.panoptic = segmenter_.segment(view_.instance, view_.semantic, static_cast<int>(k), infos_);

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "panmap/calibration/depth_calibration.h"
 #include "panmap/core/camera.h"
 #include "panmap/core/frame.h"
 #include "panmap/core/labelled_mesh.h"
@@ -22,6 +23,10 @@ struct SynthConfig {
   double depth_scale_m = 0.001;  ///< depth units of the output (millimetres)
   RenderConfig render;
   DepthNoiseConfig depth;
+  /// A fixed-pattern depth error added to every frame's noisy depth, as a real sensor's pattern
+  /// moves with the camera (sensorDepthPattern() makes one from a real sensor's calibration);
+  /// empty: none. Its image size must be the camera's.
+  DepthCalibration depth_pattern;
   SegmenterNoiseConfig masks = SegmenterNoiseConfig::fromPreset("m2f");
   PoseDriftConfig poses = PoseDriftConfig::fromPreset("slam");
   int min_view_px = 200;            ///< an instance counts as seen in a frame from this many pixels
@@ -30,6 +35,11 @@ struct SynthConfig {
   /// Throws Error naming the bad field.
   void check() const;
 };
+
+/// The fixed-pattern depth error of the sensor that `calibration` corrects, times `scale`: a
+/// calibration's offsets are added to a reading to correct it, so the sensor's error is their
+/// negative. For SynthConfig::depth_pattern. Throws Error on a non-finite or negative scale.
+DepthCalibration sensorDepthPattern(const DepthCalibration& calibration, double scale);
 
 /// One synthetic frame: what the sensor, the segmenter and the SLAM system deliver, with the
 /// ground truth beside it.
