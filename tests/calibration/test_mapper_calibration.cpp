@@ -193,5 +193,34 @@ TEST(CalibrateDepthCli, LearnsFromALogAndRefusesBadInput) {
   EXPECT_EQ(help.exit_code, 0);
 }
 
+// The log's poses drift, and tracking refines them against a map of depth with a fixed
+// pattern, which bends the refined poses with it; the first round must learn at the poses as
+// given: with one round, exactly what --tracking off learns.
+TEST(CalibrateDepthCli, TheFirstRoundLearnsAtThePosesAsGiven) {
+  test::TempDir dir;
+  std::vector<float> offsets_m(2 * 6 * 8);
+  for (size_t i = 0; i < offsets_m.size(); ++i)
+    offsets_m[i] = quantiseOffsetM(((i * 7) % 11 - 5.0) * 0.002);  // +-1 cm, no structure
+  DepthCalibration(640, 480, 8, 6, 2, 4.0, offsets_m).save(dir.path("sensor.json"));
+  const auto synth = test::runCommand(
+      test::binPath("panmap-synth") + " --room 2 --frames 40 --poses heavy --quiet " +
+      "--depth-pattern " + dir.path("sensor.json") + " --out " + dir.path("r"));
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  auto calibrate = [&](const std::string& out, const std::string& flags) {
+    const auto run = test::runCommand(
+        test::binPath("panmap-calibrate-depth") + " --log " + dir.path("r/sequence.lcmlog") +
+        " --out " + out + " --cells 8 --calibration-voxel-size 0.02 --passes 2 -q " + flags);
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    return run.output;
+  };
+  const std::string tracked = calibrate(dir.path("tracked.json"), "--rounds 1");
+  // Tracking did refine the poses of that round ...
+  EXPECT_EQ(tracked.find("(0 tracked"), std::string::npos) << tracked;
+  calibrate(dir.path("given.json"), "--rounds 1 --tracking off");
+  // ... and the calibration is the one learnt at the poses as given.
+  EXPECT_EQ(DepthCalibration::load(dir.path("tracked.json")),
+            DepthCalibration::load(dir.path("given.json")));
+}
+
 }  // namespace
 }  // namespace panmap
