@@ -239,6 +239,20 @@ void MappingSession::flush() {
   }
 }
 
+void MappingSession::recordRevertedPoses(int count) {
+  writer_->flush();  // the frames are in the store before their poses change
+  countStoreErrors();
+  const std::vector<StampedPose>& trajectory = mapper_->trajectory();
+  const size_t end = trajectory.size() - 1;  // the frame being integrated is not stored yet
+  for (size_t i = end - std::min(end, static_cast<size_t>(count)); i < end; ++i) {
+    try {
+      options_.frame_store->updatePose(trajectory[i].utime, trajectory[i].T_W_C);
+    } catch (const Error& e) {
+      ++stats_.rejected["frame store: " + reasonOf(e.what())];
+    }
+  }
+}
+
 void MappingSession::integrate(std::vector<SyncedFrame> ready) {
   for (SyncedFrame& f : ready) {
     if (done_) return;
@@ -251,10 +265,11 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
       for (const auto& [stage, ms] : s.stageTimes()) times_ms_[stage].push_back(ms);
       if (s.reverted_frames > 0) {
         // The depth check found the sensor uncalibrated: the refined frames went back to their
-        // given poses (the frame store keeps the poses they were first stored with; repairs
-        // start from the mapper's trajectory).
+        // given poses, so the store records those, as after a repair (this frame is stored
+        // below with the pose it now has).
         refinement_moved_m_.clear();
         refinement_turned_deg_.clear();
+        if (writer_) recordRevertedPoses(s.reverted_frames - 1);
       }
       if (s.tracked && !s.pose_kept) {
         refinement_moved_m_.push_back((s.T_W_C.translation() - f.T_W_C.translation()).norm());

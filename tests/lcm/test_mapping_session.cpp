@@ -79,6 +79,53 @@ TEST_F(MappingSessionTest, RefinementReportsHowFarItMovedTheGivenPoses) {
   EXPECT_LE(r.turned_deg.median, r.turned_deg.max);
 }
 
+// Depth with a fixed error pattern and SLAM poses: auto refines the first frames, the depth
+// check finds the pattern and takes them back to their given poses; the frame store then holds
+// the poses the map holds them at, so a later repair or a reopened store starts from those.
+TEST_F(MappingSessionTest, TheFrameStoreKeepsThePosesTheDepthCheckRevertedTo) {
+  const test::SyntheticStream& source = test::syntheticStream(16);
+  test::SyntheticStream slam = source;
+  for (size_t k = 0; k < slam.poses.size(); ++k) {
+    slam.poses[k].source = PoseSource::kSlam;
+    // A few millimetres off, growing: refinement has something to correct.
+    slam.poses[k].T_W_C.translation().x() += 0.001 * static_cast<double>(k);
+    DepthImage& depth = slam.frames[k].depth;
+    for (int v = 0; v < depth.height(); ++v) {
+      for (int u = 0; u < depth.width(); ++u) {
+        uint16_t& d = depth(u, v);  // 20 px squares 8 mm long and short: no rigid motion
+        if (d > 8) d = static_cast<uint16_t>((u / 20 + v / 20) % 2 ? d + 8 : d - 8);
+      }
+    }
+  }
+  MapperConfig config = test::streamMapperConfig();
+  config.tracking.level_strides_px = {4, 2};
+  config.depth_check.frames = 6;  // 16 frames: a verdict after the warm-up and 6 alignments
+  config.depth_check.min_cell_frames = 2;
+  test::TempDir dir;
+  FrameStoreConfig store_config;
+  store_config.folder = dir.path("store");
+  FrameStore store(store_config);
+  SessionOptions options;
+  options.frame_store = &store;
+  Mapper mapper(config);
+  MappingSession session(options, &mapper);
+  feed(&session, slam.messages());
+  ASSERT_EQ(mapper.depthCheck().verdict(), DepthPatternMonitor::Verdict::kUncalibrated);
+  EXPECT_TRUE(session.stats().rejected.empty());
+  ASSERT_EQ(store.size(), slam.frames.size());
+  const std::vector<StampedPose>& trajectory = mapper.trajectory();
+  ASSERT_EQ(trajectory.size(), slam.poses.size());
+  for (size_t k = 0; k < trajectory.size(); ++k) {
+    // The given poses (as LCM carried them: a quaternion, so not to the last bit).
+    EXPECT_TRUE(trajectory[k].T_W_C.isApprox(slam.poses[k].T_W_C, 1e-9)) << k;
+    EXPECT_TRUE(store.load(trajectory[k].utime).T_W_C.isApprox(trajectory[k].T_W_C, 0.0)) << k;
+  }
+  // Reopened, the store says the same.
+  const std::unique_ptr<FrameStore> reopened = FrameStore::open(store_config.folder);
+  for (const StampedPose& p : trajectory)
+    EXPECT_TRUE(reopened->load(p.utime).T_W_C.isApprox(p.T_W_C, 0.0)) << p.utime;
+}
+
 TEST_F(MappingSessionTest, MalformedAndTruncatedMessagesAreCounted) {
   std::vector<test::Encoded> messages = stream_.messages();
   std::vector<test::Encoded> bad;

@@ -136,6 +136,9 @@ class MappingSession {
   void recordRepair(const MapRepairResult& result);
   void countRepairError(const std::string& what);
   void countStoreErrors();
+  // Records in the frame store the poses of the `count` frames before the newest that the
+  // depth check took back to their given poses.
+  void recordRevertedPoses(int count);
 
   SessionOptions options_;
   Mapper* mapper_;
