@@ -23,6 +23,23 @@ void feed(MappingSession* session, const std::vector<test::Encoded>& messages) {
   session->flush();
 }
 
+// A frame store in a temporary folder, and session options that write to it.
+struct TempStore {
+  TempStore() : store(config()) {}
+  FrameStoreConfig config() const {
+    FrameStoreConfig c;
+    c.folder = dir.path("store");
+    return c;
+  }
+  SessionOptions options() {
+    SessionOptions o;
+    o.frame_store = &store;
+    return o;
+  }
+  test::TempDir dir;  // first: the store's folder is in it
+  FrameStore store;
+};
+
 class MappingSessionTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -101,14 +118,10 @@ TEST_F(MappingSessionTest, TheFrameStoreKeepsThePosesTheDepthCheckRevertedTo) {
   config.tracking.level_strides_px = {4, 2};
   config.depth_check.frames = 6;  // 16 frames: a verdict after the warm-up and 6 alignments
   config.depth_check.min_cell_frames = 2;
-  test::TempDir dir;
-  FrameStoreConfig store_config;
-  store_config.folder = dir.path("store");
-  FrameStore store(store_config);
-  SessionOptions options;
-  options.frame_store = &store;
+  TempStore temp;
+  FrameStore& store = temp.store;
   Mapper mapper(config);
-  MappingSession session(options, &mapper);
+  MappingSession session(temp.options(), &mapper);
   feed(&session, slam.messages());
   ASSERT_EQ(mapper.depthCheck().verdict(), DepthPatternMonitor::Verdict::kUncalibrated);
   EXPECT_TRUE(session.stats().rejected.empty());
@@ -121,7 +134,7 @@ TEST_F(MappingSessionTest, TheFrameStoreKeepsThePosesTheDepthCheckRevertedTo) {
     EXPECT_TRUE(store.load(trajectory[k].utime).T_W_C.isApprox(trajectory[k].T_W_C, 0.0)) << k;
   }
   // Reopened, the store says the same.
-  const std::unique_ptr<FrameStore> reopened = FrameStore::open(store_config.folder);
+  const std::unique_ptr<FrameStore> reopened = FrameStore::open(temp.config().folder);
   for (const StampedPose& p : trajectory)
     EXPECT_TRUE(reopened->load(p.utime).T_W_C.isApprox(p.T_W_C, 0.0)) << p.utime;
 }
@@ -253,19 +266,15 @@ TEST_F(MappingSessionTest, AGridShiftMovesEveryPoseItMaps) {
 
 TEST_F(MappingSessionTest, AGridShiftIsRefusedWithAFrameStoreOrWhenNotFinite) {
   Mapper mapper(test::streamMapperConfig());
-  test::TempDir dir;
-  FrameStoreConfig store_config;
-  store_config.folder = dir.path("store");
-  FrameStore store(store_config);
-  SessionOptions options;
+  TempStore temp;
+  SessionOptions options = temp.options();
   options.grid_shift_m = Eigen::Vector3d(0.01, 0.0, 0.0);
-  options.frame_store = &store;
   EXPECT_THROW(MappingSession(options, &mapper), Error);
   options.frame_store = nullptr;
   options.grid_shift_m.y() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(MappingSession(options, &mapper), Error);
   options.grid_shift_m = Eigen::Vector3d::Zero();
-  options.frame_store = &store;
+  options.frame_store = &temp.store;
   EXPECT_NO_THROW(MappingSession(options, &mapper));
 }
 
@@ -282,12 +291,9 @@ TEST_F(MappingSessionTest, ACorrectionRepairsTheMapFromTheFrameStore) {
   correction.poses.push_back(keyframe);
   messages.push_back(encodeMessage(kChannelPoseCorrection, toMessage(correction)));
 
-  test::TempDir dir;
-  FrameStoreConfig store_config;
-  store_config.folder = dir.path("store");
-  FrameStore store(store_config);
-  SessionOptions options;
-  options.frame_store = &store;
+  TempStore temp;
+  FrameStore& store = temp.store;
+  SessionOptions options = temp.options();
   Mapper mapper(test::streamMapperConfig());
   MappingSession session(options, &mapper);
   std::vector<int64_t> progress;
@@ -373,12 +379,9 @@ TEST_F(MappingSessionTest, ABackgroundRepairTakesTheFramesMappedMeanwhile) {
   messages.push_back(encodeMessage(kChannelPoseCorrection, toMessage(correction)));
   messages.insert(messages.end(), stream.begin() + 18, stream.end());
 
-  test::TempDir dir;
-  FrameStoreConfig store_config;
-  store_config.folder = dir.path("store");
-  FrameStore store(store_config);
-  SessionOptions options;
-  options.frame_store = &store;
+  TempStore temp;
+  FrameStore& store = temp.store;
+  SessionOptions options = temp.options();
   options.background_repair = true;
   Mapper mapper(test::streamMapperConfig());
   MappingSession session(options, &mapper);
