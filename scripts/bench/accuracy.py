@@ -170,20 +170,29 @@ def largest(rows, key):
     return "%d vertices: %s" % (lg["vertices"], mix)
 
 
+def bridge_reaches(rows, key=None, **kw):
+    """Reach (metres) of every bridging super-point in the runs of one key, or of all keys."""
+    keys = rows.keys if key is None else [key]
+    return [b["reach_m"] for k in keys for e in rows.runs(k, **kw)
+            for b in e["diagnostics"]["bridges"] if "reach_m" in b]
+
+
 def diagnostics_table(rows):
     lines = ["| scene | annotation | purity | bridging super-points (counting boundaries) | "
-             "worst 2nd class | "
+             "worst 2nd class | farthest reach of a bridge | "
              "largest super-point (seed 1) | objects / GT things | confidence >= 0.5: "
-             "precision | GT things covered |", "|---|---|---:|---:|---:|---|---:|---:|---:|"]
+             "precision | GT things covered |", "|---|---|---:|---:|---:|---:|---|---:|---:|---:|"]
     for key in rows.keys:
         runs = rows.runs(key)
         objects = mean([e["diagnostics"]["num_objects"] for e in runs])
         things = mean([e["diagnostics"]["num_gt_things"] for e in runs])
-        lines.append("| %s | %s | %.3f | %.1f (%.1f) | %.2f | %s | %.0f / %.0f | %s | %s |" % (
+        reach = bridge_reaches(rows, key)
+        lines.append("| %s | %s | %.3f | %.1f (%.1f) | %.2f | %s | %s | %.0f / %.0f | %s | %s |" % (
             key[0], key[1], rows.diag(key, "superpoint_purity"),
             rows.diag(key, "num_bridging_superpoints"),
             rows.diag(key, "num_bridging_superpoints_with_boundaries"),
-            rows.diag(key, "worst_second_class_share"), largest(rows, key), objects, things,
+            rows.diag(key, "worst_second_class_share"),
+            "%.1f cm" % (100 * max(reach)) if reach else "-", largest(rows, key), objects, things,
             pct(rows.diag(key, "confident_precision")), pct(rows.diag(key, "confident_recall"))))
     return "\n".join(lines)
 
@@ -202,12 +211,24 @@ def bridge_note(rows):
                     "class boundaries (a small object's neighbouring GT vertices transfer to "
                     "its super-point: pictures, mirrors, papers, books)." % (
                         min(clean), max(clean), min(clean_banded), max(clean_banded)))
+    full, spatial = bridge_reaches(rows), bridge_reaches(rows, variant="w/o III-B")
+    reach = (" A bridge's reach is how far it extends past the boundary between its two "
+             "classes, on the side it extends less (for each class, the farthest of its "
+             "vertices in the super-point from the other class; the smaller of the two): a "
+             "super-point that chains classes reaches far into both, one that took a few "
+             "centimetres of a neighbour's surface reaches that far, however large a share "
+             "those centimetres are of a small object's super-point.")
+    if full:
+        reach += (" The full method's %d bridges over every run reach %.1f-%.1f cm" % (
+            len(full), 100 * min(full), 100 * max(full)))
+        reach += ("; with spatial-only merging (w/o III-B) %d bridges reach %.1f-%.1f cm." % (
+            len(spatial), 100 * min(spatial), 100 * max(spatial)) if spatial else ".")
     return ("A bridging super-point has two GT classes each above 10 % of its vertices, counting "
             "only GT vertices farther than 1.5 voxels (3 cm) from an annotated vertex of another "
             "class: the voxel a class boundary crosses can take either class, and the "
             "nearest-vertex label transfer moves labels by up to half a voxel more. In brackets, "
-            "the count with every vertex." + evidence + " `panmap-eval --boundary-band` sets "
-            "the band; `include/panmap/eval/diagnostics.h` defines it.")
+            "the count with every vertex." + evidence + reach + " `panmap-eval "
+            "--boundary-band` sets the band; `include/panmap/eval/diagnostics.h` defines it.")
 
 
 CAUSES = ["unobserved", "wrong class", "unlabelled", "merged", "split"]

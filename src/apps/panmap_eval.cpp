@@ -127,8 +127,10 @@ json toJson(const panmap::SceneDiagnostics& d) {
     for (const auto& [cls, share] : b.class_mix) {
       classes.push_back({{"class_id", cls}, {"name", panmap::nyu40Name(cls)}, {"share", share}});
     }
-    bridges.push_back(
-        {{"superpoint", b.superpoint}, {"vertices", b.vertices}, {"classes", classes}});
+    bridges.push_back({{"superpoint", b.superpoint},
+                       {"vertices", b.vertices},
+                       {"classes", classes},
+                       {"reach_m", b.reach_m}});
   }
   json things = json::array();
   for (const auto& t : d.gt_things) {

@@ -1,13 +1,16 @@
 #include "panmap/eval/diagnostics.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <unordered_map>
 
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
+#include "panmap/core/nearest_point.h"
 #include "panmap/eval/instance_matching.h"
 
 namespace panmap {
@@ -91,6 +94,48 @@ std::pair<std::vector<std::pair<int32_t, double>>, int64_t> classMix(
   return {mix, sum};
 }
 
+// Bridge::reach_m of every bridge: one pass over the GT vertices collects each bridge's
+// two classes' points, a k-d tree per class involved answers the distances.
+void measureReach(const LabelledMesh& gt, const TransferredLabels& pred,
+                  const std::vector<bool>& away, std::vector<SceneDiagnostics::Bridge>* bridges) {
+  if (bridges->empty()) return;
+  std::map<int32_t, size_t> bridge_of;  // super-point -> index in bridges
+  std::map<int32_t, std::vector<Eigen::Vector3f>> class_points;
+  for (size_t b = 0; b < bridges->size(); ++b) {
+    const auto& bridge = (*bridges)[b];
+    bridge_of[bridge.superpoint] = b;
+    class_points[bridge.class_mix[0].first];
+    class_points[bridge.class_mix[1].first];
+  }
+  const size_t n = gt.numVertices();
+  for (size_t v = 0; v < n; ++v) {
+    const auto it = class_points.find(gt.semantic[v]);
+    if (it != class_points.end()) it->second.push_back(gt.vertices[v]);
+  }
+  // The map's nodes stay where they are, so each tree's pointer to its points stays valid.
+  std::map<int32_t, std::unique_ptr<NearestPointIndex>> trees;
+  for (const auto& [cls, points] : class_points) {
+    trees[cls] = std::make_unique<NearestPointIndex>(&points);
+  }
+  std::vector<std::array<double, 2>> farthest(bridges->size(), {0.0, 0.0});
+  for (size_t v = 0; v < n; ++v) {
+    if (!away[v]) continue;
+    const auto it = bridge_of.find(pred.superpoint[v]);
+    if (it == bridge_of.end()) continue;
+    const auto& mix = (*bridges)[it->second].class_mix;
+    const int side = gt.semantic[v] == mix[0].first ? 0 : gt.semantic[v] == mix[1].first ? 1 : -1;
+    if (side < 0) continue;
+    const auto& other = class_points.at(mix[1 - side].first);
+    const int64_t w = trees.at(mix[1 - side].first)->nearest(gt.vertices[v]);
+    if (w < 0) continue;
+    const double dist = (other[static_cast<size_t>(w)] - gt.vertices[v]).cast<double>().norm();
+    farthest[it->second][side] = std::max(farthest[it->second][side], dist);
+  }
+  for (size_t b = 0; b < bridges->size(); ++b) {
+    (*bridges)[b].reach_m = std::min(farthest[b][0], farthest[b][1]);
+  }
+}
+
 }  // namespace
 
 SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
@@ -149,12 +194,13 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
       d.worst_second_class_share = std::max(d.worst_second_class_share, mix[1].second);
       if (mix[1].second > d.bridge_share) {
         ++d.num_bridging_superpoints;
-        d.bridges.push_back({s, sum_away, mix});
+        d.bridges.push_back({s, sum_away, mix, 0.0});
       }
     }
   }
   std::stable_sort(d.bridges.begin(), d.bridges.end(),
                    [](const auto& a, const auto& b) { return a.vertices > b.vertices; });
+  measureReach(gt, pred, away, &d.bridges);
   d.num_superpoints = static_cast<int64_t>(sp_identities.size());
   d.superpoint_purity = total ? static_cast<double>(majority) / static_cast<double>(total) : kNaN;
   d.superpoint_class_purity =
@@ -357,6 +403,17 @@ std::string formatDiagnostics(const SceneDiagnostics& d) {
                 100 * d.bridge_share, 100 * d.boundary_band_m, d.worst_second_class_share,
                 d.num_bridging_superpoints_with_boundaries);
   out += line;
+  for (size_t b = 0; b < d.bridges.size() && b < 3; ++b) {
+    const auto& bridge = d.bridges[b];
+    std::snprintf(line, sizeof(line),
+                  "  spanning super-point %d: %lld vertices, %s %.0f %%, %s %.0f %%, reaching "
+                  "%.1f cm past their boundary\n",
+                  bridge.superpoint, static_cast<long long>(bridge.vertices),
+                  nyu40Name(bridge.class_mix[0].first).c_str(), 100 * bridge.class_mix[0].second,
+                  nyu40Name(bridge.class_mix[1].first).c_str(), 100 * bridge.class_mix[1].second,
+                  100 * bridge.reach_m);
+    out += line;
+  }
   std::string mix;
   for (size_t k = 0; k < d.largest_class_mix.size() && k < 5; ++k) {
     char part[64];

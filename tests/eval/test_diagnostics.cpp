@@ -221,6 +221,10 @@ TEST(Diagnostics, ASuperPointReachingWellIntoTheWallStillBridges) {
   EXPECT_EQ(d.bridges[0].class_mix[0].first, 1);
   EXPECT_NEAR(d.bridges[0].class_mix[0].second, 416.0 / 740.0, 1e-12);
   EXPECT_NEAR(d.bridges[0].class_mix[1].second, 324.0 / 740.0, 1e-12);
+  // Reach: its wall goes 5 cm past the picture on both axes (corner (5, 5) is 7.07 cm from the
+  // picture's (10, 10)); its picture lies at most 10 cm from the wall (the centre, (19, 19) to
+  // (9, 19)). The smaller of the two.
+  EXPECT_NEAR(d.bridges[0].reach_m, 0.05 * std::sqrt(2.0), 1e-6);
   EXPECT_THROW(diagnose(wide.gt, wide.pred, {}, 5, -0.01), Error);
 }
 

@@ -44,6 +44,13 @@ struct SceneDiagnostics {
     int32_t superpoint = 0;
     int64_t vertices = 0;
     std::vector<std::pair<int32_t, double>> class_mix;
+    /// How far it reaches past the boundary of its two largest classes, metres: for each of
+    /// the two, the largest distance from one of its vertices here (boundary bands left out)
+    /// to the nearest GT vertex of the other class; the smaller of the two. A super-point that
+    /// chains classes reaches far into both (the floor-and-wall super-point of issue 19:
+    /// metres); one that takes a few centimetres of a neighbour's surface at their boundary
+    /// reaches that far into it, whatever the share those centimetres make of a small object.
+    double reach_m = 0.0;
   };
   std::vector<Bridge> bridges;  ///< the bridging super-points, largest first
 
