@@ -26,7 +26,8 @@ SCANNET_LABELS = os.path.join(ROOT, "..", "shared", "data", "scannet-meta",
 # Method variants: (name, map, optimiser flags). Map A: semantically consistent super-points
 # (III-B); map B: spatial-only merging, the same per-frame pipeline otherwise; map V: as B, and
 # without the mask edge fill (not in Voxblox++, and it joins objects through their contacts
-# when super-points merge by overlap alone: a baseline should not carry it).
+# when super-points merge by overlap alone: a baseline should not carry it) and without
+# mask-only surfaces (Voxblox++ labels geometric segments only).
 VARIANTS = [
     ("full", "A", []),
     ("w/o III-B", "B", []),
@@ -221,7 +222,8 @@ def map_sequence(work, seq_dir, spec, voxel_m, config="", variants=None):
             run(fixed + ["--spatial-only", "--no-regularise", "--no-refine",
                          "--out", os.path.join(out, "B")], log)
         if any(v[1] == "V" for v in wanted):
-            run(fixed + ["--spatial-only", "--no-mask-edge-fill", "--pair-interior-px", "0",
+            run(fixed + ["--spatial-only", "--no-mask-edge-fill", "--no-mask-only-surfaces",
+                         "--pair-interior-px", "0",
                          "--no-regularise", "--no-refine", "--out", os.path.join(out, "V")], log)
         if drifting and spec.runs == "tracked":
             ate["refined"] = trajectory_ate(seq_dir, os.path.join(out, "A", "trajectory.txt"),

@@ -218,7 +218,7 @@ int main(int argc, char** argv) {
   panmap::LiveOptions live;
   panmap::SessionOptions& options = live.session;
   bool quiet = false, geometry_only = false, spatial_only = false, no_snapshots = false;
-  bool no_mask_edge_fill = false;
+  bool no_mask_edge_fill = false, no_mask_only_surfaces = false;
   bool no_regularise = false, no_refine = false, print_config = false, export_only = false;
   app.add_option("--log", log_path, "LCM log to map offline (omit for the live LCM mode)");
   app.add_option("--out", out_dir, "output folder")->required(false);
@@ -233,6 +233,9 @@ int main(int argc, char** argv) {
   app.add_flag("--no-mask-edge-fill", no_mask_edge_fill,
                "pixels of a mask outside every surface cast no vote (fusion.fill_mask_edges 0; "
                "as Voxblox++)");
+  app.add_flag("--no-mask-only-surfaces", no_mask_only_surfaces,
+               "a thing mask without a geometric segment (a small or far object) casts no vote "
+               "(fusion.mask_only_surfaces 0; as Voxblox++)");
   int pair_interior_px = -1;
   app.add_option("--pair-interior-px", pair_interior_px,
                  "co-observation (Eq. 6) counts only pixels this far inside their mask's outline "
@@ -362,6 +365,7 @@ int main(int argc, char** argv) {
     }
     config.superpoints.semantic_consistency = !spatial_only;
     if (no_mask_edge_fill) config.mask_edge_fill.enabled = false;
+    if (no_mask_only_surfaces) config.fusion.mask_only_surfaces = false;
     if (app.count("--pair-interior-px") > 0) config.graph.pair_interior_px = pair_interior_px;
     if (tracking == "off") config.tracking_mode = panmap::MapperConfig::TrackingMode::kOff;
     if (tracking == "auto") config.tracking_mode = panmap::MapperConfig::TrackingMode::kAuto;

@@ -173,6 +173,8 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("min_surface_px", &m.fusion.min_surface_px);
     s.read("stuff_confidence", &m.fusion.stuff_confidence);
     s.read("geometry_only", &m.fusion.geometry_only);
+    s.read("mask_only_surfaces", &m.fusion.mask_only_surfaces);
+    s.read("mask_only_depth_step", &m.fusion.mask_only_depth_step);
     s.read("fill_mask_edges", &m.mask_edge_fill.enabled);
     s.read("fill_max_depth_step", &m.mask_edge_fill.max_depth_step);
     s.read("fill_max_distance_px", &m.mask_edge_fill.max_distance_px);
@@ -414,6 +416,10 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   min_surface_px: " << m.fusion.min_surface_px << "   # smaller surfaces are dropped\n"
     << "   stuff_confidence: " << m.fusion.stuff_confidence << "   # P_o of stuff (Eq. 1)\n"
     << "   geometry_only: " << m.fusion.geometry_only << "   # ignore panoptic masks (0/1)\n"
+    << "   mask_only_surfaces: " << m.fusion.mask_only_surfaces
+    << "   # a thing mask with no geometric segment (small, far) votes with its own pixels (0/1)\n"
+    << "   mask_only_depth_step: " << m.fusion.mask_only_depth_step
+    << "   # ... split where the depth steps by more than this share\n"
     << "   fill_mask_edges: " << m.mask_edge_fill.enabled
     << "   # a mask's pixels outside every surface (edges, thin parts) vote with its surfaces "
        "(0/1)\n"

@@ -42,7 +42,9 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 // 16: the depth check of auto tracking (MapperConfig::depth_check) and its state, and the
 //     counts of poses kept as given and corrected; older files load with the check off
 //     (frames 0), as they were built.
-constexpr uint32_t kVersion = 16;
+// 17: fusion's mask-only surfaces (SurfaceFusionConfig::mask_only_surfaces and its depth step);
+//     older files load with them off, as they were built.
+constexpr uint32_t kVersion = 17;
 
 // Bytes of one voxel's votes in a file: four slots of a 4-byte label and a 2-byte count.
 constexpr size_t kVoteSetBytes = kVoteSlots * 6;
@@ -248,6 +250,8 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   const DepthPatternMonitor::Config& k = c.depth_check;
   for (int v : {k.frames, k.min_cell_points, k.min_cell_frames, k.min_cells}) w->put<int32_t>(v);
   w->put(k.max_pattern_m);
+  w->put<uint8_t>(c.fusion.mask_only_surfaces);
+  w->put(c.fusion.mask_only_depth_step);
 }
 
 MapperConfig getConfig(BinaryReader* r, uint32_t version) {
@@ -344,6 +348,12 @@ MapperConfig getConfig(BinaryReader* r, uint32_t version) {
     k.max_pattern_m = r->get<double>();
   } else {
     k.frames = 0;
+  }
+  if (version >= 17) {
+    c.fusion.mask_only_surfaces = r->get<uint8_t>() != 0;
+    c.fusion.mask_only_depth_step = r->get<float>();
+  } else {
+    c.fusion.mask_only_surfaces = false;
   }
   return c;
 }

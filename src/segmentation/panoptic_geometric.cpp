@@ -88,6 +88,10 @@ void SurfaceFusionConfig::check() const {
     throw Error("SurfaceFusionConfig.stuff_confidence must be in [0, 1], got " +
                 std::to_string(stuff_confidence));
   }
+  if (!(mask_only_depth_step >= 0.0f) || !std::isfinite(mask_only_depth_step)) {
+    throw Error("SurfaceFusionConfig.mask_only_depth_step must be finite and >= 0, got " +
+                std::to_string(mask_only_depth_step));
+  }
 }
 
 struct PanopticGeometricSegmenter::Impl {
@@ -261,7 +265,7 @@ void PanopticGeometricSegmenter::segment(const RgbdFrame& frame, const PanopticF
   if (out->surfaces.width() != width || out->surfaces.height() != height) {
     out->surfaces = LabelImage(width, height);
   }
-  impl.fuser.fuse(panoptic, impl.fusion_config, out, &impl.pool);
+  impl.fuser.fuse(panoptic, impl.fusion_config, out, &impl.pool, &frame.depth);
 }
 
 bool PanopticGeometricSegmenter::keptLast() const { return impl_->kept_last; }

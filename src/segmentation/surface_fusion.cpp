@@ -1,5 +1,6 @@
 // Panoptic-geometric fusion: surfaces = geometric segments x panoptic masks (paper III-A).
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "panmap/core/error.h"
@@ -76,7 +77,7 @@ int32_t SurfaceFuser::findOrAddPair(int32_t geometric, int32_t segment_index, in
 }
 
 void SurfaceFuser::fuse(const PanopticFrame* panoptic, const SurfaceFusionConfig& config,
-                        FrameSegmentation* out, ThreadPool* pool) {
+                        FrameSegmentation* out, ThreadPool* pool, const DepthImage* depth) {
   const bool use_masks = panoptic != nullptr && !config.geometry_only;
   if (use_masks) {
     indexSegments(*panoptic);
@@ -159,6 +160,86 @@ void SurfaceFuser::fuse(const PanopticFrame* panoptic, const SurfaceFusionConfig
     pool->parallelFor(surfaces.size(), relabel);
   } else {
     relabel(0, surfaces.size(), 0);
+  }
+  if (use_masks && config.mask_only_surfaces && depth != nullptr) {
+    addMaskOnlySurfaces(*panoptic, *depth, config, out);
+  }
+}
+
+void SurfaceFuser::addMaskOnlySurfaces(const PanopticFrame& panoptic, const DepthImage& depth,
+                                       const SurfaceFusionConfig& config, FrameSegmentation* out) {
+  LabelImage& surfaces = out->surfaces;
+  const int w = surfaces.width(), h = surfaces.height();
+  if (depth.width() != w || depth.height() != h) {
+    throw Error("surface fusion: depth image size differs from the segmentation's");
+  }
+  // Thing masks of a known class without a surface: only these are grouped, so an object
+  // the geometric segmentation resolves keeps exactly the surfaces it had.
+  segment_has_surface_.assign(panoptic.segments.size(), 0);
+  for (const Surface& s : out->surface_list) {
+    if (s.panoptic_segment > 0) segment_has_surface_[segmentIndex(s.panoptic_segment)] = 1;
+  }
+  bool any = false;
+  for (size_t k = 0; k < panoptic.segments.size(); ++k) {
+    const PanopticSegment& segment = panoptic.segments[k];
+    if (segment.is_thing && segment.category > 0 && !segment_has_surface_[k]) any = true;
+  }
+  if (!any) return;
+  const size_t n = surfaces.size();
+  const int32_t* ids = panoptic.segment_ids.data();
+  const int32_t* geo = out->geometric.data();
+  const uint16_t* d = depth.data();
+  open_.assign(n, 0);
+  int32_t last_id = 0;
+  bool last_open = false;
+  for (size_t i = 0; i < n; ++i) {
+    const int32_t id = ids[i];
+    if (id <= 0 || geo[i] != 0 || d[i] == 0) continue;
+    if (id != last_id) {
+      last_id = id;
+      const int32_t k = segmentIndex(id);
+      last_open = k >= 0 && panoptic.segments[k].is_thing && panoptic.segments[k].category > 0 &&
+                  !segment_has_surface_[k];
+    }
+    if (last_open) open_[i] = id;
+  }
+  // Parts grown from their first pixel in raster order, so surface ids are the same every run.
+  const float step = config.mask_only_depth_step;
+  int32_t* label = surfaces.data();
+  for (size_t seed = 0; seed < n; ++seed) {
+    const int32_t id = open_[seed];
+    if (id == 0) continue;
+    queue_.clear();
+    queue_.push_back(static_cast<int32_t>(seed));
+    open_[seed] = 0;
+    for (size_t head = 0; head < queue_.size(); ++head) {
+      const int32_t i = queue_[head];
+      const int u = i % w, v = i / w;
+      const float di = static_cast<float>(d[i]);
+      auto reach = [&](int32_t j) {
+        if (open_[j] != id) return;
+        const float dj = static_cast<float>(d[j]);
+        if (std::fabs(dj - di) > step * std::min(di, dj)) return;
+        open_[j] = 0;
+        queue_.push_back(j);
+      };
+      if (u > 0) reach(i - 1);
+      if (u + 1 < w) reach(i + 1);
+      if (v > 0) reach(i - w);
+      if (v + 1 < h) reach(i + w);
+    }
+    if (static_cast<int>(queue_.size()) < config.min_surface_px) continue;
+    const PanopticSegment& segment = panoptic.segments[segmentIndex(id)];
+    Surface surface;
+    surface.id = static_cast<int32_t>(out->surface_list.size()) + 1;
+    surface.geometric_segment = 0;
+    surface.panoptic_segment = segment.id;
+    surface.category = segment.category;
+    surface.is_thing = true;
+    surface.confidence = panopticConfidence(segment, config.stuff_confidence);
+    surface.num_pixels = static_cast<int32_t>(queue_.size());
+    out->surface_list.push_back(surface);
+    for (const int32_t i : queue_) label[i] = surface.id;
   }
 }
 

@@ -360,7 +360,24 @@ constexpr size_t kDepthCheckConfigBytes = 4 * sizeof(int32_t) + sizeof(double);
 // its state (a verdict byte, a frame count, two halves of per-cell sums and counts, the counts
 // of poses kept and corrected) after the tracking counts, found by its bytes. Its layout of
 // version 15.
+// Bytes of fusion's mask-only surfaces in the config (version 17): a flag and a float.
+constexpr size_t kMaskOnlyBytes = 1 + sizeof(float);
+
+// A file of today's `config` (without a calibration) without what version 17 added after the
+// depth check's config: its layout of version 16.
+std::vector<uint8_t> withoutMaskOnlySurfaces(std::vector<uint8_t> file,
+                                             const MapperConfig& config) {
+  const size_t at =
+      calibrationFlagAt(config) + 1 + kFillBytes + sizeof(int32_t) + kDepthCheckConfigBytes;
+  EXPECT_LT(at + kMaskOnlyBytes, file.size());
+  EXPECT_EQ(file[at], config.fusion.mask_only_surfaces ? 1 : 0);
+  file.erase(file.begin() + static_cast<std::ptrdiff_t>(at),
+             file.begin() + static_cast<std::ptrdiff_t>(at + kMaskOnlyBytes));
+  return file;
+}
+
 std::vector<uint8_t> withoutDepthCheck(std::vector<uint8_t> file, const MapperConfig& config) {
+  file = withoutMaskOnlySurfaces(std::move(file), config);
   const size_t at = calibrationFlagAt(config) + 1 + kFillBytes + sizeof(int32_t);
   EXPECT_LT(at + kDepthCheckConfigBytes, file.size());
   int32_t frames = -1;
@@ -441,7 +458,7 @@ std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, u
   return reseal(std::move(file), version);
 }
 
-TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToSixteen) {
+TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToSeventeen) {
   MapperConfig a;
   a.map.voxel_size_m = 0.05f;
   a.graph.prune_edges = false;
@@ -529,17 +546,30 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToSixteen) {
   // A version 15 file refined poses with no depth check: it goes on trusting the depth.
   EXPECT_EQ(fifteen->config().depth_check.frames, 0);
   EXPECT_EQ(fifteen->depthCheck().verdict(), DepthPatternMonitor::Verdict::kTrusted);
-  // Version 16 keeps the check's settings and its state.
-  const auto sixteen = Mapper::deserialize(Mapper(fill).serialize(), "16.panmap");
+  // Version 16 keeps the check's settings and its state, and was built without mask-only
+  // surfaces.
+  const auto sixteen = Mapper::deserialize(
+      reseal(withoutMaskOnlySurfaces(Mapper(fill).serialize(), fill), 16), "16.panmap");
   EXPECT_EQ(sixteen->config().depth_check.frames, 12);
   EXPECT_EQ(sixteen->config().depth_check.max_pattern_m, 0.002);
   EXPECT_EQ(sixteen->depthCheck().verdict(), DepthPatternMonitor::Verdict::kPending);
+  EXPECT_FALSE(sixteen->config().fusion.mask_only_surfaces);
+  // Version 17 keeps them, on or off, with their depth step.
+  EXPECT_TRUE(fill.fusion.mask_only_surfaces);
+  fill.fusion.mask_only_depth_step = 0.03f;
+  const auto on = Mapper::deserialize(Mapper(fill).serialize(), "17.panmap");
+  EXPECT_TRUE(on->config().fusion.mask_only_surfaces);
+  EXPECT_EQ(on->config().fusion.mask_only_depth_step, 0.03f);
+  fill.fusion.mask_only_surfaces = false;
+  EXPECT_FALSE(Mapper::deserialize(Mapper(fill).serialize(), "17.panmap")
+                   ->config()
+                   .fusion.mask_only_surfaces);
 
-  // Versions outside 5-16 are refused by name.
+  // Versions outside 5-17 are refused by name.
   std::vector<uint8_t> future = Mapper(b).serialize();
-  future[8] = 17;
+  future[8] = 18;
   test::expectError([&] { Mapper::deserialize(future, "future.panmap"); },
-                    {"future.panmap", "version 17", "reads 5 to 16"});
+                    {"future.panmap", "version 18", "reads 5 to 17"});
 }
 
 // Bytes before a block's voxels in a map file: its index and its updated flag.
@@ -709,12 +739,12 @@ TEST_F(BoxScene, MapFileVotesRoundTripAndBadVoteListsAreRefused) {
   const size_t second_at = count_at + 2 + 2 + sizeof(VoxelVotes);
   std::vector<uint8_t> repeated = file;  // the second voted voxel's index made the first's
   std::memcpy(&repeated[second_at], &file[count_at + 2], 2);
-  test::expectError([&] { Mapper::deserialize(reseal(repeated, 16), "repeated.panmap"); },
+  test::expectError([&] { Mapper::deserialize(reseal(repeated, 17), "repeated.panmap"); },
                     {"repeated.panmap", "out of order"});
   std::vector<uint8_t> too_many = file;
   const uint16_t n = kBlockVoxels + 1;
   std::memcpy(&too_many[count_at], &n, 2);
-  test::expectError([&] { Mapper::deserialize(reseal(too_many, 16), "many.panmap"); },
+  test::expectError([&] { Mapper::deserialize(reseal(too_many, 17), "many.panmap"); },
                     {"many.panmap", "513 voted voxels"});
 }
 

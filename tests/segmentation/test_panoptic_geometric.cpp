@@ -346,6 +346,94 @@ TEST(SurfaceFusion, SmallIntersectionsAreDropped) {
   EXPECT_EQ(result.surfaces(510, 302), 1);
 }
 
+// Two 12 x 12 px box faces side by side before a wall at 3 m (columns 300-311 at 1.0 m, 312-323
+// at 1.5 m; rows 200-211), under one chair mask (thing 9). Too small for min_segment_px 400,
+// they are no geometric segment, as a far chair is for the default window and minimum.
+struct SmallThingsBeforeWall {
+  RgbdFrame frame = render([](double x, double y) {
+    auto column = [](double ray) { return std::lround(319.5 + kFocalPx * ray); };
+    const long u = column(x), v = std::lround(239.5 + kFocalPx * y);
+    if (v < 200 || v >= 212 || u < 300 || u >= 324) return 3.0;
+    return u < 312 ? 1.0 : 1.5;
+  });
+  PanopticFrame panoptic;
+  SmallThingsBeforeWall() {
+    panoptic.segment_ids = LabelImage(640, 480);
+    for (int v = 200; v < 212; ++v) {
+      for (int u = 300; u < 324; ++u) panoptic.segment_ids(u, v) = 9;
+    }
+    panoptic.segments = {{9, 5, 62, true, 0.8f}};
+  }
+};
+
+TEST(SurfaceFusion, AThingMaskWithoutSurfaceBecomesSurfacesSplitAtDepthSteps) {
+  SmallThingsBeforeWall scene;
+  DepthSegmentationConfig depth;
+  depth.min_segment_px = 400;
+  PanopticGeometricSegmenter segmenter(depth, {});
+  const FrameSegmentation result = segmenter.segment(scene.frame, &scene.panoptic);
+  for (int v = 200; v < 212; ++v) {
+    for (int u = 300; u < 324; ++u) ASSERT_EQ(result.geometric(u, v), 0) << u << ", " << v;
+  }
+  // The wall's background surface first, then one surface per box face: the 50 cm step
+  // between them splits the mask, and each face is 144 px >= min_surface_px.
+  ASSERT_EQ(result.surface_list.size(), 3u);
+  EXPECT_EQ(result.surface_list[0].panoptic_segment, 0);
+  for (size_t k = 1; k < 3; ++k) {
+    const Surface& s = result.surface_list[k];
+    EXPECT_EQ(s.id, static_cast<int32_t>(k + 1));
+    EXPECT_EQ(s.geometric_segment, 0);
+    EXPECT_EQ(s.panoptic_segment, 9);
+    EXPECT_EQ(s.category, 5);
+    EXPECT_TRUE(s.is_thing);
+    EXPECT_FLOAT_EQ(s.confidence, 0.8f);
+    EXPECT_EQ(s.num_pixels, 144);
+  }
+  for (int v = 200; v < 212; ++v) {
+    for (int u = 300; u < 324; ++u) ASSERT_EQ(result.surfaces(u, v), u < 312 ? 2 : 3);
+  }
+  EXPECT_EQ(result.surfaces(290, 205), 1);  // the wall beside them keeps its surface
+
+  // Without mask-only surfaces the chair casts no vote.
+  SurfaceFusionConfig off;
+  off.mask_only_surfaces = false;
+  PanopticGeometricSegmenter without(depth, off);
+  const FrameSegmentation none = without.segment(scene.frame, &scene.panoptic);
+  ASSERT_EQ(none.surface_list.size(), 1u);
+  EXPECT_EQ(none.surfaces(305, 205), 0);
+}
+
+TEST(SurfaceFusion, MaskOnlySurfacesNeedAThingOfKnownClassWithoutSurfaceAndEnoughPixels) {
+  SmallThingsBeforeWall scene;
+  DepthSegmentationConfig depth;
+  depth.min_segment_px = 400;
+  auto surfacesWith = [&](const PanopticSegment& segment, int min_surface_px) {
+    PanopticFrame panoptic = scene.panoptic;
+    panoptic.segments = {segment};
+    SurfaceFusionConfig fusion;
+    fusion.min_surface_px = min_surface_px;
+    return PanopticGeometricSegmenter(depth, fusion).segment(scene.frame, &panoptic);
+  };
+  // Stuff and an unknown class name no object to find.
+  EXPECT_EQ(surfacesWith({9, 1, 101, false, 0.9f}, 50).surface_list.size(), 1u);
+  EXPECT_EQ(surfacesWith({9, 0, 62, true, 0.8f}, 50).surface_list.size(), 1u);
+  // Parts below min_surface_px are dropped as any surface is.
+  EXPECT_EQ(surfacesWith({9, 5, 62, true, 0.8f}, 145).surface_list.size(), 1u);
+  EXPECT_EQ(surfacesWith({9, 5, 62, true, 0.8f}, 144).surface_list.size(), 3u);
+
+  // A mask that also covers 120 px of the wall has a surface there (the wall's pixels next to
+  // the step are edges): its parts on the boxes stay without one, as before.
+  PanopticFrame wider = scene.panoptic;
+  for (int v = 200; v < 212; ++v) {
+    for (int u = 290; u < 300; ++u) wider.segment_ids(u, v) = 9;
+  }
+  const FrameSegmentation result =
+      PanopticGeometricSegmenter(depth, {}).segment(scene.frame, &wider);
+  ASSERT_EQ(result.surface_list.size(), 2u);
+  EXPECT_EQ(result.surface_list[1].geometric_segment, 1);
+  EXPECT_EQ(result.surfaces(305, 205), 0);
+}
+
 TEST(SurfaceFusion, GeometryOnlyIgnoresMasks) {
   BandedWall scene;
   SurfaceFusionConfig fusion;

@@ -39,6 +39,13 @@ struct SurfaceFusionConfig {
   float stuff_confidence = 0.5f;
   /// Ablation "geometry only": ignore panoptic masks; every surface is background.
   bool geometry_only = false;
+  /// A thing mask that holds no surface (a small or far object: every pixel of it is a
+  /// geometric edge or in a segment below min_segment_px) becomes surfaces of its own: its
+  /// pixels with depth outside every geometric segment, split where the depth steps, each
+  /// part of at least min_surface_px. Without it such an object casts no vote at all.
+  bool mask_only_surfaces = true;
+  /// Neighbouring pixels of a mask-only surface differ in depth by at most this share of it.
+  float mask_only_depth_step = 0.01f;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -47,7 +54,7 @@ struct SurfaceFusionConfig {
 /// segment (or inside no mask: background).
 struct Surface {
   int32_t id = 0;                 ///< pixel value in FrameSegmentation::surfaces (> 0)
-  int32_t geometric_segment = 0;  ///< its geometric segment id (> 0)
+  int32_t geometric_segment = 0;  ///< its geometric segment id; 0: a mask-only surface
   int32_t panoptic_segment = 0;   ///< panoptic segment id o_i, 0 = background (no mask)
   int32_t category = 0;           ///< C(o_i), NYU40 id; 0 = background / unknown class
   bool is_thing = false;          ///< o_i is a countable object

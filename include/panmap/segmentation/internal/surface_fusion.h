@@ -23,12 +23,14 @@ class SurfaceFuser {
  public:
   /// Fills out->surfaces and out->surface_list from out->geometric (ids 1..num_geometric).
   /// Pixels in no listed panoptic segment, or in one of unknown category (0), are background.
-  /// Surface ids run from 1 in order of (geometric segment, panoptic segment id).
+  /// Surface ids run from 1 in order of (geometric segment, panoptic segment id), then the
+  /// mask-only surfaces in order of their first pixel.
   /// @param panoptic null or geometry-only: every surface is background
   /// Throws Error when a listed segment id is not positive or listed twice.
   /// @param pool threads for the final relabelling pass (not owned; null: the caller's thread)
+  /// @param depth the frame's depth, for mask-only surfaces (SurfaceFusionConfig); null: none
   void fuse(const PanopticFrame* panoptic, const SurfaceFusionConfig& config,
-            FrameSegmentation* out, ThreadPool* pool = nullptr);
+            FrameSegmentation* out, ThreadPool* pool = nullptr, const DepthImage* depth = nullptr);
 
  private:
   struct Pair {
@@ -41,6 +43,9 @@ class SurfaceFuser {
   void indexSegments(const PanopticFrame& panoptic);
   int32_t segmentIndex(int32_t panoptic_id) const;
   int32_t findOrAddPair(int32_t geometric, int32_t segment_index, int32_t panoptic_id);
+  /// Adds the mask-only surfaces of thing masks that hold no surface (after pass 2).
+  void addMaskOnlySurfaces(const PanopticFrame& panoptic, const DepthImage& depth,
+                           const SurfaceFusionConfig& config, FrameSegmentation* out);
 
   std::vector<std::pair<int32_t, int32_t>> id_to_index_;  ///< (id, index), sorted by id
   std::vector<uint64_t> table_keys_;  ///< open-addressing (geometric, index) -> pair table
@@ -48,6 +53,9 @@ class SurfaceFuser {
   std::vector<Pair> pairs_;
   std::vector<int32_t> order_;
   std::vector<int32_t> pair_to_surface_;
+  std::vector<uint8_t> segment_has_surface_;  ///< per PanopticFrame::segments index
+  std::vector<int32_t> open_;                 ///< per pixel: mask id still to group, else 0
+  std::vector<int32_t> queue_;                ///< pixels of the part being grown
 };
 
 }  // namespace internal
