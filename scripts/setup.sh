@@ -31,7 +31,7 @@ packages=(
   default-jdk-headless libjchart2d-java               # types jar for lcm-spy, its charts
   libeigen3-dev                                       # geometry
   libabsl-dev zlib1g-dev                              # block hash map, map file checksums
-  libzstd-dev                                         # frame store compression (loop repair)
+  libzstd-dev zstd                                    # frame store compression (loop repair); zstd: trace_object.py
   libopencv-dev                                       # image codecs, depth segmentation, resampling
   liboctomap-dev octomap-tools                        # occupancy tree for planners
   libceres-dev                                        # pose refinement against the map

@@ -1,0 +1,177 @@
+#!/usr/bin/env python3
+"""Follows one ground-truth object through the frames a mapper stored, frame by frame.
+
+    python3 scripts/bench/trace_object.py --store DIR --gt MESH.ply --instance N
+
+DIR is a frame store (`panmap-mapper --frame-store DIR`, docs/LOOP_CLOSURE.md) of a run whose
+poses are the ground truth's (a rendered sequence mapped with ground-truth poses); MESH.ply is
+the sequence's gt/mesh.ply (vertex properties x, y, z, semantic, instance). Each of the
+object's vertices is projected into every stored frame with the pose the frame was integrated
+with; where the stored depth agrees (within --depth-tolerance) the vertex is visible, and the
+pixel tells what the pipeline made of it: the panoptic mask there, whether the depth
+segmentation gave it a geometric segment (0: an edge or a dropped small segment) and whether it
+voted for a super-point (the pixel label association gave the integrator; 0: no vote).
+
+That is the question "why is this object unlabelled in the map": seen, but never voting, is
+a segmentation matter (docs/MAPPING.md, mask-only surfaces); voting for a super-point that
+ends up without a class is the labelling's. Needs the `zstd` command (scripts/setup.sh).
+"""
+
+import argparse
+import os
+import shutil
+import struct
+import subprocess
+import sys
+from collections import Counter
+
+PLY_TYPES = {"float": "f", "double": "d", "uchar": "B", "char": "b", "ushort": "H",
+             "short": "h", "uint": "I", "int": "i"}
+
+
+def fail(message):
+    print("trace_object: " + message, file=sys.stderr)
+    sys.exit(1)
+
+
+def read_ply_vertices(path):
+    """Returns (property names, vertex tuples) of a binary little-endian PLY."""
+    try:
+        f = open(path, "rb")
+    except OSError as e:
+        fail("cannot open %s: %s" % (path, e.strerror))
+    with f:
+        props, count, element, fmt = [], 0, None, None
+        while True:
+            line = f.readline()
+            if not line:
+                fail("%s: header has no end_header" % path)
+            words = line.decode("ascii", "replace").split()
+            if not words:
+                continue
+            if words[0] == "format":
+                fmt = words[1]
+            elif words[0] == "element":
+                element = words[1]
+                if element == "vertex":
+                    count = int(words[2])
+            elif words[0] == "property" and element == "vertex":
+                if words[1] == "list" or words[1] not in PLY_TYPES:
+                    fail("%s: vertex property '%s' not understood" % (path, " ".join(words[1:])))
+                props.append((words[2], PLY_TYPES[words[1]]))
+            elif words[0] == "end_header":
+                break
+        if fmt != "binary_little_endian":
+            fail("%s: format %s, expected binary_little_endian" % (path, fmt))
+        layout = "<" + "".join(t for _, t in props)
+        size = struct.calcsize(layout)
+        data = f.read(size * count)
+        if len(data) != size * count:
+            fail("%s: %d vertices announced, the file ends before" % (path, count))
+        return [name for name, _ in props], list(struct.iter_unpack(layout, data))
+
+
+def read_plane(path):
+    """Decodes a frame store plane (io/plane_codec.h): returns (width, pixels)."""
+    try:
+        blob = open(path, "rb").read()
+    except OSError as e:
+        fail("cannot open %s: %s" % (path, e.strerror))
+    if len(blob) < 16 or blob[:4] != b"PMZP":
+        fail("%s: not a frame store plane (stores of version 1 keep PNGs: not read here)" % path)
+    _, kind, width, height = struct.unpack("<4sIII", blob[:16])
+    raw = subprocess.run(["zstd", "-dc"], input=blob[16:], capture_output=True)
+    if raw.returncode != 0:
+        fail("%s: zstd could not decode it" % path)
+    pixels = raw.stdout
+    bytes_per_pixel = len(pixels) // (width * height) if width * height else 0
+    code = {1: "B", 2: "H", 4: "i"}.get(bytes_per_pixel)
+    if code is None or len(pixels) != width * height * bytes_per_pixel:
+        fail("%s: %d bytes for %d x %d pixels" % (path, len(pixels), width, height))
+    return width, struct.unpack("<%d%s" % (width * height, code), pixels)
+
+
+def frames_of(store):
+    """Yields (utime, fx, fy, cx, cy, width, height, depth scale, 3x4 pose) per index line."""
+    index = os.path.join(store, "index.txt")
+    if not os.path.exists(index):
+        fail("%s: no index.txt (not a frame store)" % store)
+    for line in open(index):
+        words = line.split()
+        if not words or words[0] != "frame":
+            continue
+        if len(words) < 21:
+            fail("%s: a frame line has %d fields" % (index, len(words)))
+        fx, fy, cx, cy = map(float, words[2:6])
+        pose = list(map(float, words[9:21]))
+        yield words[1], fx, fy, cx, cy, int(words[6]), int(words[7]), float(words[8]), pose
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--store", required=True, help="frame store folder of a ground-truth-pose run")
+    parser.add_argument("--gt", required=True, help="the sequence's gt/mesh.ply")
+    parser.add_argument("--instance", type=int, required=True, help="ground-truth instance id")
+    parser.add_argument("--depth-tolerance", type=float, default=0.03,
+                        help="a vertex is visible where the stored depth is this close, metres")
+    parser.add_argument("--quiet", action="store_true", help="the summary only")
+    args = parser.parse_args()
+    if shutil.which("zstd") is None:
+        fail("needs the zstd command (apt-get install zstd; scripts/setup.sh installs it)")
+
+    names, vertices = read_ply_vertices(args.gt)
+    for needed in ("x", "y", "z", "instance"):
+        if needed not in names:
+            fail("%s: no vertex property '%s'" % (args.gt, needed))
+    ix, iy, iz, ii = (names.index(n) for n in ("x", "y", "z", "instance"))
+    points = [(v[ix], v[iy], v[iz]) for v in vertices if v[ii] == args.instance]
+    if not points:
+        fail("%s: no vertex of instance %d" % (args.gt, args.instance))
+    print("instance %d: %d vertices" % (args.instance, len(points)))
+
+    totals = Counter()
+    for utime, fx, fy, cx, cy, width, height, scale, M in frames_of(args.store):
+        totals["frames"] += 1
+        pixels = {}
+        for p in points:
+            d = (p[0] - M[3], p[1] - M[7], p[2] - M[11])
+            # p_C = R^T (p_W - t), R row-major in M.
+            x = M[0] * d[0] + M[4] * d[1] + M[8] * d[2]
+            y = M[1] * d[0] + M[5] * d[1] + M[9] * d[2]
+            z = M[2] * d[0] + M[6] * d[1] + M[10] * d[2]
+            if z <= 0.05:
+                continue
+            u, v = int(round(fx * x / z + cx)), int(round(fy * y / z + cy))
+            if 0 <= u < width and 0 <= v < height:
+                pixels.setdefault((u, v), z)
+        if not pixels:
+            continue
+        base = os.path.join(args.store, "frames", utime)
+        _, depth = read_plane(base + ".depth.zst")
+        visible = [(u, v) for (u, v), z in pixels.items()
+                   if depth[v * width + u] > 0 and
+                   abs(depth[v * width + u] * scale - z) < args.depth_tolerance]
+        if not visible:
+            continue
+        totals["frames seen"] += 1
+        totals["pixels seen"] += len(visible)
+        _, labels = read_plane(base + ".labels.zst")
+        voted = sum(1 for u, v in visible if labels[v * width + u] > 0)
+        totals["pixels voting"] += voted
+        line = "frame %s: %d pixels seen, %d voting" % (utime, len(visible), voted)
+        if os.path.exists(base + ".masks.zst"):
+            _, masks = read_plane(base + ".masks.zst")
+            counts = Counter(masks[v * width + u] for u, v in visible)
+            line += ", masks %s" % ", ".join("%d: %d" % kv for kv in counts.most_common(3))
+        if os.path.exists(base + ".geometric.zst"):
+            _, geometric = read_plane(base + ".geometric.zst")
+            edge = sum(1 for u, v in visible if geometric[v * width + u] == 0)
+            totals["pixels without a geometric segment"] += edge
+            line += ", %d without a geometric segment" % edge
+        if not args.quiet:
+            print(line)
+    print("; ".join("%s %d" % kv for kv in totals.items()))
+
+
+if __name__ == "__main__":
+    main()
