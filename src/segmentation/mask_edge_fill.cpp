@@ -21,7 +21,8 @@ void MaskEdgeFillConfig::check() const {
 }
 
 int64_t fillMaskEdges(const DepthImage& depth, const PanopticFrame& masks,
-                      const MaskEdgeFillConfig& config, LabelImage* labels) {
+                      const MaskEdgeFillConfig& config, LabelImage* labels,
+                      MaskEdgeFillScratch* scratch) {
   config.check();
   if (!config.enabled || masks.segment_ids.empty()) return 0;
   const int w = labels->width(), h = labels->height();
@@ -30,61 +31,76 @@ int64_t fillMaskEdges(const DepthImage& depth, const PanopticFrame& masks,
     throw Error("mask edge fill: depth, mask and label images differ in size");
   }
   // Masks of a known class: a category-0 segment names no class to vote for.
-  const KnownSegments known_segments(masks);
-  auto known = [&known_segments](int32_t id) { return known_segments.contains(id); };
+  const KnownSegments known(masks);
   const int32_t* mask = masks.segment_ids.data();
   const uint16_t* d = depth.data();
   int32_t* label = labels->data();
-  const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
-  // Pixels a fill may reach: in a known mask, with depth, without a label.
-  std::vector<uint8_t> open(n, 0);
+  // Pixels a fill may reach (in a known mask, with depth, without a label), on a grid one pixel
+  // wider on every side whose border is never open: a neighbour is tested without bounds checks
+  // and without dividing an index back into (u, v). Pixel i = v * w + u sits at
+  // p = i + (2 v + 1) + pw.
+  MaskEdgeFillScratch local;
+  MaskEdgeFillScratch& work = scratch ? *scratch : local;
+  const int pw = w + 2;
+  work.open.assign(static_cast<size_t>(pw) * static_cast<size_t>(h + 2), 0);
+  uint8_t* open = work.open.data();
   bool any_open = false;
-  for (size_t i = 0; i < n; ++i) {
-    if (label[i] == 0 && d[i] > 0 && known(mask[i])) open[i] = 1, any_open = true;
+  for (int v = 0; v < h; ++v) {
+    const size_t row = static_cast<size_t>(v) * static_cast<size_t>(w);
+    uint8_t* open_row = open + static_cast<size_t>(v + 1) * pw + 1;
+    // Masks are piecewise constant along a row: the last id's verdict is reused.
+    int32_t last_id = 0;
+    bool last_known = false;
+    for (int u = 0; u < w; ++u) {
+      const size_t i = row + static_cast<size_t>(u);
+      if (label[i] != 0 || d[i] == 0) continue;
+      const int32_t id = mask[i];
+      if (id != last_id) last_id = id, last_known = known.contains(id);
+      if (last_known) open_row[u] = 1, any_open = true;
+    }
   }
   if (!any_open) return 0;
   // Sources, in pixel order: labelled pixels of a known mask next to an open pixel of the same
   // mask (one with none can give nothing: the fill moves through open pixels only).
-  std::vector<int32_t> queue;
+  work.queue.clear();
   for (int v = 0; v < h; ++v) {
     const size_t row = static_cast<size_t>(v) * static_cast<size_t>(w);
+    const uint8_t* open_row = open + static_cast<size_t>(v + 1) * pw + 1;
     for (int u = 0; u < w; ++u) {
+      // Most pixels have no open neighbour at all: four byte loads rule them out.
+      if (!(open_row[u - 1] | open_row[u + 1] | open_row[u - pw] | open_row[u + pw])) continue;
       const size_t k = row + static_cast<size_t>(u);
       if (label[k] <= 0) continue;
       const int32_t m = mask[k];
-      auto opens = [&](size_t j) { return open[j] && mask[j] == m; };
-      if (((u > 0 && opens(k - 1)) || (u + 1 < w && opens(k + 1)) ||
-           (v > 0 && opens(k - static_cast<size_t>(w))) ||
-           (v + 1 < h && opens(k + static_cast<size_t>(w)))) &&
-          known(m)) {
-        queue.push_back(static_cast<int32_t>(k));
+      if (((open_row[u - 1] && mask[k - 1] == m) || (open_row[u + 1] && mask[k + 1] == m) ||
+           (open_row[u - pw] && mask[k - w] == m) || (open_row[u + pw] && mask[k + w] == m)) &&
+          known.contains(m)) {
+        work.queue.push_back({static_cast<int32_t>(k), static_cast<int32_t>(k + 2 * v + 1 + pw), 0});
       }
     }
   }
   const float step = static_cast<float>(config.max_depth_step);
-  // Steps from the source of each queued pixel (sources 0), for max_distance_px.
-  std::vector<int32_t> steps(queue.size(), 0);
   int64_t filled = 0;
-  for (size_t head = 0; head < queue.size(); ++head) {
-    const int32_t i = queue[head];
-    const int u = i % w, v = i / w;
-    const float di = static_cast<float>(d[i]);
-    const int32_t next_steps = steps[head] + 1;
+  for (size_t head = 0; head < work.queue.size(); ++head) {
+    const MaskEdgeFillScratch::Item item = work.queue[head];
+    const int32_t next_steps = item.steps + 1;
     if (config.max_distance_px > 0 && next_steps > config.max_distance_px) continue;
-    auto reach = [&](int32_t j) {
-      if (!open[j] || mask[j] != mask[i]) return;
+    const int32_t i = item.pixel, p = item.padded;
+    const float di = static_cast<float>(d[i]);
+    const int32_t mi = mask[i], li = label[i];
+    auto reach = [&](int32_t j, int32_t q) {
+      if (!open[q] || mask[j] != mi) return;
       const float dj = static_cast<float>(d[j]);
       if (std::fabs(dj - di) > step * std::min(di, dj)) return;
-      open[j] = 0;
-      label[j] = label[i];
+      open[q] = 0;
+      label[j] = li;
       ++filled;
-      queue.push_back(j);
-      steps.push_back(next_steps);
+      work.queue.push_back({j, q, next_steps});
     };
-    if (u > 0) reach(i - 1);
-    if (u + 1 < w) reach(i + 1);
-    if (v > 0) reach(i - w);
-    if (v + 1 < h) reach(i + w);
+    reach(i - 1, p - 1);
+    reach(i + 1, p + 1);
+    reach(i - w, p - pw);
+    reach(i + w, p + pw);
   }
   return filled;
 }

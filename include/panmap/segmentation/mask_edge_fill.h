@@ -25,6 +25,18 @@ struct MaskEdgeFillConfig {
   void check() const;
 };
 
+/// Working memory of fillMaskEdges, kept between frames so that a frame allocates nothing.
+struct MaskEdgeFillScratch {
+  /// A pixel being filled: its index, its index on the padded grid, steps from its source.
+  struct Item {
+    int32_t pixel;
+    int32_t padded;
+    int32_t steps;
+  };
+  std::vector<uint8_t> open;
+  std::vector<Item> queue;
+};
+
 /// Gives each pixel without a label (0) that lies inside a panoptic mask of a known class, and
 /// has depth, the label of the nearest labelled pixel of the same mask it reaches through at
 /// most max_distance_px 4-neighbour steps without a depth jump (breadth first from the
@@ -36,7 +48,9 @@ struct MaskEdgeFillConfig {
 /// @param depth the frame's depth image (0 = none), in units of depth_scale_m
 /// @param masks the frame's panoptic segmentation, same size
 /// @param labels super-point label per pixel, same size; filled in place
+/// @param scratch working memory reused between calls (null: allocated for this call)
 int64_t fillMaskEdges(const DepthImage& depth, const PanopticFrame& masks,
-                      const MaskEdgeFillConfig& config, LabelImage* labels);
+                      const MaskEdgeFillConfig& config, LabelImage* labels,
+                      MaskEdgeFillScratch* scratch = nullptr);
 
 }  // namespace panmap
