@@ -273,6 +273,30 @@ def regularisation_reach(rows, masks="m2f"):
                 wrong, total, fixed, broken))
 
 
+def network_gap(rows):
+    """What the network's errors cost the full method at IoU 0.5: GT things of the rows with a
+    clean-mask run, paired across the `m2f` and the clean-mask run of the same seed."""
+    lost, gained, total = {}, 0, 0
+    for key in rows.keys:
+        for noisy, clean in zip(rows.runs(key), rows.runs(key, masks="clean")):
+            cause = {t["instance_id"]: t.get("cause") for t in noisy["diagnostics"]["gt_things"]}
+            for t in clean["diagnostics"]["gt_things"]:
+                now = cause.get(t["instance_id"])
+                total += t.get("cause") == "matched"
+                if t.get("cause") == "matched" and now != "matched":
+                    lost[now] = lost.get(now, 0) + 1
+                gained += t.get("cause") != "matched" and now == "matched"
+    if not total:
+        return ""
+    return ("What the network's errors cost (full method, ground-truth poses): of the %d GT "
+            "things matched with clean masks, %d are missed with `m2f` masks (%s), and %d "
+            "missed with clean masks are matched with `m2f`." % (
+                total, sum(lost.values()),
+                ", ".join("%d %s" % (n, c) for c, n in sorted(lost.items(),
+                                                              key=lambda kv: (-kv[1], kv[0])))
+                or "none", gained))
+
+
 def headroom_note(rows):
     """How far above the baseline any method can get: clean masks bound the full method."""
     keys = [k for k in rows.keys if rows.runs(k, masks="clean")]
@@ -656,7 +680,7 @@ def main():
                "domain); **split**, its class covers most of it but no single object more than "
                "half (fragments: III-D's domain). Defined in "
                "`include/panmap/eval/diagnostics.h` (`MissCause`).", "",
-               miss_table(rows), "", regularisation_reach(rows), "",
+               miss_table(rows), "", regularisation_reach(rows), "", network_gap(rows), "",
                "### Acceptance (issue 19)", "", acceptance(rows), "", headroom_note(rows), "",
                ceiling_note(rows), ""]
     suites = [Rows(s, results) for s in (real, likes) if s]

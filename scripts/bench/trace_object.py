@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Follows one ground-truth object through the frames a mapper stored, frame by frame.
 
-    python3 scripts/bench/trace_object.py --store DIR --gt MESH.ply --instance N
+    python3 scripts/bench/trace_object.py --store DIR --gt MESH.ply --instance N [--with M]
 
 DIR is a frame store (`panmap-mapper --frame-store DIR`, docs/LOOP_CLOSURE.md) of a run whose
 poses are the ground truth's (a rendered sequence mapped with ground-truth poses); MESH.ply is
@@ -14,7 +14,11 @@ voted for a super-point (the pixel label association gave the integrator; 0: no 
 
 That is the question "why is this object unlabelled in the map": seen, but never voting, is
 a segmentation matter (docs/MAPPING.md, mask-only surfaces); voting for a super-point that
-ends up without a class is the labelling's. Needs the `zstd` command (scripts/setup.sh).
+ends up without a class is the labelling's. With `--with M`, a second object (a neighbour the
+first came out merged with) is followed alongside: each one's mask and the super-points its
+pixels voted for, and the frames where one mask covers both ("ONE MASK": a network merging two
+touching objects, which is when III-B may join their super-points). Needs the `zstd` command
+(scripts/setup.sh).
 """
 
 import argparse
@@ -107,11 +111,38 @@ def frames_of(store):
         yield words[1], fx, fy, cx, cy, int(words[6]), int(words[7]), float(words[8]), pose
 
 
+def visible_pixels(points, M, fx, fy, cx, cy, width, height, depth, scale, tolerance):
+    """The pixels where the points project with the stored depth within `tolerance`."""
+    pixels = {}
+    for p in points:
+        d = (p[0] - M[3], p[1] - M[7], p[2] - M[11])
+        # p_C = R^T (p_W - t), R row-major in M.
+        x = M[0] * d[0] + M[4] * d[1] + M[8] * d[2]
+        y = M[1] * d[0] + M[5] * d[1] + M[9] * d[2]
+        z = M[2] * d[0] + M[6] * d[1] + M[10] * d[2]
+        if z <= 0.05:
+            continue
+        u, v = int(round(fx * x / z + cx)), int(round(fy * y / z + cy))
+        if 0 <= u < width and 0 <= v < height:
+            pixels.setdefault((u, v), z)
+    if not pixels or depth is None:
+        return list(pixels)
+    return [(u, v) for (u, v), z in pixels.items()
+            if depth[v * width + u] > 0 and abs(depth[v * width + u] * scale - z) < tolerance]
+
+
+def top(counts, n=3):
+    return ", ".join("%d: %d" % kv for kv in counts.most_common(n))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--store", required=True, help="frame store folder of a ground-truth-pose run")
     parser.add_argument("--gt", required=True, help="the sequence's gt/mesh.ply")
     parser.add_argument("--instance", type=int, required=True, help="ground-truth instance id")
+    parser.add_argument("--with", dest="other", type=int,
+                        help="a second ground-truth instance (a neighbour the first was merged "
+                             "with): frames where one mask covers both, and each one's votes")
     parser.add_argument("--depth-tolerance", type=float, default=0.03,
                         help="a vertex is visible where the stored depth is this close, metres")
     parser.add_argument("--quiet", action="store_true", help="the summary only")
@@ -124,52 +155,68 @@ def main():
         if needed not in names:
             fail("%s: no vertex property '%s'" % (args.gt, needed))
     ix, iy, iz, ii = (names.index(n) for n in ("x", "y", "z", "instance"))
-    points = [(v[ix], v[iy], v[iz]) for v in vertices if v[ii] == args.instance]
-    if not points:
-        fail("%s: no vertex of instance %d" % (args.gt, args.instance))
-    print("instance %d: %d vertices" % (args.instance, len(points)))
+    ids = [args.instance] + ([args.other] if args.other is not None else [])
+    if len(set(ids)) != len(ids):
+        fail("--with names the same instance as --instance")
+    objects = {}
+    for i in ids:
+        objects[i] = [(v[ix], v[iy], v[iz]) for v in vertices if v[ii] == i]
+        if not objects[i]:
+            fail("%s: no vertex of instance %d" % (args.gt, i))
+        print("instance %d: %d vertices" % (i, len(objects[i])))
 
     totals = Counter()
     for utime, fx, fy, cx, cy, width, height, scale, M in frames_of(args.store):
         totals["frames"] += 1
-        pixels = {}
-        for p in points:
-            d = (p[0] - M[3], p[1] - M[7], p[2] - M[11])
-            # p_C = R^T (p_W - t), R row-major in M.
-            x = M[0] * d[0] + M[4] * d[1] + M[8] * d[2]
-            y = M[1] * d[0] + M[5] * d[1] + M[9] * d[2]
-            z = M[2] * d[0] + M[6] * d[1] + M[10] * d[2]
-            if z <= 0.05:
-                continue
-            u, v = int(round(fx * x / z + cx)), int(round(fy * y / z + cy))
-            if 0 <= u < width and 0 <= v < height:
-                pixels.setdefault((u, v), z)
-        if not pixels:
+        if not any(visible_pixels(objects[i], M, fx, fy, cx, cy, width, height, None, scale, 0)
+                   for i in ids):
             continue
         base = os.path.join(args.store, "frames", utime)
         _, depth = read_plane(base + ".depth.zst")
-        visible = [(u, v) for (u, v), z in pixels.items()
-                   if depth[v * width + u] > 0 and
-                   abs(depth[v * width + u] * scale - z) < args.depth_tolerance]
-        if not visible:
+        seen = {i: visible_pixels(objects[i], M, fx, fy, cx, cy, width, height, depth, scale,
+                                  args.depth_tolerance) for i in ids}
+        if not seen[args.instance] and not (args.other is not None and seen[args.other]):
             continue
-        totals["frames seen"] += 1
-        totals["pixels seen"] += len(visible)
         _, labels = read_plane(base + ".labels.zst")
-        voted = sum(1 for u, v in visible if labels[v * width + u] > 0)
-        totals["pixels voting"] += voted
-        line = "frame %s: %d pixels seen, %d voting" % (utime, len(visible), voted)
+        masks = geometric = None
         if os.path.exists(base + ".masks.zst"):
             _, masks = read_plane(base + ".masks.zst")
-            counts = Counter(masks[v * width + u] for u, v in visible)
-            line += ", masks %s" % ", ".join("%d: %d" % kv for kv in counts.most_common(3))
         if os.path.exists(base + ".geometric.zst"):
             _, geometric = read_plane(base + ".geometric.zst")
-            edge = sum(1 for u, v in visible if geometric[v * width + u] == 0)
-            totals["pixels without a geometric segment"] += edge
-            line += ", %d without a geometric segment" % edge
+        parts, main_mask = [], {}
+        for i in ids:
+            visible = seen[i]
+            if not visible:
+                parts.append("%d unseen" % i if args.other is not None else "")
+                continue
+            prefix = "%d: " % i if args.other is not None else ""
+            if i == args.instance:
+                totals["frames seen"] += 1
+                totals["pixels seen"] += len(visible)
+            voted = sum(1 for u, v in visible if labels[v * width + u] > 0)
+            if i == args.instance:
+                totals["pixels voting"] += voted
+            line = "%s%d pixels seen, %d voting" % (prefix, len(visible), voted)
+            if masks is not None:
+                counts = Counter(masks[v * width + u] for u, v in visible)
+                main_mask[i] = counts.most_common(1)[0][0]
+                line += ", masks %s" % top(counts)
+            if geometric is not None:
+                edge = sum(1 for u, v in visible if geometric[v * width + u] == 0)
+                if i == args.instance:
+                    totals["pixels without a geometric segment"] += edge
+                line += ", %d without a geometric segment" % edge
+            if args.other is not None:
+                line += ", super-points %s" % top(Counter(labels[v * width + u]
+                                                          for u, v in visible))
+            parts.append(line)
+        if args.other is not None and len(main_mask) == 2:
+            totals["frames both seen"] += 1
+            if main_mask[args.instance] > 0 and main_mask[args.instance] == main_mask[args.other]:
+                totals["frames one mask covers both"] += 1
+                parts.append("ONE MASK")
         if not args.quiet:
-            print(line)
+            print("frame %s: %s" % (utime, " | ".join(p for p in parts if p)))
     print("; ".join("%s %d" % kv for kv in totals.items()))
 
 
