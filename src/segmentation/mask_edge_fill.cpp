@@ -75,7 +75,8 @@ int64_t fillMaskEdges(const DepthImage& depth, const PanopticFrame& masks,
       if (((open_row[u - 1] && mask[k - 1] == m) || (open_row[u + 1] && mask[k + 1] == m) ||
            (open_row[u - pw] && mask[k - w] == m) || (open_row[u + pw] && mask[k + w] == m)) &&
           known.contains(m)) {
-        work.queue.push_back({static_cast<int32_t>(k), static_cast<int32_t>(k + 2 * v + 1 + pw), 0});
+        work.queue.push_back(
+            {static_cast<int32_t>(k), static_cast<int32_t>(k + 2 * v + 1 + pw), 0});
       }
     }
   }

@@ -99,9 +99,9 @@ TEST(MaskEdgeFill, NeverWrapsAroundTheImageEdges) {
   // neighbours: the label at the end of row 0 must not reach the start of row 1, nor the one
   // at the start of row 1 the end of row 0.
   Tiny end_of_row({"00005", "00000"}, {"bbbba", "a...."});
-  EXPECT_EQ(fillMaskEdges(end_of_row.depth, end_of_row.masks, MaskEdgeFillConfig{},
-                          &end_of_row.labels),
-            0);
+  EXPECT_EQ(
+      fillMaskEdges(end_of_row.depth, end_of_row.masks, MaskEdgeFillConfig{}, &end_of_row.labels),
+      0);
   EXPECT_EQ(end_of_row.row(1), (std::vector<int32_t>{0, 0, 0, 0, 0}));
   Tiny start_of_row({"00000", "30000"}, {"bbbba", "a...."});
   EXPECT_EQ(fillMaskEdges(start_of_row.depth, start_of_row.masks, MaskEdgeFillConfig{},
@@ -115,14 +115,13 @@ TEST(MaskEdgeFill, ReusedScratchGivesWhatAFreshCallGives) {
   MaskEdgeFillScratch scratch;
   Tiny big({"7090000", "0000000", "0000008"}, {"aaaaabb", "aaaaabb", "aaaaabb"});
   Tiny big_fresh = big;
-  EXPECT_EQ(fillMaskEdges(big.depth, big.masks, MaskEdgeFillConfig{}, &big.labels, &scratch),
-            fillMaskEdges(big_fresh.depth, big_fresh.masks, MaskEdgeFillConfig{},
-                          &big_fresh.labels));
+  EXPECT_EQ(
+      fillMaskEdges(big.depth, big.masks, MaskEdgeFillConfig{}, &big.labels, &scratch),
+      fillMaskEdges(big_fresh.depth, big_fresh.masks, MaskEdgeFillConfig{}, &big_fresh.labels));
   EXPECT_EQ(big.labels, big_fresh.labels);
   EXPECT_EQ(big.row(2), (std::vector<int32_t>{7, 7, 9, 9, 9, 8, 8}));
   Tiny small({"000", "040"}, {"aaa", "aaa"});
-  EXPECT_EQ(fillMaskEdges(small.depth, small.masks, MaskEdgeFillConfig{}, &small.labels,
-                          &scratch),
+  EXPECT_EQ(fillMaskEdges(small.depth, small.masks, MaskEdgeFillConfig{}, &small.labels, &scratch),
             5);
   EXPECT_EQ(small.row(0), (std::vector<int32_t>{4, 4, 4}));
   EXPECT_EQ(small.row(1), (std::vector<int32_t>{4, 4, 4}));

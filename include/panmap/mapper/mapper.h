@@ -401,7 +401,7 @@ class Mapper {
   FrameSegmentation segmentation_;  // scratch, reused every frame
   RgbdFrame calibrated_frame_;      // scratch: the frame with the depth calibration applied
   int64_t frames_with_kept_segments_ = 0;
-  FrameAssociation association_;  // scratch, reused every frame
+  FrameAssociation association_;      // scratch, reused every frame
   MaskEdgeFillScratch fill_scratch_;  // scratch, reused every frame
   uint64_t superpoints_forgotten_ = 0;
   uint64_t edges_pruned_ = 0;
