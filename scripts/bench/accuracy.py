@@ -280,8 +280,9 @@ def regularisation_effect(rows, work, masks="m2f"):
     III-C maps are one map labelled twice (same mesh vertices), so the vertices whose class
     differs are exactly III-C's changes; each is given the class of the nearest ground-truth
     vertex within 3 cm."""
+    from surface_distance import nearest
     from trace_object import read_ply_vertices
-    reach_m, cell = 0.03, 0.05
+    reach_m = 0.03
     counts = {"changed": 0, "vertices": 0, "void": 0, "off": 0, "right": 0, "wrong": 0,
               "neither": 0}
     for key in rows.keys:
@@ -302,28 +303,17 @@ def regularisation_effect(rows, work, masks="m2f"):
                 continue
             gt_names, gt = read_ply_vertices(gt_path)
             gx, gy, gz, gc = (gt_names.index(n) for n in ("x", "y", "z", "semantic"))
-            grid = {}
-            for g in gt:
-                k = (int(g[gx] // cell), int(g[gy] // cell), int(g[gz] // cell))
-                grid.setdefault(k, []).append((g[gx], g[gy], g[gz], g[gc]))
-            for a, was in changed:
-                p = (a[ix], a[iy], a[iz])
-                k = tuple(int(c // cell) for c in p)
-                best, best_d2 = None, reach_m * reach_m
-                for dx in (-1, 0, 1):
-                    for dy in (-1, 0, 1):
-                        for dz in (-1, 0, 1):
-                            for q in grid.get((k[0] + dx, k[1] + dy, k[2] + dz), ()):
-                                d2 = (q[0] - p[0]) ** 2 + (q[1] - p[1]) ** 2 + (q[2] - p[2]) ** 2
-                                if d2 < best_d2:
-                                    best, best_d2 = q, d2
-                if best is None:
+            found = nearest([(a[ix], a[iy], a[iz]) for a, _ in changed],
+                            [(g[gx], g[gy], g[gz]) for g in gt], cap=reach_m)
+            for (a, was), (at, _) in zip(changed, found):
+                truth = None if at is None else gt[at][gc]
+                if truth is None:
                     counts["off"] += 1
-                elif best[3] == 0:
+                elif truth == 0:
                     counts["void"] += 1
-                elif best[3] == a[ic]:
+                elif truth == a[ic]:
                     counts["right"] += 1
-                elif best[3] == was:
+                elif truth == was:
                     counts["wrong"] += 1
                 else:
                     counts["neither"] += 1
