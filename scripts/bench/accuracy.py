@@ -280,8 +280,7 @@ def regularisation_effect(rows, work, masks="m2f"):
     III-C maps are one map labelled twice (same mesh vertices), so the vertices whose class
     differs are exactly III-C's changes; each is given the class of the nearest ground-truth
     vertex within 3 cm."""
-    from surface_distance import nearest
-    from trace_object import read_ply_vertices
+    from surface_distance import nearest, read_ply_vertices
     reach_m = 0.03
     counts = {"changed": 0, "vertices": 0, "void": 0, "off": 0, "right": 0, "wrong": 0,
               "neither": 0}

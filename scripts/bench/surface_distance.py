@@ -7,18 +7,49 @@ import struct
 import sys
 
 
+PLY_TYPES = {"float": "f", "double": "d", "uchar": "B", "char": "b", "ushort": "H",
+             "short": "h", "uint": "I", "int": "i"}
+
+
+def read_ply_vertices(path):
+    """(property names, vertex tuples) of a binary little-endian PLY. Raises OSError when the
+    file cannot be read and ValueError naming what is wrong with it."""
+    with open(path, "rb") as f:
+        props, count, element, fmt = [], 0, None, None
+        while True:
+            line = f.readline()
+            if not line:
+                raise ValueError("%s: header has no end_header" % path)
+            words = line.decode("ascii", "replace").split()
+            if not words:
+                continue
+            if words[0] == "format":
+                fmt = words[1]
+            elif words[0] == "element":
+                element = words[1]
+                if element == "vertex":
+                    count = int(words[2])
+            elif words[0] == "property" and element == "vertex":
+                if words[1] == "list" or words[1] not in PLY_TYPES:
+                    raise ValueError("%s: vertex property '%s' not understood" % (
+                        path, " ".join(words[1:])))
+                props.append((words[2], PLY_TYPES[words[1]]))
+            elif words[0] == "end_header":
+                break
+        if fmt != "binary_little_endian":
+            raise ValueError("%s: format %s, expected binary_little_endian" % (path, fmt))
+        layout = "<" + "".join(t for _, t in props)
+        size = struct.calcsize(layout)
+        data = f.read(size * count)
+        if len(data) != size * count:
+            raise ValueError("%s: %d vertices announced, the file ends before" % (path, count))
+        return [name for name, _ in props], list(struct.iter_unpack(layout, data))
+
+
 def load_vertices(path):
     """The vertices of a binary little-endian PLY as dicts of their scalar properties."""
-    f = open(path, 'rb'); props = []; n = 0
-    while True:
-        l = f.readline().decode().strip()
-        if l.startswith('element vertex'): n = int(l.split()[2])
-        elif l.startswith('property') and 'list' not in l: props.append(l.split()[1:])
-        elif l == 'end_header': break
-    fmt = '<' + ''.join({'float': 'f', 'uchar': 'B', 'int': 'i'}[t] for t, _ in props)
-    names = [name for _, name in props]
-    sz = struct.calcsize(fmt); data = f.read(sz * n)
-    return [dict(zip(names, struct.unpack_from(fmt, data, i * sz))) for i in range(n)]
+    names, vertices = read_ply_vertices(path)
+    return [dict(zip(names, v)) for v in vertices]
 
 
 def load(path):

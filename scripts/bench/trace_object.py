@@ -29,50 +29,20 @@ import subprocess
 import sys
 from collections import Counter
 
-PLY_TYPES = {"float": "f", "double": "d", "uchar": "B", "char": "b", "ushort": "H",
-             "short": "h", "uint": "I", "int": "i"}
-
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from surface_distance import read_ply_vertices  # noqa: E402  (same folder)
 
 def fail(message):
     print("trace_object: " + message, file=sys.stderr)
     sys.exit(1)
 
 
-def read_ply_vertices(path):
-    """Returns (property names, vertex tuples) of a binary little-endian PLY."""
+def read_mesh(path):
+    """read_ply_vertices, a failure named in one line."""
     try:
-        f = open(path, "rb")
-    except OSError as e:
-        fail("cannot open %s: %s" % (path, e.strerror))
-    with f:
-        props, count, element, fmt = [], 0, None, None
-        while True:
-            line = f.readline()
-            if not line:
-                fail("%s: header has no end_header" % path)
-            words = line.decode("ascii", "replace").split()
-            if not words:
-                continue
-            if words[0] == "format":
-                fmt = words[1]
-            elif words[0] == "element":
-                element = words[1]
-                if element == "vertex":
-                    count = int(words[2])
-            elif words[0] == "property" and element == "vertex":
-                if words[1] == "list" or words[1] not in PLY_TYPES:
-                    fail("%s: vertex property '%s' not understood" % (path, " ".join(words[1:])))
-                props.append((words[2], PLY_TYPES[words[1]]))
-            elif words[0] == "end_header":
-                break
-        if fmt != "binary_little_endian":
-            fail("%s: format %s, expected binary_little_endian" % (path, fmt))
-        layout = "<" + "".join(t for _, t in props)
-        size = struct.calcsize(layout)
-        data = f.read(size * count)
-        if len(data) != size * count:
-            fail("%s: %d vertices announced, the file ends before" % (path, count))
-        return [name for name, _ in props], list(struct.iter_unpack(layout, data))
+        return read_ply_vertices(path)
+    except (OSError, ValueError) as e:
+        fail(str(e) if isinstance(e, ValueError) else "cannot open %s: %s" % (path, e.strerror))
 
 
 def read_plane(path):
@@ -111,8 +81,8 @@ def frames_of(store):
         yield words[1], fx, fy, cx, cy, int(words[6]), int(words[7]), float(words[8]), pose
 
 
-def visible_pixels(points, M, fx, fy, cx, cy, width, height, depth, scale, tolerance):
-    """The pixels where the points project with the stored depth within `tolerance`."""
+def project(points, M, fx, fy, cx, cy, width, height):
+    """{pixel: depth} of the points that land in the image in front of the camera."""
     pixels = {}
     for p in points:
         d = (p[0] - M[3], p[1] - M[7], p[2] - M[11])
@@ -125,8 +95,11 @@ def visible_pixels(points, M, fx, fy, cx, cy, width, height, depth, scale, toler
         u, v = int(round(fx * x / z + cx)), int(round(fy * y / z + cy))
         if 0 <= u < width and 0 <= v < height:
             pixels.setdefault((u, v), z)
-    if not pixels or depth is None:
-        return list(pixels)
+    return pixels
+
+
+def agreeing(pixels, depth, width, scale, tolerance):
+    """The projected pixels where the stored depth agrees within `tolerance`."""
     return [(u, v) for (u, v), z in pixels.items()
             if depth[v * width + u] > 0 and abs(depth[v * width + u] * scale - z) < tolerance]
 
@@ -150,7 +123,7 @@ def main():
     if shutil.which("zstd") is None:
         fail("needs the zstd command (apt-get install zstd; scripts/setup.sh installs it)")
 
-    names, vertices = read_ply_vertices(args.gt)
+    names, vertices = read_mesh(args.gt)
     for needed in ("x", "y", "z", "instance"):
         if needed not in names:
             fail("%s: no vertex property '%s'" % (args.gt, needed))
@@ -168,13 +141,12 @@ def main():
     totals = Counter()
     for utime, fx, fy, cx, cy, width, height, scale, M in frames_of(args.store):
         totals["frames"] += 1
-        if not any(visible_pixels(objects[i], M, fx, fy, cx, cy, width, height, None, scale, 0)
-                   for i in ids):
+        projected = {i: project(objects[i], M, fx, fy, cx, cy, width, height) for i in ids}
+        if not any(projected.values()):
             continue
         base = os.path.join(args.store, "frames", utime)
         _, depth = read_plane(base + ".depth.zst")
-        seen = {i: visible_pixels(objects[i], M, fx, fy, cx, cy, width, height, depth, scale,
-                                  args.depth_tolerance) for i in ids}
+        seen = {i: agreeing(projected[i], depth, width, scale, args.depth_tolerance) for i in ids}
         if not seen[args.instance] and not (args.other is not None and seen[args.other]):
             continue
         _, labels = read_plane(base + ".labels.zst")
