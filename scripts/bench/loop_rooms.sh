@@ -8,9 +8,13 @@
 # and the occupancy agreement with the ground-truth-pose run for each (docs/LOOP_CLOSURE.md).
 #   scripts/bench/loop_rooms.sh [--room N] [--seed N] [--poses slam|slam-hard|light|heavy] [--frames N]
 #                               [--residual-cm S] [--residual-deg S] [--style boxes|scannet]
+#                               [--reintegrate-also]
+# --reintegrate-also maps a fourth way: repaired by re-integration only (--repair-reintegrate-only,
+# the stored pixel labels of the first mapping), to compare with mapping the frames again.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 room=3 seed=3 poses=slam-hard frames=450 residual_cm=0 residual_deg=0 style=boxes
+reintegrate_also=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --room) room="$2"; shift 2 ;;
@@ -20,7 +24,8 @@ while [ $# -gt 0 ]; do
     --residual-cm) residual_cm="$2"; shift 2 ;;
     --residual-deg) residual_deg="$2"; shift 2 ;;
     --style) style="$2"; shift 2 ;;
-    -h|--help) sed -n 2,10p "$0"; exit 0 ;;
+    --reintegrate-also) reintegrate_also=1; shift ;;
+    -h|--help) sed -n 2,13p "$0"; exit 0 ;;
     *) echo "loop_rooms.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -40,6 +45,12 @@ map() {  # log, out, extra args
 map "$work/gt_seq/sequence.lcmlog" gt_poses
 map "$work/drift_seq/sequence.lcmlog" drifted
 map "$work/drift_seq/sequence.lcmlog" repaired --frame-store "$work/store"
+maps=(gt_poses drifted repaired)
+if [ "$reintegrate_also" = 1 ]; then
+  map "$work/drift_seq/sequence.lcmlog" reintegrated --frame-store "$work/store_reintegrated" \
+    --repair-reintegrate-only
+  maps+=(reintegrated)
+fi
 python3 - "$work" <<'PY'
 import json, sys
 work = sys.argv[1]
@@ -50,8 +61,13 @@ print("sequence: %d frames, input ATE %.2f cm, correction of %d keyframes (resid
          info["correction"]["keyframes"], info["correction"]["residual_cm"],
          info["correction"]["residual_deg"]))
 print("repair:", "; ".join(r["corrections"]["repairs"]) or "none")
+try:
+    r = json.load(open(work + "/reintegrated/report.json"))
+    print("re-integration:", "; ".join(r["corrections"]["repairs"]) or "none")
+except FileNotFoundError:
+    pass
 PY
-for m in gt_poses drifted repaired; do
+for m in "${maps[@]}"; do
   build/panmap-eval --pred "$work/$m/mesh_instance.ply" --gt "$work/gt_seq/gt/mesh.ply" \
     --json "$work/$m/eval.json" >/dev/null
   map50=$(python3 -c "import json,sys; print('%.1f' % (100*json.load(open(sys.argv[1]))['map50']))" \
@@ -60,5 +76,7 @@ for m in gt_poses drifted repaired; do
     "$work/gt_seq/gt/mesh.ply")
   occupancy=$(build/panmap-occupancy-probe --file "$work/$m/occupancy.bt" \
     --compare "$work/gt_poses/occupancy.bt")
-  echo "$m: mAP50 $map50; ${surface#*: }; occupancy vs gt_poses: $occupancy"
+  purity=$(python3 -c "import json,sys; print('%.3f' % json.load(open(sys.argv[1]))['diagnostics']['superpoint_purity'])" \
+    "$work/$m/eval.json")
+  echo "$m: mAP50 $map50; purity $purity; ${surface#*: }; occupancy vs gt_poses: $occupancy"
 done

@@ -7,8 +7,19 @@ distance to the ground-truth mesh and occupancy agreement of the ground-truth-po
 of the repaired one, the GT objects matched by each, and every GT object whose outcome
 differs between the two, with its best IoU. About 2.5 minutes per run on 2 cores.
 
+With --reintegrate-also each run is also repaired by re-integration only (the pixel labels of
+the first mapping, `panmap-mapper --repair-reintegrate-only`) and the section written is
+another one (between its loop-reintegration markers): the map from ground-truth poses, the
+repair that maps the frames again and the re-integration side by side, with the correction's
+largest move, and every GT object whose outcome differs between the two repairs: what mapping
+the frames again buys over the cheaper re-integration. --report-only writes either section
+from the run folders loop_rooms.sh left, without running anything.
+
   python3 scripts/bench/loop_rooms_suite.py [--runs 3:3,3:4,3:5,4:3,5:3] [--poses heavy]
+                                            [--reintegrate-also] [--report-only]
                                             [--out docs/LOOP_CLOSURE.md] [--no-write]
+
+A run is ROOM:SEED, or ROOM:SEED:STYLE:FRAMES for loop_rooms.sh's --style and --frames.
 """
 import argparse
 import datetime
@@ -22,14 +33,29 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BEGIN = "<!-- loop-suite:begin (scripts/bench/loop_rooms_suite.py) -->"
 END = "<!-- loop-suite:end -->"
+BEGIN_REINTEGRATION = ("<!-- loop-reintegration:begin (scripts/bench/loop_rooms_suite.py "
+                       "--reintegrate-also) -->")
+END_REINTEGRATION = "<!-- loop-reintegration:end -->"
+REPAIR = re.compile(r"in ([0-9.]+) s, largest move ([0-9.]+) m")
 LINE = re.compile(r"^(gt_poses|drifted|repaired): mAP50 ([0-9.]+); mean ([0-9.]+) cm.*"
                   r"agree on ([0-9.]+) % of")
 
 
-def run_one(room, seed, poses):
+def work_folder(room, seed, poses):
+    """The folder loop_rooms.sh maps a run in."""
+    return os.path.join(ROOT, "build", "loop_rooms", "room%s-seed%s-%s" % (room, seed, poses))
+
+
+def run_one(room, seed, poses, style=None, frames=None, reintegrate_also=False):
     """Runs loop_rooms.sh once; returns its figures per map and the work folder."""
     cmd = ["bash", "scripts/bench/loop_rooms.sh", "--room", str(room), "--seed", str(seed),
            "--poses", poses]
+    if style:
+        cmd += ["--style", style]
+    if frames:
+        cmd += ["--frames", str(frames)]
+    if reintegrate_also:
+        cmd.append("--reintegrate-also")
     out = subprocess.run(cmd, cwd=ROOT, check=True, capture_output=True, text=True).stdout
     figures = {}
     repair = ""
@@ -43,13 +69,104 @@ def run_one(room, seed, poses):
     if set(figures) != {"gt_poses", "drifted", "repaired"}:
         sys.exit("loop_rooms_suite: loop_rooms.sh printed no figures for room %s seed %s:\n%s"
                  % (room, seed, out))
-    work = os.path.join(ROOT, "build", "loop_rooms", "room%s-seed%s-%s" % (room, seed, poses))
-    return figures, repair, work
+    return figures, repair, work_folder(room, seed, poses)
+
+
+def read_json(path):
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError) as e:
+        sys.exit("loop_rooms_suite: cannot read %s: %s" % (path, e))
 
 
 def gt_things(path):
+    return {t["instance_id"]: t for t in read_json(path)["diagnostics"]["gt_things"]}
+
+
+def repair_of(work, name):
+    """(seconds, largest move in m) of the one repair in a map's report.json."""
+    repairs = read_json(os.path.join(work, name, "report.json"))["corrections"]["repairs"]
+    m = REPAIR.search(repairs[0]) if len(repairs) == 1 else None
+    if not m:
+        sys.exit("loop_rooms_suite: %s/%s made no single repair: %s" % (work, name, repairs))
+    return float(m.group(1)), float(m.group(2))
+
+
+def reintegration_section(args, pairs, minutes):
+    """The table of ground-truth poses / mapped again / re-integrated, from the run folders."""
+    rows, changes = [], []
+    totals = [0, 0, 0, 0]
+    for room, seed, style, frames in pairs:
+        work = work_folder(room, seed, args.poses)
+        things = [gt_things(os.path.join(work, m, "eval.json"))
+                  for m in ("gt_poses", "repaired", "reintegrated")]
+        map50 = [100 * read_json(os.path.join(work, m, "eval.json"))["map50"]
+                 for m in ("gt_poses", "repaired", "reintegrated")]
+        matched = [sum(t["cause"] == "matched" for t in m.values()) for m in things]
+        iou = [sum(t["best_same_class_iou"] for t in m.values()) / len(m) for m in things]
+        for i in range(3):
+            totals[i] += matched[i]
+        totals[3] += len(things[0])
+        remap_s, move_m = repair_of(work, "repaired")
+        reintegration_s, _ = repair_of(work, "reintegrated")
+        info = read_json(os.path.join(work, "drift_seq", "info.json"))
+        rows.append("| %s | %s | %s | %d | %.2f | %.3f | %.1f / %.1f / %.1f | %d / %d / %d of %d "
+                    "| %.3f / %.3f / %.3f | %.2f / %.2f |" % (
+                        room, style or "boxes", seed, info["frames"],
+                        100 * info["measured"]["input_ate_rmse_m"], move_m, *map50, *matched,
+                        len(things[0]), *iou, remap_s, reintegration_s))
+        rep, rei = things[1], things[2]
+        for k in sorted(rep):
+            if k in rei and rep[k]["cause"] != rei[k]["cause"]:
+                changes.append("| %s | %s | %d | %d | %d | %s %.2f | %s %.2f |" % (
+                    room, seed, k, rep[k]["class_id"], rep[k]["vertices"], rep[k]["cause"],
+                    rep[k]["best_same_class_iou"], rei[k]["cause"],
+                    rei[k]["best_same_class_iou"]))
+    head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
+                          capture_output=True, text=True).stdout.strip()
+    return "\n".join([
+        BEGIN_REINTEGRATION,
+        "### Mapping the frames again against re-integrating them",
+        "",
+        "Generated by `python3 scripts/bench/loop_rooms_suite.py --runs %s --poses %s "
+        "--reintegrate-also%s` on %s at commit `%s`%s (do not edit by hand): each run of "
+        "`scripts/bench/loop_rooms.sh --reintegrate-also` repaired twice from one frame store, "
+        "by mapping the frames again (the default) and by re-integration only "
+        "(`--repair-reintegrate-only`: each frame votes again for the super-points association "
+        "gave it under the drifted poses). Per run: input ATE of the drifted poses, the "
+        "correction's largest move of a camera, then for the map from ground-truth poses / "
+        "mapped again / re-integrated: mAP50, GT things matched (IoU > 0.5), mean best IoU of a "
+        "GT thing with an object of its class; repair seconds mapped again / re-integrated."
+        % (args.runs, args.poses, " --report-only" if args.report_only else "",
+           datetime.date.today().isoformat(), head,
+           "" if args.report_only else " in %.1f minutes" % minutes),
+        "",
+        "| room | style | seed | frames | input ATE cm | largest move m | mAP50 | GT things "
+        "matched | mean best IoU | repair s |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|",
+    ] + rows + [
+        "",
+        "GT things matched over all runs: %d from ground-truth poses, %d mapped again, %d "
+        "re-integrated, of %d. Every GT thing whose outcome differs between the two repairs "
+        "(cause as `panmap-eval` names it, best IoU with an object of its class):"
+        % tuple(totals),
+        "",
+        "| room | seed | GT thing | class | vertices | mapped again | re-integrated |",
+        "|---|---|---:|---:|---:|---|---|",
+    ] + (changes or ["| - | - | - | - | - | - | - |"]) + [END_REINTEGRATION])
+
+
+def write_section(path, section, begin, end):
     with open(path) as f:
-        return {t["instance_id"]: t for t in json.load(f)["diagnostics"]["gt_things"]}
+        text = f.read()
+    if begin in text and end in text:
+        text = text[:text.index(begin)] + section + text[text.index(end) + len(end):]
+    else:
+        text = text.rstrip("\n") + "\n\n" + section + "\n"
+    with open(path, "w") as f:
+        f.write(text)
+    print("loop_rooms_suite: wrote %s" % path, file=sys.stderr)
 
 
 def main():
@@ -58,17 +175,37 @@ def main():
     ap.add_argument("--poses", default="heavy", help="drift preset of panmap-synth")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "LOOP_CLOSURE.md"))
     ap.add_argument("--no-write", action="store_true", help="print the section only")
+    ap.add_argument("--reintegrate-also", action="store_true",
+                    help="also repair by re-integration only and write that comparison instead")
+    ap.add_argument("--report-only", action="store_true",
+                    help="with --reintegrate-also: write the section from the run folders only")
     args = ap.parse_args()
-    pairs = [tuple(p.split(":")) for p in args.runs.split(",") if p]
-    if not pairs or any(len(p) != 2 for p in pairs):
-        sys.exit("loop_rooms_suite: --runs takes ROOM:SEED pairs separated by commas")
+    pairs = [p.split(":") for p in args.runs.split(",") if p]
+    if not pairs or any(len(p) not in (2, 4) for p in pairs):
+        sys.exit("loop_rooms_suite: --runs takes ROOM:SEED or ROOM:SEED:STYLE:FRAMES, separated "
+                 "by commas")
+    pairs = [(p[0], p[1], p[2] if len(p) == 4 else None, p[3] if len(p) == 4 else None)
+             for p in pairs]
+    if args.report_only and not args.reintegrate_also:
+        sys.exit("loop_rooms_suite: --report-only needs --reintegrate-also")
     start = time.time()
+    if args.reintegrate_also:
+        if not args.report_only:
+            for i, (room, seed, style, frames) in enumerate(pairs):
+                print("loop_rooms_suite: run %d/%d, room %s seed %s (%.0f s so far)"
+                      % (i + 1, len(pairs), room, seed, time.time() - start), file=sys.stderr)
+                run_one(room, seed, args.poses, style, frames, reintegrate_also=True)
+        section = reintegration_section(args, pairs, (time.time() - start) / 60)
+        print(section)
+        if not args.no_write:
+            write_section(args.out, section, BEGIN_REINTEGRATION, END_REINTEGRATION)
+        return
     rows, changes = [], []
     matched_total = [0, 0]
-    for i, (room, seed) in enumerate(pairs):
+    for i, (room, seed, style, frames) in enumerate(pairs):
         print("loop_rooms_suite: run %d/%d, room %s seed %s (%.0f s so far)"
               % (i + 1, len(pairs), room, seed, time.time() - start), file=sys.stderr)
-        figures, repair, work = run_one(room, seed, args.poses)
+        figures, repair, work = run_one(room, seed, args.poses, style, frames)
         gt = gt_things(os.path.join(work, "gt_poses", "eval.json"))
         rep = gt_things(os.path.join(work, "repaired", "eval.json"))
         matched = [sum(t["cause"] == "matched" for t in m.values()) for m in (gt, rep)]
@@ -117,17 +254,8 @@ def main():
         "|---|---|---:|---:|---:|---:|---|---|",
     ] + (changes or ["| - | - | - | - | - | - | - | - |"]) + [END])
     print(section)
-    if args.no_write:
-        return
-    with open(args.out) as f:
-        text = f.read()
-    if BEGIN in text and END in text:
-        text = text[:text.index(BEGIN)] + section + text[text.index(END) + len(END):]
-    else:
-        text = text.rstrip("\n") + "\n\n" + section + "\n"
-    with open(args.out, "w") as f:
-        f.write(text)
-    print("loop_rooms_suite: wrote %s" % args.out, file=sys.stderr)
+    if not args.no_write:
+        write_section(args.out, section, BEGIN, END)
 
 
 if __name__ == "__main__":
