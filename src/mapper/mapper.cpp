@@ -314,7 +314,7 @@ FrameStats Mapper::integrate(const RgbdFrame& raw_frame, const Eigen::Isometry3d
   applySplits(&association, segmentation, frame, T_W_C, tracker_->labels(), map_.get());
   if (panoptic && !config_.fusion.geometry_only) {
     fillMaskEdges(frame.depth, *panoptic, config_.mask_edge_fill, &association.pixel_labels,
-                  &fill_scratch_);
+                  &fill_scratch_, pool_.get());
   }
   const auto t2 = Clock::now();
   stats.integration = integrator_->integrate(frame, T_W_C, &association.pixel_labels, map_.get());

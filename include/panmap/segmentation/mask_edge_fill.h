@@ -5,6 +5,7 @@
 
 #include "panmap/core/frame.h"
 #include "panmap/core/image.h"
+#include "panmap/core/thread_pool.h"
 
 namespace panmap {
 
@@ -27,14 +28,21 @@ struct MaskEdgeFillConfig {
 
 /// Working memory of fillMaskEdges, kept between frames so that a frame allocates nothing.
 struct MaskEdgeFillScratch {
-  /// A pixel being filled: its index, its index on the padded grid, steps from its source.
+  /// A pixel being filled: its index, its index on the padded grid of its band, steps from its
+  /// source and the label it carries.
   struct Item {
     int32_t pixel;
     int32_t padded;
     int32_t steps;
+    int32_t label;
   };
-  std::vector<uint8_t> open;
-  std::vector<Item> queue;
+  /// One band's: reachable pixels, the breadth-first queue, the pixels it filled.
+  struct Band {
+    std::vector<uint8_t> open;
+    std::vector<Item> queue;
+    std::vector<Item> filled;
+  };
+  std::vector<Band> bands;
 };
 
 /// Gives each pixel without a label (0) that lies inside a panoptic mask of a known class, and
@@ -49,8 +57,11 @@ struct MaskEdgeFillScratch {
 /// @param masks the frame's panoptic segmentation, same size
 /// @param labels super-point label per pixel, same size; filled in place
 /// @param scratch working memory reused between calls (null: allocated for this call)
+/// @param pool threads to fill horizontal bands of the image with (null: one); the result is
+///        the same whatever the number of threads (each band runs the fill over its rows and
+///        max_distance_px + 1 rows around them, all a band pixel's label can depend on)
 int64_t fillMaskEdges(const DepthImage& depth, const PanopticFrame& masks,
                       const MaskEdgeFillConfig& config, LabelImage* labels,
-                      MaskEdgeFillScratch* scratch = nullptr);
+                      MaskEdgeFillScratch* scratch = nullptr, ThreadPool* pool = nullptr);
 
 }  // namespace panmap
