@@ -30,6 +30,8 @@ import subprocess
 import sys
 import time
 
+import doc_section  # same folder
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BEGIN = "<!-- loop-suite:begin (scripts/bench/loop_rooms_suite.py) -->"
 END = "<!-- loop-suite:end -->"
@@ -158,14 +160,7 @@ def reintegration_section(args, pairs, minutes):
 
 
 def write_section(path, section, begin, end):
-    with open(path) as f:
-        text = f.read()
-    if begin in text and end in text:
-        text = text[:text.index(begin)] + section + text[text.index(end) + len(end):]
-    else:
-        text = text.rstrip("\n") + "\n\n" + section + "\n"
-    with open(path, "w") as f:
-        f.write(text)
+    doc_section.splice(path, section, begin, end)
     print("loop_rooms_suite: wrote %s" % path, file=sys.stderr)
 
 

@@ -24,6 +24,8 @@ import subprocess
 import sys
 import time
 
+import doc_section  # same folder
+
 import suite
 
 BEGIN = "<!-- refinement:begin (scripts/bench/refinement.py) -->"
@@ -347,13 +349,7 @@ def render(rows, skipped, layouts, seconds):
 
 def splice(path, section):
     """Replaces the refinement section of path (or appends it)."""
-    text = open(path).read() if os.path.exists(path) else ""
-    if BEGIN in text and END in text:
-        text = text[:text.index(BEGIN)] + section + text[text.index(END) + len(END):]
-    else:
-        text = text.rstrip("\n") + "\n\n" + section + "\n"
-    with open(path, "w") as f:
-        f.write(text)
+    doc_section.splice(path, section, BEGIN, END)
 
 
 def independent_files(pairs):

@@ -29,6 +29,8 @@ import sys
 import tempfile
 import time
 
+import doc_section  # same folder
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BUILD = os.path.join(ROOT, "build")
 BEGIN = "<!-- soak:begin (scripts/bench/soak.py) -->"
@@ -289,13 +291,7 @@ def write_section(args, r):
                report.get("graph_requests_sent", 0), autosave.get("written", 0),
                autosave.get("last_bytes", 0) / 1e6, autosave.get("last_serialize_ms", 0),
                autosave.get("last_write_ms", 0)), "", END]
-    text = open(args.out).read() if os.path.exists(args.out) else "# Performance\n"
-    if BEGIN in text and END in text:
-        text = text[:text.index(BEGIN)] + "\n".join(md) + text[text.index(END) + len(END):]
-    else:
-        text = text.rstrip("\n") + "\n\n" + "\n".join(md) + "\n"
-    with open(args.out, "w") as f:
-        f.write(text)
+    doc_section.splice(args.out, "\n".join(md), BEGIN, END, empty="# Performance\n")
     log("wrote the soak section of %s" % args.out)
 
 
