@@ -142,7 +142,8 @@ def reintegration_section(args, pairs, minutes):
         "GT thing with an object of its class; repair seconds mapped again / re-integrated."
         % (args.runs, args.poses, " --report-only" if args.report_only else "",
            datetime.date.today().isoformat(), head,
-           "" if args.report_only else " in %.1f minutes" % minutes),
+           " from the runs loop_rooms.sh left in build/loop_rooms" if args.report_only
+           else " in %.1f minutes" % minutes),
         "",
         "| room | style | seed | frames | input ATE cm | largest move m | mAP50 | GT things "
         "matched | mean best IoU | repair s |",
