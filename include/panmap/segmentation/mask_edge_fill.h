@@ -36,11 +36,11 @@ struct MaskEdgeFillScratch {
     int32_t steps;
     int32_t label;
   };
-  /// One band's: reachable pixels, the breadth-first queue, the pixels it filled.
+  /// One band's: the pixels a fill may reach, and the breadth-first queue (its sources, then
+  /// every pixel it filled).
   struct Band {
     std::vector<uint8_t> open;
     std::vector<Item> queue;
-    std::vector<Item> filled;
   };
   std::vector<Band> bands;
 };
