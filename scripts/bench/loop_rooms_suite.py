@@ -39,8 +39,8 @@ BEGIN_REINTEGRATION = ("<!-- loop-reintegration:begin (scripts/bench/loop_rooms_
                        "--reintegrate-also) -->")
 END_REINTEGRATION = "<!-- loop-reintegration:end -->"
 REPAIR = re.compile(r"in ([0-9.]+) s, largest move ([0-9.]+) m")
-LINE = re.compile(r"^(gt_poses|drifted|repaired): mAP50 ([0-9.]+); mean ([0-9.]+) cm.*"
-                  r"agree on ([0-9.]+) % of")
+LINE = re.compile(r"^(gt_poses|drifted|repaired): mAP50 ([0-9.]+);(?: purity [0-9.]+;)? "
+                  r"mean ([0-9.]+) cm.*agree on ([0-9.]+) % of")
 
 
 def work_folder(room, seed, poses):

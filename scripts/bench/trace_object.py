@@ -32,6 +32,7 @@ from collections import Counter
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from surface_distance import read_ply_vertices  # noqa: E402  (same folder)
 
+
 def fail(message):
     print("trace_object: " + message, file=sys.stderr)
     sys.exit(1)
