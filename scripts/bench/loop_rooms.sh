@@ -5,7 +5,8 @@
 # residual error); the same sequence is also rendered with ground-truth poses. Mapped three
 # ways at 2 cm, tracking off: ground-truth poses, drifted poses, drifted poses repaired by the
 # correction (--frame-store). Prints mAP50, the mean surface distance to the ground-truth mesh
-# and the occupancy agreement with the ground-truth-pose run for each (docs/LOOP_CLOSURE.md).
+# and the occupancy agreement with the ground-truth-pose run for each, and how many of the
+# drifted map's objects keep their id through the repair (object_ids.py; docs/LOOP_CLOSURE.md).
 #   scripts/bench/loop_rooms.sh [--room N] [--seed N] [--poses slam|slam-hard|light|heavy] [--frames N]
 #                               [--residual-cm S] [--residual-deg S] [--style boxes|scannet]
 #                               [--reintegrate-also]
@@ -43,8 +44,10 @@ map() {  # log, out, extra args
     --out "$work/$2" "${@:3}" >/dev/null
 }
 map "$work/gt_seq/sequence.lcmlog" gt_poses
-map "$work/drift_seq/sequence.lcmlog" drifted
-map "$work/drift_seq/sequence.lcmlog" repaired --frame-store "$work/store"
+# The graphs say which objects kept their ids through the repair (scripts/bench/object_ids.py).
+map "$work/drift_seq/sequence.lcmlog" drifted --graph-json "$work/drifted/graph.json"
+map "$work/drift_seq/sequence.lcmlog" repaired --frame-store "$work/store" \
+  --graph-json "$work/repaired/graph.json"
 maps=(gt_poses drifted repaired)
 if [ "$reintegrate_also" = 1 ]; then
   map "$work/drift_seq/sequence.lcmlog" reintegrated --frame-store "$work/store_reintegrated" \
@@ -80,3 +83,4 @@ for m in "${maps[@]}"; do
     "$work/$m/eval.json")
   echo "$m: mAP50 $map50; purity $purity; ${surface#*: }; occupancy vs gt_poses: $occupancy"
 done
+python3 scripts/bench/object_ids.py "$work/drifted/graph.json" "$work/repaired/graph.json"

@@ -125,6 +125,9 @@ void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& 
         const int64_t request = ++request_id_;
         const std::string graph_channel = options_.channel_graph;
         post(Item{"", {}, [this, request, graph_channel](Mapper* mapper) {
+                    graph_remaps_[request] = mapper->remaps();
+                    // Only the latest few requests can still be answered.
+                    while (graph_remaps_.size() > 16) graph_remaps_.erase(graph_remaps_.begin());
                     const superpoint_graph_t graph =
                         toMessage(mapper->graph(), wallUtime(), request);
                     std::lock_guard<std::mutex> lock(outbox_mutex_);
@@ -138,9 +141,19 @@ void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& 
         const int8_t command = msg.command;
         const std::string argument = msg.argument;
         const std::optional<GraphLabels> labels = labels_;
-        post(Item{"", {}, [this, command, argument, labels](Mapper* mapper) {
+        const int64_t labels_request = labels_request_id_;
+        post(Item{"", {}, [this, command, argument, labels, labels_request](Mapper* mapper) {
+                    const GraphLabels* use = labels ? &*labels : nullptr;
+                    const auto taken = graph_remaps_.find(labels_request);
+                    if (use &&
+                        (taken == graph_remaps_.end() || taken->second != mapper->remaps())) {
+                      std::fprintf(stderr,
+                                   "panmap-mapper: the optimiser's labels predate the last "
+                                   "loop-closure repair; written with frame-count labels\n");
+                      use = nullptr;
+                    }
                     try {
-                      command_handler_(command, argument, mapper, labels ? &*labels : nullptr);
+                      command_handler_(command, argument, mapper, use);
                     } catch (const std::exception& e) {
                       std::fprintf(stderr, "panmap-mapper: command failed: %s\n", e.what());
                     }

@@ -46,6 +46,7 @@ void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
       throw Error(name + ": " + e.what());
     }
     votes_evicted_ = mapper_->voteEvictions();
+    instance_samples_.push_back(sampleFrame(frame, poses_.size(), T_W_C, kInstanceSampleStepPx));
     poses_.push_back(pose);
     return;
   }

@@ -1,10 +1,12 @@
 // Mapper::reintegrate(): the map rebuilt from its frames at new poses (a loop closure's repair).
 #include <chrono>
+#include <map>
 #include <string>
 #include <utility>
 
 #include "panmap/core/error.h"
 #include "panmap/mapper/frame_prefetcher.h"
+#include "panmap/mapper/instance_carry_over.h"
 #include "panmap/mapper/mapper.h"
 
 namespace panmap {
@@ -31,7 +33,18 @@ void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild) {
     if (rebuild->mapper_->config_.occupancy_enabled != config_.occupancy_enabled) {
       throw Error("commitRebuild: the rebuild was made with another occupancy setting");
     }
+    // The remap numbered its instances anew: those that hold an old instance's surface take
+    // its id, so objects keep the ids a planner knows them by (docs/LOOP_CLOSURE.md).
+    Mapper& fresh = *rebuild->mapper_;
+    const InstanceOverlap overlap =
+        countInstanceOverlap(rebuild->instance_samples_, trajectory_, *map_, *tracker_, *fresh.map_,
+                             *fresh.tracker_, pool_.get());
+    int32_t next_instance = 1;
+    const std::map<int32_t, int32_t> ids = carriedInstanceIds(
+        overlap, fresh.tracker_->numInstances() + 1, tracker_->numInstances() + 1, &next_instance);
+    fresh.tracker_->renumberInstances(ids, next_instance);
     adoptRemapped(rebuild->mapper_.get());
+    ++remaps_;
   } else {
     if (static_cast<bool>(rebuild->occupancy_) != static_cast<bool>(occupancy_)) {
       throw Error("commitRebuild: the rebuild was made with another occupancy setting");

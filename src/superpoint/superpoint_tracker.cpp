@@ -411,6 +411,31 @@ void SuperpointTracker::associateInstances(const FrameSegmentation& segmentation
   }
 }
 
+void SuperpointTracker::renumberInstances(const std::map<int32_t, int32_t>& ids,
+                                          int32_t next_instance) {
+  const auto renamed = [&ids](int32_t id) {
+    const auto it = ids.find(id);
+    return it == ids.end() ? id : it->second;
+  };
+  std::set<int32_t> taken;
+  for (int32_t id = 1; id < next_instance_; ++id) {
+    const int32_t to = renamed(id);
+    if (to <= 0 || to >= next_instance) {
+      throw Error("renumberInstances: instance " + std::to_string(id) + " would become " +
+                  std::to_string(to) + ", outside 1.." + std::to_string(next_instance - 1));
+    }
+    if (!taken.insert(to).second) {
+      throw Error("renumberInstances: two instances would become " + std::to_string(to));
+    }
+  }
+  for (auto& [label, state] : states_) {
+    std::map<int32_t, int> counts;
+    for (const auto& [id, count] : state.instance_counts) counts[renamed(id)] += count;
+    state.instance_counts = std::move(counts);
+  }
+  next_instance_ = next_instance;
+}
+
 SuperpointTracker::Snapshot SuperpointTracker::snapshot() const {
   Snapshot s;
   s.parents = labels_.parents();

@@ -8,6 +8,7 @@
 
 #include "panmap/command_t.hpp"
 #include "panmap/lcm/correction_conversions.h"
+#include "panmap/lcm/graph_conversions.h"
 #include "panmap/lcm/live_mapper.h"
 #include "panmap/lcm/optimizer_node.h"
 #include "synthetic_stream.h"
@@ -168,6 +169,56 @@ void checkLiveRepair(bool background) {
 TEST(LiveMapper, ACorrectionRepairsTheLiveMapAndTheStatusReportsIt) { checkLiveRepair(false); }
 
 TEST(LiveMapper, ABackgroundRepairRepairsTheLiveMapAndTheStatusReportsIt) { checkLiveRepair(true); }
+
+// The optimiser's labels name super-points by id; a repair that maps the frames again makes
+// every super-point anew, and their ids would mean other surfaces. An export after such a
+// repair writes frame-count labels instead of the old ones (the next optimisation gives new).
+TEST(LiveMapper, LabelsFromBeforeARemapAreNotUsedAfterIt) {
+  const test::SyntheticStream& stream = test::syntheticStream();
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  test::TempDir dir;
+  FrameStoreConfig store_config;
+  store_config.folder = dir.path("store");
+  FrameStore store(store_config);
+  LiveOptions options = testOptions();
+  options.session.frame_store = &store;
+  Mapper mapper(test::streamMapperConfig());
+  LiveMapper live(&lcm, options, &mapper);
+  std::vector<bool> exported_with_labels;
+  live.setCommandHandler(
+      [&](int8_t command, const std::string&, Mapper*, const GraphLabels* labels) {
+        ASSERT_EQ(command, +command_t::COMMAND_EXPORT);
+        exported_with_labels.push_back(labels != nullptr);
+      });
+  publishAll(&lcm, stream.messages());
+  publishCommand(&lcm, command_t::COMMAND_OPTIMISE);  // request 1
+  // The optimiser's answer to request 1 (handled after the command, as the bus orders them).
+  GraphLabels labels;
+  for (int32_t id = 1; id <= 5000; ++id) {
+    labels.semantic[id] = 5;
+    labels.instance[id] = 999;
+  }
+  const graph_labels_t answer = toMessage(labels, 0, 1);
+  lcm.publish("PANMAP_LABELS", &answer);
+  publishCommand(&lcm, command_t::COMMAND_EXPORT, dir.path("before"));
+  PoseCorrection correction;
+  correction.correction_id = 1;
+  StampedPose keyframe = stream.poses[4];
+  keyframe.T_W_C.translation() += Eigen::Vector3d(0.05, 0.0, 0.0);
+  correction.poses.push_back(keyframe);
+  const pose_correction_t msg = toMessage(correction);
+  lcm.publish("PANMAP_POSE_CORRECTION", &msg);
+  publishCommand(&lcm, command_t::COMMAND_EXPORT, dir.path("after"));
+  publishCommand(&lcm, command_t::COMMAND_FINISH);
+  std::atomic<bool> stop{false};
+  EXPECT_TRUE(live.run(stop));
+  live.drain();
+  ASSERT_EQ(live.stats().corrections_applied, 1);
+  ASSERT_TRUE(mapper.trajectory().back().T_W_C.isApprox(Eigen::Translation3d(0.05, 0.0, 0.0) *
+                                                        stream.poses.back().T_W_C));
+  EXPECT_EQ(exported_with_labels, (std::vector<bool>{true, false}));
+}
 
 TEST(LiveMapper, FullQueueDropsTheOldestFramesAndCountsThem) {
   const test::SyntheticStream& stream = test::syntheticStream();

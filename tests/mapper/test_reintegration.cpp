@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <map>
@@ -10,6 +11,7 @@
 #include "panmap/core/error.h"
 #include "panmap/io/atomic_file.h"
 #include "panmap/mapper/mapper.h"
+#include "panmap/mapper/objects.h"
 #include "test_helpers.h"
 
 namespace panmap {
@@ -310,6 +312,64 @@ TEST_F(Reintegration, ARemapIsTheMapOfTheFramesMappedAtTheNewPoses) {
   reference.integrate(frame, D * pose(6), &panoptic);
   EXPECT_EQ(bytes(*mapper), bytes(reference));
   EXPECT_EQ(mapper->extractMesh().vertices, reference.extractMesh().vertices);
+}
+
+// The id of the object of class c whose centroid is within 0.3 m of p_W (0: none).
+int32_t objectNear(const std::vector<MappedObject>& objects, int32_t c,
+                   const Eigen::Vector3d& p_W) {
+  for (const MappedObject& o : objects) {
+    if (o.class_id == c && (o.centroid_W - p_W).norm() < 0.3) return o.id;
+  }
+  return 0;
+}
+
+// The first three frames came 1.6 m off along y: they left a cabinet and a fridge beside the
+// real ones, which the later frames then met as new instances. The correction puts those frames
+// where they were; a remap maps every frame again and meets the real objects first, yet they
+// keep the ids the map had given them (a planner knows them by those), the ghosts are gone,
+// and no id names another object than before.
+TEST_F(Reintegration, ARemapKeepsTheIdsOfTheObjectsItFindsAgain) {
+  Eigen::Isometry3d off = Eigen::Isometry3d::Identity();
+  off.translation() = Eigen::Vector3d(0.0, 1.6, 0.0);
+  Mapper mapper(config());
+  for (int k = 0; k < 8; ++k) {
+    Recorded r;
+    frameAt(k, &r.frame, &r.panoptic);
+    mapper.integrate(r.frame, k < 3 ? off * pose(k) : pose(k), &r.panoptic);
+    r.geometric = mapper.lastGeometricSegments();
+    stored_[r.frame.utime] = r;
+  }
+  std::vector<StampedPose> corrected = mapper.trajectory();
+  for (int k = 0; k < 3; ++k) corrected[k].T_W_C = pose(k);
+  const Eigen::Vector3d cabinet_W(1.1, -0.4, 0.45), fridge_W(1.1, 0.35, 0.8);
+  const std::vector<MappedObject> before = computeObjects(mapper);
+  const int32_t cabinet = objectNear(before, 3, cabinet_W);
+  const int32_t fridge = objectNear(before, 24, fridge_W);
+  ASSERT_GT(objectNear(before, 3, off * cabinet_W), 0) << "no ghost: nothing to show";
+  ASSERT_GT(cabinet, 0);
+  ASSERT_GT(fridge, 0);
+  // A remap that numbered its instances afresh would call the real ones 1 and 2.
+  ASSERT_GT(std::min(cabinet, fridge), 2);
+  const int32_t instances_before = mapper.superpoints().numInstances();
+
+  const ReintegrationStats stats = mapper.remap(corrected, panopticLoader(true));
+  ASSERT_TRUE(stats.completed);
+  EXPECT_EQ(stats.frames_moved, 3u);
+  const std::vector<MappedObject> after = computeObjects(mapper);
+  EXPECT_EQ(objectNear(after, 3, cabinet_W), cabinet);
+  EXPECT_EQ(objectNear(after, 24, fridge_W), fridge);
+  EXPECT_EQ(objectNear(after, 3, off * cabinet_W), 0);
+  for (const MappedObject& o : after) {
+    if (o.id != cabinet && o.id != fridge) {
+      EXPECT_GT(o.id, instances_before) << o.id;
+    }
+  }
+  EXPECT_GE(mapper.superpoints().numInstances(), instances_before);
+  // Saved and loaded, the map keeps the ids and where new instances start.
+  const std::unique_ptr<Mapper> loaded =
+      Mapper::deserialize(mapper.serialize(), "the repaired map");
+  EXPECT_EQ(computeObjects(*loaded), after);
+  EXPECT_EQ(loaded->superpoints().numInstances(), mapper.superpoints().numInstances());
 }
 
 TEST_F(Reintegration, AFailedOrAbandonedRemapLeavesTheMapAsItWas) {

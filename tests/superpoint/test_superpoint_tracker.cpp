@@ -1,3 +1,4 @@
+#include <map>
 #include <utility>
 
 #include <gtest/gtest.h>
@@ -521,6 +522,51 @@ TEST(SuperpointTracker, ForgetsSuperpointsWithoutVotes) {
   // Labels beyond the flags (created after they were computed) count as unvoted.
   EXPECT_EQ(2u, tracker.forgetUnvoted({0, 0}));
   EXPECT_TRUE(tracker.states().empty());
+}
+
+}  // namespace
+}  // namespace panmap
+
+namespace panmap {
+namespace {
+
+// Three super-points over instances 1-3, as a repair finds them before it renumbers.
+SuperpointTracker trackerWithInstances() {
+  SuperpointTracker tracker{SuperpointConfig()};
+  SuperpointTracker::Snapshot s;
+  s.parents = {0, 1, 2, 3};
+  s.states[1].instance_counts = {{1, 4}, {2, 1}};
+  s.states[2].instance_counts = {{2, 3}};
+  s.states[3].instance_counts = {{3, 2}, {1, 2}};
+  s.next_instance = 4;
+  tracker.restore(s);
+  return tracker;
+}
+
+TEST(SuperpointTrackerInstances, RenumberingRenamesEveryCountAndContinuesAfterIt) {
+  SuperpointTracker tracker = trackerWithInstances();
+  // 1 -> 7, 3 -> 1, 2 keeps its id; new instances from 9 on.
+  tracker.renumberInstances({{1, 7}, {3, 1}}, 9);
+  EXPECT_EQ(tracker.numInstances(), 8);
+  EXPECT_EQ(tracker.state(1)->instance_counts, (std::map<int32_t, int>{{2, 1}, {7, 4}}));
+  EXPECT_EQ(tracker.state(1)->instance(), 7);
+  EXPECT_EQ(tracker.state(2)->instance(), 2);
+  // The tie of 3 and 1 (two frames each) now reads 1 and 7: the smaller id still wins.
+  EXPECT_EQ(tracker.state(3)->instance_counts, (std::map<int32_t, int>{{1, 2}, {7, 2}}));
+  EXPECT_EQ(tracker.state(3)->instance(), 1);
+}
+
+TEST(SuperpointTrackerInstances, ARenumberingThatWouldJoinOrLoseInstancesChangesNothing) {
+  SuperpointTracker tracker = trackerWithInstances();
+  const SuperpointTracker::Snapshot before = tracker.snapshot();
+  EXPECT_THROW(tracker.renumberInstances({{1, 2}}, 4), Error);          // 1 and 2 as one
+  EXPECT_THROW(tracker.renumberInstances({{1, 5}}, 5), Error);          // 5 not below next
+  EXPECT_THROW(tracker.renumberInstances({{2, 0}}, 4), Error);          // no id
+  EXPECT_THROW(tracker.renumberInstances({{1, 4}, {2, 1}}, 4), Error);  // 4 not below next
+  EXPECT_EQ(tracker.numInstances(), before.next_instance - 1);
+  for (const auto& [label, state] : before.states) {
+    EXPECT_EQ(tracker.state(label)->instance_counts, state.instance_counts) << label;
+  }
 }
 
 }  // namespace

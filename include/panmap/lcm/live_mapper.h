@@ -161,6 +161,9 @@ class LiveMapper {
   // Idle work (worker only).
   int64_t scanned_at_frame_ = 0;
   int64_t idle_scan_refreshes_ = 0;
+  // Per optimisation request, Mapper::remaps() when its graph was taken (worker only): labels
+  // answering a graph from before a remap name super-points that are gone.
+  std::map<int64_t, int64_t> graph_remaps_;
 
   std::atomic<int64_t> received_frames_{0};
   std::atomic<int64_t> dropped_frames_{0};

@@ -13,6 +13,7 @@
 #include "panmap/core/thread_pool.h"
 #include "panmap/map/projective_integrator.h"
 #include "panmap/map/tsdf_map.h"
+#include "panmap/mapper/instance_carry_over.h"
 #include "panmap/occupancy/occupancy_map.h"
 #include "panmap/segmentation/panoptic_geometric.h"
 
@@ -70,6 +71,8 @@ class MapRebuild {
   std::unique_ptr<OccupancyMap> occupancy_;  // null when the mapper keeps none
   std::unique_ptr<Mapper> mapper_;           // a remap's mapper (then the three above are null)
   std::vector<StampedPose> poses_;
+  // A remap's depth samples of every frame, for the instance ids it carries over.
+  std::vector<InstanceSampleFrame> instance_samples_;
   uint64_t votes_evicted_ = 0;
   RgbdFrame calibrated_;  // scratch: a frame with the depth calibration applied
 };

@@ -141,6 +141,11 @@ class SuperpointTracker {
   const std::vector<SuperpointMerge>& merges() const { return merge_log_; }
   /// Global instances created so far.
   int32_t numInstances() const { return next_instance_ - 1; }
+  /// Gives the global instances new ids (a repair keeps the ids the map had before it:
+  /// carriedInstanceIds()); ids not in `ids` keep theirs. Instances created afterwards start at
+  /// `next_instance`. Throws Error, changing nothing, when two instances would share an id or
+  /// an id would not be below `next_instance`.
+  void renumberInstances(const std::map<int32_t, int32_t>& ids, int32_t next_instance);
   /// Co-observation counts M(L1, L2) of live super-points (L1 < L2).
   const std::map<std::pair<int32_t, int32_t>, int>& coObservations() const { return co_observed_; }
   /// Frames that showed two live super-points (L1 < L2) as two objects: each significant in a

@@ -1,0 +1,127 @@
+// Instance ids kept across a repair that maps the frames again (docs/LOOP_CLOSURE.md).
+#include "panmap/mapper/instance_carry_over.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <string>
+#include <tuple>
+
+#include "panmap/core/error.h"
+#include "panmap/map/voxel_label_sampler.h"
+
+namespace panmap {
+
+namespace {
+
+// The frame-count instance of the voxel each sample of a frame sees from T_W_C (0: none).
+std::vector<int32_t> instancesSeen(const InstanceSampleFrame& frame, const Eigen::Isometry3d& T_W_C,
+                                   const TsdfMap& map, const SuperpointTracker& tracker) {
+  auto resolve = [&tracker](int32_t label) { return tracker.labels().resolve(label); };
+  VoxelLabelSampler<decltype(resolve)> sampler(map, T_W_C.cast<float>(), frame.camera, resolve);
+  std::vector<int32_t> out(frame.samples.size(), 0);
+  for (size_t k = 0; k < frame.samples.size(); ++k) {
+    const InstanceSampleFrame::Sample& s = frame.samples[k];
+    const int32_t label = sampler.label(s.u, s.v, s.d_m);
+    if (label <= 0) continue;
+    const SuperpointState* state = tracker.state(label);
+    out[k] = state ? state->instance() : 0;
+  }
+  return out;
+}
+
+}  // namespace
+
+InstanceSampleFrame sampleFrame(const RgbdFrame& frame, size_t index,
+                                const Eigen::Isometry3d& T_W_C, int step_px) {
+  if (step_px < 1) throw Error("sampleFrame: step_px must be at least 1");
+  InstanceSampleFrame out;
+  out.index = index;
+  out.T_W_C = T_W_C;
+  out.camera = frame.camera;
+  const int width = std::min(frame.depth.width(), 65536);
+  const int height = std::min(frame.depth.height(), 65536);
+  // The middle of each grid cell, so a coarse grid stays clear of the image border.
+  for (int v = step_px / 2; v < height; v += step_px) {
+    for (int u = step_px / 2; u < width; u += step_px) {
+      const float d_m = static_cast<float>(frame.depth(u, v) * frame.depth_scale_m);
+      if (!(d_m > 0.0f) || !std::isfinite(d_m)) continue;
+      out.samples.push_back({static_cast<uint16_t>(u), static_cast<uint16_t>(v), d_m});
+    }
+  }
+  return out;
+}
+
+InstanceOverlap countInstanceOverlap(const std::vector<InstanceSampleFrame>& frames,
+                                     const std::vector<StampedPose>& trajectory_old,
+                                     const TsdfMap& old_map, const SuperpointTracker& old_tracker,
+                                     const TsdfMap& new_map, const SuperpointTracker& new_tracker,
+                                     ThreadPool* pool) {
+  for (const InstanceSampleFrame& frame : frames) {
+    if (frame.index >= trajectory_old.size()) {
+      throw Error("countInstanceOverlap: sampled frame " + std::to_string(frame.index) +
+                  " of a trajectory of " + std::to_string(trajectory_old.size()));
+    }
+  }
+  // resolve() only reads once flattened, so the threads may share the registries.
+  old_tracker.labels().flatten();
+  new_tracker.labels().flatten();
+  const int threads = pool ? pool->size() : 1;
+  std::vector<InstanceOverlap> per_thread(threads);
+  const auto count = [&](size_t begin, size_t end, int thread) {
+    InstanceOverlap& overlap = per_thread[thread];
+    for (size_t f = begin; f < end; ++f) {
+      const InstanceSampleFrame& frame = frames[f];
+      const std::vector<int32_t> old_ids =
+          instancesSeen(frame, trajectory_old[frame.index].T_W_C, old_map, old_tracker);
+      const std::vector<int32_t> new_ids = instancesSeen(frame, frame.T_W_C, new_map, new_tracker);
+      for (size_t k = 0; k < old_ids.size(); ++k) {
+        if (old_ids[k] > 0 && new_ids[k] > 0) ++overlap[{new_ids[k], old_ids[k]}];
+      }
+    }
+  };
+  if (pool) {
+    pool->parallelForDynamic(frames.size(), 8, count);
+  } else {
+    count(0, frames.size(), 0);
+  }
+  InstanceOverlap overlap;
+  for (const InstanceOverlap& part : per_thread) {
+    for (const auto& [ids, samples] : part) overlap[ids] += samples;
+  }
+  return overlap;
+}
+
+std::map<int32_t, int32_t> carriedInstanceIds(const InstanceOverlap& overlap,
+                                              int32_t new_next_instance, int32_t old_next_instance,
+                                              int32_t* next_instance) {
+  constexpr int kMinSamples = 3;
+  constexpr int kMinShareOfNew = 5;  // the pair holds at least 1/5 of the new one's samples
+  std::map<int32_t, int> new_total;
+  std::vector<std::tuple<int, int32_t, int32_t>> pairs;  // (-samples, new, old)
+  for (const auto& [ids, samples] : overlap) {
+    new_total[ids.first] += samples;
+    pairs.emplace_back(-samples, ids.first, ids.second);
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::map<int32_t, int32_t> out;
+  std::set<int32_t> old_taken;
+  for (const auto& [neg_samples, new_id, old_id] : pairs) {
+    const int samples = -neg_samples;
+    if (samples < kMinSamples || samples * kMinShareOfNew < new_total[new_id]) continue;
+    if (new_id <= 0 || new_id >= new_next_instance || old_id <= 0 || old_id >= old_next_instance) {
+      continue;  // not an instance of the maps the ids came from
+    }
+    if (out.count(new_id) || old_taken.count(old_id)) continue;
+    out[new_id] = old_id;
+    old_taken.insert(old_id);
+  }
+  int32_t next = std::max<int32_t>(old_next_instance, 1);
+  for (int32_t id = 1; id < new_next_instance; ++id) {
+    if (!out.count(id)) out[id] = next++;
+  }
+  if (next_instance) *next_instance = next;
+  return out;
+}
+
+}  // namespace panmap

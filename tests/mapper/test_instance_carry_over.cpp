@@ -1,0 +1,101 @@
+#include <map>
+
+#include <gtest/gtest.h>
+
+#include "box_scene.h"
+
+#include "panmap/core/error.h"
+#include "panmap/core/thread_pool.h"
+#include "panmap/mapper/instance_carry_over.h"
+#include "panmap/mapper/mapper.h"
+
+namespace panmap {
+namespace {
+
+TEST(CarriedInstanceIds, EachNewInstanceTakesTheOldIdItSharesMostSurfaceWith) {
+  // New 1 lies mostly on old 4 (and a little on old 2); new 2 on old 2; new 3 shares too few
+  // samples with old 1; new 4 has none. Old ids ran up to 5.
+  const InstanceOverlap overlap = {{{1, 4}, 40}, {{1, 2}, 6}, {{2, 2}, 30}, {{3, 1}, 2}};
+  int32_t next = 0;
+  const std::map<int32_t, int32_t> ids = carriedInstanceIds(overlap, 5, 6, &next);
+  EXPECT_EQ(ids, (std::map<int32_t, int32_t>{{1, 4}, {2, 2}, {3, 6}, {4, 7}}));
+  EXPECT_EQ(next, 8);
+}
+
+TEST(CarriedInstanceIds, AnOldIdGoesToOneNewInstanceOnlyAndOnlyForAFairShare) {
+  // Old 3 split in two (new 1 and 2): the larger piece keeps 3, the other gets a new id. New 3
+  // lies on old 2 (50 of its 60 samples) and a little on old 1. New 4 and 5 tie on old 5: the
+  // smaller new id takes it.
+  const InstanceOverlap overlap = {{{1, 3}, 20}, {{2, 3}, 25}, {{3, 1}, 10},
+                                   {{3, 2}, 50}, {{4, 5}, 8},  {{5, 5}, 8}};
+  int32_t next = 0;
+  const std::map<int32_t, int32_t> ids = carriedInstanceIds(overlap, 6, 6, &next);
+  EXPECT_EQ(ids, (std::map<int32_t, int32_t>{{1, 6}, {2, 3}, {3, 2}, {4, 5}, {5, 7}}));
+  EXPECT_EQ(next, 8);
+}
+
+TEST(CarriedInstanceIds, WithoutAnOldMapTheIdsStay) {
+  int32_t next = 0;
+  EXPECT_EQ(carriedInstanceIds({}, 3, 1, &next), (std::map<int32_t, int32_t>{{1, 1}, {2, 2}}));
+  EXPECT_EQ(next, 3);
+  // Pairs naming instances neither map has are ignored.
+  EXPECT_EQ(carriedInstanceIds({{{9, 1}, 50}, {{1, 9}, 50}}, 2, 2, &next),
+            (std::map<int32_t, int32_t>{{1, 2}}));
+  EXPECT_EQ(next, 3);
+}
+
+TEST(SampleFrame, TakesTheMiddleOfEachGridCellWithDepth) {
+  RgbdFrame frame;
+  frame.camera.fx = frame.camera.fy = 500.0;
+  frame.camera.width = 8;
+  frame.camera.height = 4;
+  frame.depth = DepthImage(8, 4, uint16_t{0});
+  frame.depth(2, 2) = 1500;  // the only cell middle with depth besides (6, 2)
+  frame.depth(6, 2) = 2000;
+  frame.depth(0, 0) = 1000;  // not a cell middle
+  const InstanceSampleFrame s = sampleFrame(frame, 7, Eigen::Isometry3d::Identity(), 4);
+  EXPECT_EQ(s.index, 7u);
+  ASSERT_EQ(s.samples.size(), 2u);
+  EXPECT_EQ(s.samples[0].u, 2);
+  EXPECT_EQ(s.samples[0].v, 2);
+  EXPECT_FLOAT_EQ(s.samples[0].d_m, 1.5f);
+  EXPECT_EQ(s.samples[1].u, 6);
+  EXPECT_FLOAT_EQ(s.samples[1].d_m, 2.0f);
+  EXPECT_THROW(sampleFrame(frame, 0, Eigen::Isometry3d::Identity(), 0), Error);
+}
+
+class InstanceOverlapTest : public BoxScene {};
+
+// Two maps of the same frames at the same poses: every sample sees the same object in both, so
+// each instance shares its samples with itself only; threads change nothing.
+TEST_F(InstanceOverlapTest, TheSameFramesAtTheSamePosesPairEachInstanceWithItself) {
+  const auto old_map = run(config(), 4);
+  const auto new_map = run(config(), 4);
+  std::vector<InstanceSampleFrame> frames;
+  for (int k = 0; k < 4; ++k) {
+    RgbdFrame frame;
+    PanopticFrame panoptic;
+    frameAt(k, &frame, &panoptic);
+    frames.push_back(sampleFrame(frame, k, pose(k), 16));
+  }
+  const InstanceOverlap serial =
+      countInstanceOverlap(frames, old_map->trajectory(), old_map->map(), old_map->superpoints(),
+                           new_map->map(), new_map->superpoints());
+  ThreadPool pool(2);
+  EXPECT_EQ(
+      countInstanceOverlap(frames, old_map->trajectory(), old_map->map(), old_map->superpoints(),
+                           new_map->map(), new_map->superpoints(), &pool),
+      serial);
+  ASSERT_EQ(serial.size(), 2u);  // the cabinet and the fridge
+  for (const auto& [ids, samples] : serial) {
+    EXPECT_EQ(ids.first, ids.second);
+    EXPECT_GT(samples, 20);
+  }
+  frames[1].index = 4;  // beyond the trajectory
+  EXPECT_THROW(countInstanceOverlap(frames, old_map->trajectory(), old_map->map(),
+                                    old_map->superpoints(), new_map->map(), new_map->superpoints()),
+               Error);
+}
+
+}  // namespace
+}  // namespace panmap
