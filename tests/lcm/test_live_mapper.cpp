@@ -38,6 +38,28 @@ void publishCommand(lcm::LCM* lcm, int8_t command, const std::string& argument =
   lcm->publish("PANMAP_COMMAND", &msg);
 }
 
+// A frame store in a folder of its own, for live runs that repair.
+struct TempStore {
+  static FrameStoreConfig configIn(const test::TempDir& dir) {
+    FrameStoreConfig config;
+    config.folder = dir.path("store");
+    return config;
+  }
+  test::TempDir dir;
+  FrameStore store{configIn(dir)};
+};
+
+// A back-end's correction moving keyframe 4 (and so every frame) 5 cm along x.
+void publishKeyframeCorrection(lcm::LCM* lcm, const test::SyntheticStream& stream) {
+  PoseCorrection correction;
+  correction.correction_id = 1;
+  StampedPose keyframe = stream.poses[4];
+  keyframe.T_W_C.translation() += Eigen::Vector3d(0.05, 0.0, 0.0);
+  correction.poses.push_back(keyframe);
+  const pose_correction_t msg = toMessage(correction);
+  lcm->publish("PANMAP_POSE_CORRECTION", &msg);
+}
+
 LiveOptions testOptions() {
   LiveOptions options;
   options.max_queued_frames = 1000;  // no drops: the result must equal the session's
@@ -122,23 +144,15 @@ void checkLiveRepair(bool background) {
   ASSERT_TRUE(lcm.good());
   StatusInbox inbox;
   lcm.subscribe("PANMAP_STATUS", &StatusInbox::onStatus, &inbox);
-  test::TempDir dir;
-  FrameStoreConfig store_config;
-  store_config.folder = dir.path("store");
-  FrameStore store(store_config);
+  TempStore stored;
+  FrameStore& store = stored.store;
   LiveOptions options = testOptions();
   options.session.frame_store = &store;
   options.session.background_repair = background;
   Mapper mapper(test::streamMapperConfig());
   LiveMapper live(&lcm, options, &mapper);
   publishAll(&lcm, stream.messages());
-  PoseCorrection correction;
-  correction.correction_id = 1;
-  StampedPose keyframe = stream.poses[4];
-  keyframe.T_W_C.translation() += Eigen::Vector3d(0.05, 0.0, 0.0);
-  correction.poses.push_back(keyframe);
-  const pose_correction_t msg = toMessage(correction);
-  lcm.publish("PANMAP_POSE_CORRECTION", &msg);
+  publishKeyframeCorrection(&lcm, stream);
   publishCommand(&lcm, command_t::COMMAND_FINISH);
   std::atomic<bool> stop{false};
   EXPECT_TRUE(live.run(stop));
@@ -177,12 +191,10 @@ TEST(LiveMapper, LabelsFromBeforeARemapAreNotUsedAfterIt) {
   const test::SyntheticStream& stream = test::syntheticStream();
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
-  test::TempDir dir;
-  FrameStoreConfig store_config;
-  store_config.folder = dir.path("store");
-  FrameStore store(store_config);
+  TempStore stored;
+  const test::TempDir& dir = stored.dir;
   LiveOptions options = testOptions();
-  options.session.frame_store = &store;
+  options.session.frame_store = &stored.store;
   Mapper mapper(test::streamMapperConfig());
   LiveMapper live(&lcm, options, &mapper);
   std::vector<bool> exported_with_labels;
@@ -202,13 +214,7 @@ TEST(LiveMapper, LabelsFromBeforeARemapAreNotUsedAfterIt) {
   const graph_labels_t answer = toMessage(labels, 0, 1);
   lcm.publish("PANMAP_LABELS", &answer);
   publishCommand(&lcm, command_t::COMMAND_EXPORT, dir.path("before"));
-  PoseCorrection correction;
-  correction.correction_id = 1;
-  StampedPose keyframe = stream.poses[4];
-  keyframe.T_W_C.translation() += Eigen::Vector3d(0.05, 0.0, 0.0);
-  correction.poses.push_back(keyframe);
-  const pose_correction_t msg = toMessage(correction);
-  lcm.publish("PANMAP_POSE_CORRECTION", &msg);
+  publishKeyframeCorrection(&lcm, stream);
   publishCommand(&lcm, command_t::COMMAND_EXPORT, dir.path("after"));
   publishCommand(&lcm, command_t::COMMAND_FINISH);
   std::atomic<bool> stop{false};

@@ -19,7 +19,7 @@ namespace panmap {
 
 /// A repair that maps the frames again makes its instances anew, numbered in the order it meets
 /// them, while a planner knows the objects by the ids it was given before. Depth samples of
-/// some of the repaired frames say which old instance and which new one hold the same surface:
+/// the repaired frames say which old instance and which new one hold the same surface:
 /// each sample is looked up in the old map at the frame's old pose and in the new map at its
 /// new pose (the same pixel sees the same surface in both), so the match does not depend on how
 /// far the correction moved anything.
