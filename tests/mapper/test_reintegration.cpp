@@ -370,6 +370,10 @@ TEST_F(Reintegration, ARemapKeepsTheIdsOfTheObjectsItFindsAgain) {
       Mapper::deserialize(mapper.serialize(), "the repaired map");
   EXPECT_EQ(computeObjects(*loaded), after);
   EXPECT_EQ(loaded->superpoints().numInstances(), mapper.superpoints().numInstances());
+  // A second repair (here to the same poses) finds the same objects and keeps their ids again,
+  // though mapping the frames afresh numbers them 1 and 2 once more.
+  ASSERT_TRUE(mapper.remap(corrected, panopticLoader(true)).completed);
+  EXPECT_EQ(computeObjects(mapper), after);
 }
 
 TEST_F(Reintegration, AFailedOrAbandonedRemapLeavesTheMapAsItWas) {
