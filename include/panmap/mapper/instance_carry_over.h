@@ -36,9 +36,10 @@ struct InstanceSampleFrame {
   std::vector<Sample> samples;
 };
 
-/// Every frame of a repair is sampled on a grid of this many pixels (a 640x480 frame: up to 300
-/// samples, one every 11 cm at 2 m), so that each part of the trajectory counts alike.
-constexpr int kInstanceSampleStepPx = 32;
+/// Every frame of a repair is sampled on a grid of this many pixels (a 640x480 frame: up to 1,200
+/// samples, one every 5.6 cm at 2 m), so that each part of the trajectory counts alike and a
+/// small object gets the 3 samples a pairing needs (a 32 px grid left more of them a new id).
+constexpr int kInstanceSampleStepPx = 16;
 
 /// The pixels with depth of `frame` on a grid of `step_px` (>= 1) pixels, as frame `index` of a
 /// repair mapped at T_W_C.
