@@ -33,7 +33,8 @@ std::vector<int32_t> instancesSeen(const InstanceSampleFrame& frame, const Eigen
 }  // namespace
 
 InstanceSampleFrame sampleFrame(const RgbdFrame& frame, size_t index,
-                                const Eigen::Isometry3d& T_W_C, int step_px) {
+                                const Eigen::Isometry3d& T_W_C, int step_px,
+                                const DepthCalibration* calibration) {
   if (step_px < 1) throw Error("sampleFrame: step_px must be at least 1");
   InstanceSampleFrame out;
   out.index = index;
@@ -44,7 +45,11 @@ InstanceSampleFrame sampleFrame(const RgbdFrame& frame, size_t index,
   // The middle of each grid cell, so a coarse grid stays clear of the image border.
   for (int v = step_px / 2; v < height; v += step_px) {
     for (int u = step_px / 2; u < width; u += step_px) {
-      const float d_m = static_cast<float>(frame.depth(u, v) * frame.depth_scale_m);
+      uint16_t reading = frame.depth(u, v);
+      if (calibration && !calibration->empty()) {
+        reading = calibration->correctedReading(u, v, reading, frame.depth_scale_m);
+      }
+      const float d_m = static_cast<float>(reading * frame.depth_scale_m);
       if (!(d_m > 0.0f) || !std::isfinite(d_m)) continue;
       out.samples.push_back({static_cast<uint16_t>(u), static_cast<uint16_t>(v), d_m});
     }

@@ -46,7 +46,8 @@ void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
       throw Error(name + ": " + e.what());
     }
     votes_evicted_ = mapper_->voteEvictions();
-    instance_samples_.push_back(sampleFrame(frame, poses_.size(), T_W_C, kInstanceSampleStepPx));
+    instance_samples_.push_back(sampleFrame(frame, poses_.size(), T_W_C, kInstanceSampleStepPx,
+                                            config_->depth_calibration.get()));
     poses_.push_back(pose);
     return;
   }

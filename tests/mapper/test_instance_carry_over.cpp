@@ -64,6 +64,28 @@ TEST(SampleFrame, TakesTheMiddleOfEachGridCellWithDepth) {
   EXPECT_THROW(sampleFrame(frame, 0, Eigen::Isometry3d::Identity(), 0), Error);
 }
 
+TEST(SampleFrame, CorrectsTheDepthAsTheMapperDoes) {
+  RgbdFrame frame;
+  frame.camera.fx = frame.camera.fy = 500.0;
+  frame.camera.width = 8;
+  frame.camera.height = 4;
+  frame.depth = DepthImage(8, 4, uint16_t{0});
+  frame.depth(2, 2) = 1500;
+  // 1 cm deeper everywhere, at every depth.
+  const DepthCalibration calibration(8, 4, 1, 1, 2, 5.0, {0.01f, 0.01f});
+  RgbdFrame corrected;
+  calibration.apply(frame, &corrected);
+  const InstanceSampleFrame s =
+      sampleFrame(frame, 0, Eigen::Isometry3d::Identity(), 4, &calibration);
+  ASSERT_EQ(s.samples.size(), 1u);
+  EXPECT_FLOAT_EQ(s.samples[0].d_m, 1.51f);
+  EXPECT_FLOAT_EQ(s.samples[0].d_m,
+                  static_cast<float>(corrected.depth(2, 2) * corrected.depth_scale_m));
+  const DepthCalibration identity;
+  EXPECT_FLOAT_EQ(sampleFrame(frame, 0, Eigen::Isometry3d::Identity(), 4, &identity).samples[0].d_m,
+                  1.5f);
+}
+
 class InstanceOverlapTest : public BoxScene {};
 
 // Two maps of the same frames at the same poses: every sample sees the same object in both, so

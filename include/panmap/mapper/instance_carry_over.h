@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include "panmap/calibration/depth_calibration.h"
 #include "panmap/core/camera.h"
 #include "panmap/core/frame.h"
 #include "panmap/core/pose.h"
@@ -43,8 +44,12 @@ constexpr int kInstanceSampleStepPx = 16;
 
 /// The pixels with depth of `frame` on a grid of `step_px` (>= 1) pixels, as frame `index` of a
 /// repair mapped at T_W_C.
+/// @param calibration the depth calibration the frame was mapped with, if any: each sampled
+///        reading is corrected as the mapper corrected the whole frame, so the samples see the
+///        surfaces the maps hold
 InstanceSampleFrame sampleFrame(const RgbdFrame& frame, size_t index,
-                                const Eigen::Isometry3d& T_W_C, int step_px);
+                                const Eigen::Isometry3d& T_W_C, int step_px,
+                                const DepthCalibration* calibration = nullptr);
 
 /// Samples per (new instance, old instance) pair: how much surface the two share.
 using InstanceOverlap = std::map<std::pair<int32_t, int32_t>, int>;
