@@ -524,12 +524,6 @@ TEST(SuperpointTracker, ForgetsSuperpointsWithoutVotes) {
   EXPECT_TRUE(tracker.states().empty());
 }
 
-}  // namespace
-}  // namespace panmap
-
-namespace panmap {
-namespace {
-
 // Three super-points over instances 1-3, as a repair finds them before it renumbers.
 SuperpointTracker trackerWithInstances() {
   SuperpointTracker tracker{SuperpointConfig()};
