@@ -6,7 +6,8 @@
 # ways at 2 cm, tracking off: ground-truth poses, drifted poses, drifted poses repaired by the
 # correction (--frame-store). Prints mAP50, the mean surface distance to the ground-truth mesh
 # and the occupancy agreement with the ground-truth-pose run for each, and how many of the
-# drifted map's objects keep their id through the repair (object_ids.py; docs/LOOP_CLOSURE.md).
+# drifted map's objects and super-points keep their id through the repair (object_ids.py;
+# docs/LOOP_CLOSURE.md).
 #   scripts/bench/loop_rooms.sh [--room N] [--seed N] [--poses slam|slam-hard|light|heavy] [--frames N]
 #                               [--residual-cm S] [--residual-deg S] [--style boxes|scannet]
 #                               [--reintegrate-also]
@@ -44,7 +45,8 @@ map() {  # log, out, extra args
     --out "$work/$2" "${@:3}" >/dev/null
 }
 map "$work/gt_seq/sequence.lcmlog" gt_poses
-# The graphs say which objects kept their ids through the repair (scripts/bench/object_ids.py).
+# The graphs say which objects and super-points kept their ids through the repair
+# (scripts/bench/object_ids.py).
 map "$work/drift_seq/sequence.lcmlog" drifted --graph-json "$work/drifted/graph.json"
 map "$work/drift_seq/sequence.lcmlog" repaired --frame-store "$work/store" \
   --graph-json "$work/repaired/graph.json"

@@ -8,7 +8,10 @@ PANMAP_OBJECTS publishes while mapping). For every group of at least --min-voxel
 repaired map, its counterpart is the group of the same class (the voxel-weighted majority of
 `initial_class`) in the map before whose voxel-weighted centroid is nearest, within
 --radius-m. Prints how many repaired objects have a counterpart and how many of those carry
-its id; --details lists the others.
+its id; --details lists the others. A second line counts the super-points: how many of the
+repaired graph's vertices carry an id the graph before had (a repair gives every other one an
+id never used before, so a shared id is a kept one), the share of their voxels, and of the
+graph before's edges between those super-points, how many the repaired graph has.
 
   python3 scripts/bench/object_ids.py BEFORE.json REPAIRED.json [--min-voxels 100]
                                       [--radius-m 0.3] [--details]
@@ -20,14 +23,35 @@ import math
 import sys
 
 
-def objects(path, min_voxels):
-    """{instance: (voxels, centroid, class)} of the groups with at least min_voxels voxels."""
+def load(path):
+    """The graph JSON at path; exits with a one-line reason when it cannot be read."""
     try:
         with open(path) as f:
             graph = json.load(f)
-        vertices = graph["vertices"]
+        if not isinstance(graph["vertices"], list) or not isinstance(graph["edges"], list):
+            raise ValueError("vertices and edges must be lists")
+        return graph
     except (OSError, ValueError, KeyError) as e:
         sys.exit("object_ids: %s: %s" % (path, e))
+
+
+def superpoint_ids(before, repaired):
+    """(vertices, of them with an id of before, share of their voxels, edges of before between
+    those, of them in repaired)."""
+    old_ids = {v["id"] for v in before["vertices"]}
+    kept = {v["id"] for v in repaired["vertices"] if v["id"] in old_ids}
+    voxels = sum(v["voxels"] for v in repaired["vertices"])
+    kept_voxels = sum(v["voxels"] for v in repaired["vertices"] if v["id"] in kept)
+    def pairs(graph):
+        return {(e["a"], e["b"]) for e in graph["edges"] if e["a"] in kept and e["b"] in kept}
+    old_edges = pairs(before)
+    return (len(repaired["vertices"]), len(kept), kept_voxels / voxels if voxels else 0.0,
+            len(old_edges), len(old_edges & pairs(repaired)))
+
+
+def objects(graph, min_voxels):
+    """{instance: (voxels, centroid, class)} of the groups with at least min_voxels voxels."""
+    vertices = graph["vertices"]
     groups = collections.defaultdict(lambda: [0, [0.0, 0.0, 0.0], collections.Counter()])
     for v in vertices:
         instance = v["initial_instance"]
@@ -80,11 +104,16 @@ def main():
     ap.add_argument("--radius-m", type=float, default=0.3)
     ap.add_argument("--details", action="store_true", help="list the objects that changed id")
     args = ap.parse_args()
-    before = objects(args.before, args.min_voxels)
-    repaired = objects(args.repaired, args.min_voxels)
+    before_graph, repaired_graph = load(args.before), load(args.repaired)
+    before = objects(before_graph, args.min_voxels)
+    repaired = objects(repaired_graph, args.min_voxels)
     with_counterpart, kept, others = compare(before, repaired, args.radius_m)
     print("object ids: %d repaired objects, %d with a counterpart before, %d of them keep its id"
           % (len(repaired), with_counterpart, kept))
+    vertices, kept_ids, share, old_edges, kept_edges = superpoint_ids(before_graph, repaired_graph)
+    print("super-point ids: %d of %d graph vertices keep an id (%.1f %% of their voxels); "
+          "%d edges between them before, %d of them kept"
+          % (kept_ids, vertices, 100.0 * share, old_edges, kept_edges))
     if args.details:
         for line in others:
             print("  " + line)

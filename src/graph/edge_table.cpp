@@ -68,6 +68,18 @@ void EdgeTable::applyMerges(const std::vector<SuperpointMerge>& merges, size_t b
   for (auto& [k, classes] : pulled) table_[k] = std::move(classes);
 }
 
+void EdgeTable::rename(const std::function<int32_t(int32_t)>& to) {
+  absl::flat_hash_map<uint64_t, Classes> renamed;
+  renamed.reserve(table_.size());
+  for (auto& [k, classes] : table_) {
+    const int32_t a = to(first(k)), b = to(second(k));
+    if (a <= 0 || b <= 0 || a == b) continue;
+    // Distinct ends stay distinct, so no two pairs meet and no sum depends on the order.
+    renamed.emplace(key(std::min(a, b), std::max(a, b)), std::move(classes));
+  }
+  table_ = std::move(renamed);
+}
+
 void EdgeTable::keepIf(const std::function<bool(int32_t)>& keep) {
   for (auto it = table_.begin(); it != table_.end();) {
     if (keep(first(it->first)) && keep(second(it->first))) {

@@ -101,6 +101,23 @@ void GraphAccumulator::applyMerges(const SuperpointTracker& tracker) {
   edges_.applyMerges(merges, first_merge, merges.size());
 }
 
+void GraphAccumulator::renumberSuperpoints(const SuperpointTracker& tracker,
+                                           const std::vector<int32_t>& to) {
+  applyMerges(tracker);
+  const auto renamed = [&to](int32_t label) {
+    return label > 0 && static_cast<size_t>(label) < to.size() ? to[label] : 0;
+  };
+  std::map<int32_t, std::map<int32_t, double>> scores;
+  for (auto& [label, classes] : scores_) {
+    const int32_t id = renamed(label);
+    if (id <= 0) continue;
+    for (const auto& [cls, score] : classes) scores[id][cls] += score;
+  }
+  scores_ = std::move(scores);
+  edges_.rename(renamed);
+  surface_scan_ = SurfaceScan();
+}
+
 void GraphAccumulator::applySplits(const std::vector<SuperpointSplit>& splits,
                                    const SuperpointTracker& tracker) {
   applyMerges(tracker);

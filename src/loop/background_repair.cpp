@@ -198,7 +198,7 @@ MapRepairResult BackgroundRepair::commit() {
     stats.frames_moved += corrected_.translation_m[i] > 0.0 || corrected_.rotation_rad[i] > 0.0;
   }
   try {
-    mapper_->commitRebuild(std::move(rebuild_));
+    mapper_->commitRebuild(std::move(rebuild_), &stats);
   } catch (const Error& e) {
     result.failure = e.what();
     stats.frames = 0;

@@ -96,11 +96,22 @@ std::string describe(const MapRepairResult& r) {
                 r.reintegration.reassociated ? "mapped again" : "re-integrated",
                 r.reintegration.frames_moved, r.reintegration.seconds, r.max_translation_m,
                 r.max_rotation_rad * 180.0 / M_PI);
+  std::string out = line;
   if (r.reintegration.frames_with_kept_segments > 0) {
-    return line + ("; kept geometric segments of " +
-                   std::to_string(r.reintegration.frames_with_kept_segments) + " frames");
+    out += "; kept geometric segments of " +
+           std::to_string(r.reintegration.frames_with_kept_segments) + " frames";
   }
-  return line;
+  if (r.reintegration.reassociated) {
+    char ids[160];
+    std::snprintf(ids, sizeof(ids),
+                  "; ids kept: %zu of %zu instances (%.0f %% of the surface), %zu of %zu "
+                  "super-points (%.0f %%)",
+                  r.reintegration.instances_kept, r.reintegration.instances,
+                  100.0 * r.reintegration.instance_surface_kept, r.reintegration.superpoints_kept,
+                  r.reintegration.superpoints, 100.0 * r.reintegration.superpoint_surface_kept);
+    out += ids;
+  }
+  return out;
 }
 
 }  // namespace panmap

@@ -1,6 +1,7 @@
 #include "panmap/map/tsdf_map.h"
 
 #include <cmath>
+#include <string>
 
 #include "panmap/core/error.h"
 
@@ -108,6 +109,26 @@ size_t TsdfMap::numVotedVoxels() const {
   size_t n = 0;
   for (const auto& block : blocks_) n += block->vote_sets.size();
   return n;
+}
+
+void TsdfMap::renameVotes(const std::vector<int32_t>& to) {
+  for (const auto& block : blocks_) {
+    for (const VoxelVotes& votes : block->vote_sets) {
+      for (const LabelVote& v : votes.slots) {
+        if (v.count == 0) continue;
+        const int32_t label = v.label;
+        if (label < 0 || static_cast<size_t>(label) >= to.size() || to[label] <= 0) {
+          throw Error("renameVotes: no new label for label " + std::to_string(label));
+        }
+      }
+    }
+  }
+  const auto rename = [&to](int32_t label) { return to[label]; };
+  for (const auto& block : blocks_) {
+    if (block->vote_sets.empty()) continue;
+    for (VoxelVotes& votes : block->vote_sets) panmap::renameVotes(&votes, rename);
+    markChanged(block.get());
+  }
 }
 
 size_t TsdfMap::memoryBytes() const {

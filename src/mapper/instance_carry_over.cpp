@@ -7,6 +7,8 @@
 #include <string>
 #include <tuple>
 
+#include <absl/container/flat_hash_map.h>
+
 #include "panmap/core/error.h"
 #include "panmap/map/voxel_label_sampler.h"
 
@@ -14,20 +16,23 @@ namespace panmap {
 
 namespace {
 
-// The frame-count instance of the voxel each sample of a frame sees from T_W_C (0: none).
-std::vector<int32_t> instancesSeen(const InstanceSampleFrame& frame, const Eigen::Isometry3d& T_W_C,
-                                   const TsdfMap& map, const SuperpointTracker& tracker) {
+// The super-point (root label) and frame-count instance of the voxel each sample of a frame
+// sees from T_W_C (0: none).
+void idsSeen(const InstanceSampleFrame& frame, const Eigen::Isometry3d& T_W_C, const TsdfMap& map,
+             const SuperpointTracker& tracker, std::vector<int32_t>* superpoints,
+             std::vector<int32_t>* instances) {
   auto resolve = [&tracker](int32_t label) { return tracker.labels().resolve(label); };
   VoxelLabelSampler<decltype(resolve)> sampler(map, T_W_C.cast<float>(), frame.camera, resolve);
-  std::vector<int32_t> out(frame.samples.size(), 0);
+  superpoints->assign(frame.samples.size(), 0);
+  instances->assign(frame.samples.size(), 0);
   for (size_t k = 0; k < frame.samples.size(); ++k) {
     const InstanceSampleFrame::Sample& s = frame.samples[k];
     const int32_t label = sampler.label(s.u, s.v, s.d_m);
     if (label <= 0) continue;
+    (*superpoints)[k] = label;
     const SuperpointState* state = tracker.state(label);
-    out[k] = state ? state->instance() : 0;
+    (*instances)[k] = state ? state->instance() : 0;
   }
-  return out;
 }
 
 }  // namespace
@@ -57,14 +62,14 @@ InstanceSampleFrame sampleFrame(const RgbdFrame& frame, size_t index,
   return out;
 }
 
-InstanceOverlap countInstanceOverlap(const std::vector<InstanceSampleFrame>& frames,
-                                     const std::vector<StampedPose>& trajectory_old,
-                                     const TsdfMap& old_map, const SuperpointTracker& old_tracker,
-                                     const TsdfMap& new_map, const SuperpointTracker& new_tracker,
-                                     ThreadPool* pool) {
+CarryOverlap countCarryOverlap(const std::vector<InstanceSampleFrame>& frames,
+                               const std::vector<StampedPose>& trajectory_old,
+                               const TsdfMap& old_map, const SuperpointTracker& old_tracker,
+                               const TsdfMap& new_map, const SuperpointTracker& new_tracker,
+                               ThreadPool* pool) {
   for (const InstanceSampleFrame& frame : frames) {
     if (frame.index >= trajectory_old.size()) {
-      throw Error("countInstanceOverlap: sampled frame " + std::to_string(frame.index) +
+      throw Error("countCarryOverlap: sampled frame " + std::to_string(frame.index) +
                   " of a trajectory of " + std::to_string(trajectory_old.size()));
     }
   }
@@ -72,16 +77,21 @@ InstanceOverlap countInstanceOverlap(const std::vector<InstanceSampleFrame>& fra
   old_tracker.labels().flatten();
   new_tracker.labels().flatten();
   const int threads = pool ? pool->size() : 1;
-  std::vector<InstanceOverlap> per_thread(threads);
+  // Counted in hash tables (a sample is one increment), ordered once at the end.
+  using Counts = absl::flat_hash_map<uint64_t, int>;
+  const auto key = [](int32_t a, int32_t b) {
+    return (static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32) | static_cast<uint32_t>(b);
+  };
+  std::vector<Counts> instances(threads), superpoints(threads);
   const auto count = [&](size_t begin, size_t end, int thread) {
-    InstanceOverlap& overlap = per_thread[thread];
+    std::vector<int32_t> old_sp, old_inst, new_sp, new_inst;
     for (size_t f = begin; f < end; ++f) {
       const InstanceSampleFrame& frame = frames[f];
-      const std::vector<int32_t> old_ids =
-          instancesSeen(frame, trajectory_old[frame.index].T_W_C, old_map, old_tracker);
-      const std::vector<int32_t> new_ids = instancesSeen(frame, frame.T_W_C, new_map, new_tracker);
-      for (size_t k = 0; k < old_ids.size(); ++k) {
-        if (old_ids[k] > 0 && new_ids[k] > 0) ++overlap[{new_ids[k], old_ids[k]}];
+      idsSeen(frame, trajectory_old[frame.index].T_W_C, old_map, old_tracker, &old_sp, &old_inst);
+      idsSeen(frame, frame.T_W_C, new_map, new_tracker, &new_sp, &new_inst);
+      for (size_t k = 0; k < old_sp.size(); ++k) {
+        if (old_sp[k] > 0 && new_sp[k] > 0) ++superpoints[thread][key(new_sp[k], old_sp[k])];
+        if (old_inst[k] > 0 && new_inst[k] > 0) ++instances[thread][key(new_inst[k], old_inst[k])];
       }
     }
   };
@@ -90,18 +100,26 @@ InstanceOverlap countInstanceOverlap(const std::vector<InstanceSampleFrame>& fra
   } else {
     count(0, frames.size(), 0);
   }
-  InstanceOverlap overlap;
-  for (const InstanceOverlap& part : per_thread) {
-    for (const auto& [ids, samples] : part) overlap[ids] += samples;
-  }
+  const auto ordered = [](const std::vector<Counts>& parts) {
+    IdOverlap out;
+    for (const Counts& part : parts) {
+      for (const auto& [k, samples] : part) {
+        out[{static_cast<int32_t>(k >> 32), static_cast<int32_t>(k & 0xFFFFFFFFu)}] += samples;
+      }
+    }
+    return out;
+  };
+  CarryOverlap overlap;
+  overlap.instances = ordered(instances);
+  overlap.superpoints = ordered(superpoints);
   return overlap;
 }
 
-std::map<int32_t, int32_t> carriedInstanceIds(const InstanceOverlap& overlap,
-                                              int32_t new_next_instance, int32_t old_next_instance,
-                                              int32_t* next_instance) {
+std::map<int32_t, int32_t> carriedIds(const IdOverlap& overlap, const std::vector<int32_t>& new_ids,
+                                      int32_t old_next, int32_t* next) {
   constexpr int kMinSamples = 3;
   constexpr int kMinShareOfNew = 5;  // the pair holds at least 1/5 of the new one's samples
+  const std::set<int32_t> wanted(new_ids.begin(), new_ids.end());
   std::map<int32_t, int> new_total;
   std::vector<std::tuple<int, int32_t, int32_t>> pairs;  // (-samples, new, old)
   for (const auto& [ids, samples] : overlap) {
@@ -114,19 +132,27 @@ std::map<int32_t, int32_t> carriedInstanceIds(const InstanceOverlap& overlap,
   for (const auto& [neg_samples, new_id, old_id] : pairs) {
     const int samples = -neg_samples;
     if (samples < kMinSamples || samples * kMinShareOfNew < new_total[new_id]) continue;
-    if (new_id <= 0 || new_id >= new_next_instance || old_id <= 0 || old_id >= old_next_instance) {
-      continue;  // not an instance of the maps the ids came from
+    if (!wanted.count(new_id) || old_id <= 0 || old_id >= old_next) {
+      continue;  // not an id of the maps the ids came from
     }
     if (out.count(new_id) || old_taken.count(old_id)) continue;
     out[new_id] = old_id;
     old_taken.insert(old_id);
   }
-  int32_t next = std::max<int32_t>(old_next_instance, 1);
-  for (int32_t id = 1; id < new_next_instance; ++id) {
-    if (!out.count(id)) out[id] = next++;
+  int32_t free_id = std::max<int32_t>(old_next, 1);
+  for (const int32_t id : wanted) {
+    if (!out.count(id)) out[id] = free_id++;
   }
-  if (next_instance) *next_instance = next;
+  if (next) *next = free_id;
   return out;
+}
+
+std::map<int32_t, int32_t> carriedInstanceIds(const InstanceOverlap& overlap,
+                                              int32_t new_next_instance, int32_t old_next_instance,
+                                              int32_t* next_instance) {
+  std::vector<int32_t> new_ids;
+  for (int32_t id = 1; id < new_next_instance; ++id) new_ids.push_back(id);
+  return carriedIds(overlap, new_ids, old_next_instance, next_instance);
 }
 
 }  // namespace panmap

@@ -15,7 +15,7 @@ std::unique_ptr<MapRebuild> Mapper::beginRebuild(ThreadPool* pool, bool remap) c
   return std::make_unique<MapRebuild>(config_, pool ? pool : pool_.get(), remap);
 }
 
-void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild) {
+void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild, ReintegrationStats* stats) {
   if (!rebuild) throw Error("commitRebuild: no rebuild");
   const std::vector<StampedPose>& poses = rebuild->poses();
   if (poses.size() != trajectory_.size()) {
@@ -33,16 +33,45 @@ void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild) {
     if (rebuild->mapper_->config_.occupancy_enabled != config_.occupancy_enabled) {
       throw Error("commitRebuild: the rebuild was made with another occupancy setting");
     }
-    // The remap numbered its instances anew: those that hold an old instance's surface take
-    // its id, so objects keep the ids a planner knows them by (docs/LOOP_CLOSURE.md).
+    // The remap numbered its instances and super-points anew: those that hold an old one's
+    // surface take its id, so objects keep the ids a planner knows them by and super-points the
+    // ids the graph and the optimiser's labels know them by (docs/LOOP_CLOSURE.md).
     Mapper& fresh = *rebuild->mapper_;
-    const InstanceOverlap overlap =
-        countInstanceOverlap(rebuild->instance_samples_, trajectory_, *map_, *tracker_, *fresh.map_,
-                             *fresh.tracker_, pool_.get());
+    const CarryOverlap overlap =
+        countCarryOverlap(rebuild->instance_samples_, trajectory_, *map_, *tracker_, *fresh.map_,
+                          *fresh.tracker_, pool_.get());
     int32_t next_instance = 1;
-    const std::map<int32_t, int32_t> ids = carriedInstanceIds(
-        overlap, fresh.tracker_->numInstances() + 1, tracker_->numInstances() + 1, &next_instance);
-    fresh.tracker_->renumberInstances(ids, next_instance);
+    const std::map<int32_t, int32_t> instance_ids =
+        carriedInstanceIds(overlap.instances, fresh.tracker_->numInstances() + 1,
+                           tracker_->numInstances() + 1, &next_instance);
+    const std::vector<int32_t> superpoints = fresh.liveSuperpoints();
+    int32_t next_label = 1;
+    const std::map<int32_t, int32_t> superpoint_ids =
+        carriedIds(overlap.superpoints, superpoints, tracker_->labels().size() + 1, &next_label);
+    fresh.tracker_->renumberInstances(instance_ids, next_instance);
+    fresh.renumberSuperpoints(superpoint_ids, next_label - 1);
+    if (stats) {
+      const auto kept = [](const std::map<int32_t, int32_t>& ids, int32_t old_next) {
+        size_t n = 0;
+        for (const auto& entry : ids) n += entry.second < old_next ? 1 : 0;
+        return n;
+      };
+      stats->instances = instance_ids.size();
+      stats->instances_kept = kept(instance_ids, tracker_->numInstances() + 1);
+      stats->superpoints = superpoint_ids.size();
+      stats->superpoints_kept = kept(superpoint_ids, tracker_->labels().size() + 1);
+      const auto sameId = [](const IdOverlap& overlap, const std::map<int32_t, int32_t>& ids) {
+        size_t same = 0, all = 0;
+        for (const auto& [pair, samples] : overlap) {
+          const auto it = ids.find(pair.first);
+          same += it != ids.end() && it->second == pair.second ? samples : 0;
+          all += samples;
+        }
+        return all > 0 ? static_cast<double>(same) / static_cast<double>(all) : 0.0;
+      };
+      stats->instance_surface_kept = sameId(overlap.instances, instance_ids);
+      stats->superpoint_surface_kept = sameId(overlap.superpoints, superpoint_ids);
+    }
     adoptRemapped(rebuild->mapper_.get());
     ++remaps_;
   } else {
@@ -125,7 +154,7 @@ ReintegrationStats Mapper::rebuildFrom(const std::vector<StampedPose>& poses,
   }
   stats.votes_evicted = rebuild->votesEvicted();
   stats.frames_with_kept_segments = rebuild->framesWithKeptSegments();
-  commitRebuild(std::move(rebuild));
+  commitRebuild(std::move(rebuild), &stats);
   stats.completed = true;
   stats.blocks_after = map_->numBlocks();
   stats.seconds = seconds();

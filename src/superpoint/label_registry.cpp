@@ -37,9 +37,22 @@ int32_t LabelRegistry::merge(int32_t a, int32_t b) {
 void LabelRegistry::restore(std::vector<int32_t> parents) {
   if (parents.empty() || parents[0] != 0) throw Error("super-point labels: bad parent array");
   for (size_t i = 1; i < parents.size(); ++i) {
-    if (parents[i] <= 0 || parents[i] > static_cast<int32_t>(i)) {
+    if (parents[i] < 0 || parents[i] > static_cast<int32_t>(i)) {
       throw Error("super-point labels: parent of " + std::to_string(i) + " is invalid");
     }
+  }
+  parent_ = std::move(parents);
+}
+
+void LabelRegistry::renumber(const std::vector<int32_t>& roots, int32_t size) {
+  if (size < 0) throw Error("super-point labels: negative size");
+  std::vector<int32_t> parents(static_cast<size_t>(size) + 1, 0);
+  for (const int32_t root : roots) {
+    if (root <= 0 || root > size) {
+      throw Error("super-point labels: root " + std::to_string(root) + " outside 1.." +
+                  std::to_string(size));
+    }
+    parents[root] = root;
   }
   parent_ = std::move(parents);
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <set>
+#include <string>
 #include <tuple>
 
 #include "panmap/core/container_memory.h"
@@ -434,6 +435,58 @@ void SuperpointTracker::renumberInstances(const std::map<int32_t, int32_t>& ids,
     state.instance_counts = std::move(counts);
   }
   next_instance_ = next_instance;
+}
+
+void SuperpointTracker::checkSuperpointIds(const std::map<int32_t, int32_t>& ids,
+                                           int32_t size) const {
+  std::set<int32_t> taken;
+  for (const auto& [from, to] : ids) {
+    if (!labels_.isRoot(from)) {
+      throw Error("renumberSuperpoints: label " + std::to_string(from) + " is not a super-point");
+    }
+    if (to <= 0 || to > size) {
+      throw Error("renumberSuperpoints: super-point " + std::to_string(from) + " would become " +
+                  std::to_string(to) + ", outside 1.." + std::to_string(size));
+    }
+    if (!taken.insert(to).second) {
+      throw Error("renumberSuperpoints: two super-points would become " + std::to_string(to));
+    }
+  }
+  for (const auto& entry : states_) {
+    if (!ids.count(entry.first)) {
+      throw Error("renumberSuperpoints: no new id for super-point " + std::to_string(entry.first));
+    }
+  }
+}
+
+void SuperpointTracker::renumberSuperpoints(const std::map<int32_t, int32_t>& ids, int32_t size) {
+  checkSuperpointIds(ids, size);
+  std::vector<int32_t> roots;
+  for (const auto& entry : ids) roots.push_back(entry.second);
+  // Every key below is a live super-point's; an unknown one is dropped rather than kept under
+  // an id that may now name another.
+  const auto renamed = [&](int32_t label) {
+    const auto it = ids.find(labels_.resolve(label));
+    return it == ids.end() ? 0 : it->second;
+  };
+  const auto renamePairs = [&](const std::map<std::pair<int32_t, int32_t>, int>& in) {
+    std::map<std::pair<int32_t, int32_t>, int> out;
+    for (const auto& [pair, count] : in) {
+      const int32_t a = renamed(pair.first), b = renamed(pair.second);
+      if (a > 0 && b > 0 && a != b) out[{std::min(a, b), std::max(a, b)}] += count;
+    }
+    return out;
+  };
+  std::map<int32_t, SuperpointState> states;
+  for (auto& [label, state] : states_) states[ids.at(label)] = std::move(state);
+  co_observed_ = renamePairs(co_observed_);
+  apart_ = renamePairs(apart_);
+  for (SuperpointMerge& merge : merge_log_) {
+    merge.kept = renamed(merge.kept);
+    merge.removed = 0;
+  }
+  states_ = std::move(states);
+  labels_.renumber(roots, size);
 }
 
 SuperpointTracker::Snapshot SuperpointTracker::snapshot() const {

@@ -265,6 +265,54 @@ TEST(Votes, ABlockKeepsVoteSetsOnlyForVotedVoxels) {
   EXPECT_EQ(Block::linear(1, 2, 3), 1 + 8 * 2 + 64 * 3);
 }
 
+// Renamed votes that name one label afterwards are one slot, as if they had been cast for it;
+// a sum beyond a slot's count halves the voxel's counts first, as addVotes does.
+TEST(Votes, RenamingFoldsVotesThatNowNameOneLabel) {
+  VoxelVotes v;
+  addVotes(&v, 4, 10);
+  addVotes(&v, 7, 3);
+  addVotes(&v, 9, 6);
+  renameVotes(&v, [](int32_t l) { return l == 9 ? 2 : (l == 4 ? 12 : 5); });
+  EXPECT_EQ(v.slots[0].label, 12);
+  EXPECT_EQ(v.slots[0].count, 10u);
+  EXPECT_EQ(v.slots[1].label, 5);
+  EXPECT_EQ(v.slots[1].count, 3u);
+  EXPECT_EQ(v.slots[2].label, 2);
+  EXPECT_EQ(v.slots[2].count, 6u);
+  renameVotes(&v, [](int32_t l) { return l == 2 ? 12 : l; });
+  EXPECT_EQ(v.slots[0].label, 12);
+  EXPECT_EQ(v.slots[0].count, 16u);
+  EXPECT_EQ(v.slots[2].count, 0u);
+  EXPECT_EQ(v.total(), 19u);
+
+  VoxelVotes full;
+  addVotes(&full, 1, 60000);
+  addVotes(&full, 2, 10000);
+  addVotes(&full, 3, 7);
+  renameVotes(&full, [](int32_t l) { return l == 2 ? 1 : l; });
+  EXPECT_EQ(full.slots[0].count, 35000u);  // (30000 + 5000)
+  EXPECT_EQ(full.slots[2].count, 4u);      // 7 halved, rounding up
+}
+
+// TsdfMap::renameVotes renames every voxel's votes, or, when a label has no new one, none.
+TEST(Votes, AMapRenamesAllItsVotesOrNone) {
+  TsdfMap map(TsdfMap::Config{0.05f});
+  Block* a = map.allocateBlock(BlockIndex(0, 0, 0));
+  Block* b = map.allocateBlock(BlockIndex(1, 0, 0));
+  addVotes(a->votesToWrite(5), 1, 3);
+  addVotes(b->votesToWrite(9), 3, 2);
+  addVotes(b->votesToWrite(9), 2, 4);
+  EXPECT_THROW(map.renameVotes({0, 8, 0, 6}), Error);  // 2 has no new label
+  EXPECT_EQ(a->votes(5)->slots[0].label, 1);
+  EXPECT_THROW(map.renameVotes({0, 8, 7}), Error);  // nor 3
+  EXPECT_EQ(b->votes(9)->slots[0].label, 3);
+  map.renameVotes({0, 8, 6, 6});
+  EXPECT_EQ(a->votes(5)->slots[0].label, 8);
+  EXPECT_EQ(b->votes(9)->slots[0].label, 6);
+  EXPECT_EQ(b->votes(9)->slots[0].count, 6u);
+  EXPECT_EQ(b->votes(9)->total(), 6u);
+}
+
 TEST(Votes, EvictionIsWeakestFirstAndCounted) {
   VoxelVotes v;
   for (int i = 0; i < 5; ++i) EXPECT_FALSE(addVote(&v, 1));

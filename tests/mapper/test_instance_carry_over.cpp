@@ -88,9 +88,10 @@ TEST(SampleFrame, CorrectsTheDepthAsTheMapperDoes) {
 
 class InstanceOverlapTest : public BoxScene {};
 
-// Two maps of the same frames at the same poses: every sample sees the same object in both, so
-// each instance shares its samples with itself only; threads change nothing.
-TEST_F(InstanceOverlapTest, TheSameFramesAtTheSamePosesPairEachInstanceWithItself) {
+// Two maps of the same frames at the same poses: every sample sees the same object and the same
+// super-point in both, so each instance and each super-point shares its samples with itself
+// only; threads change nothing.
+TEST_F(InstanceOverlapTest, TheSameFramesAtTheSamePosesPairEachIdWithItself) {
   const auto old_map = run(config(), 4);
   const auto new_map = run(config(), 4);
   std::vector<InstanceSampleFrame> frames;
@@ -100,23 +101,37 @@ TEST_F(InstanceOverlapTest, TheSameFramesAtTheSamePosesPairEachInstanceWithItsel
     frameAt(k, &frame, &panoptic);
     frames.push_back(sampleFrame(frame, k, pose(k), 16));
   }
-  const InstanceOverlap serial =
-      countInstanceOverlap(frames, old_map->trajectory(), old_map->map(), old_map->superpoints(),
-                           new_map->map(), new_map->superpoints());
+  const CarryOverlap serial =
+      countCarryOverlap(frames, old_map->trajectory(), old_map->map(), old_map->superpoints(),
+                        new_map->map(), new_map->superpoints());
   ThreadPool pool(2);
-  EXPECT_EQ(
-      countInstanceOverlap(frames, old_map->trajectory(), old_map->map(), old_map->superpoints(),
-                           new_map->map(), new_map->superpoints(), &pool),
-      serial);
-  ASSERT_EQ(serial.size(), 2u);  // the cabinet and the fridge
-  for (const auto& [ids, samples] : serial) {
+  const CarryOverlap threaded =
+      countCarryOverlap(frames, old_map->trajectory(), old_map->map(), old_map->superpoints(),
+                        new_map->map(), new_map->superpoints(), &pool);
+  EXPECT_EQ(threaded.instances, serial.instances);
+  EXPECT_EQ(threaded.superpoints, serial.superpoints);
+  ASSERT_EQ(serial.instances.size(), 2u);  // the cabinet and the fridge
+  for (const auto& [ids, samples] : serial.instances) {
     EXPECT_EQ(ids.first, ids.second);
     EXPECT_GT(samples, 20);
   }
+  // Walls, floor and the objects' faces: more super-points than objects, each with itself.
+  EXPECT_GT(serial.superpoints.size(), 2u);
+  for (const auto& [ids, samples] : serial.superpoints) EXPECT_EQ(ids.first, ids.second);
   frames[1].index = 4;  // beyond the trajectory
-  EXPECT_THROW(countInstanceOverlap(frames, old_map->trajectory(), old_map->map(),
-                                    old_map->superpoints(), new_map->map(), new_map->superpoints()),
+  EXPECT_THROW(countCarryOverlap(frames, old_map->trajectory(), old_map->map(),
+                                 old_map->superpoints(), new_map->map(), new_map->superpoints()),
                Error);
+}
+
+// carriedIds() numbers only the ids it is given (a map's live super-points need not be
+// consecutive): the others get no entry, and fresh ids follow the old map's.
+TEST(CarriedIds, OnlyTheGivenIdsAreNumbered) {
+  int32_t next = 0;
+  const IdOverlap overlap = {{{4, 7}, 10}, {{9, 2}, 8}, {{6, 3}, 1}};
+  EXPECT_EQ(carriedIds(overlap, {4, 6, 11}, 20, &next),
+            (std::map<int32_t, int32_t>{{4, 7}, {6, 20}, {11, 21}}));
+  EXPECT_EQ(next, 22);
 }
 
 }  // namespace

@@ -475,6 +475,33 @@ TEST(LabelRegistry, MergesResolveToTheOldestId) {
   EXPECT_THROW(copy.restore({0, 2}), Error);
 }
 
+// A renumbered registry: the given roots live, every other label up to its size retired (it
+// resolves to none and cannot merge), new labels above it; it saves and loads as it is.
+TEST(LabelRegistry, RenumberingRetiresEveryOtherLabel) {
+  LabelRegistry labels;
+  for (int i = 0; i < 4; ++i) labels.create();
+  labels.merge(4, 3);
+  labels.renumber({2, 7}, 9);
+  EXPECT_EQ(labels.size(), 9);
+  EXPECT_EQ(labels.resolve(2), 2);
+  EXPECT_EQ(labels.resolve(7), 7);
+  for (const int32_t retired : {1, 3, 4, 5, 6, 8, 9}) {
+    EXPECT_EQ(labels.resolve(retired), 0) << retired;
+    EXPECT_FALSE(labels.isRoot(retired)) << retired;
+  }
+  EXPECT_THROW(labels.merge(2, 3), Error);
+  EXPECT_EQ(labels.create(), 10);
+  EXPECT_EQ(labels.merge(10, 7), 7);
+  LabelRegistry copy;
+  copy.restore(labels.parents());
+  EXPECT_EQ(copy.parents(), labels.parents());
+  EXPECT_EQ(copy.resolve(10), 7);
+  EXPECT_EQ(copy.resolve(5), 0);
+  const std::vector<int32_t> parents = labels.parents();
+  EXPECT_THROW(labels.renumber({2, 12}, 11), Error);  // 12 outside 1..11
+  EXPECT_EQ(labels.parents(), parents);
+}
+
 TEST(LabelRegistry, LongChainsResolveAndCompress) {
   LabelRegistry labels;
   for (int i = 0; i < 6; ++i) labels.create();
@@ -561,6 +588,59 @@ TEST(SuperpointTrackerInstances, ARenumberingThatWouldJoinOrLoseInstancesChanges
   for (const auto& [label, state] : before.states) {
     EXPECT_EQ(tracker.state(label)->instance_counts, state.instance_counts) << label;
   }
+}
+
+// Super-points 1, 2 (2 merged away into 1) and 3, 4 renamed 1 -> 12, 3 -> 5, 4 -> 2: states,
+// co-observations and apart counts follow, pairs stay ordered, the merge names its survivor by
+// the new id, and labels up to 12 not given are retired.
+TEST(SuperpointTrackerRenumbering, EveryRecordFollowsTheNewIds) {
+  SuperpointTracker tracker{SuperpointConfig()};
+  SuperpointTracker::Snapshot s;
+  s.parents = {0, 1, 1, 3, 4};
+  s.states[1].class_counts = {{5, 3.0}};
+  s.states[3].class_counts = {{7, 1.0}};
+  s.states[4].class_counts = {{9, 2.0}};
+  s.co_observed = {{{1, 3}, 2}, {{3, 4}, 5}};
+  s.apart = {{{1, 4}, 1}};
+  s.merges = {SuperpointMerge{1, 2, 6}};
+  tracker.restore(s);
+  tracker.renumberSuperpoints({{1, 12}, {3, 5}, {4, 2}}, 12);
+  EXPECT_EQ(tracker.states().size(), 3u);
+  EXPECT_EQ(tracker.state(12)->class_counts, (std::map<int32_t, double>{{5, 3.0}}));
+  EXPECT_EQ(tracker.state(5)->class_counts, (std::map<int32_t, double>{{7, 1.0}}));
+  EXPECT_EQ(tracker.state(2)->class_counts, (std::map<int32_t, double>{{9, 2.0}}));
+  EXPECT_EQ(tracker.state(1), nullptr);
+  EXPECT_EQ(tracker.state(3), nullptr);
+  EXPECT_EQ(tracker.coObservations(),
+            (std::map<std::pair<int32_t, int32_t>, int>{{{5, 12}, 2}, {{2, 5}, 5}}));
+  EXPECT_EQ(tracker.apartCounts(), (std::map<std::pair<int32_t, int32_t>, int>{{{2, 12}, 1}}));
+  ASSERT_EQ(tracker.merges().size(), 1u);
+  EXPECT_EQ(tracker.merges()[0].kept, 12);
+  EXPECT_EQ(tracker.merges()[0].removed, 0);
+  EXPECT_EQ(tracker.merges()[0].frame, 6);
+  EXPECT_EQ(tracker.labels().size(), 12);
+  EXPECT_EQ(tracker.labels().resolve(1), 0);
+  EXPECT_EQ(tracker.labels().resolve(12), 12);
+}
+
+TEST(SuperpointTrackerRenumbering, IdsThatDoNotFitChangeNothing) {
+  SuperpointTracker tracker{SuperpointConfig()};
+  SuperpointTracker::Snapshot s;
+  s.parents = {0, 1, 1, 3};
+  s.states[1].class_counts = {{5, 3.0}};
+  s.states[3].class_counts = {{7, 1.0}};
+  s.co_observed = {{{1, 3}, 2}};
+  tracker.restore(s);
+  const auto same = [&tracker, &s] {
+    const SuperpointTracker::Snapshot now = tracker.snapshot();
+    return now.parents == s.parents && now.states.size() == s.states.size() &&
+           now.co_observed == s.co_observed;
+  };
+  EXPECT_THROW(tracker.renumberSuperpoints({{1, 4}}, 5), Error);                  // 3 has no id
+  EXPECT_THROW(tracker.renumberSuperpoints({{1, 4}, {3, 4}}, 5), Error);          // one id for two
+  EXPECT_THROW(tracker.renumberSuperpoints({{1, 4}, {3, 6}}, 5), Error);          // 6 beyond 5
+  EXPECT_THROW(tracker.renumberSuperpoints({{1, 4}, {2, 1}, {3, 5}}, 5), Error);  // 2 merged
+  EXPECT_TRUE(same());
 }
 
 }  // namespace

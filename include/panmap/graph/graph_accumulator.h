@@ -123,6 +123,13 @@ class GraphAccumulator {
   /// per-block results and the scratch.
   size_t memoryBytes() const;
 
+  /// Follows SuperpointTracker::renumberSuperpoints(): call first, with the tracker as it is
+  /// before it. Folds in the tracker's merges not yet applied, then keys the scores and edges
+  /// by the new ids, to[label] for every label the tracker knows (merged away or not; an entry
+  /// whose label has none, 0, is dropped: no live super-point); the surface scan reads the
+  /// whole map again at its next refresh.
+  void renumberSuperpoints(const SuperpointTracker& tracker, const std::vector<int32_t>& to);
+
   /// Full state for saving and restoring a map.
   struct Snapshot {
     std::map<int32_t, std::map<int32_t, double>> scores;

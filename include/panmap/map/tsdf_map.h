@@ -129,6 +129,12 @@ class TsdfMap {
   /// Voxels that hold votes (a vote set): those a measured point fell in.
   size_t numVotedVoxels() const;
 
+  /// Renames the label of every vote: label l becomes to[l]. Votes that then name one label in
+  /// a voxel are folded into one slot (renameVotes). Every block holding votes is stamped as
+  /// changed. Throws Error, changing nothing, when a vote's label has no entry in `to` or
+  /// would become <= 0.
+  void renameVotes(const std::vector<int32_t>& to);
+
   /// Unique among the maps of this process: results kept per block (graph/surface_scan.h)
   /// belong to one map, and a map built in its place may reuse the old one's address.
   uint64_t id() const { return id_; }

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 
 #include <Eigen/Core>
@@ -162,6 +163,32 @@ int32_t argmaxLabel(const VoxelVotes& votes, const Resolve& resolve, bool* tie =
     *tie = winners > 1;
   }
   return best;
+}
+
+/// Renames every vote of a voxel through `rename` (stored label -> new label, > 0), folding
+/// votes that now name one label into its first slot, as addVotes would have counted them (a
+/// sum above kMaxVoteCount first halves every count of the voxel, then saturates).
+template <typename Rename>
+void renameVotes(VoxelVotes* votes, const Rename& rename) {
+  for (LabelVote& v : votes->slots) {
+    if (v.count > 0) v.label = rename(v.label);
+  }
+  for (int i = 0; i < kVoteSlots; ++i) {
+    LabelVote& kept = votes->slots[i];
+    if (kept.count == 0) continue;
+    for (int j = i + 1; j < kVoteSlots; ++j) {
+      LabelVote& other = votes->slots[j];
+      if (other.count == 0 || other.label != kept.label) continue;
+      if (static_cast<uint32_t>(kept.count) + other.count > kMaxVoteCount) {
+        for (LabelVote& any : votes->slots) {
+          any.count = static_cast<uint16_t>((any.count + 1u) / 2u);
+        }
+      }
+      kept.count = static_cast<uint16_t>(
+          std::min<uint32_t>(static_cast<uint32_t>(kept.count) + other.count, kMaxVoteCount));
+      other = LabelVote{};
+    }
+  }
 }
 
 /// argmaxLabel of a voxel's votes, 0 (and no tie) when it has none (`votes` null).

@@ -18,8 +18,9 @@
 
 namespace panmap {
 
-/// A repair that maps the frames again makes its instances anew, numbered in the order it meets
-/// them, while a planner knows the objects by the ids it was given before. Depth samples of
+/// A repair that maps the frames again makes its instances and super-points anew, numbered in
+/// the order it meets them, while a planner knows the objects (and the optimiser the
+/// super-points) by the ids they were given before. Depth samples of
 /// the repaired frames say which old instance and which new one hold the same surface:
 /// each sample is looked up in the old map at the frame's old pose and in the new map at its
 /// new pose (the same pixel sees the same surface in both), so the match does not depend on how
@@ -51,28 +52,42 @@ InstanceSampleFrame sampleFrame(const RgbdFrame& frame, size_t index,
                                 const Eigen::Isometry3d& T_W_C, int step_px,
                                 const DepthCalibration* calibration = nullptr);
 
-/// Samples per (new instance, old instance) pair: how much surface the two share.
-using InstanceOverlap = std::map<std::pair<int32_t, int32_t>, int>;
+/// Samples per (new id, old id) pair: how much surface the two share.
+using IdOverlap = std::map<std::pair<int32_t, int32_t>, int>;
+/// Samples per (new instance, old instance) pair.
+using InstanceOverlap = IdOverlap;
+
+/// What the samples of a repair found in both maps.
+struct CarryOverlap {
+  IdOverlap instances;    ///< per (new, old) frame-count instance
+  IdOverlap superpoints;  ///< per (new, old) super-point (root labels)
+};
 
 /// Looks every sample up in both maps: in the old one at trajectory_old[index] with the old
 /// super-points, in the new one at the frame's new pose with the new super-points; counts the
-/// samples whose voxel belongs to a (frame-count) instance in both. Neither map may change
-/// meanwhile. Throws Error when a frame's index is outside trajectory_old.
+/// samples whose voxel belongs to a super-point in both, and to a (frame-count) instance in
+/// both. Neither map may change meanwhile. Throws Error when a frame's index is outside
+/// trajectory_old.
 /// @param pool threads to share the frames among (null: this thread only; same result)
-InstanceOverlap countInstanceOverlap(const std::vector<InstanceSampleFrame>& frames,
-                                     const std::vector<StampedPose>& trajectory_old,
-                                     const TsdfMap& old_map, const SuperpointTracker& old_tracker,
-                                     const TsdfMap& new_map, const SuperpointTracker& new_tracker,
-                                     ThreadPool* pool = nullptr);
+CarryOverlap countCarryOverlap(const std::vector<InstanceSampleFrame>& frames,
+                               const std::vector<StampedPose>& trajectory_old,
+                               const TsdfMap& old_map, const SuperpointTracker& old_tracker,
+                               const TsdfMap& new_map, const SuperpointTracker& new_tracker,
+                               ThreadPool* pool = nullptr);
 
-/// New ids for the instances of a repaired map (ids 1 .. new_next_instance - 1), for
-/// SuperpointTracker::renumberInstances(). Pairs are taken by the samples they share, most
-/// first (ties: smaller new id, then smaller old id), each old and each new instance at most
-/// once, and only when they share at least 3 samples and a fifth of the new instance's samples
-/// that found an old instance: that new instance takes the old id. Every other new instance
-/// gets an id no instance had before, from old_next_instance up, in the order of its new id,
-/// so an id never names another object than it did.
-/// @param next_instance receives the first id free after the renumbering
+/// New ids for `new_ids` (the ids of a repaired map's instances or super-points, ascending).
+/// Pairs are taken by the samples they share, most first (ties: smaller new id, then smaller
+/// old id), each old and each new id at most once, and only when they share at least 3 samples
+/// and a fifth of the new id's samples that found an old one: that new id takes the old id.
+/// Every other one gets an id no instance or super-point had before, from old_next up, in
+/// ascending order, so an id never names another object or surface than it did.
+/// @param old_next the first id the old map never handed out (old ids are below it)
+/// @param next receives the first id free after the renumbering
+std::map<int32_t, int32_t> carriedIds(const IdOverlap& overlap, const std::vector<int32_t>& new_ids,
+                                      int32_t old_next, int32_t* next);
+
+/// carriedIds() for the instances 1 .. new_next_instance - 1 of a repaired map, the old map's
+/// being below old_next_instance (SuperpointTracker::renumberInstances()).
 std::map<int32_t, int32_t> carriedInstanceIds(const InstanceOverlap& overlap,
                                               int32_t new_next_instance, int32_t old_next_instance,
                                               int32_t* next_instance);

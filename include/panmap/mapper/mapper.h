@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -171,6 +172,16 @@ struct ReintegrationStats {
   /// Of a remap's frames, those whose geometric segments were kept with them (not computed
   /// again from the depth).
   size_t frames_with_kept_segments = 0;
+  /// A remap's frame-count instances, and of those, the ones that took an old instance's id.
+  size_t instances = 0;
+  size_t instances_kept = 0;  ///< (see instances)
+  /// A remap's super-points, and of those, the ones that took an old super-point's id.
+  size_t superpoints = 0;
+  size_t superpoints_kept = 0;  ///< (see superpoints)
+  /// Of the depth samples that found an instance (a super-point) in both maps, the share that
+  /// found the same id in both: how much of the surface kept its object's (super-point's) id.
+  double instance_surface_kept = 0.0;
+  double superpoint_surface_kept = 0.0;  ///< (see instance_surface_kept)
 };
 
 class BinaryReader;
@@ -301,9 +312,21 @@ class Mapper {
   /// updateMesh() lists every block. The running correction of tracked poses starts again from
   /// identity: the repaired map sits where the SLAM back-end's corrected poses put it, and
   /// those are what its next poses build on (docs/LOOP_CLOSURE.md). A remap's super-points,
-  /// graph and their counters replace this mapper's too. Throws Error, changing nothing,
-  /// unless the rebuild holds exactly the frames of trajectory(), in order.
-  void commitRebuild(std::unique_ptr<MapRebuild> rebuild);
+  /// graph and their counters replace this mapper's too; its instances and super-points take
+  /// the ids of the old ones they hold the surface of (carriedIds()). Throws Error, changing
+  /// nothing, unless the rebuild holds exactly the frames of trajectory(), in order.
+  /// @param stats if given, receives the counts of ids kept (ReintegrationStats::instances ...)
+  void commitRebuild(std::unique_ptr<MapRebuild> rebuild, ReintegrationStats* stats = nullptr);
+
+  /// Gives the live super-points new ids: root label r becomes ids.at(r) (every super-point
+  /// with a state or a vote needs one), every other label up to `size` is retired (it
+  /// resolves to no super-point and is never handed out again), and super-points created
+  /// afterwards start at size + 1. Votes, states, co-observations and graph evidence follow;
+  /// meshes are made again. Throws Error, changing nothing, when an id is missing, shared or
+  /// outside 1..size.
+  void renumberSuperpoints(const std::map<int32_t, int32_t>& ids, int32_t size);
+  /// The super-points that hold a vote or have a state (root labels, ascending).
+  std::vector<int32_t> liveSuperpoints() const;
 
   /// The labelled mesh of the current map: marching cubes re-run only on changed blocks;
   /// per vertex the super-point (argmax of its voxel's votes, merges resolved), and the

@@ -7,7 +7,8 @@
 namespace panmap {
 
 /// Super-point labels L_S: integer ids from 1, merged through a union-find so that every id
-/// ever handed out stays resolvable to the super-point it belongs to now.
+/// ever handed out stays resolvable to the super-point it belongs to now, or to 0 once it is
+/// retired (renumber(): a repair gave its super-point another id).
 class LabelRegistry {
  public:
   /// A new label (ids are consecutive from 1).
@@ -32,10 +33,14 @@ class LabelRegistry {
   bool isRoot(int32_t label) const {
     return label > 0 && label < static_cast<int32_t>(parent_.size()) && parent_[label] == label;
   }
-  /// Parent array (index = label; parent_[0] = 0) for saving.
+  /// Parent array (index = label; parent_[0] = 0; 0 for a retired label) for saving.
   const std::vector<int32_t>& parents() const { return parent_; }
-  /// Restores from a saved parent array (validated: every parent <= its label).
+  /// Restores from a saved parent array (validated: every parent <= its label; 0 = retired).
   void restore(std::vector<int32_t> parents);
+  /// Replaces the registry by one in which `roots` (each in 1..size) are live super-points and
+  /// every other label up to `size` is retired: it resolves to 0 and is never handed out again.
+  /// New labels start at size + 1. Throws Error, changing nothing, on a root outside 1..size.
+  void renumber(const std::vector<int32_t>& roots, int32_t size);
 
  private:
   // resolve() of a label two or more links below its root; compresses the path.

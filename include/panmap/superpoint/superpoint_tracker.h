@@ -146,6 +146,18 @@ class SuperpointTracker {
   /// `next_instance`. Throws Error, changing nothing, when two instances would share an id or
   /// an id would not be below `next_instance`.
   void renumberInstances(const std::map<int32_t, int32_t>& ids, int32_t next_instance);
+  /// Gives the live super-points new ids (a repair keeps the ids the map had before it:
+  /// carriedIds()): root label r becomes ids.at(r), every other label up to `size` is retired
+  /// (LabelRegistry::renumber), and super-points created afterwards start at size + 1. States,
+  /// co-observations and the apart counts follow; the merges logged so far keep their frame and
+  /// name the survivor by its new id and the merged-away label as 0 (it no longer exists).
+  /// Throws Error, changing nothing, when a super-point with a state has no new id, two would
+  /// share one, or one would fall outside 1..size.
+  void renumberSuperpoints(const std::map<int32_t, int32_t>& ids, int32_t size);
+  /// Throws Error, as renumberSuperpoints() would, when the ids do not fit: a key that is not a
+  /// live label, two keys with one id, an id outside 1..size, a super-point with a state and
+  /// no id.
+  void checkSuperpointIds(const std::map<int32_t, int32_t>& ids, int32_t size) const;
   /// Co-observation counts M(L1, L2) of live super-points (L1 < L2).
   const std::map<std::pair<int32_t, int32_t>, int>& coObservations() const { return co_observed_; }
   /// Frames that showed two live super-points (L1 < L2) as two objects: each significant in a

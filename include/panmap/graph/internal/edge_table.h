@@ -42,6 +42,9 @@ class EdgeTable {
   /// one (summed into an existing edge class by class), the edge between the two disappears.
   /// Same sums as moving them one merge at a time, with one pass over the table for all.
   void applyMerges(const std::vector<SuperpointMerge>& merges, size_t begin, size_t end);
+  /// Renames both ends of every edge through `to`, which must give distinct super-points
+  /// distinct ids; an edge with an end it maps to 0 or less is dropped.
+  void rename(const std::function<int32_t(int32_t)>& to);
   /// Drops every edge with an end for which keep() is false.
   void keepIf(const std::function<bool(int32_t)>& keep);
   /// Drops every edge for which keep(a, b, classes) is false; returns how many.
