@@ -31,16 +31,36 @@ struct Recorded {
 class Reintegration : public BoxScene {
  protected:
   // Maps `frames` frames, keeping each one as a frame store would.
-  std::unique_ptr<Mapper> record(int frames) {
+  // The first `frames` frames mapped and stored; the first `off_frames` of them at
+  // off * pose(k) instead of pose(k) (a drift the repair then corrects).
+  std::unique_ptr<Mapper> record(int frames, int off_frames = 0,
+                                 const Eigen::Isometry3d& off = Eigen::Isometry3d::Identity()) {
     auto mapper = std::make_unique<Mapper>(config());
     for (int k = 0; k < frames; ++k) {
       Recorded r;
       frameAt(k, &r.frame, &r.panoptic);
-      mapper->integrate(r.frame, pose(k), &r.panoptic);
+      mapper->integrate(r.frame, k < off_frames ? off * pose(k) : pose(k), &r.panoptic);
       r.labels = mapper->lastPixelLabels();
       r.geometric = mapper->lastGeometricSegments();
       stored_[r.frame.utime] = r;
     }
+    return mapper;
+  }
+  // The centroids of the box scene's cabinet and fridge, world frame.
+  const Eigen::Vector3d cabinet_W{1.1, -0.4, 0.45};
+  const Eigen::Vector3d fridge_W{1.1, 0.35, 0.8};
+  // Where the first three frames of recordWithGhosts() were mapped: 1.6 m off along y.
+  static Eigen::Isometry3d ghostOffset() {
+    Eigen::Isometry3d off = Eigen::Isometry3d::Identity();
+    off.translation() = Eigen::Vector3d(0.0, 1.6, 0.0);
+    return off;
+  }
+  // Eight frames, the first three mapped ghostOffset() off, so that they leave ghost copies of
+  // the cabinet and the fridge; `corrected` receives the trajectory with those three put back.
+  std::unique_ptr<Mapper> recordWithGhosts(std::vector<StampedPose>* corrected) {
+    std::unique_ptr<Mapper> mapper = record(8, 3, ghostOffset());
+    *corrected = mapper->trajectory();
+    for (int k = 0; k < 3; ++k) (*corrected)[k].T_W_C = pose(k);
     return mapper;
   }
   // With `kept`, each frame's geometric segments come back with it, as a frame store gives them.
@@ -333,19 +353,10 @@ int32_t objectNear(const std::vector<MappedObject>& objects, int32_t c,
 // keep the ids the map had given them (a planner knows them by those), the ghosts are gone,
 // and no id names another object than before.
 TEST_F(Reintegration, ARemapKeepsTheIdsOfTheObjectsItFindsAgain) {
-  Eigen::Isometry3d off = Eigen::Isometry3d::Identity();
-  off.translation() = Eigen::Vector3d(0.0, 1.6, 0.0);
-  Mapper mapper(config());
-  for (int k = 0; k < 8; ++k) {
-    Recorded r;
-    frameAt(k, &r.frame, &r.panoptic);
-    mapper.integrate(r.frame, k < 3 ? off * pose(k) : pose(k), &r.panoptic);
-    r.geometric = mapper.lastGeometricSegments();
-    stored_[r.frame.utime] = r;
-  }
-  std::vector<StampedPose> corrected = mapper.trajectory();
-  for (int k = 0; k < 3; ++k) corrected[k].T_W_C = pose(k);
-  const Eigen::Vector3d cabinet_W(1.1, -0.4, 0.45), fridge_W(1.1, 0.35, 0.8);
+  std::vector<StampedPose> corrected;
+  const std::unique_ptr<Mapper> recorded = recordWithGhosts(&corrected);
+  Mapper& mapper = *recorded;
+  const Eigen::Isometry3d off = ghostOffset();
   const std::vector<MappedObject> before = computeObjects(mapper);
   const int32_t cabinet = objectNear(before, 3, cabinet_W);
   const int32_t fridge = objectNear(before, 24, fridge_W);
@@ -399,22 +410,13 @@ int32_t superpointNear(const LabelledMesh& mesh, const Eigen::Vector3d& p_W) {
 
 // The scene of the test above: the super-points a remap finds again keep their ids (the graph
 // and the optimiser's labels know them by those), the ghosts' ids are retired, every other
-// super-point gets an id the map never gave before, and the map is otherwise the one the remap
-// made (the same bytes once both are numbered alike).
+// super-point gets an id the map never gave before, and the map is otherwise the one a remap
+// without the renaming makes (but where a tie is broken by the smaller id).
 TEST_F(Reintegration, ARemapKeepsTheIdsOfTheSuperpointsItFindsAgain) {
-  Eigen::Isometry3d off = Eigen::Isometry3d::Identity();
-  off.translation() = Eigen::Vector3d(0.0, 1.6, 0.0);
-  Mapper mapper(config());
-  for (int k = 0; k < 8; ++k) {
-    Recorded r;
-    frameAt(k, &r.frame, &r.panoptic);
-    mapper.integrate(r.frame, k < 3 ? off * pose(k) : pose(k), &r.panoptic);
-    r.geometric = mapper.lastGeometricSegments();
-    stored_[r.frame.utime] = r;
-  }
-  std::vector<StampedPose> corrected = mapper.trajectory();
-  for (int k = 0; k < 3; ++k) corrected[k].T_W_C = pose(k);
-  const Eigen::Vector3d cabinet_W(1.1, -0.4, 0.45), fridge_W(1.1, 0.35, 0.8);
+  std::vector<StampedPose> corrected;
+  const std::unique_ptr<Mapper> recorded = recordWithGhosts(&corrected);
+  Mapper& mapper = *recorded;
+  const Eigen::Isometry3d off = ghostOffset();
   const LabelledMesh before = mapper.extractMesh();
   const int32_t cabinet = superpointNear(before, cabinet_W);
   const int32_t fridge = superpointNear(before, fridge_W);
