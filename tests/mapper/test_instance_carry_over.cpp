@@ -44,13 +44,19 @@ TEST(CarriedInstanceIds, WithoutAnOldMapTheIdsStay) {
   EXPECT_EQ(next, 3);
 }
 
-TEST(SampleFrame, TakesTheMiddleOfEachGridCellWithDepth) {
+// An 8x4 frame without depth but at (2, 2), 1.5 m.
+RgbdFrame smallFrame() {
   RgbdFrame frame;
   frame.camera.fx = frame.camera.fy = 500.0;
   frame.camera.width = 8;
   frame.camera.height = 4;
   frame.depth = DepthImage(8, 4, uint16_t{0});
-  frame.depth(2, 2) = 1500;  // the only cell middle with depth besides (6, 2)
+  frame.depth(2, 2) = 1500;
+  return frame;
+}
+
+TEST(SampleFrame, TakesTheMiddleOfEachGridCellWithDepth) {
+  RgbdFrame frame = smallFrame();  // (2, 2): a cell middle with depth, as (6, 2) below
   frame.depth(6, 2) = 2000;
   frame.depth(0, 0) = 1000;  // not a cell middle
   const InstanceSampleFrame s = sampleFrame(frame, 7, Eigen::Isometry3d::Identity(), 4);
@@ -65,12 +71,7 @@ TEST(SampleFrame, TakesTheMiddleOfEachGridCellWithDepth) {
 }
 
 TEST(SampleFrame, CorrectsTheDepthAsTheMapperDoes) {
-  RgbdFrame frame;
-  frame.camera.fx = frame.camera.fy = 500.0;
-  frame.camera.width = 8;
-  frame.camera.height = 4;
-  frame.depth = DepthImage(8, 4, uint16_t{0});
-  frame.depth(2, 2) = 1500;
+  const RgbdFrame frame = smallFrame();
   // 1 cm deeper everywhere, at every depth.
   const DepthCalibration calibration(8, 4, 1, 1, 2, 5.0, {0.01f, 0.01f});
   RgbdFrame corrected;
