@@ -1,7 +1,5 @@
 // Mapper::renumberSuperpoints(): super-points under new ids (a repair keeps the old ones).
-#include <string>
 
-#include "panmap/core/error.h"
 #include "panmap/mapper/mapper.h"
 
 namespace panmap {
@@ -25,13 +23,9 @@ std::vector<int32_t> Mapper::liveSuperpoints() const {
 }
 
 void Mapper::renumberSuperpoints(const std::map<int32_t, int32_t>& ids, int32_t size) {
-  // Checked in full before anything changes.
+  // Checked in full before anything changes: the states here, every vote by renameVotes (it
+  // looks at all of them before it renames one).
   tracker_->checkSuperpointIds(ids, size);
-  for (const int32_t label : liveSuperpoints()) {
-    if (!ids.count(label)) {
-      throw Error("renumberSuperpoints: no new id for super-point " + std::to_string(label));
-    }
-  }
   const LabelRegistry& labels = tracker_->labels();
   // Every stored label, merged away or not, becomes its super-point's new id.
   std::vector<int32_t> to(static_cast<size_t>(labels.size()) + 1, 0);

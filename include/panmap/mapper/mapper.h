@@ -322,8 +322,8 @@ class Mapper {
   /// with a state or a vote needs one), every other label up to `size` is retired (it
   /// resolves to no super-point and is never handed out again), and super-points created
   /// afterwards start at size + 1. Votes, states, co-observations and graph evidence follow;
-  /// meshes are made again. Throws Error, changing nothing, when an id is missing, shared or
-  /// outside 1..size.
+  /// meshes are made again. Throws Error, changing nothing, when an id is missing (for a
+  /// super-point with a state, or a vote), shared or outside 1..size.
   void renumberSuperpoints(const std::map<int32_t, int32_t>& ids, int32_t size);
   /// The super-points that hold a vote or have a state (root labels, ascending).
   std::vector<int32_t> liveSuperpoints() const;
