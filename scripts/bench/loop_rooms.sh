@@ -6,7 +6,8 @@
 # ways at 2 cm, tracking off: ground-truth poses, drifted poses, drifted poses repaired by the
 # correction (--frame-store). Prints mAP50, the mean surface distance to the ground-truth mesh
 # and the occupancy agreement with the ground-truth-pose run for each, and how many of the
-# drifted map's objects and super-points keep their id through the repair (object_ids.py;
+# drifted map's objects and super-points keep their id through the repair, and which of the
+# graph edges it keeps or drops the ground-truth-pose map has too (object_ids.py;
 # docs/LOOP_CLOSURE.md).
 #   scripts/bench/loop_rooms.sh [--room N] [--seed N] [--poses slam|slam-hard|light|heavy] [--frames N]
 #                               [--residual-cm S] [--residual-deg S] [--style boxes|scannet]
@@ -44,9 +45,9 @@ map() {  # log, out, extra args
   build/panmap-mapper -q --no-snapshots --voxel-size 0.02 --tracking off --log "$1" \
     --out "$work/$2" "${@:3}" >/dev/null
 }
-map "$work/gt_seq/sequence.lcmlog" gt_poses
-# The graphs say which objects and super-points kept their ids through the repair
-# (scripts/bench/object_ids.py).
+# The graphs say which objects and super-points kept their ids through the repair, and which
+# of the edges it dropped the map from ground-truth poses has (scripts/bench/object_ids.py).
+map "$work/gt_seq/sequence.lcmlog" gt_poses --graph-json "$work/gt_poses/graph.json"
 map "$work/drift_seq/sequence.lcmlog" drifted --graph-json "$work/drifted/graph.json"
 map "$work/drift_seq/sequence.lcmlog" repaired --frame-store "$work/store" \
   --graph-json "$work/repaired/graph.json"
@@ -85,4 +86,6 @@ for m in "${maps[@]}"; do
     "$work/$m/eval.json")
   echo "$m: mAP50 $map50; purity $purity; ${surface#*: }; occupancy vs gt_poses: $occupancy"
 done
-python3 scripts/bench/object_ids.py "$work/drifted/graph.json" "$work/repaired/graph.json"
+python3 scripts/bench/object_ids.py "$work/drifted/graph.json" "$work/repaired/graph.json" \
+  --reference "$work/gt_poses/graph.json" --repaired-mesh "$work/repaired/mesh_superpoint.ply" \
+  --reference-mesh "$work/gt_poses/mesh_superpoint.ply"

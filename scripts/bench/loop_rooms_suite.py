@@ -19,8 +19,10 @@ With --ids the section written is the one between the loop-ids markers: per run,
 repair kept (its report line: instances and super-points, by count and by share of the depth
 samples) and, from the drifted and repaired maps' graphs (`object_ids.py`), the objects that
 keep the id of their counterpart, the graph's super-points that keep an id with the share of
-their voxels, and the drifted graph's edges between those super-points that the repaired graph
-has. --ids --report-only writes it from the run folders.
+their voxels, the drifted graph's edges between those super-points that the repaired graph
+has, and of the edges kept and of those lost, how many the map from ground-truth poses has
+too. --ids --report-only writes it from the run folders (a run from before loop_rooms.sh wrote
+the ground-truth-pose graph gets it from that map's file, `panmap-mapper --export-only`).
 
   python3 scripts/bench/loop_rooms_suite.py [--runs 3:3,3:4,3:5,4:3,5:3] [--poses heavy]
                                             [--reintegrate-also | --ids] [--report-only]
@@ -35,6 +37,7 @@ import os
 import re
 import subprocess
 import sys
+import tempfile
 import time
 
 import doc_section  # same folder
@@ -177,9 +180,31 @@ def reintegration_section(args, pairs, minutes):
     ] + (changes or ["| - | - | - | - | - | - | - |"]) + [END_REINTEGRATION])
 
 
+def reference_graph(work):
+    """The graph JSON of the run's map from ground-truth poses, written from its map file when
+    the run predates loop_rooms.sh writing it."""
+    path = os.path.join(work, "gt_poses", "graph.json")
+    if not os.path.exists(path):
+        with tempfile.TemporaryDirectory() as out:
+            subprocess.run([os.path.join(ROOT, "build", "panmap-mapper"), "-q", "--no-snapshots",
+                            "--export-only", "--load",
+                            os.path.join(work, "gt_poses", "map.panmap"), "--graph-json", path,
+                            "--out", out], cwd=ROOT, check=True, capture_output=True)
+    return object_ids.load(path)
+
+
+def edge_fates(work, before, repaired):
+    """object_ids.edges_in_reference() of a run against its ground-truth-pose map."""
+    partner = object_ids.partners(
+        object_ids.mesh_superpoints(os.path.join(work, "repaired", "mesh_superpoint.ply"), 0.02),
+        object_ids.mesh_superpoints(os.path.join(work, "gt_poses", "mesh_superpoint.ply"), 0.02))
+    return object_ids.edges_in_reference(before, repaired, reference_graph(work), partner)
+
+
 def ids_section(args, pairs, minutes):
     """The table of ids kept through each repair, from the run folders."""
     rows = []
+    totals = {"kept": [0, 0], "lost": [0, 0]}  # edges in the reference, edges judged
     for room, seed, style, frames in pairs:
         work = work_folder(room, seed, args.poses)
         repairs = read_json(os.path.join(work, "repaired", "report.json"))["corrections"]["repairs"]
@@ -192,12 +217,20 @@ def ids_section(args, pairs, minutes):
                                      object_ids.objects(repaired, 100), 0.3)
         vertices, kept, share, edges, kept_edges = object_ids.superpoint_ids(before, repaired)
         info = read_json(os.path.join(work, "drift_seq", "info.json"))
+        fates = edge_fates(work, before, repaired)
+        def judged(fate):  # edges of this fate whose two ends have distinct partners
+            return fates[(fate, "in reference")] + fates[(fate, "not in reference")]
+        for fate in ("kept", "lost"):
+            totals[fate][0] += fates[(fate, "in reference")]
+            totals[fate][1] += judged(fate)
         rows.append("| %s | %s | %s | %.2f | %s of %s (%s %%) | %d of %d | %s of %s (%s %%) | "
-                    "%d of %d (%.1f %%) | %d of %d |" % (
+                    "%d of %d (%.1f %%) | %d of %d | %d of %d | %d of %d |" % (
                         room, style or "boxes", seed,
                         100 * info["measured"]["input_ate_rmse_m"], m.group(1), m.group(2),
                         m.group(3), objects[1], objects[0], m.group(4), m.group(5), m.group(6),
-                        kept, vertices, 100 * share, kept_edges, edges))
+                        kept, vertices, 100 * share, kept_edges, edges,
+                        fates[("kept", "in reference")], judged("kept"),
+                        fates[("lost", "in reference")], judged("lost")))
     return "\n".join([
         BEGIN_IDS,
         "### Ids kept through a repair",
@@ -209,12 +242,27 @@ def ids_section(args, pairs, minutes):
         "(`object_ids.py`, super-points that own surface): repaired objects of at least 100 "
         "voxels that keep the id of their counterpart (same class within 30 cm), of those with "
         "one; graph vertices that keep an id, with the share of the graph's voxels they hold; "
-        "the drifted graph's edges between those super-points that the repaired graph has.",
+        "the drifted graph's edges between those super-points that the repaired graph has; "
+        "then, of those edges the repair kept and of those it lost, how many the graph of the "
+        "map from ground-truth poses has too (each repaired super-point paired with the "
+        "ground-truth-pose super-point that holds most of its mesh vertices, compared by 2 cm "
+        "cell; counted where the two ends have distinct partners).",
         "",
         "| room | style | seed | input ATE cm | instances kept (repair) | objects kept "
-        "| super-points kept (repair) | graph vertices kept | edges between them kept |",
-        "|---|---|---|---:|---:|---:|---:|---:|---:|",
-    ] + rows + [END_IDS])
+        "| super-points kept (repair) | graph vertices kept | edges between them kept "
+        "| kept edges the GT-pose graph has | lost edges the GT-pose graph has |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ] + rows + [
+        "",
+        "Over every run: the map from ground-truth poses has %d of the %d edges the repair kept "
+        "(%.0f %%) and %d of the %d it lost (%.0f %%). The edges a repair drops are mostly "
+        "co-observations that only the drifted poses made: a mask's pixels fell on a "
+        "neighbour's surface where the drift had put it."
+        % (totals["kept"][0], totals["kept"][1],
+           100.0 * totals["kept"][0] / max(1, totals["kept"][1]),
+           totals["lost"][0], totals["lost"][1],
+           100.0 * totals["lost"][0] / max(1, totals["lost"][1])),
+        END_IDS])
 
 
 def write_section(path, section, begin, end):
