@@ -10,6 +10,7 @@
 #include "panmap/graph_labels_t.hpp"
 #include "panmap/lcm/decode.h"
 #include "panmap/lcm/graph_conversions.h"
+#include "panmap/mapper/final_labels.h"
 
 namespace panmap {
 
@@ -125,11 +126,13 @@ void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& 
         const int64_t request = ++request_id_;
         const std::string graph_channel = options_.channel_graph;
         post(Item{"", {}, [this, request, graph_channel](Mapper* mapper) {
-                    graph_remaps_[request] = mapper->remaps();
+                    const SuperpointGraph taken = mapper->graph();
+                    graph_instances_[request] = largestInitialInstance(taken);
                     // Only the latest few requests can still be answered.
-                    while (graph_remaps_.size() > 16) graph_remaps_.erase(graph_remaps_.begin());
-                    const superpoint_graph_t graph =
-                        toMessage(mapper->graph(), wallUtime(), request);
+                    while (graph_instances_.size() > 16) {
+                      graph_instances_.erase(graph_instances_.begin());
+                    }
+                    const superpoint_graph_t graph = toMessage(taken, wallUtime(), request);
                     std::lock_guard<std::mutex> lock(outbox_mutex_);
                     outbox_.push_back(encodeMessage(graph_channel, graph));
                   }});
@@ -143,15 +146,18 @@ void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& 
         const std::optional<GraphLabels> labels = labels_;
         const int64_t labels_request = labels_request_id_;
         post(Item{"", {}, [this, command, argument, labels, labels_request](Mapper* mapper) {
-                    const GraphLabels* use = labels ? &*labels : nullptr;
-                    const auto taken = graph_remaps_.find(labels_request);
-                    if (use &&
-                        (taken == graph_remaps_.end() || taken->second != mapper->remaps())) {
+                    // The answer names the super-points of its graph; those made since (new
+                    // frames, a repair) keep their frame-count labels beside it.
+                    std::optional<GraphLabels> fitted;
+                    const auto taken = graph_instances_.find(labels_request);
+                    if (labels && taken != graph_instances_.end()) {
+                      fitted = fitLabelsToMap(*labels, taken->second, mapper->superpoints());
+                    } else if (labels) {
                       std::fprintf(stderr,
-                                   "panmap-mapper: the optimiser's labels predate the last "
-                                   "loop-closure repair; written with frame-count labels\n");
-                      use = nullptr;
+                                   "panmap-mapper: the optimiser's labels answer a request too "
+                                   "old to match; written with frame-count labels\n");
                     }
+                    const GraphLabels* use = fitted ? &*fitted : nullptr;
                     try {
                       command_handler_(command, argument, mapper, use);
                     } catch (const std::exception& e) {

@@ -1,5 +1,7 @@
 #include "panmap/mapper/final_labels.h"
 
+#include <algorithm>
+
 namespace panmap {
 
 SuperpointLabels finalLabels(int32_t superpoint, const SuperpointTracker& tracker,
@@ -14,6 +16,39 @@ SuperpointLabels finalLabels(int32_t superpoint, const SuperpointTracker& tracke
     if (s != labels->semantic.end()) out.semantic = s->second;
     const auto i = labels->instance.find(superpoint);
     if (i != labels->instance.end()) out.instance = i->second;
+  }
+  return out;
+}
+
+int32_t largestInitialInstance(const SuperpointGraph& graph) {
+  int32_t largest = 0;
+  for (const GraphVertex& v : graph.vertices) largest = std::max(largest, v.instance);
+  return largest;
+}
+
+GraphLabels fitLabelsToMap(const GraphLabels& labels, int32_t graph_largest_instance,
+                           const SuperpointTracker& tracker) {
+  bool clash = false;
+  for (const auto& [superpoint, state] : tracker.states()) {
+    if (labels.instance.count(superpoint)) continue;
+    if (state.instance() > graph_largest_instance) {
+      clash = true;
+      break;
+    }
+  }
+  if (!clash) return labels;
+  // Above every id the tracker has given, so no frame-count instance can have it.
+  const int32_t shift = std::max(0, tracker.numInstances() - graph_largest_instance);
+  const auto moved = [&](int32_t id) { return id > graph_largest_instance ? id + shift : id; };
+  GraphLabels out = labels;
+  for (auto& [superpoint, instance] : out.instance) instance = moved(instance);
+  out.instance_confidence.clear();
+  for (const auto& [id, confidence] : labels.instance_confidence) {
+    out.instance_confidence[moved(id)] = confidence;
+  }
+  out.instance_evidence.clear();
+  for (const auto& [id, evidence] : labels.instance_evidence) {
+    out.instance_evidence[moved(id)] = evidence;
   }
   return out;
 }

@@ -73,7 +73,6 @@ void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild, ReintegrationSta
       stats->superpoint_surface_kept = sameId(overlap.superpoints, superpoint_ids);
     }
     adoptRemapped(rebuild->mapper_.get());
-    ++remaps_;
   } else {
     if (static_cast<bool>(rebuild->occupancy_) != static_cast<bool>(occupancy_)) {
       throw Error("commitRebuild: the rebuild was made with another occupancy setting");

@@ -11,6 +11,7 @@
 #include "panmap/lcm/graph_conversions.h"
 #include "panmap/lcm/live_mapper.h"
 #include "panmap/lcm/optimizer_node.h"
+#include "panmap/mapper/final_labels.h"
 #include "synthetic_stream.h"
 #include "test_helpers.h"
 
@@ -184,11 +185,30 @@ TEST(LiveMapper, ACorrectionRepairsTheLiveMapAndTheStatusReportsIt) { checkLiveR
 
 TEST(LiveMapper, ABackgroundRepairRepairsTheLiveMapAndTheStatusReportsIt) { checkLiveRepair(true); }
 
-// The optimiser's labels name super-points by id; a repair that maps the frames again makes
-// every super-point anew, and their ids would mean other surfaces. An export after such a
-// repair writes frame-count labels instead of the old ones (the next optimisation gives new).
-TEST(LiveMapper, LabelsFromBeforeARemapAreNotUsedAfterIt) {
+// The optimiser's labels name super-points by id, and a repair that maps the frames again keeps
+// the ids of the super-points it finds again: an export after it still uses the labels, fitted
+// to the map as it is then (fitLabelsToMap), and they name super-points that are still there.
+TEST(LiveMapper, LabelsFromBeforeARemapStillNameTheSuperpointsThatKeptTheirIds) {
   const test::SyntheticStream& stream = test::syntheticStream();
+  // The graph the optimisation request will carry: every frame mapped, no correction yet.
+  Mapper reference(test::streamMapperConfig());
+  for (size_t k = 0; k < stream.frames.size(); ++k) {
+    reference.integrate(stream.frames[k], stream.poses[k].T_W_C, &stream.masks[k],
+                        stream.poses[k].source);
+  }
+  const SuperpointGraph graph = reference.graph();
+  ASSERT_FALSE(graph.vertices.empty());
+  const int32_t largest = largestInitialInstance(graph);
+  // Half the super-points keep their frame-count instance, the other half go to one the
+  // optimiser made (an id above the graph's).
+  GraphLabels labels;
+  for (size_t i = 0; i < graph.vertices.size(); ++i) {
+    const GraphVertex& v = graph.vertices[i];
+    labels.semantic[v.id] = 5;
+    labels.instance[v.id] = i % 2 == 0 ? v.instance : largest + 1;
+  }
+  labels.instance_confidence[largest + 1] = 0.75f;
+
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
   TempStore stored;
@@ -197,20 +217,25 @@ TEST(LiveMapper, LabelsFromBeforeARemapAreNotUsedAfterIt) {
   options.session.frame_store = &stored.store;
   Mapper mapper(test::streamMapperConfig());
   LiveMapper live(&lcm, options, &mapper);
-  std::vector<bool> exported_with_labels;
+  std::vector<GraphLabels> exported;
+  std::vector<size_t> named_live;  // per export: named super-points live in the map it writes
   live.setCommandHandler(
-      [&](int8_t command, const std::string&, Mapper*, const GraphLabels* labels) {
+      [&](int8_t command, const std::string&, Mapper* m, const GraphLabels* given) {
         ASSERT_EQ(command, +command_t::COMMAND_EXPORT);
-        exported_with_labels.push_back(labels != nullptr);
+        ASSERT_NE(given, nullptr);
+        exported.push_back(*given);
+        named_live.push_back(0);
+        for (const auto& entry : given->instance) {
+          named_live.back() += m->superpoints().states().count(entry.first);
+        }
+        // What the export got is the answer fitted to the map it writes.
+        const GraphLabels fitted = fitLabelsToMap(labels, largest, m->superpoints());
+        EXPECT_EQ(given->instance, fitted.instance);
+        EXPECT_EQ(given->instance_confidence, fitted.instance_confidence);
       });
   publishAll(&lcm, stream.messages());
   publishCommand(&lcm, command_t::COMMAND_OPTIMISE);  // request 1
   // The optimiser's answer to request 1 (handled after the command, as the bus orders them).
-  GraphLabels labels;
-  for (int32_t id = 1; id <= 5000; ++id) {
-    labels.semantic[id] = 5;
-    labels.instance[id] = 999;
-  }
   const graph_labels_t answer = toMessage(labels, 0, 1);
   lcm.publish("PANMAP_LABELS", &answer);
   publishCommand(&lcm, command_t::COMMAND_EXPORT, dir.path("before"));
@@ -223,7 +248,15 @@ TEST(LiveMapper, LabelsFromBeforeARemapAreNotUsedAfterIt) {
   ASSERT_EQ(live.stats().corrections_applied, 1);
   ASSERT_TRUE(mapper.trajectory().back().T_W_C.isApprox(Eigen::Translation3d(0.05, 0.0, 0.0) *
                                                         stream.poses.back().T_W_C));
-  EXPECT_EQ(exported_with_labels, (std::vector<bool>{true, false}));
+  ASSERT_EQ(exported.size(), 2u);
+  // Before the repair the map is the graph's: every named super-point is live.
+  EXPECT_EQ(named_live[0], graph.vertices.size());
+  // After it, those that kept their ids are still named.
+  EXPECT_GT(named_live[1], 0u);
+  EXPECT_LE(named_live[1], graph.vertices.size());
+  // The repair numbered the instances it did not pair above the graph's largest: the one the
+  // optimiser made moved above them (checked against fitLabelsToMap in the handler).
+  EXPECT_NE(exported[1].instance, labels.instance);
 }
 
 TEST(LiveMapper, FullQueueDropsTheOldestFramesAndCountsThem) {

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "panmap/core/error.h"
+#include "panmap/mapper/final_labels.h"
 #include "panmap/mapper/mapper.h"
 #include "panmap/mapper/objects.h"
 #include "panmap/sim/depth_noise.h"
@@ -146,6 +147,49 @@ TEST(Objects, SquareFootprintGetsItsTightYaw) {
   EXPECT_NEAR((o.obb_center_W - Eigen::Vector3d(0.875, 0.875, 0.625)).norm(), 0.0, 1e-12);
   EXPECT_EQ(o.aabb_min_W, Eigen::Vector3d(0.0, 0.0, 0.5));
   EXPECT_EQ(o.aabb_max_W, Eigen::Vector3d(1.75, 1.75, 0.75));
+}
+
+// makeTracker() gave instances up to 9; the optimiser's graph was taken when the largest was 7,
+// and it made instances 8 and 9 of its own. Super-point 3, made since and not named, counts
+// frame instance 9: reported as they are, it and the optimiser's 9 would be one object.
+TEST(FitLabels, InstancesTheOptimiserMadeMoveAboveEveryFrameCountId) {
+  const TsdfMap map = makeMap();
+  const SuperpointTracker tracker = makeTracker();
+  GraphLabels labels;
+  labels.semantic = {{1, 5}, {2, 24}};
+  labels.instance = {{1, 8}, {2, 9}};
+  labels.instance_confidence = {{8, 0.25f}, {9, 0.5f}};
+  labels.instance_evidence[9].area_m2 = 2.0f;
+  const GraphLabels fitted = fitLabelsToMap(labels, 7, tracker);
+  EXPECT_EQ(fitted.semantic, labels.semantic);
+  EXPECT_EQ(fitted.instance, (std::map<int32_t, int32_t>{{1, 10}, {2, 11}}));
+  EXPECT_EQ(fitted.instance_confidence, (std::map<int32_t, float>{{10, 0.25f}, {11, 0.5f}}));
+  ASSERT_EQ(fitted.instance_evidence.size(), 1u);
+  EXPECT_EQ(fitted.instance_evidence.at(11).area_m2, 2.0f);
+  std::vector<int32_t> ids;
+  for (const MappedObject& o : computeObjects(map, tracker, &fitted)) ids.push_back(o.id);
+  EXPECT_EQ(ids, (std::vector<int32_t>{9, 10, 11}));
+  // Unfitted, super-point 3 joins the optimiser's instance 9.
+  ids.clear();
+  for (const MappedObject& o : computeObjects(map, tracker, &labels)) ids.push_back(o.id);
+  EXPECT_EQ(ids, (std::vector<int32_t>{8, 9}));
+}
+
+// Kept frame-count ids (at most the graph's largest) never move, and without an unnamed
+// super-point above the graph's largest instance nothing does.
+TEST(FitLabels, WithoutAClashTheLabelsStayAsTheyAre) {
+  const SuperpointTracker tracker = makeTracker();
+  GraphLabels labels;
+  labels.semantic = {{1, 5}, {2, 5}, {3, 3}};
+  labels.instance = {{1, 7}, {2, 10}, {3, 9}};
+  labels.instance_confidence = {{7, 0.5f}, {10, 0.25f}};
+  const GraphLabels fitted = fitLabelsToMap(labels, 9, tracker);
+  EXPECT_EQ(fitted.instance, labels.instance);
+  EXPECT_EQ(fitted.instance_confidence, labels.instance_confidence);
+  // Super-point 3 unnamed, its frame instance 9 above a graph whose largest was 8: 10 moves.
+  labels.instance.erase(3);
+  EXPECT_EQ(fitLabelsToMap(labels, 8, tracker).instance,
+            (std::map<int32_t, int32_t>{{1, 7}, {2, 11}}));
 }
 
 TEST(Objects, OptimisedLabelsOverrideFrameCounts) {

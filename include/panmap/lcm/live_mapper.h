@@ -161,9 +161,10 @@ class LiveMapper {
   // Idle work (worker only).
   int64_t scanned_at_frame_ = 0;
   int64_t idle_scan_refreshes_ = 0;
-  // Per optimisation request, Mapper::remaps() when its graph was taken (worker only): labels
-  // answering a graph from before a remap name super-points that are gone.
-  std::map<int64_t, int64_t> graph_remaps_;
+  // Per optimisation request, largestInitialInstance() of the graph it sent (worker only):
+  // what fitLabelsToMap() needs to use its answer on the map as it is later (super-points keep
+  // their ids through a loop-closure repair, so the answer still names the same surfaces).
+  std::map<int64_t, int32_t> graph_instances_;
 
   std::atomic<int64_t> received_frames_{0};
   std::atomic<int64_t> dropped_frames_{0};

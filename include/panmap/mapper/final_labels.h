@@ -18,4 +18,19 @@ struct SuperpointLabels {
 SuperpointLabels finalLabels(int32_t superpoint, const SuperpointTracker& tracker,
                              const GraphLabels* labels);
 
+/// The largest frame-count instance of a graph's vertices: the optimiser's instances above it
+/// are ones it made itself (kept ids are frame-count ids of the graph).
+int32_t largestInitialInstance(const SuperpointGraph& graph);
+
+/// The optimiser's labels for a graph taken from this map earlier (`graph_largest_instance`:
+/// largestInitialInstance() of that graph), fitted to the map as it is now. Super-points made
+/// since (new frames, or a loop-closure repair that numbered them anew) are not named and keep
+/// their frame-count labels, whose instance ids may reach above the graph's; an instance the
+/// optimiser made could then share an id with one of them, and the two would be reported as one
+/// object. When some unnamed live super-point has such an id, every instance the optimiser made
+/// moves above all the tracker has given (confidences and evidence with it); otherwise the
+/// labels are returned as they are.
+GraphLabels fitLabelsToMap(const GraphLabels& labels, int32_t graph_largest_instance,
+                           const SuperpointTracker& tracker);
+
 }  // namespace panmap

@@ -231,9 +231,6 @@ class Mapper {
   uint64_t superpointsForgotten() const { return superpoints_forgotten_; }
   /// Graph edges dropped so far by GraphConfig::prune_edges (in this process).
   uint64_t edgesPruned() const { return edges_pruned_; }
-  /// Repairs so far (in this process) that mapped the frames again: each made every
-  /// super-point anew, so labels of a graph taken before it name other surfaces.
-  int64_t remaps() const { return remaps_; }
   /// Frames between checks for super-points without votes.
   static constexpr int64_t kForgetEveryFrames = 100;
   /// Frames between refreshSurfaceScan() calls in idle time that the live mapper and the
@@ -431,7 +428,6 @@ class Mapper {
   MaskEdgeFillScratch fill_scratch_;  // scratch, reused every frame
   uint64_t superpoints_forgotten_ = 0;
   uint64_t edges_pruned_ = 0;
-  int64_t remaps_ = 0;
 };
 
 }  // namespace panmap
