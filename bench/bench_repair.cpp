@@ -8,8 +8,10 @@
 // the frames are a ScanNet-like procedural room rendered with `m2f` masks (panmap-synth
 // --room S --room-style scannet, surveyed twice at 5 Hz): the store keeps the masks and the
 // repair maps the frames again, as it does for every labelled map (--segment-again: without the
-// geometric segments kept in the store).
-//   panmap-bench-repair [--data DIR | --room S [--segment-again]] [--frames N] [--voxel-size M]
+// geometric segments kept in the store; --reintegrate-only: re-integration with the stored pixel
+// labels instead, as panmap-mapper --repair-reintegrate-only).
+//   panmap-bench-repair [--data DIR | --room S [--segment-again | --reintegrate-only]]
+//                       [--frames N] [--voxel-size M]
 //                       [--threads N] [--rate-hz R] [--live-frames K]
 
 #include <algorithm>
@@ -98,7 +100,7 @@ int main(int argc, char** argv) {
   std::string data = "../shared/data/7scenes-200";
 #endif
   int frames = 1000, threads = 2, live_frames = 0, room = -1;
-  bool segment_again = false;
+  bool segment_again = false, reintegrate_only = false;
   double rate_hz = 5.0;
   float voxel_size_m = 0.02f;
   app.add_option("--data", data, "dataset folder (7-Scenes, ScanNet export, TUM, folder)")
@@ -109,6 +111,10 @@ int main(int argc, char** argv) {
   app.add_flag("--segment-again", segment_again,
                "store no geometric segments, so that the repair segments every frame again (what "
                "keeping them saves)");
+  app.add_flag("--reintegrate-only", reintegrate_only,
+               "with --room: repair by re-integration only (each frame votes again with the "
+               "pixel labels of its first mapping, MapRepairConfig::reassociate off), as "
+               "panmap-mapper --repair-reintegrate-only");
   app.add_option("--frames", frames, "frames in the map when the correction comes")
       ->capture_default_str();
   app.add_option("--voxel-size", voxel_size_m, "voxel size, metres")->capture_default_str();
@@ -216,7 +222,10 @@ int main(int argc, char** argv) {
       load_total_ms += load_ms.back();
     }
     const panmap::PoseCorrection first = driftCorrection(mapper.trajectory(), 1);
-    const panmap::MapRepairResult blocking = panmap::repairMap(&mapper, &store, first);
+    panmap::MapRepairConfig repair_config;
+    repair_config.reassociate = !reintegrate_only;
+    const panmap::MapRepairResult blocking =
+        panmap::repairMap(&mapper, &store, first, repair_config);
     std::printf("blocking repair:   %s\n", panmap::describe(blocking).c_str());
     std::printf("  loading frames   %.2f s alone (%.1f ms median per frame)\n",
                 load_total_ms / 1000.0, panmap::spreadOf(load_ms).median);
@@ -224,7 +233,7 @@ int main(int argc, char** argv) {
                 1000.0 * blocking.reintegration.seconds / static_cast<double>(n), map_median_ms);
 
     // On its own thread while frames keep coming at rate_hz.
-    panmap::BackgroundRepair repair(&mapper, &store);
+    panmap::BackgroundRepair repair(&mapper, &store, repair_config);
     const panmap::PoseCorrection second = driftCorrection(mapper.trajectory(), 2);
     map_ms.clear();
     const auto period =
