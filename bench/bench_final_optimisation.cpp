@@ -4,6 +4,7 @@
 // fingerprint of every super-point's id, class and instance) so that a faster build can be checked
 // for equal output. With --mesh, also the whole labelled mesh from the block meshes a live
 // session keeps (Mapper::extractMesh after a first call: welding and labelling, one thread).
+// Also the size of the PANMAP_GRAPH message the live mapper sends for each optimisation.
 //   panmap-bench-final MAP.panmap [--repeats 5] [--mesh]
 
 #include <algorithm>
@@ -17,6 +18,7 @@
 
 #include "panmap/core/fingerprint.h"
 #include "panmap/graph/optimiser.h"
+#include "panmap/lcm/graph_conversions.h"
 #include "panmap/mapper/mapper.h"
 
 namespace {
@@ -81,6 +83,11 @@ int main(int argc, char** argv) {
         path.c_str(), mapper->map().numBlocks(), vertices, edges, repeats, median(graph_ms),
         median(solve_ms), median(graph_ms) + median(solve_ms),
         static_cast<unsigned long long>(digest));
+    // What the live mapper publishes on PANMAP_GRAPH for each optimisation request.
+    const size_t message_bytes =
+        static_cast<size_t>(panmap::toMessage(mapper->graph(), 0, 0).getEncodedSize());
+    std::printf("%s: PANMAP_GRAPH message %zu bytes (%.2f MB)\n", path.c_str(), message_bytes,
+                static_cast<double>(message_bytes) / 1e6);
     if (mesh) {
       size_t mesh_vertices = mapper->extractMesh().numVertices();  // meshes every block once
       std::vector<double> mesh_ms;

@@ -313,6 +313,12 @@ int main(int argc, char** argv) {
                    "optimiser restarted meanwhile still answers)")
       ->capture_default_str();
   live_group
+      ->add_option("--optimise-every-s", live.optimise_period_s,
+                   "while mapping, send the graph to panmap-optimizer at this period; "
+                   "PANMAP_OBJECTS and exports use its latest answer (0: only on the optimise "
+                   "command)")
+      ->capture_default_str();
+  live_group
       ->add_option("--queue-frames", live.max_queued_frames,
                    "frames waiting for the mapper at most; the oldest is dropped beyond")
       ->capture_default_str();
@@ -512,23 +518,24 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "panmap-mapper: outputs written to %s\n", dir.c_str());
       }
     });
-    node.setPeriodicPublisher([&live](panmap::Mapper* m, int64_t utime) {
-      std::vector<panmap::OutgoingMessage> out;
-      out.push_back(panmap::encodeMessage(
-          live.channel_objects, panmap::toMessage(panmap::computeObjects(*m, nullptr), utime)));
-      if (m->occupancy()) {
-        panmap::octomap_t tree;
-        tree.utime = utime;
-        tree.resolution_m = m->occupancy()->resolution();
-        tree.tree_type = "OcTree";
-        tree.binary = true;
-        const std::string data = m->occupancy()->toBinaryData();
-        tree.data.assign(data.begin(), data.end());
-        tree.size = static_cast<int32_t>(tree.data.size());
-        out.push_back(panmap::encodeMessage(live.channel_octomap, tree));
-      }
-      return out;
-    });
+    node.setPeriodicPublisher(
+        [&live](panmap::Mapper* m, int64_t utime, const panmap::GraphLabels* labels) {
+          std::vector<panmap::OutgoingMessage> out;
+          out.push_back(panmap::encodeMessage(
+              live.channel_objects, panmap::toMessage(panmap::computeObjects(*m, labels), utime)));
+          if (m->occupancy()) {
+            panmap::octomap_t tree;
+            tree.utime = utime;
+            tree.resolution_m = m->occupancy()->resolution();
+            tree.tree_type = "OcTree";
+            tree.binary = true;
+            const std::string data = m->occupancy()->toBinaryData();
+            tree.data.assign(data.begin(), data.end());
+            tree.size = static_cast<int32_t>(tree.data.size());
+            out.push_back(panmap::encodeMessage(live.channel_octomap, tree));
+          }
+          return out;
+        });
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
     std::fprintf(stderr,

@@ -31,6 +31,7 @@ void LiveOptions::check() const {
   if (max_queued_frames < 1) throw Error("live: max_queued_frames must be at least 1");
   if (!(optimiser_timeout_s >= 0.0)) throw Error("live: optimiser_timeout_s must be >= 0");
   if (!(optimiser_retry_s > 0.0)) throw Error("live: optimiser_retry_s must be positive");
+  if (!(optimise_period_s >= 0.0)) throw Error("live: optimise_period_s must be >= 0");
   if (idle_scan_every_frames < 0) throw Error("live: idle_scan_every_frames must be >= 0");
 }
 
@@ -122,48 +123,21 @@ void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& 
       case command_t::COMMAND_FINISH:
         finish_requested_ = true;
         return;
-      case command_t::COMMAND_OPTIMISE: {
-        const int64_t request = ++request_id_;
-        const std::string graph_channel = options_.channel_graph;
-        post(Item{"", {}, [this, request, graph_channel](Mapper* mapper) {
-                    const SuperpointGraph taken = mapper->graph();
-                    graph_instances_[request] = largestInitialInstance(taken);
-                    // Only the latest few requests can still be answered.
-                    while (graph_instances_.size() > 16) {
-                      graph_instances_.erase(graph_instances_.begin());
-                    }
-                    const superpoint_graph_t graph = toMessage(taken, wallUtime(), request);
-                    std::lock_guard<std::mutex> lock(outbox_mutex_);
-                    outbox_.push_back(encodeMessage(graph_channel, graph));
-                  }});
+      case command_t::COMMAND_OPTIMISE:
+        requestOptimisation();
         return;
-      }
       case command_t::COMMAND_SAVE:
       case command_t::COMMAND_EXPORT: {
         if (!command_handler_) return;
         const int8_t command = msg.command;
         const std::string argument = msg.argument;
-        const std::optional<GraphLabels> labels = labels_;
-        const int64_t labels_request = labels_request_id_;
-        post(Item{"", {}, [this, command, argument, labels, labels_request](Mapper* mapper) {
-                    // The answer names the super-points of its graph; those made since (new
-                    // frames, a repair) keep their frame-count labels beside it.
-                    std::optional<GraphLabels> fitted;
-                    const auto taken = graph_instances_.find(labels_request);
-                    if (labels && taken != graph_instances_.end()) {
-                      fitted = fitLabelsToMap(*labels, taken->second, mapper->superpoints());
-                    } else if (labels) {
-                      std::fprintf(stderr,
-                                   "panmap-mapper: the optimiser's labels answer a request too "
-                                   "old to match; written with frame-count labels\n");
-                    }
-                    const GraphLabels* use = fitted ? &*fitted : nullptr;
-                    try {
-                      command_handler_(command, argument, mapper, use);
-                    } catch (const std::exception& e) {
-                      std::fprintf(stderr, "panmap-mapper: command failed: %s\n", e.what());
-                    }
-                  }});
+        postWithLabels([this, command, argument](Mapper* mapper, const GraphLabels* labels) {
+          try {
+            command_handler_(command, argument, mapper, labels);
+          } catch (const std::exception& e) {
+            std::fprintf(stderr, "panmap-mapper: command failed: %s\n", e.what());
+          }
+        });
         return;
       }
       default:
@@ -175,6 +149,39 @@ void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& 
   }
 }
 
+void LiveMapper::requestOptimisation() {
+  const int64_t request = ++request_id_;
+  const std::string graph_channel = options_.channel_graph;
+  post(Item{"", {}, [this, request, graph_channel](Mapper* mapper) {
+              const SuperpointGraph taken = mapper->graph();
+              graph_instances_[request] = largestInitialInstance(taken);
+              // Only the latest few requests can still be answered.
+              while (graph_instances_.size() > 16) graph_instances_.erase(graph_instances_.begin());
+              const superpoint_graph_t graph = toMessage(taken, wallUtime(), request);
+              std::lock_guard<std::mutex> lock(outbox_mutex_);
+              outbox_.push_back(encodeMessage(graph_channel, graph));
+            }});
+}
+
+void LiveMapper::postWithLabels(std::function<void(Mapper*, const GraphLabels*)> use) {
+  const std::optional<GraphLabels> labels = labels_;
+  const int64_t labels_request = labels_request_id_;
+  post(Item{"", {}, [this, use, labels, labels_request](Mapper* mapper) {
+              // The answer names the super-points of its graph; those made since (new frames, a
+              // repair) keep their frame-count labels beside it.
+              std::optional<GraphLabels> fitted;
+              const auto taken = graph_instances_.find(labels_request);
+              if (labels && taken != graph_instances_.end()) {
+                fitted = fitLabelsToMap(*labels, taken->second, mapper->superpoints());
+              } else if (labels) {
+                std::fprintf(stderr,
+                             "panmap-mapper: the optimiser's labels answer a request too old to "
+                             "match; frame-count labels used\n");
+              }
+              use(mapper, fitted ? &*fitted : nullptr);
+            }});
+}
+
 void LiveMapper::onLabels(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
   try {
     graph_labels_t msg;
@@ -182,8 +189,12 @@ void LiveMapper::onLabels(const lcm::ReceiveBuffer* buffer, const std::string& c
       countRejected("malformed " + channel);
       return;
     }
-    // Only answers to our own latest request count (another mapper may share the bus).
-    if (msg.request_id != request_id_ || request_id_ == 0) return;
+    // Only answers to our own requests count (another mapper may share the bus), the newest
+    // first: with periodic requests an answer may come after the next request went out.
+    if (msg.request_id <= 0 || msg.request_id > request_id_ ||
+        msg.request_id <= labels_request_id_) {
+      return;
+    }
     labels_ = fromMessage(msg);
     labels_request_id_ = msg.request_id;
   } catch (const std::exception& e) {
@@ -307,6 +318,7 @@ bool LiveMapper::run(const std::atomic<bool>& stop) {
   };
   auto next_status = Clock::now();
   auto next_publish = Clock::now() + period(options_.publish_period_s);
+  auto next_optimise = Clock::now() + period(options_.optimise_period_s);
   while (!stop && !finish_requested_) {
     lcm_->handleTimeout(20);
     publishOutbox();
@@ -323,13 +335,17 @@ bool LiveMapper::run(const std::atomic<bool>& stop) {
                   outbox_.push_back(encodeMessage(channel, msg));
                 }});
     }
+    if (options_.optimise_period_s > 0.0 && now >= next_optimise) {
+      next_optimise = now + period(options_.optimise_period_s);
+      requestOptimisation();
+    }
     if (options_.publish_period_s > 0.0 && publisher_ && now >= next_publish) {
       next_publish = now + period(options_.publish_period_s);
-      post(Item{"", {}, [this](Mapper* mapper) {
-                  std::vector<OutgoingMessage> out = publisher_(mapper, wallUtime());
-                  std::lock_guard<std::mutex> lock(outbox_mutex_);
-                  for (OutgoingMessage& m : out) outbox_.push_back(std::move(m));
-                }});
+      postWithLabels([this](Mapper* mapper, const GraphLabels* labels) {
+        std::vector<OutgoingMessage> out = publisher_(mapper, wallUtime(), labels);
+        std::lock_guard<std::mutex> lock(outbox_mutex_);
+        for (OutgoingMessage& m : out) outbox_.push_back(std::move(m));
+      });
     }
   }
   return finish_requested_;

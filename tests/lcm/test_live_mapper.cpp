@@ -7,11 +7,13 @@
 #include <iterator>
 
 #include "panmap/command_t.hpp"
+#include "panmap/graph/optimiser.h"
 #include "panmap/lcm/correction_conversions.h"
 #include "panmap/lcm/graph_conversions.h"
 #include "panmap/lcm/live_mapper.h"
 #include "panmap/lcm/optimizer_node.h"
 #include "panmap/mapper/final_labels.h"
+#include "panmap/mapper/objects.h"
 #include "synthetic_stream.h"
 #include "test_helpers.h"
 
@@ -66,6 +68,7 @@ LiveOptions testOptions() {
   options.max_queued_frames = 1000;  // no drops: the result must equal the session's
   options.optimiser_timeout_s = 0.5;
   options.publish_period_s = 0.0;
+  options.optimise_period_s = 0.0;
   return options;
 }
 
@@ -257,6 +260,64 @@ TEST(LiveMapper, LabelsFromBeforeARemapStillNameTheSuperpointsThatKeptTheirIds) 
   // The repair numbered the instances it did not pair above the graph's largest: the one the
   // optimiser made moved above them (checked against fitLabelsToMap in the handler).
   EXPECT_NE(exported[1].instance, labels.instance);
+}
+
+// With optimise_period_s the mapper sends its graph to the optimiser while it maps, and
+// PANMAP_OBJECTS carries the objects of the latest answer (fragments folded, calibrated
+// confidences): once every frame is in, those of the labels the optimiser gives the final graph.
+TEST(LiveMapper, PeriodicObjectsUseTheOptimisersLatestAnswer) {
+  const test::SyntheticStream& stream = test::syntheticStream();
+  const int64_t n = static_cast<int64_t>(stream.frames.size());
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  LiveOptions options = testOptions();
+  options.optimise_period_s = 0.02;
+  options.publish_period_s = 0.02;
+  Mapper mapper(test::streamMapperConfig());
+  LiveMapper live(&lcm, options, &mapper);
+  OptimizerNode optimiser(&lcm, OptimizerNode::Config{});
+  std::atomic<bool> stop{false};
+  int publications = 0, with_labels = 0;
+  bool matched = false;
+  std::vector<MappedObject> published, frame_count;
+  live.setPeriodicPublisher([&](Mapper* m, int64_t, const GraphLabels* labels) {
+    // A bound on the wait, in publications, should the answer never come.
+    if (++publications >= 2000) stop = true;
+    with_labels += labels != nullptr;
+    if (!labels || matched || m->framesIntegrated() < n) return std::vector<OutgoingMessage>{};
+    const SuperpointGraph graph = m->graph();
+    const GraphLabels expected = fitLabelsToMap(optimise(graph, OptimiserConfig{}),
+                                                largestInitialInstance(graph), m->superpoints());
+    if (labels->instance == expected.instance && labels->semantic == expected.semantic &&
+        labels->instance_confidence == expected.instance_confidence) {
+      matched = true;
+      published = computeObjects(*m, labels);
+      frame_count = computeObjects(*m, nullptr);
+      stop = true;
+    }
+    return std::vector<OutgoingMessage>{};
+  });
+  publishAll(&lcm, stream.messages());
+  EXPECT_FALSE(live.run(stop));  // ended by `stop`, not a finish command
+  live.drain();
+  ASSERT_TRUE(matched) << publications << " publications, " << with_labels << " with labels";
+  EXPECT_EQ(mapper.framesIntegrated(), n);
+  ASSERT_FALSE(published.empty());
+  // Not the frame-count objects: the optimiser's confidences are calibrated (on this stream the
+  // instances are the same five).
+  std::vector<float> calibrated, counted;
+  for (const MappedObject& o : published) calibrated.push_back(o.confidence);
+  for (const MappedObject& o : frame_count) counted.push_back(o.confidence);
+  EXPECT_NE(calibrated, counted);
+  const GraphLabels final_labels = optimise(mapper.graph(), OptimiserConfig{});
+  const std::vector<MappedObject> final_objects = computeObjects(mapper, &final_labels);
+  ASSERT_EQ(published.size(), final_objects.size());
+  for (size_t i = 0; i < published.size(); ++i) {
+    EXPECT_EQ(published[i].id, final_objects[i].id);
+    EXPECT_EQ(published[i].class_id, final_objects[i].class_id);
+    EXPECT_EQ(published[i].num_voxels, final_objects[i].num_voxels);
+    EXPECT_EQ(published[i].confidence, final_objects[i].confidence);
+  }
 }
 
 TEST(LiveMapper, FullQueueDropsTheOldestFramesAndCountsThem) {

@@ -41,6 +41,11 @@ struct LiveOptions {
   /// The graph is published again at this period while no labels came: an optimiser started
   /// (or restarted) after the first request still answers.
   double optimiser_retry_s = 2.0;
+  /// While mapping, the graph goes to the optimiser at this period (as the optimise command
+  /// sends it), and PANMAP_OBJECTS and exports use its latest answer, fitted to the map as it
+  /// is then (fitLabelsToMap): objects as the final optimisation makes them (fragments folded,
+  /// calibrated confidences), not the frame-count instances. 0: only on request.
+  double optimise_period_s = 10.0;
   /// When the worker finds its queue empty and at least this many frames were integrated since
   /// the last time, it brings the graph's surface scan up to date (Mapper::refreshSurfaceScan),
   /// so that the final graph reads only the blocks of the last few frames instead of those of up
@@ -74,7 +79,9 @@ class LiveMapper {
   /// Work run on the worker thread with exclusive access to the mapper.
   using Task = std::function<void(Mapper* mapper)>;
   /// Builds periodic messages on the worker thread (objects, occupancy); may return none.
-  using Publisher = std::function<std::vector<OutgoingMessage>(Mapper* mapper, int64_t utime)>;
+  /// Labels are the latest optimised ones fitted to the map (fitLabelsToMap), or null.
+  using Publisher = std::function<std::vector<OutgoingMessage>(Mapper* mapper, int64_t utime,
+                                                               const GraphLabels* labels)>;
   /// Runs a command's file work on the worker thread: COMMAND_SAVE / COMMAND_EXPORT with the
   /// command's argument. Labels are the latest optimised ones, or null.
   using CommandHandler = std::function<void(int8_t command, const std::string& argument,
@@ -128,6 +135,10 @@ class LiveMapper {
   void onInput(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void onCommand(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void onLabels(const lcm::ReceiveBuffer* buffer, const std::string& channel);
+  /// Posts a task that publishes the graph for the optimiser (LCM thread).
+  void requestOptimisation();
+  /// Runs `use` on the worker with the latest answer fitted to the map, or null (LCM thread).
+  void postWithLabels(std::function<void(Mapper*, const GraphLabels*)> use);
   void post(Item item);
   void workerLoop();
   /// Refreshes the surface scan when the queue is empty and enough frames came (worker only).
