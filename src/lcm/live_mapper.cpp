@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <random>
 
 #include "panmap/command_t.hpp"
 #include "panmap/core/error.h"
@@ -32,6 +33,7 @@ void LiveOptions::check() const {
   if (!(optimiser_timeout_s >= 0.0)) throw Error("live: optimiser_timeout_s must be >= 0");
   if (!(optimiser_retry_s > 0.0)) throw Error("live: optimiser_retry_s must be positive");
   if (!(optimise_period_s >= 0.0)) throw Error("live: optimise_period_s must be >= 0");
+  if (request_id_base < -1) throw Error("live: request_id_base must be >= -1 (-1: random)");
   if (idle_scan_every_frames < 0) throw Error("live: idle_scan_every_frames must be >= 0");
 }
 
@@ -39,6 +41,12 @@ LiveMapper::LiveMapper(lcm::LCM* lcm, const LiveOptions& options, Mapper* mapper
                        MappingSession::FrameHook hook)
     : lcm_(lcm), options_(options), mapper_(mapper), session_(options.session, mapper) {
   options_.check();
+  // 2^24 requests of room above a random base below 2^56.
+  request_base_ = options_.request_id_base >= 0
+                      ? options_.request_id_base
+                      : static_cast<int64_t>((static_cast<uint64_t>(std::random_device{}()) << 24) &
+                                             ((uint64_t{1} << 56) - 1));
+  request_id_ = request_base_;
   if (hook) session_.setFrameHook(std::move(hook));
   if (!lcm_ || !lcm_->good()) throw Error("LCM is not ready");
   // A repair that runs on the worker (without SessionOptions::background_repair) blocks it:
@@ -191,7 +199,7 @@ void LiveMapper::onLabels(const lcm::ReceiveBuffer* buffer, const std::string& c
     }
     // Only answers to our own requests count (another mapper may share the bus), the newest
     // first: with periodic requests an answer may come after the next request went out.
-    if (msg.request_id <= 0 || msg.request_id > request_id_ ||
+    if (msg.request_id <= request_base_ || msg.request_id > request_id_ ||
         msg.request_id <= labels_request_id_) {
       return;
     }

@@ -69,6 +69,7 @@ LiveOptions testOptions() {
   options.optimiser_timeout_s = 0.5;
   options.publish_period_s = 0.0;
   options.optimise_period_s = 0.0;
+  options.request_id_base = 0;  // the first request is 1
   return options;
 }
 
@@ -416,6 +417,42 @@ TEST(LiveMapper, RefusesBadOptionsNamingThem) {
   }
   options.idle_scan_every_frames = 0;  // never: valid
   EXPECT_NO_THROW(options.check());
+  options.optimise_period_s = -1.0;
+  EXPECT_THROW(options.check(), Error);
+  options.optimise_period_s = 0.0;
+  options.request_id_base = -2;
+  EXPECT_THROW(options.check(), Error);
+}
+
+// An optimiser answers every graph on the bus: an answer to another mapper's request (its ids
+// count from its own base) is not taken for one of ours.
+TEST(LiveMapper, AnswersToAnotherMappersRequestsAreIgnored) {
+  const test::SyntheticStream& stream = test::syntheticStream();
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  LiveOptions options = testOptions();
+  options.request_id_base = 1000;
+  Mapper mapper(test::streamMapperConfig());
+  LiveMapper live(&lcm, options, &mapper);
+  std::vector<bool> exported_with_labels;
+  live.setCommandHandler([&](int8_t, const std::string&, Mapper*, const GraphLabels* labels) {
+    exported_with_labels.push_back(labels != nullptr);
+  });
+  GraphLabels labels;
+  labels.semantic[1] = 5;
+  publishAll(&lcm, stream.messages());
+  publishCommand(&lcm, command_t::COMMAND_OPTIMISE);       // request 1001
+  const graph_labels_t foreign = toMessage(labels, 0, 1);  // another mapper's first request
+  lcm.publish("PANMAP_LABELS", &foreign);
+  publishCommand(&lcm, command_t::COMMAND_EXPORT);
+  const graph_labels_t ours = toMessage(labels, 0, 1001);
+  lcm.publish("PANMAP_LABELS", &ours);
+  publishCommand(&lcm, command_t::COMMAND_EXPORT);
+  publishCommand(&lcm, command_t::COMMAND_FINISH);
+  std::atomic<bool> stop{false};
+  EXPECT_TRUE(live.run(stop));
+  live.drain();
+  EXPECT_EQ(exported_with_labels, (std::vector<bool>{false, true}));
 }
 
 }  // namespace

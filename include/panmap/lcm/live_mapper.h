@@ -46,6 +46,11 @@ struct LiveOptions {
   /// is then (fitLabelsToMap): objects as the final optimisation makes them (fragments folded,
   /// calibrated confidences), not the frame-count instances. 0: only on request.
   double optimise_period_s = 10.0;
+  /// The first optimisation request gets this id + 1, and answers (PANMAP_LABELS echo the id)
+  /// count only for ids this mapper gave. -1: a random base per process, so that two mappers
+  /// sharing a bus and an optimiser never take each other's answers (requests go out every
+  /// optimise_period_s; counting from 0, theirs would meet).
+  int64_t request_id_base = -1;
   /// When the worker finds its queue empty and at least this many frames were integrated since
   /// the last time, it brings the graph's surface scan up to date (Mapper::refreshSurfaceScan),
   /// so that the final graph reads only the blocks of the last few frames instead of those of up
@@ -185,6 +190,7 @@ class LiveMapper {
   bool finish_requested_ = false;  // LCM thread only
 
   // Optimiser round trip (LCM thread only).
+  int64_t request_base_ = 0;  // request ids above this are ours
   int64_t request_id_ = 0;
   std::optional<GraphLabels> labels_;
   int64_t labels_request_id_ = -1;
