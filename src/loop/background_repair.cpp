@@ -2,6 +2,7 @@
 #include "panmap/loop/background_repair.h"
 
 #include <chrono>
+#include <cstdio>
 #include <utility>
 
 #include "panmap/core/error.h"
@@ -51,6 +52,8 @@ void BackgroundRepair::stopWorker() {
 void BackgroundRepair::cancel() {
   stopWorker();
   rebuild_.reset();
+  occupancy_.reset();
+  occupancy_pass_ = false;
 }
 
 MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
@@ -85,10 +88,18 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
       holds_segmentations_ ? holds_segmentations_() : store_ && store_->sizeWithPanoptic() > 0;
   remap_ = config_.reassociate && panoptic_load_ && holds;
   rebuild_ = mapper_->beginRebuild(&pool_, remap_);
+  // Mapping the frames again takes the whole pipeline per frame; the occupancy tree a planner
+  // reads needs only the depth and the pose, so it goes first.
+  const bool occupancy_first = remap_ && config_.occupancy_first && mapper_->occupancy();
+  occupancy_ =
+      occupancy_first ? std::make_unique<OccupancyRebuild>(mapper_->config(), &pool_) : nullptr;
+  occupancy_swapped_s_ = -1.0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     jobs_ = corrected_.poses;
     next_ = 0;
+    occupancy_pass_ = occupancy_first;
+    occupancy_next_ = 0;
     idle_ = false;
     stop_ = false;
     failure_.clear();
@@ -132,7 +143,77 @@ void BackgroundRepair::addLoaded(const StampedPose& job, const RgbdFrame& frame,
   rebuild_->add(frame, job.T_W_C, &labels, panoptic, kept);
 }
 
+bool BackgroundRepair::occupancyPass() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!occupancy_pass_) return true;
+  }
+  RgbdFrame frame;
+  LabelImage labels;
+  std::vector<int64_t> covered;
+  for (const StampedPose& p : corrected_.poses) covered.push_back(p.utime);
+  FramePrefetcher prefetched(load_, std::move(covered));
+  for (;;) {
+    StampedPose job;
+    size_t index = 0;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (occupancy_next_ == jobs_.size()) {
+        // Caught up: poll() takes the tree while this waits.
+        idle_ = true;
+        cv_.notify_all();
+        cv_.wait(lock,
+                 [this] { return stop_ || !occupancy_pass_ || occupancy_next_ < jobs_.size(); });
+        idle_ = false;
+      }
+      if (stop_) return false;
+      if (!occupancy_pass_) return true;
+      index = occupancy_next_;
+      job = jobs_[index];
+    }
+    try {
+      if (index < corrected_.poses.size()) {
+        prefetched.next(&frame, &labels);
+      } else {
+        frame = RgbdFrame();
+        load_(job.utime, &frame, &labels);
+      }
+      if (frame.utime != job.utime) {
+        throw Error("asked for the frame of utime " + std::to_string(job.utime) + ", got " +
+                    std::to_string(frame.utime));
+      }
+      occupancy_->add(frame, job.T_W_C);
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      failure_ = e.what();
+      idle_ = true;
+      cv_.notify_all();
+      return false;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++occupancy_next_;
+  }
+}
+
+void BackgroundRepair::takeOccupancyIfReady() {
+  if (!occupancy_pass_ || !failure_.empty() || !idle_ || occupancy_next_ != jobs_.size()) return;
+  // The worker waits: the tree is this thread's. It holds every frame the map holds.
+  try {
+    const std::vector<StampedPose> poses = occupancy_->poses();
+    mapper_->replaceOccupancy(occupancy_->take(), poses);
+    occupancy_swapped_s_ =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  } catch (const Error& e) {
+    // The commit brings the repaired tree all the same.
+    std::fprintf(stderr, "panmap: occupancy of the repair not swapped in early: %s\n", e.what());
+  }
+  occupancy_.reset();
+  occupancy_pass_ = false;
+  cv_.notify_all();
+}
+
 void BackgroundRepair::work() {
+  if (!occupancyPass()) return;
   RgbdFrame frame;
   LabelImage labels;
   PanopticFrame panoptic;
@@ -180,6 +261,7 @@ void BackgroundRepair::work() {
 MapRepairResult BackgroundRepair::commit() {
   // The worker has returned: everything below is this thread's.
   MapRepairResult result = std::move(result_);
+  result.occupancy_swapped_s = occupancy_swapped_s_;
   ReintegrationStats& stats = result.reintegration;
   stats.blocks_before = blocks_before_;
   stats.seconds =
@@ -222,9 +304,12 @@ std::optional<MapRepairResult> BackgroundRepair::poll() {
   if (!running()) return std::nullopt;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    takeOccupancyIfReady();
     // Frames keep coming while the worker catches up, so it is never quite done when asked:
     // the last few frames are re-integrated here instead.
-    if (failure_.empty() && jobs_.size() - next_ > kFramesLeftToCommit) return std::nullopt;
+    if (failure_.empty() && (occupancy_pass_ || jobs_.size() - next_ > kFramesLeftToCommit)) {
+      return std::nullopt;
+    }
   }
   stopWorker();  // it finishes the frame it is on
   if (failure_.empty()) {
@@ -247,7 +332,14 @@ std::optional<MapRepairResult> BackgroundRepair::finish() {
   if (!running()) return std::nullopt;
   {
     std::unique_lock<std::mutex> lock(mutex_);
-    cv_.wait(lock, [this] { return !failure_.empty() || (idle_ && next_ == jobs_.size()); });
+    for (;;) {
+      cv_.wait(lock, [this] {
+        return !failure_.empty() ||
+               (idle_ && (occupancy_pass_ ? occupancy_next_ : next_) == jobs_.size());
+      });
+      if (!failure_.empty() || !occupancy_pass_) break;
+      takeOccupancyIfReady();
+    }
   }
   return poll();
 }

@@ -101,6 +101,12 @@ std::string describe(const MapRepairResult& r) {
     out += "; kept geometric segments of " +
            std::to_string(r.reintegration.frames_with_kept_segments) + " frames";
   }
+  if (r.occupancy_swapped_s >= 0.0) {
+    char occupancy[80];
+    std::snprintf(occupancy, sizeof(occupancy), "; occupancy swapped in after %.2f s",
+                  r.occupancy_swapped_s);
+    out += occupancy;
+  }
   if (r.reintegration.reassociated) {
     char ids[160];
     std::snprintf(ids, sizeof(ids),

@@ -14,6 +14,8 @@
 #include "panmap/loop/background_repair.h"
 #include "panmap/loop/frame_store.h"
 #include "panmap/loop/map_repair.h"
+#include "panmap/loop/pose_correction.h"
+#include "panmap/occupancy/occupancy_map.h"
 #include "test_helpers.h"
 
 namespace panmap {
@@ -230,6 +232,79 @@ TEST_F(BackgroundRepairTest, BadCorrectionsAndLostFramesChangeNothing) {
   EXPECT_NE(describe(*done).find("abandoned: frame store"), std::string::npos) << describe(*done);
   EXPECT_EQ(mapper->serialize(), before);
   EXPECT_FALSE(repair.poll());
+}
+
+// With the segmentations stored the repair maps the frames again, and first swaps in the
+// occupancy tree of the frames at their corrected poses (occupancy_first): held before it maps
+// the first frame again, the map already has the tree a planner needs; the repair then commits
+// the same tree. Without occupancy_first the occupancy changes only at the commit.
+TEST_F(BackgroundRepairTest, TheOccupancyTreeIsSwappedInBeforeTheFramesAreMappedAgain) {
+  for (const bool occupancy_first : {true, false}) {
+    SCOPED_TRACE(occupancy_first ? "occupancy first" : "occupancy at the commit");
+    test::TempDir dir;
+    FrameStore store(storeConfig(dir.path("store")));
+    auto mapper = std::make_unique<Mapper>(config());
+    for (int k = 0; k < 6; ++k) {
+      RgbdFrame frame;
+      PanopticFrame panoptic;
+      frameAt(k, &frame, &panoptic);
+      const FrameStats stats = mapper->integrate(frame, pose(k), &panoptic);
+      store.add(frame, stats.T_W_C, mapper->lastPixelLabels(), &panoptic);
+    }
+    ASSERT_NE(mapper->occupancy(), nullptr);
+    const PoseCorrection correction =
+        keyframeCorrection(*mapper, 3, move(0.03, {0.05, -0.03, 0.01}), 7);
+    // The tree of the six frames at their corrected poses, built here alone.
+    const CorrectedTrajectory corrected = applyCorrection(mapper->trajectory(), correction);
+    OccupancyMap expected(config().occupancy);
+    for (int k = 0; k < 6; ++k) {
+      expected.integrate(store.load(corrected.poses[k].utime).rgbd, corrected.poses[k].T_W_C);
+    }
+    const std::string old_tree = mapper->occupancy()->toBinaryData();
+    ASSERT_NE(old_tree, expected.toBinaryData());
+
+    MapRepairConfig repair_config;
+    repair_config.occupancy_first = occupancy_first;
+    Gate gate;
+    const PanopticFrameLoader store_panoptic = storePanopticLoader(&store);
+    BackgroundRepair repair(
+        mapper.get(), storeLoader(&store), &store, repair_config,
+        [&](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic, GeometricSegments* kept) {
+          gate.wait();  // mapping again waits for the test
+          return store_panoptic(utime, frame, panoptic, kept);
+        });
+    // Destroyed before the repair, whose thread must not be left waiting at the gate.
+    struct OpenAtExit {
+      Gate* gate;
+      ~OpenAtExit() { gate->open(); }
+    } open_at_exit{&gate};
+    repair.start(correction);
+    if (occupancy_first) {
+      const OccupancyMap* before = mapper->occupancy();
+      for (int64_t polls = 0; mapper->occupancy() == before; ++polls) {
+        ASSERT_LT(polls, 100000000) << "the occupancy tree was never swapped in";
+        ASSERT_FALSE(repair.poll()) << "committed while mapping again was held";
+        std::this_thread::yield();
+      }
+      EXPECT_EQ(mapper->occupancy()->toBinaryData(), expected.toBinaryData());
+      EXPECT_EQ(repair.framesDone(), 0);
+      // The poses change at the commit, with the label-TSDF.
+      EXPECT_TRUE(mapper->trajectory()[0].T_W_C.isApprox(pose(0), 1e-12));
+    } else {
+      EXPECT_FALSE(repair.poll());
+      EXPECT_EQ(mapper->occupancy()->toBinaryData(), old_tree);
+    }
+    gate.open();
+    const std::optional<MapRepairResult> done = repair.finish();
+    ASSERT_TRUE(done);
+    ASSERT_TRUE(done->reintegration.completed) << done->failure;
+    EXPECT_TRUE(done->reintegration.reassociated);
+    EXPECT_EQ(done->occupancy_swapped_s >= 0.0, occupancy_first);
+    EXPECT_EQ(describe(*done).find("occupancy swapped in after") != std::string::npos,
+              occupancy_first)
+        << describe(*done);
+    EXPECT_EQ(mapper->occupancy()->toBinaryData(), expected.toBinaryData());
+  }
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "panmap/core/thread_pool.h"
 #include "panmap/loop/frame_store.h"
 #include "panmap/loop/map_repair.h"
+#include "panmap/loop/occupancy_rebuild.h"
 #include "panmap/loop/pose_correction.h"
 #include "panmap/mapper/mapper.h"
 
@@ -23,7 +24,9 @@ namespace panmap {
 /// thread keeps integrating frames: the repair re-integrates (or, with the segmentations
 /// stored, maps again) the frames the map held when the correction came, at their corrected
 /// poses, then every frame integrated since, at the pose it was mapped with; once it has
-/// caught up, poll() swaps the repaired map in between two frames.
+/// caught up, poll() swaps the repaired map in between two frames. Before it maps the frames
+/// again (MapRepairConfig::occupancy_first), it runs over them once for the occupancy tree
+/// alone, which poll() swaps in as soon as it has caught up.
 /// A newer correction abandons a running repair and starts again from the map (superseded).
 ///
 /// Threads: every member function is called from the mapping thread (the one that calls
@@ -88,6 +91,12 @@ class BackgroundRepair {
   /// Loads one frame and adds it to the rebuild at the job's pose; throws Error.
   void reintegrate(const StampedPose& job, RgbdFrame* frame, LabelImage* labels,
                    PanopticFrame* panoptic, GeometricSegments* kept);
+  /// The occupancy pass: every job into occupancy_, until poll() takes the tree. Returns
+  /// false when the worker must return (stopped or failed).
+  bool occupancyPass();
+  /// With mutex_ held: when the occupancy pass has caught up and waits, swaps its tree into
+  /// the mapper and lets the worker go on to map the frames again.
+  void takeOccupancyIfReady();
   /// Adds a loaded frame at the job's pose; throws Error when it is another frame.
   void addLoaded(const StampedPose& job, const RgbdFrame& frame, const LabelImage& labels,
                  const PanopticFrame* panoptic, const GeometricSegments* kept);
@@ -105,6 +114,9 @@ class BackgroundRepair {
   CorrectedTrajectory corrected_;
   std::unique_ptr<MapRebuild> rebuild_;
   bool remap_ = false;  // the running repair maps the frames again
+  // The occupancy pass (occupancy_first): the worker's until it waits with every job done.
+  std::unique_ptr<OccupancyRebuild> occupancy_;
+  double occupancy_swapped_s_ = -1.0;
   std::chrono::steady_clock::time_point started_;
   size_t blocks_before_ = 0;
   int64_t superseded_ = 0;
@@ -114,6 +126,8 @@ class BackgroundRepair {
   std::condition_variable cv_;
   std::vector<StampedPose> jobs_;  // frames to re-integrate, in order, with their poses
   size_t next_ = 0;                // jobs_ done by the worker
+  bool occupancy_pass_ = false;    // the worker builds occupancy_ (until poll() takes it)
+  size_t occupancy_next_ = 0;      // jobs_ in occupancy_
   bool idle_ = false;              // the worker waits for a job
   bool stop_ = false;              // the worker must return
   std::string failure_;            // why the worker gave up

@@ -22,6 +22,11 @@ struct MapRepairConfig {
   /// (docs/LOOP_CLOSURE.md). Once a repair has mapped the frames again, the pixel labels in
   /// the store name super-points that are gone: only a remap repairs such a map correctly.
   bool reassociate = true;
+  /// A repair on its own thread (BackgroundRepair) that maps the frames again first rebuilds
+  /// the occupancy tree alone and swaps it in (OccupancyRebuild: a planner's phantom obstacles
+  /// go after about 2 ms a frame instead of the whole pipeline's 10-20), then maps the frames
+  /// again as before; the tree the repair commits is the same.
+  bool occupancy_first = true;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -43,6 +48,9 @@ struct MapRepairResult {
   double max_rotation_rad = 0.0;        ///< largest turn of a camera
   ReintegrationStats reintegration;     ///< completed = false: abandoned, map unchanged
   std::string failure;                  ///< why a background repair gave up (empty: it did not)
+  /// Seconds after the correction at which a background repair swapped in the occupancy tree
+  /// it built first (MapRepairConfig::occupancy_first); negative: it did not.
+  double occupancy_swapped_s = -1.0;
 };
 
 /// The repair after a loop closure (docs/LOOP_CLOSURE.md): spreads the correction over every

@@ -314,6 +314,12 @@ class Mapper {
   /// nothing, unless the rebuild holds exactly the frames of trajectory(), in order.
   /// @param stats if given, receives the counts of ids kept (ReintegrationStats::instances ...)
   void commitRebuild(std::unique_ptr<MapRebuild> rebuild, ReintegrationStats* stats = nullptr);
+  /// Swaps in an occupancy tree built from every frame of trajectory() at `poses` (a repair's,
+  /// ahead of its label-TSDF: OccupancyRebuild); the trajectory keeps its poses until the repair
+  /// commits. Throws Error, changing nothing, unless `poses` has the utimes of trajectory() in
+  /// order and this mapper keeps an occupancy map.
+  void replaceOccupancy(std::unique_ptr<OccupancyMap> occupancy,
+                        const std::vector<StampedPose>& poses);
 
   /// Gives the live super-points new ids: root label r becomes ids.at(r) (every super-point
   /// with a state or a vote needs one), every other label up to `size` is retired (it
