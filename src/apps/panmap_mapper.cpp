@@ -282,6 +282,11 @@ int main(int argc, char** argv) {
                "repair by re-integrating the stored frames with the super-points they had, "
                "never by mapping them again with their masks (faster; objects formed under "
                "large drift stay as they were)");
+  bool repair_occupancy_last = false;
+  app.add_flag("--repair-occupancy-last", repair_occupancy_last,
+               "live repairs that map the frames again swap the occupancy tree in with the rest "
+               "of the map, not first (by default planners get the repaired tree after one pass "
+               "over the stored depth)");
   std::vector<double> grid_shift;
   app.add_option("--grid-shift", grid_shift,
                  "X,Y,Z metres: move every pose by this before mapping, so the voxel grid falls "
@@ -406,6 +411,7 @@ int main(int argc, char** argv) {
       }
       options.frame_store = frame_store.get();
       options.repair.reassociate = !repair_reintegrate_only;
+      options.repair.occupancy_first = !repair_occupancy_last;
     }
     // Offline runs can be replayed from their log, so they autosave only when asked to.
     const bool offline = !log_path.empty() || export_only;

@@ -54,6 +54,7 @@ void BackgroundRepair::cancel() {
   rebuild_.reset();
   occupancy_.reset();
   occupancy_pass_ = false;
+  occupancy_handover_ = false;
 }
 
 MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
@@ -99,6 +100,7 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
     jobs_ = corrected_.poses;
     next_ = 0;
     occupancy_pass_ = occupancy_first;
+    occupancy_handover_ = false;
     occupancy_next_ = 0;
     idle_ = false;
     stop_ = false;
@@ -158,12 +160,14 @@ bool BackgroundRepair::occupancyPass() {
     size_t index = 0;
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      if (occupancy_next_ == jobs_.size()) {
-        // Caught up: poll() takes the tree while this waits.
+      if (occupancy_handover_ || occupancy_next_ == jobs_.size()) {
+        // Caught up, or poll() takes the tree over with the last few frames: wait.
         idle_ = true;
         cv_.notify_all();
-        cv_.wait(lock,
-                 [this] { return stop_ || !occupancy_pass_ || occupancy_next_ < jobs_.size(); });
+        cv_.wait(lock, [this] {
+          return stop_ || !occupancy_pass_ ||
+                 (!occupancy_handover_ && occupancy_next_ < jobs_.size());
+        });
         idle_ = false;
       }
       if (stop_) return false;
@@ -195,20 +199,36 @@ bool BackgroundRepair::occupancyPass() {
   }
 }
 
-void BackgroundRepair::takeOccupancyIfReady() {
-  if (!occupancy_pass_ || !failure_.empty() || !idle_ || occupancy_next_ != jobs_.size()) return;
-  // The worker waits: the tree is this thread's. It holds every frame the map holds.
+void BackgroundRepair::takeOccupancyIfReady(std::unique_lock<std::mutex>* lock) {
+  if (!occupancy_pass_ || !failure_.empty()) return;
+  // Frames keep coming, so the pass is never quite done when asked (as for the commit): at most
+  // kFramesLeftToCommit behind, it hands the tree over after the frame it is on.
+  if (jobs_.size() - occupancy_next_ > kFramesLeftToCommit) return;
+  occupancy_handover_ = true;
+  cv_.notify_all();
+  cv_.wait(*lock, [this] { return !failure_.empty() || idle_; });
+  if (!failure_.empty()) return;
+  // The worker waits: the tree is this thread's until the pass ends.
   try {
+    RgbdFrame frame;
+    LabelImage labels;
+    for (; occupancy_next_ < jobs_.size(); ++occupancy_next_) {
+      const StampedPose& job = jobs_[occupancy_next_];
+      load_(job.utime, &frame, &labels);
+      if (frame.utime != job.utime) throw Error("the store gave another frame");
+      occupancy_->add(frame, job.T_W_C);
+    }
     const std::vector<StampedPose> poses = occupancy_->poses();
     mapper_->replaceOccupancy(occupancy_->take(), poses);
     occupancy_swapped_s_ =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
-  } catch (const Error& e) {
+  } catch (const std::exception& e) {
     // The commit brings the repaired tree all the same.
     std::fprintf(stderr, "panmap: occupancy of the repair not swapped in early: %s\n", e.what());
   }
   occupancy_.reset();
   occupancy_pass_ = false;
+  occupancy_handover_ = false;
   cv_.notify_all();
 }
 
@@ -303,8 +323,8 @@ MapRepairResult BackgroundRepair::commit() {
 std::optional<MapRepairResult> BackgroundRepair::poll() {
   if (!running()) return std::nullopt;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    takeOccupancyIfReady();
+    std::unique_lock<std::mutex> lock(mutex_);
+    takeOccupancyIfReady(&lock);
     // Frames keep coming while the worker catches up, so it is never quite done when asked:
     // the last few frames are re-integrated here instead.
     if (failure_.empty() && (occupancy_pass_ || jobs_.size() - next_ > kFramesLeftToCommit)) {
@@ -338,7 +358,7 @@ std::optional<MapRepairResult> BackgroundRepair::finish() {
                (idle_ && (occupancy_pass_ ? occupancy_next_ : next_) == jobs_.size());
       });
       if (!failure_.empty() || !occupancy_pass_) break;
-      takeOccupancyIfReady();
+      takeOccupancyIfReady(&lock);
     }
   }
   return poll();

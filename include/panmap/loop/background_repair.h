@@ -94,9 +94,10 @@ class BackgroundRepair {
   /// The occupancy pass: every job into occupancy_, until poll() takes the tree. Returns
   /// false when the worker must return (stopped or failed).
   bool occupancyPass();
-  /// With mutex_ held: when the occupancy pass has caught up and waits, swaps its tree into
-  /// the mapper and lets the worker go on to map the frames again.
-  void takeOccupancyIfReady();
+  /// With mutex_ held by `lock`: when the occupancy pass is at most kFramesLeftToCommit frames
+  /// behind, waits for the worker to finish the frame it is on, adds the rest itself, swaps the
+  /// tree into the mapper and lets the worker go on to map the frames again.
+  void takeOccupancyIfReady(std::unique_lock<std::mutex>* lock);
   /// Adds a loaded frame at the job's pose; throws Error when it is another frame.
   void addLoaded(const StampedPose& job, const RgbdFrame& frame, const LabelImage& labels,
                  const PanopticFrame* panoptic, const GeometricSegments* kept);
@@ -124,13 +125,14 @@ class BackgroundRepair {
   std::thread worker_;
   mutable std::mutex mutex_;  // guards what follows
   std::condition_variable cv_;
-  std::vector<StampedPose> jobs_;  // frames to re-integrate, in order, with their poses
-  size_t next_ = 0;                // jobs_ done by the worker
-  bool occupancy_pass_ = false;    // the worker builds occupancy_ (until poll() takes it)
-  size_t occupancy_next_ = 0;      // jobs_ in occupancy_
-  bool idle_ = false;              // the worker waits for a job
-  bool stop_ = false;              // the worker must return
-  std::string failure_;            // why the worker gave up
+  std::vector<StampedPose> jobs_;    // frames to re-integrate, in order, with their poses
+  size_t next_ = 0;                  // jobs_ done by the worker
+  bool occupancy_pass_ = false;      // the worker builds occupancy_ (until poll() takes it)
+  bool occupancy_handover_ = false;  // poll() takes occupancy_ over: the worker stops at once
+  size_t occupancy_next_ = 0;        // jobs_ in occupancy_
+  bool idle_ = false;                // the worker waits for a job
+  bool stop_ = false;                // the worker must return
+  std::string failure_;              // why the worker gave up
 };
 
 }  // namespace panmap
