@@ -307,5 +307,49 @@ TEST_F(BackgroundRepairTest, TheOccupancyTreeIsSwappedInBeforeTheFramesAreMapped
   }
 }
 
+// A frame comes, is handed to the repair, and the mapping thread asks at once: the occupancy
+// pass is then busy with that frame every time. It hands its tree over anyway once at most
+// two frames behind (the first version waited for an idle pass, and at 5 Hz swapped the tree in
+// after 80 s instead of 2).
+TEST_F(BackgroundRepairTest, TheOccupancyTreeComesWhileFramesKeepComing) {
+  test::TempDir dir;
+  FrameStore store(storeConfig(dir.path("store")));
+  auto mapper = std::make_unique<Mapper>(config());
+  auto add = [&](int k) {
+    RgbdFrame frame;
+    PanopticFrame panoptic;
+    frameAt(k, &frame, &panoptic);
+    const FrameStats stats = mapper->integrate(frame, pose(k), &panoptic);
+    store.add(frame, stats.T_W_C, mapper->lastPixelLabels(), &panoptic);
+  };
+  for (int k = 0; k < 6; ++k) add(k);
+  Gate gate;
+  const PanopticFrameLoader store_panoptic = storePanopticLoader(&store);
+  BackgroundRepair repair(
+      mapper.get(), storeLoader(&store), &store, MapRepairConfig{},
+      [&](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic, GeometricSegments* kept) {
+        gate.wait();  // mapping again waits for the test
+        return store_panoptic(utime, frame, panoptic, kept);
+      });
+  struct OpenAtExit {
+    Gate* gate;
+    ~OpenAtExit() { gate->open(); }
+  } open_at_exit{&gate};
+  repair.start(keyframeCorrection(*mapper, 3, move(0.03, {0.05, -0.03, 0.01}), 7));
+  const OccupancyMap* before = mapper->occupancy();
+  int k = 6;
+  for (; k < 46 && mapper->occupancy() == before; ++k) {
+    add(k);
+    repair.frameIntegrated();
+    ASSERT_FALSE(repair.poll()) << "committed while mapping again was held";
+  }
+  EXPECT_NE(mapper->occupancy(), before) << "no tree after " << k - 6 << " frames";
+  gate.open();
+  const std::optional<MapRepairResult> done = repair.finish();
+  ASSERT_TRUE(done && done->reintegration.completed);
+  EXPECT_GE(done->occupancy_swapped_s, 0.0);
+  EXPECT_EQ(done->reintegration.frames, static_cast<size_t>(k));
+}
+
 }  // namespace
 }  // namespace panmap
