@@ -93,17 +93,7 @@ void Mapper::replaceOccupancy(std::unique_ptr<OccupancyMap> occupancy,
                               const std::vector<StampedPose>& poses) {
   if (!occupancy) throw Error("replaceOccupancy: no occupancy map");
   if (!occupancy_) throw Error("replaceOccupancy: this mapper keeps no occupancy map");
-  if (poses.size() != trajectory_.size()) {
-    throw Error("replaceOccupancy: the tree holds " + std::to_string(poses.size()) +
-                " frames, the map " + std::to_string(trajectory_.size()));
-  }
-  for (size_t i = 0; i < poses.size(); ++i) {
-    if (poses[i].utime != trajectory_[i].utime) {
-      throw Error("replaceOccupancy: frame " + std::to_string(i) + " of the tree has utime " +
-                  std::to_string(poses[i].utime) + ", the map's " +
-                  std::to_string(trajectory_[i].utime));
-    }
-  }
+  checkRepairPoses(poses, "replaceOccupancy");
   occupancy_ = std::move(occupancy);
 }
 

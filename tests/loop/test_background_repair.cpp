@@ -59,6 +59,13 @@ class Gate {
   bool open_ = false;
 };
 
+// Opens a gate when it goes out of scope: declared after the repair, it is destroyed first,
+// so a failed assertion never leaves the repair's thread waiting at the gate.
+struct OpenAtExit {
+  Gate* gate;
+  ~OpenAtExit() { gate->open(); }
+};
+
 class BackgroundRepairTest : public BoxScene {
  protected:
   void integrate(Mapper* mapper, int k, FrameStore* store) {
@@ -67,6 +74,27 @@ class BackgroundRepairTest : public BoxScene {
     frameAt(k, &frame, &panoptic);
     const FrameStats stats = mapper->integrate(frame, pose(k), &panoptic);
     store->add(frame, stats.T_W_C, mapper->lastPixelLabels());
+  }
+  // integrate() that also stores the frame's masks: a repair then maps the frames again.
+  void integrateWithMasks(Mapper* mapper, int k, FrameStore* store) {
+    RgbdFrame frame;
+    PanopticFrame panoptic;
+    frameAt(k, &frame, &panoptic);
+    const FrameStats stats = mapper->integrate(frame, pose(k), &panoptic);
+    store->add(frame, stats.T_W_C, mapper->lastPixelLabels(), &panoptic);
+  }
+  // A repair of `mapper` from `store` whose mapping again waits at `gate` (its occupancy pass
+  // loads the frames without masks and does not wait).
+  static std::unique_ptr<BackgroundRepair> gatedRepair(Mapper* mapper, FrameStore* store,
+                                                       const MapRepairConfig& config, Gate* gate) {
+    const PanopticFrameLoader load = storePanopticLoader(store);
+    return std::make_unique<BackgroundRepair>(
+        mapper, storeLoader(store), store, config,
+        [gate, load](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic,
+                     GeometricSegments* kept) {
+          gate->wait();
+          return load(utime, frame, panoptic, kept);
+        });
   }
   std::unique_ptr<Mapper> mapWithStore(int frames, FrameStore* store) {
     auto mapper = std::make_unique<Mapper>(config());
@@ -244,13 +272,7 @@ TEST_F(BackgroundRepairTest, TheOccupancyTreeIsSwappedInBeforeTheFramesAreMapped
     test::TempDir dir;
     FrameStore store(storeConfig(dir.path("store")));
     auto mapper = std::make_unique<Mapper>(config());
-    for (int k = 0; k < 6; ++k) {
-      RgbdFrame frame;
-      PanopticFrame panoptic;
-      frameAt(k, &frame, &panoptic);
-      const FrameStats stats = mapper->integrate(frame, pose(k), &panoptic);
-      store.add(frame, stats.T_W_C, mapper->lastPixelLabels(), &panoptic);
-    }
+    for (int k = 0; k < 6; ++k) integrateWithMasks(mapper.get(), k, &store);
     ASSERT_NE(mapper->occupancy(), nullptr);
     const PoseCorrection correction =
         keyframeCorrection(*mapper, 3, move(0.03, {0.05, -0.03, 0.01}), 7);
@@ -266,18 +288,10 @@ TEST_F(BackgroundRepairTest, TheOccupancyTreeIsSwappedInBeforeTheFramesAreMapped
     MapRepairConfig repair_config;
     repair_config.occupancy_first = occupancy_first;
     Gate gate;
-    const PanopticFrameLoader store_panoptic = storePanopticLoader(&store);
-    BackgroundRepair repair(
-        mapper.get(), storeLoader(&store), &store, repair_config,
-        [&](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic, GeometricSegments* kept) {
-          gate.wait();  // mapping again waits for the test
-          return store_panoptic(utime, frame, panoptic, kept);
-        });
-    // Destroyed before the repair, whose thread must not be left waiting at the gate.
-    struct OpenAtExit {
-      Gate* gate;
-      ~OpenAtExit() { gate->open(); }
-    } open_at_exit{&gate};
+    const std::unique_ptr<BackgroundRepair> held =
+        gatedRepair(mapper.get(), &store, repair_config, &gate);
+    BackgroundRepair& repair = *held;
+    const OpenAtExit open_at_exit{&gate};
     repair.start(correction);
     if (occupancy_first) {
       const OccupancyMap* before = mapper->occupancy();
@@ -315,31 +329,17 @@ TEST_F(BackgroundRepairTest, TheOccupancyTreeComesWhileFramesKeepComing) {
   test::TempDir dir;
   FrameStore store(storeConfig(dir.path("store")));
   auto mapper = std::make_unique<Mapper>(config());
-  auto add = [&](int k) {
-    RgbdFrame frame;
-    PanopticFrame panoptic;
-    frameAt(k, &frame, &panoptic);
-    const FrameStats stats = mapper->integrate(frame, pose(k), &panoptic);
-    store.add(frame, stats.T_W_C, mapper->lastPixelLabels(), &panoptic);
-  };
-  for (int k = 0; k < 6; ++k) add(k);
+  for (int k = 0; k < 6; ++k) integrateWithMasks(mapper.get(), k, &store);
   Gate gate;
-  const PanopticFrameLoader store_panoptic = storePanopticLoader(&store);
-  BackgroundRepair repair(
-      mapper.get(), storeLoader(&store), &store, MapRepairConfig{},
-      [&](int64_t utime, RgbdFrame* frame, PanopticFrame* panoptic, GeometricSegments* kept) {
-        gate.wait();  // mapping again waits for the test
-        return store_panoptic(utime, frame, panoptic, kept);
-      });
-  struct OpenAtExit {
-    Gate* gate;
-    ~OpenAtExit() { gate->open(); }
-  } open_at_exit{&gate};
+  const std::unique_ptr<BackgroundRepair> held =
+      gatedRepair(mapper.get(), &store, MapRepairConfig{}, &gate);
+  BackgroundRepair& repair = *held;
+  const OpenAtExit open_at_exit{&gate};
   repair.start(keyframeCorrection(*mapper, 3, move(0.03, {0.05, -0.03, 0.01}), 7));
   const OccupancyMap* before = mapper->occupancy();
   int k = 6;
   for (; k < 46 && mapper->occupancy() == before; ++k) {
-    add(k);
+    integrateWithMasks(mapper.get(), k, &store);
     repair.frameIntegrated();
     ASSERT_FALSE(repair.poll()) << "committed while mapping again was held";
   }
