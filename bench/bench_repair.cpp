@@ -10,7 +10,8 @@
 // repair maps the frames again, as it does for every labelled map (--segment-again: without the
 // geometric segments kept in the store; --reintegrate-only: re-integration with the stored pixel
 // labels instead, as panmap-mapper --repair-reintegrate-only).
-//   panmap-bench-repair [--data DIR | --room S [--segment-again | --reintegrate-only]]
+//   panmap-bench-repair [--data DIR | --room S [--segment-again | --reintegrate-only]
+//                       [--occupancy-last]]
 //                       [--frames N] [--voxel-size M]
 //                       [--threads N] [--rate-hz R] [--live-frames K]
 
@@ -100,7 +101,7 @@ int main(int argc, char** argv) {
   std::string data = "../shared/data/7scenes-200";
 #endif
   int frames = 1000, threads = 2, live_frames = 0, room = -1;
-  bool segment_again = false, reintegrate_only = false;
+  bool segment_again = false, reintegrate_only = false, occupancy_last = false;
   double rate_hz = 5.0;
   float voxel_size_m = 0.02f;
   app.add_option("--data", data, "dataset folder (7-Scenes, ScanNet export, TUM, folder)")
@@ -115,6 +116,9 @@ int main(int argc, char** argv) {
                "with --room: repair by re-integration only (each frame votes again with the "
                "pixel labels of its first mapping, MapRepairConfig::reassociate off), as "
                "panmap-mapper --repair-reintegrate-only");
+  app.add_flag("--occupancy-last", occupancy_last,
+               "with --room: the background repair swaps the occupancy tree in with the rest of "
+               "the map instead of first (MapRepairConfig::occupancy_first off)");
   app.add_option("--frames", frames, "frames in the map when the correction comes")
       ->capture_default_str();
   app.add_option("--voxel-size", voxel_size_m, "voxel size, metres")->capture_default_str();
@@ -224,6 +228,7 @@ int main(int argc, char** argv) {
     const panmap::PoseCorrection first = driftCorrection(mapper.trajectory(), 1);
     panmap::MapRepairConfig repair_config;
     repair_config.reassociate = !reintegrate_only;
+    repair_config.occupancy_first = !occupancy_last;
     const panmap::MapRepairResult blocking =
         panmap::repairMap(&mapper, &store, first, repair_config);
     std::printf("blocking repair:   %s\n", panmap::describe(blocking).c_str());
