@@ -135,13 +135,17 @@ void BackgroundRepair::reintegrate(const StampedPose& job, RgbdFrame* frame, Lab
   }
 }
 
-void BackgroundRepair::addLoaded(const StampedPose& job, const RgbdFrame& frame,
-                                 const LabelImage& labels, const PanopticFrame* panoptic,
-                                 const GeometricSegments* kept) {
+void BackgroundRepair::checkFrameOf(const StampedPose& job, const RgbdFrame& frame) {
   if (frame.utime != job.utime) {
     throw Error("asked for the frame of utime " + std::to_string(job.utime) + ", got " +
                 std::to_string(frame.utime));
   }
+}
+
+void BackgroundRepair::addLoaded(const StampedPose& job, const RgbdFrame& frame,
+                                 const LabelImage& labels, const PanopticFrame* panoptic,
+                                 const GeometricSegments* kept) {
+  checkFrameOf(job, frame);
   rebuild_->add(frame, job.T_W_C, &labels, panoptic, kept);
 }
 
@@ -182,10 +186,7 @@ bool BackgroundRepair::occupancyPass() {
         frame = RgbdFrame();
         load_(job.utime, &frame, &labels);
       }
-      if (frame.utime != job.utime) {
-        throw Error("asked for the frame of utime " + std::to_string(job.utime) + ", got " +
-                    std::to_string(frame.utime));
-      }
+      checkFrameOf(job, frame);
       occupancy_->add(frame, job.T_W_C);
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -215,7 +216,7 @@ void BackgroundRepair::takeOccupancyIfReady(std::unique_lock<std::mutex>* lock) 
     for (; occupancy_next_ < jobs_.size(); ++occupancy_next_) {
       const StampedPose& job = jobs_[occupancy_next_];
       load_(job.utime, &frame, &labels);
-      if (frame.utime != job.utime) throw Error("the store gave another frame");
+      checkFrameOf(job, frame);
       occupancy_->add(frame, job.T_W_C);
     }
     const std::vector<StampedPose> poses = occupancy_->poses();

@@ -98,6 +98,8 @@ class BackgroundRepair {
   /// behind, waits for the worker to finish the frame it is on, adds the rest itself, swaps the
   /// tree into the mapper and lets the worker go on to map the frames again.
   void takeOccupancyIfReady(std::unique_lock<std::mutex>* lock);
+  /// Throws Error naming both utimes when `frame` is not the job's frame.
+  static void checkFrameOf(const StampedPose& job, const RgbdFrame& frame);
   /// Adds a loaded frame at the job's pose; throws Error when it is another frame.
   void addLoaded(const StampedPose& job, const RgbdFrame& frame, const LabelImage& labels,
                  const PanopticFrame* panoptic, const GeometricSegments* kept);
