@@ -220,6 +220,7 @@ int main(int argc, char** argv) {
   bool quiet = false, geometry_only = false, spatial_only = false, no_snapshots = false;
   bool no_mask_edge_fill = false, no_mask_only_surfaces = false;
   bool no_regularise = false, no_refine = false, print_config = false, export_only = false;
+  bool no_optimise = false;
   app.add_option("--log", log_path, "LCM log to map offline (omit for the live LCM mode)");
   app.add_option("--out", out_dir, "output folder")->required(false);
   app.add_option("--config", config_path,
@@ -265,6 +266,9 @@ int main(int argc, char** argv) {
                  "snapshot the map every S seconds of stream time into OUT/autosave (atomic, "
                  "two kept; 0: never). Default 60 live, off offline unless given")
       ->capture_default_str();
+  app.add_flag("--no-optimise", no_optimise,
+               "offline and --export-only: write frame-count outputs without the final "
+               "optimisation, as a live mapper does when no panmap-optimizer answers");
   app.add_flag("--export-only", export_only,
                "with --load: no mapping, only run the final optimisation and write the outputs");
   app.add_option("--channel-rgbd", options.channel_rgbd)->capture_default_str();
@@ -438,6 +442,10 @@ int main(int argc, char** argv) {
 
     if (export_only && load_path.empty()) throw panmap::Error("--export-only needs --load");
     if (export_only && !log_path.empty()) throw panmap::Error("--export-only takes no --log");
+    if (no_optimise && log_path.empty() && !export_only) {
+      throw panmap::Error(
+          "--no-optimise needs --log or --export-only (live: run no panmap-optimizer)");
+    }
 
     if (!log_path.empty() || export_only) {
       // Offline: every frame, in log order, optimisation in-process.
@@ -461,12 +469,13 @@ int main(int argc, char** argv) {
       }
       const auto optimise_start = std::chrono::steady_clock::now();
       const panmap::SuperpointGraph graph = mapper->graph();
-      const panmap::GraphLabels labels = panmap::optimise(graph, optimiser);
+      const panmap::GraphLabels labels =
+          no_optimise ? panmap::GraphLabels{} : panmap::optimise(graph, optimiser);
       const double optimise_ms = msSince(optimise_start);
       output_options.utime = report.last_frame_utime;
       output_options.final_export = true;  // nothing meshes this map after it
-      const panmap::OutputSummary outputs =
-          panmap::writeOutputs(out_dir, mapper.get(), &labels, optimiser, output_options);
+      const panmap::OutputSummary outputs = panmap::writeOutputs(
+          out_dir, mapper.get(), no_optimise ? nullptr : &labels, optimiser, output_options);
       // After the outputs, which create OUT: OUT/graph.json is the natural place for it.
       if (!graph_json.empty()) panmap::writeGraphJson(graph_json, graph, labels);
       nlohmann::json json = sessionJson(report);
@@ -480,7 +489,7 @@ int main(int argc, char** argv) {
       json["graph"] = {{"vertices", graph.vertices.size()},
                        {"edges", graph.edges.size()},
                        {"edges_pruned", mapper->edgesPruned()},
-                       {"optimised", true},
+                       {"optimised", !no_optimise},
                        {"optimise_ms", optimise_ms},
                        {"solve_ms", labels.solve_ms},
                        {"fragments_folded", labels.fragments_folded},
@@ -525,10 +534,11 @@ int main(int argc, char** argv) {
       }
     });
     node.setPeriodicPublisher(
-        [&live](panmap::Mapper* m, int64_t utime, const panmap::GraphLabels* labels) {
+        [&live, &optimiser](panmap::Mapper* m, int64_t utime, const panmap::GraphLabels* labels) {
           std::vector<panmap::OutgoingMessage> out;
           out.push_back(panmap::encodeMessage(
-              live.channel_objects, panmap::toMessage(panmap::computeObjects(*m, labels), utime)));
+              live.channel_objects,
+              panmap::toMessage(panmap::computeObjects(*m, labels, optimiser.objects), utime)));
           if (m->occupancy()) {
             panmap::octomap_t tree;
             tree.utime = utime;

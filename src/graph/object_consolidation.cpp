@@ -6,6 +6,7 @@
 #include <tuple>
 
 #include "panmap/graph/internal/graph_check.h"
+#include "panmap/graph/object_confidence.h"
 
 namespace panmap {
 namespace internal {
@@ -21,16 +22,6 @@ double areaOf(int64_t voxels, double voxel_size_m) {
 }
 
 }  // namespace
-
-float objectConfidence(const InstanceEvidence& e, double voxel_size_m,
-                       const OptimiserConfig::Objects& config) {
-  // Floors keep the logarithms finite for an instance without area or observations.
-  const double area = std::max(areaOf(e.voxels, voxel_size_m), 1e-4);
-  const double support = std::max(e.support(), 1e-2);
-  const double z = config.bias + config.area * std::log10(area) +
-                   config.support * std::log2(support) + config.share * e.classShare();
-  return static_cast<float>(1.0 / (1.0 + std::exp(-z)));
-}
 
 ConsolidatedObjects consolidateObjects(const SuperpointGraph& graph,
                                        const std::vector<int32_t>& classes,
@@ -101,10 +92,7 @@ ConsolidatedObjects consolidateObjects(const SuperpointGraph& graph,
   }
   for (const InstanceEvidence& e : instanceEvidence(graph, classes, out.instance)) {
     out.confidence[e.instance] = objectConfidence(e, voxel_m, config);
-    ObjectEvidence& ev = out.evidence[e.instance];
-    ev.area_m2 = static_cast<float>(areaOf(e.voxels, voxel_m));
-    ev.support = static_cast<float>(e.support());
-    ev.class_share = static_cast<float>(e.classShare());
+    out.evidence[e.instance] = objectEvidence(e, voxel_m);
   }
   return out;
 }

@@ -11,6 +11,7 @@
 
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
+#include "panmap/graph/object_confidence.h"
 #include "panmap/mapper/final_labels.h"
 #include "panmap/mapper/mapper.h"
 
@@ -175,7 +176,7 @@ T readNumber(const json& o, const char* key, const std::string& where) {
 }  // namespace
 
 std::vector<MappedObject> computeObjects(const TsdfMap& map, const SuperpointTracker& tracker,
-                                         const GraphLabels* labels) {
+                                         const GraphLabels* labels, const ObjectScoring* scoring) {
   const float band_m = kObjectSurfaceBandVoxels * map.voxelSize();
   auto resolve = [&tracker](int32_t l) { return tracker.labels().resolve(l); };
   std::map<int32_t, SuperpointLabels> cache;  // super-point -> labels, looked up once each
@@ -212,17 +213,35 @@ std::vector<MappedObject> computeObjects(const TsdfMap& map, const SuperpointTra
     for (const auto& [cls, count] : inst.voxels_per_class) {
       if (count > best) o.class_id = cls, best = count;  // ascending: ties keep the smaller id
     }
-    double weighted = 0.0;
-    for (const auto& [superpoint, count] : inst.voxels_per_superpoint) {
-      o.superpoints.push_back(superpoint);
-      weighted += static_cast<double>(count) * frameCountStability(tracker.state(superpoint));
-    }
-    o.confidence = static_cast<float>(weighted / o.num_voxels);
-    if (labels) {
-      const auto c = labels->instance_confidence.find(id);
-      if (c != labels->instance_confidence.end()) o.confidence = c->second;
+    for (const auto& entry : inst.voxels_per_superpoint) o.superpoints.push_back(entry.first);
+    const auto optimised =
+        labels ? labels->instance_confidence.find(id) : std::map<int32_t, float>::const_iterator();
+    if (labels && optimised != labels->instance_confidence.end()) {
+      o.confidence = optimised->second;
       const auto e = labels->instance_evidence.find(id);
       if (e != labels->instance_evidence.end()) o.evidence = e->second;
+    } else if (scoring && scoring->graph) {
+      // The evidence InstanceEvidence would give this instance in the optimiser's graph.
+      InstanceEvidence e;
+      e.instance = id;
+      e.class_id = o.class_id;
+      e.voxels = o.num_voxels;
+      for (const auto& entry : inst.voxels_per_superpoint) {
+        ++e.superpoints;
+        const int32_t own_class = cache.at(entry.first).semantic;
+        for (const auto& [cls, value] : scoring->graph->scores(entry.first)) {
+          e.score_all += value;
+          if (cls == own_class) e.score += value;
+        }
+      }
+      o.confidence = objectConfidence(e, map.voxelSize(), scoring->model);
+      o.evidence = objectEvidence(e, map.voxelSize());
+    } else {
+      double weighted = 0.0;
+      for (const auto& [superpoint, count] : inst.voxels_per_superpoint) {
+        weighted += static_cast<double>(count) * frameCountStability(tracker.state(superpoint));
+      }
+      o.confidence = static_cast<float>(weighted / o.num_voxels);
     }
     fitBoxes(inst.centres_W, map.voxelSize(), &o);
     objects.push_back(std::move(o));
@@ -230,8 +249,10 @@ std::vector<MappedObject> computeObjects(const TsdfMap& map, const SuperpointTra
   return objects;
 }
 
-std::vector<MappedObject> computeObjects(const Mapper& mapper, const GraphLabels* labels) {
-  return computeObjects(mapper.map(), mapper.superpoints(), labels);
+std::vector<MappedObject> computeObjects(const Mapper& mapper, const GraphLabels* labels,
+                                         const OptimiserConfig::Objects& model) {
+  const ObjectScoring scoring{&mapper.graphAccumulator(), model};
+  return computeObjects(mapper.map(), mapper.superpoints(), labels, &scoring);
 }
 
 void writeObjectsJson(const std::string& path, const std::vector<MappedObject>& objects,

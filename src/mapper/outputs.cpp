@@ -78,7 +78,7 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
       step("snapshots");
     }
   }
-  const std::vector<MappedObject> objects = computeObjects(*mapper, labels);
+  const std::vector<MappedObject> objects = computeObjects(*mapper, labels, optimiser.objects);
   writeObjectsJson(dir + "/objects.json", objects, options.utime);
   summary.objects = objects.size();
   summary.files.push_back("objects.json");

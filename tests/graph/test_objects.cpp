@@ -8,6 +8,7 @@
 #include "panmap/core/error.h"
 #include "panmap/graph/instance_evidence.h"
 #include "panmap/graph/internal/object_consolidation.h"
+#include "panmap/graph/object_confidence.h"
 #include "panmap/graph/optimiser.h"
 
 namespace panmap {
@@ -118,16 +119,16 @@ TEST(ObjectConsolidation, ConfidenceRisesWithAreaSupportAndShare) {
   e.voxels = 1000;
   e.score = 8000.0;
   e.score_all = 10000.0;
-  const float base = internal::objectConfidence(e, 0.02, config);
+  const float base = objectConfidence(e, 0.02, config);
   InstanceEvidence larger = e, seen_more = e, purer = e;
   larger.voxels = 4000, larger.score = 32000.0, larger.score_all = 40000.0;
   seen_more.score = 16000.0, seen_more.score_all = 18000.0;
   purer.score_all = 8000.0;
-  EXPECT_GT(internal::objectConfidence(larger, 0.02, config), base);
-  EXPECT_GT(internal::objectConfidence(seen_more, 0.02, config), base);
-  EXPECT_GT(internal::objectConfidence(purer, 0.02, config), base);
+  EXPECT_GT(objectConfidence(larger, 0.02, config), base);
+  EXPECT_GT(objectConfidence(seen_more, 0.02, config), base);
+  EXPECT_GT(objectConfidence(purer, 0.02, config), base);
   InstanceEvidence empty;  // no voxels, no scores: finite, low
-  const float none = internal::objectConfidence(empty, 0.02, config);
+  const float none = objectConfidence(empty, 0.02, config);
   EXPECT_TRUE(std::isfinite(none));
   EXPECT_LT(none, base);
 }

@@ -35,12 +35,44 @@ TEST(Cli, ImportOfAMissingFolderFailsWithOneLine) {
 TEST(Cli, MapperRefusesAGridShiftWithAFrameStoreInOneLine) {
   test::TempDir dir;
   const auto r = runCommand(binPath("panmap-mapper") + " --grid-shift 0.01,0,0 --frame-store " +
-                            dir.path("store") + " --log " + dir.path("absent.lcmlog") +
-                            " --out " + dir.path("out"));
+                            dir.path("store") + " --log " + dir.path("absent.lcmlog") + " --out " +
+                            dir.path("out"));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_EQ(test::countLines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("--grid-shift"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir.path("store")));
+}
+
+TEST(Cli, MapperRefusesNoOptimiseLiveInOneLine) {
+  test::TempDir dir;
+  const auto r = runCommand(binPath("panmap-mapper") + " --no-optimise --out " + dir.path("out"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(test::countLines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("--no-optimise"), std::string::npos) << r.output;
+}
+
+// Offline --no-optimise writes the outputs a live mapper writes without an optimiser, and says
+// so in report.json; --export-only of its map with the optimisation says the opposite.
+TEST(Cli, MapperWithoutTheOptimisationSaysSo) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  const auto imp = runCommand(binPath("panmap-import") + " --quiet --max-frames 3 " +
+                              test::dataDir("7scenes-200") + " " + dir.path("s.lcmlog"));
+  ASSERT_EQ(imp.exit_code, 0) << imp.output;
+  const std::string common = binPath("panmap-mapper") + " -q --voxel-size 0.05 --no-snapshots ";
+  const auto mapped = runCommand(common + "--no-optimise --log " + dir.path("s.lcmlog") +
+                                 " --out " + dir.path("a"));
+  ASSERT_EQ(mapped.exit_code, 0) << mapped.output;
+  auto optimised = [&](const std::string& out) {
+    std::ifstream in(dir.path(out + "/report.json"));
+    return nlohmann::json::parse(in)["graph"]["optimised"].get<bool>();
+  };
+  EXPECT_FALSE(optimised("a"));
+  EXPECT_TRUE(std::filesystem::exists(dir.path("a/objects.json")));
+  const auto exported = runCommand(common + "--export-only --load " + dir.path("a/map.panmap") +
+                                   " --out " + dir.path("b"));
+  ASSERT_EQ(exported.exit_code, 0) << exported.output;
+  EXPECT_TRUE(optimised("b"));
 }
 
 TEST(Cli, ImportThenLogInfoJson) {

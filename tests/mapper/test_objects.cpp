@@ -227,6 +227,40 @@ TEST(Objects, OptimisedLabelsOverrideFrameCounts) {
   EXPECT_EQ(objects[0].aabb_max_W, Eigen::Vector3d(1.5, 3.5, 0.5));
 }
 
+// Without an optimised confidence, an instance is scored as the optimiser scores its own: the
+// logistic model of its voxels and of the class scores P_nu^C of its super-points, each
+// super-point's score of its own class counting as support. Instance 9 keeps the optimiser's.
+TEST(Objects, InstancesWithoutAnOptimisedConfidenceGetTheOptimisersModel) {
+  const TsdfMap map = makeMap();
+  const SuperpointTracker tracker = makeTracker();
+  GraphAccumulator graph{GraphConfig{}};
+  GraphAccumulator::Snapshot snapshot;
+  snapshot.scores[1] = {{5, 40.0}, {1, 8.0}};  // chair super-point, seen as wall sometimes
+  snapshot.scores[2] = {{5, 8.0}, {3, 8.0}};
+  snapshot.scores[3] = {{3, 64.0}};
+  graph.restore(snapshot);
+  OptimiserConfig::Objects model;
+  model.share = 0.5;  // the default holds it at 0: here it must count too
+  const ObjectScoring scoring{&graph, model};
+  GraphLabels labels;
+  labels.instance_confidence = {{9, 0.125f}};
+  const std::vector<MappedObject> objects = computeObjects(map, tracker, &labels, &scoring);
+  ASSERT_EQ(objects.size(), 2u);
+  // Chair: 16 voxels of 0.25 m (1 m2, log10 0); score of class 5: 40 + 8 of 64 in all.
+  const MappedObject& chair = objects[0];
+  EXPECT_EQ(chair.id, 7);
+  const double z = model.bias + model.support * std::log2(48.0 / 16.0) + model.share * 0.75;
+  EXPECT_FLOAT_EQ(chair.confidence, static_cast<float>(1.0 / (1.0 + std::exp(-z))));
+  EXPECT_FLOAT_EQ(chair.evidence.area_m2, 1.0f);
+  EXPECT_FLOAT_EQ(chair.evidence.support, 3.0f);
+  EXPECT_FLOAT_EQ(chair.evidence.class_share, 0.75f);
+  EXPECT_EQ(objects[1].id, 9);
+  EXPECT_EQ(objects[1].confidence, 0.125f);
+  EXPECT_EQ(objects[1].evidence, ObjectEvidence{});
+  // Without scoring: the frame-count stability of HandBuiltFrameCountObjects.
+  EXPECT_FLOAT_EQ(computeObjects(map, tracker, &labels)[0].confidence, 0.55f);
+}
+
 TEST(Objects, JsonRoundTripIsExactAndReadableByPanmapEval) {
   const TsdfMap map = makeMap();
   const SuperpointTracker tracker = makeTracker();

@@ -6,6 +6,8 @@
 
 #include <Eigen/Geometry>
 
+#include "panmap/graph/graph_accumulator.h"
+#include "panmap/graph/optimiser.h"
 #include "panmap/graph/superpoint_graph.h"
 #include "panmap/map/tsdf_map.h"
 #include "panmap/superpoint/superpoint_tracker.h"
@@ -52,14 +54,26 @@ struct MappedObject {
   }
 };
 
+/// How computeObjects() scores an instance that `labels` give no confidence (frame-count
+/// instances: no optimiser answer yet, or none at all): with the evidence the optimiser would
+/// read, the graph's class scores P_nu^C of its super-points, and the optimiser's logistic
+/// model (objectConfidence), so a confidence means the same whichever labels made the object.
+struct ObjectScoring {
+  const GraphAccumulator* graph = nullptr;  ///< P_nu^C of each live super-point (not owned)
+  OptimiserConfig::Objects model;           ///< the confidence model
+};
+
 /// The objects of a map, ascending by id. Every observed voxel within
 /// kObjectSurfaceBandVoxels of the surface counts for the instance of its super-point (Eq. 2
 /// argmax, merges resolved). Super-point labels follow Mapper::extractMesh: `labels` first,
 /// frame counting for super-points it does not name, so ids match mesh_instance.ply.
-/// Class: the class of most voxels. Confidence: labels->instance_confidence of the id when
-/// given; otherwise the voxel-weighted mean over its super-points of n_best / (n + 1), n the
-/// frames that assigned the super-point to any instance and n_best those that chose its
-/// current one (stable super-points seen often approach 1; one sighting gives 0.5).
+/// Class: the class of most voxels. Confidence and evidence: labels->instance_confidence and
+/// instance_evidence of the id when given; otherwise, with `scoring`, the model's confidence of
+/// the instance's evidence: its counted voxels, and the sum over its super-points of P_nu^C of
+/// each one's own class (support), as InstanceEvidence counts them; without `scoring`, the
+/// voxel-weighted mean over its super-points of n_best / (n + 1), n the frames that assigned the
+/// super-point to any instance and n_best those that chose its current one (stable super-points
+/// seen often approach 1; one sighting gives 0.5), and no evidence.
 /// Oriented box: yaw-only about world z (what ground robots plan with), the yaw of the
 /// minimum-area rectangle around the footprint of the voxel centres (rotating calipers over
 /// the convex hull). PCA was not used: its axes are undefined for square footprints (most
@@ -67,11 +81,15 @@ struct MappedObject {
 /// @param map the label-TSDF (voxel centres in the world frame)
 /// @param tracker the super-points and their frame-count labels
 /// @param labels optimised labels, or null for frame-count labels only
+/// @param scoring how to score instances `labels` do not, or null (see above)
 std::vector<MappedObject> computeObjects(const TsdfMap& map, const SuperpointTracker& tracker,
-                                         const GraphLabels* labels);
+                                         const GraphLabels* labels,
+                                         const ObjectScoring* scoring = nullptr);
 
-/// computeObjects() of a mapper's current state.
-std::vector<MappedObject> computeObjects(const Mapper& mapper, const GraphLabels* labels = nullptr);
+/// computeObjects() of a mapper's current state; instances `labels` do not score are scored by
+/// `model` with the mapper's graph (ObjectScoring).
+std::vector<MappedObject> computeObjects(const Mapper& mapper, const GraphLabels* labels = nullptr,
+                                         const OptimiserConfig::Objects& model = {});
 
 /// Writes objects.json: {"utime", "objects": [{"id", "class", "class_name", "confidence",
 /// "num_voxels", "centroid", "aabb_min", "aabb_max", "obb_center", "obb_orientation_wxyz",

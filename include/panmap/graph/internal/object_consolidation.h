@@ -33,9 +33,5 @@ ConsolidatedObjects consolidateObjects(const SuperpointGraph& graph,
                                        const std::vector<int32_t>& instances,
                                        const OptimiserConfig::Objects& config);
 
-/// The logistic confidence of one instance's evidence (area from voxel_size_m).
-float objectConfidence(const InstanceEvidence& evidence, double voxel_size_m,
-                       const OptimiserConfig::Objects& config);
-
 }  // namespace internal
 }  // namespace panmap
