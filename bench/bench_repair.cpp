@@ -11,7 +11,7 @@
 // geometric segments kept in the store; --reintegrate-only: re-integration with the stored pixel
 // labels instead, as panmap-mapper --repair-reintegrate-only).
 //   panmap-bench-repair [--data DIR | --room S [--segment-again | --reintegrate-only]
-//                       [--occupancy-last]]
+//                       [--occupancy-last] [--reintegrate-first]]
 //                       [--frames N] [--voxel-size M]
 //                       [--threads N] [--rate-hz R] [--live-frames K]
 
@@ -102,6 +102,7 @@ int main(int argc, char** argv) {
 #endif
   int frames = 1000, threads = 2, live_frames = 0, room = -1;
   bool segment_again = false, reintegrate_only = false, occupancy_last = false;
+  bool reintegrate_first = false;
   double rate_hz = 5.0;
   float voxel_size_m = 0.02f;
   app.add_option("--data", data, "dataset folder (7-Scenes, ScanNet export, TUM, folder)")
@@ -119,6 +120,9 @@ int main(int argc, char** argv) {
   app.add_flag("--occupancy-last", occupancy_last,
                "with --room: the background repair swaps the occupancy tree in with the rest of "
                "the map instead of first (MapRepairConfig::occupancy_first off)");
+  app.add_flag("--reintegrate-first", reintegrate_first,
+               "with --room: the background repair first re-integrates the frames and swaps that "
+               "map in, then maps them again (MapRepairConfig::reintegrate_first)");
   app.add_option("--frames", frames, "frames in the map when the correction comes")
       ->capture_default_str();
   app.add_option("--voxel-size", voxel_size_m, "voxel size, metres")->capture_default_str();
@@ -229,6 +233,7 @@ int main(int argc, char** argv) {
     panmap::MapRepairConfig repair_config;
     repair_config.reassociate = !reintegrate_only;
     repair_config.occupancy_first = !occupancy_last;
+    repair_config.reintegrate_first = reintegrate_first;
     const panmap::MapRepairResult blocking =
         panmap::repairMap(&mapper, &store, first, repair_config);
     std::printf("blocking repair:   %s\n", panmap::describe(blocking).c_str());

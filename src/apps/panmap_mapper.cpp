@@ -291,6 +291,11 @@ int main(int argc, char** argv) {
                "live repairs that map the frames again swap the occupancy tree in with the rest "
                "of the map, not first (by default planners get the repaired tree after one pass "
                "over the stored depth)");
+  bool repair_reintegrate_first = false;
+  app.add_flag("--repair-reintegrate-first", repair_reintegrate_first,
+               "live repairs that map the frames again first re-integrate them and swap that "
+               "map in (geometry, labels, objects and occupancy repaired in about a third of "
+               "the time), then map them again (instead of the occupancy tree alone first)");
   std::vector<double> grid_shift;
   app.add_option("--grid-shift", grid_shift,
                  "X,Y,Z metres: move every pose by this before mapping, so the voxel grid falls "
@@ -416,6 +421,7 @@ int main(int argc, char** argv) {
       options.frame_store = frame_store.get();
       options.repair.reassociate = !repair_reintegrate_only;
       options.repair.occupancy_first = !repair_occupancy_last;
+      options.repair.reintegrate_first = repair_reintegrate_first;
     }
     // Offline runs can be replayed from their log, so they autosave only when asked to.
     const bool offline = !log_path.empty() || export_only;

@@ -53,8 +53,9 @@ void BackgroundRepair::cancel() {
   stopWorker();
   rebuild_.reset();
   occupancy_.reset();
-  occupancy_pass_ = false;
-  occupancy_handover_ = false;
+  early_map_.reset();
+  early_pass_ = false;
+  early_handover_ = false;
 }
 
 MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
@@ -89,19 +90,25 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
       holds_segmentations_ ? holds_segmentations_() : store_ && store_->sizeWithPanoptic() > 0;
   remap_ = config_.reassociate && panoptic_load_ && holds;
   rebuild_ = mapper_->beginRebuild(&pool_, remap_);
-  // Mapping the frames again takes the whole pipeline per frame; the occupancy tree a planner
-  // reads needs only the depth and the pose, so it goes first.
-  const bool occupancy_first = remap_ && config_.occupancy_first && mapper_->occupancy();
+  // Mapping the frames again takes the whole pipeline per frame. Re-integrating them with the
+  // super-points they voted for takes integration alone, and the occupancy tree a planner
+  // reads needs only the depth and the pose: either goes first.
+  const bool early_map = remap_ && config_.reintegrate_first;
+  const bool early_occupancy =
+      remap_ && !early_map && config_.occupancy_first && mapper_->occupancy();
   occupancy_ =
-      occupancy_first ? std::make_unique<OccupancyRebuild>(mapper_->config(), &pool_) : nullptr;
+      early_occupancy ? std::make_unique<OccupancyRebuild>(mapper_->config(), &pool_) : nullptr;
+  early_map_ = early_map ? mapper_->beginRebuild(&pool_, false) : nullptr;
   occupancy_swapped_s_ = -1.0;
+  map_swapped_s_ = -1.0;
+  poses_recorded_ = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     jobs_ = corrected_.poses;
     next_ = 0;
-    occupancy_pass_ = occupancy_first;
-    occupancy_handover_ = false;
-    occupancy_next_ = 0;
+    early_pass_ = early_occupancy || early_map;
+    early_handover_ = false;
+    early_next_ = 0;
     idle_ = false;
     stop_ = false;
     failure_.clear();
@@ -149,10 +156,20 @@ void BackgroundRepair::addLoaded(const StampedPose& job, const RgbdFrame& frame,
   rebuild_->add(frame, job.T_W_C, &labels, panoptic, kept);
 }
 
-bool BackgroundRepair::occupancyPass() {
+void BackgroundRepair::addEarly(const StampedPose& job, const RgbdFrame& frame,
+                                const LabelImage& labels) {
+  checkFrameOf(job, frame);
+  if (early_map_) {
+    early_map_->add(frame, job.T_W_C, &labels);
+  } else {
+    occupancy_->add(frame, job.T_W_C);
+  }
+}
+
+bool BackgroundRepair::earlyPass() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!occupancy_pass_) return true;
+    if (!early_pass_) return true;
   }
   RgbdFrame frame;
   LabelImage labels;
@@ -164,19 +181,18 @@ bool BackgroundRepair::occupancyPass() {
     size_t index = 0;
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      if (occupancy_handover_ || occupancy_next_ == jobs_.size()) {
-        // Caught up, or poll() takes the tree over with the last few frames: wait.
+      if (early_handover_ || early_next_ == jobs_.size()) {
+        // Caught up, or poll() takes the pass over with the last few frames: wait.
         idle_ = true;
         cv_.notify_all();
         cv_.wait(lock, [this] {
-          return stop_ || !occupancy_pass_ ||
-                 (!occupancy_handover_ && occupancy_next_ < jobs_.size());
+          return stop_ || !early_pass_ || (!early_handover_ && early_next_ < jobs_.size());
         });
         idle_ = false;
       }
       if (stop_) return false;
-      if (!occupancy_pass_) return true;
-      index = occupancy_next_;
+      if (!early_pass_) return true;
+      index = early_next_;
       job = jobs_[index];
     }
     try {
@@ -186,8 +202,7 @@ bool BackgroundRepair::occupancyPass() {
         frame = RgbdFrame();
         load_(job.utime, &frame, &labels);
       }
-      checkFrameOf(job, frame);
-      occupancy_->add(frame, job.T_W_C);
+      addEarly(job, frame, labels);
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex_);
       failure_ = e.what();
@@ -196,45 +211,65 @@ bool BackgroundRepair::occupancyPass() {
       return false;
     }
     std::lock_guard<std::mutex> lock(mutex_);
-    ++occupancy_next_;
+    ++early_next_;
   }
 }
 
-void BackgroundRepair::takeOccupancyIfReady(std::unique_lock<std::mutex>* lock) {
-  if (!occupancy_pass_ || !failure_.empty()) return;
+void BackgroundRepair::takeEarlyIfReady(std::unique_lock<std::mutex>* lock) {
+  if (!early_pass_ || !failure_.empty()) return;
   // Frames keep coming, so the pass is never quite done when asked (as for the commit): at most
-  // kFramesLeftToCommit behind, it hands the tree over after the frame it is on.
-  if (jobs_.size() - occupancy_next_ > kFramesLeftToCommit) return;
-  occupancy_handover_ = true;
+  // kFramesLeftToCommit behind, it is handed over after the frame it is on.
+  if (jobs_.size() - early_next_ > kFramesLeftToCommit) return;
+  early_handover_ = true;
   cv_.notify_all();
   cv_.wait(*lock, [this] { return !failure_.empty() || idle_; });
   if (!failure_.empty()) return;
-  // The worker waits: the tree is this thread's until the pass ends.
+  // The worker waits: the pass is this thread's until it ends.
+  const bool map = static_cast<bool>(early_map_);
   try {
     RgbdFrame frame;
     LabelImage labels;
-    for (; occupancy_next_ < jobs_.size(); ++occupancy_next_) {
-      const StampedPose& job = jobs_[occupancy_next_];
+    for (; early_next_ < jobs_.size(); ++early_next_) {
+      const StampedPose& job = jobs_[early_next_];
       load_(job.utime, &frame, &labels);
-      checkFrameOf(job, frame);
-      occupancy_->add(frame, job.T_W_C);
+      addEarly(job, frame, labels);
     }
-    const std::vector<StampedPose> poses = occupancy_->poses();
-    mapper_->replaceOccupancy(occupancy_->take(), poses);
-    occupancy_swapped_s_ =
+    const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+    if (map) {
+      mapper_->commitRebuild(std::move(early_map_), nullptr);
+      map_swapped_s_ = seconds;
+      if (mapper_->occupancy()) occupancy_swapped_s_ = seconds;
+      recordPoses();
+    } else {
+      const std::vector<StampedPose> poses = occupancy_->poses();
+      mapper_->replaceOccupancy(occupancy_->take(), poses);
+      occupancy_swapped_s_ = seconds;
+    }
   } catch (const std::exception& e) {
-    // The commit brings the repaired tree all the same.
-    std::fprintf(stderr, "panmap: occupancy of the repair not swapped in early: %s\n", e.what());
+    // The commit brings the whole repair all the same.
+    std::fprintf(stderr, "panmap: the repair's early %s not swapped in: %s\n",
+                 map ? "re-integrated map" : "occupancy tree", e.what());
   }
   occupancy_.reset();
-  occupancy_pass_ = false;
-  occupancy_handover_ = false;
+  early_map_.reset();
+  early_pass_ = false;
+  early_handover_ = false;
   cv_.notify_all();
 }
 
+void BackgroundRepair::recordPoses() {
+  if (!store_ || poses_recorded_) return;
+  for (size_t i = 0; i < corrected_.poses.size(); ++i) {
+    if (corrected_.translation_m[i] > 0.0 || corrected_.rotation_rad[i] > 0.0) {
+      store_->updatePose(corrected_.poses[i].utime, corrected_.poses[i].T_W_C);
+    }
+  }
+  poses_recorded_ = true;
+}
+
 void BackgroundRepair::work() {
-  if (!occupancyPass()) return;
+  if (!earlyPass()) return;
   RgbdFrame frame;
   LabelImage labels;
   PanopticFrame panoptic;
@@ -283,6 +318,7 @@ MapRepairResult BackgroundRepair::commit() {
   // The worker has returned: everything below is this thread's.
   MapRepairResult result = std::move(result_);
   result.occupancy_swapped_s = occupancy_swapped_s_;
+  result.map_swapped_s = map_swapped_s_;
   ReintegrationStats& stats = result.reintegration;
   stats.blocks_before = blocks_before_;
   stats.seconds =
@@ -309,13 +345,7 @@ MapRepairResult BackgroundRepair::commit() {
     stats.blocks_after = blocks_before_;
     return result;
   }
-  if (store_) {
-    for (size_t i = 0; i < corrected_.poses.size(); ++i) {
-      if (corrected_.translation_m[i] > 0.0 || corrected_.rotation_rad[i] > 0.0) {
-        store_->updatePose(corrected_.poses[i].utime, corrected_.poses[i].T_W_C);
-      }
-    }
-  }
+  recordPoses();
   stats.completed = true;
   stats.blocks_after = mapper_->map().numBlocks();
   return result;
@@ -325,10 +355,10 @@ std::optional<MapRepairResult> BackgroundRepair::poll() {
   if (!running()) return std::nullopt;
   {
     std::unique_lock<std::mutex> lock(mutex_);
-    takeOccupancyIfReady(&lock);
+    takeEarlyIfReady(&lock);
     // Frames keep coming while the worker catches up, so it is never quite done when asked:
     // the last few frames are re-integrated here instead.
-    if (failure_.empty() && (occupancy_pass_ || jobs_.size() - next_ > kFramesLeftToCommit)) {
+    if (failure_.empty() && (early_pass_ || jobs_.size() - next_ > kFramesLeftToCommit)) {
       return std::nullopt;
     }
   }
@@ -355,11 +385,10 @@ std::optional<MapRepairResult> BackgroundRepair::finish() {
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
       cv_.wait(lock, [this] {
-        return !failure_.empty() ||
-               (idle_ && (occupancy_pass_ ? occupancy_next_ : next_) == jobs_.size());
+        return !failure_.empty() || (idle_ && (early_pass_ ? early_next_ : next_) == jobs_.size());
       });
-      if (!failure_.empty() || !occupancy_pass_) break;
-      takeOccupancyIfReady(&lock);
+      if (!failure_.empty() || !early_pass_) break;
+      takeEarlyIfReady(&lock);
     }
   }
   return poll();

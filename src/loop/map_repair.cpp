@@ -101,7 +101,12 @@ std::string describe(const MapRepairResult& r) {
     out += "; kept geometric segments of " +
            std::to_string(r.reintegration.frames_with_kept_segments) + " frames";
   }
-  if (r.occupancy_swapped_s >= 0.0) {
+  if (r.map_swapped_s >= 0.0) {
+    char early[80];
+    std::snprintf(early, sizeof(early), "; re-integrated map swapped in after %.2f s",
+                  r.map_swapped_s);
+    out += early;
+  } else if (r.occupancy_swapped_s >= 0.0) {
     char occupancy[80];
     std::snprintf(occupancy, sizeof(occupancy), "; occupancy swapped in after %.2f s",
                   r.occupancy_swapped_s);

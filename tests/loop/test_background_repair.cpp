@@ -321,6 +321,71 @@ TEST_F(BackgroundRepairTest, TheOccupancyTreeIsSwappedInBeforeTheFramesAreMapped
   }
 }
 
+// With reintegrate_first the repair first re-integrates the frames at their corrected poses
+// with the super-points they voted for, and swaps that map in while mapping them again is still
+// held: the map is then, bit for bit, what a blocking re-integration gives, and the store
+// already has the new poses. The repair then maps the frames again and swaps in the same
+// geometry as one without the early map.
+TEST_F(BackgroundRepairTest, TheReintegratedMapIsSwappedInBeforeTheFramesAreMappedAgain) {
+  test::TempDir dir;
+  FrameStore store(storeConfig(dir.path("store")));
+  auto mapper = std::make_unique<Mapper>(config());
+  test::TempDir other;
+  FrameStore other_store(storeConfig(other.path("store")));
+  auto reference = std::make_unique<Mapper>(config());
+  for (int k = 0; k < 6; ++k) {
+    integrateWithMasks(mapper.get(), k, &store);
+    integrateWithMasks(reference.get(), k, &other_store);
+  }
+  ASSERT_EQ(mapper->serialize(), reference->serialize());
+  const PoseCorrection correction =
+      keyframeCorrection(*mapper, 3, move(0.03, {0.05, -0.03, 0.01}), 7);
+  const CorrectedTrajectory corrected = applyCorrection(mapper->trajectory(), correction);
+  ASSERT_TRUE(reference->reintegrate(corrected.poses, storeLoader(&store)).completed);
+  const std::vector<uint8_t> reintegrated = reference->serialize();
+  ASSERT_NE(mapper->serialize(), reintegrated);
+
+  MapRepairConfig repair_config;
+  repair_config.reintegrate_first = true;
+  Gate gate;
+  const std::unique_ptr<BackgroundRepair> held =
+      gatedRepair(mapper.get(), &store, repair_config, &gate);
+  BackgroundRepair& repair = *held;
+  const OpenAtExit open_at_exit{&gate};
+  repair.start(correction);
+  // The poses change with the swap (the frame the correction names moved by 5 cm).
+  for (int64_t polls = 0; mapper->trajectory()[3].T_W_C.isApprox(pose(3), 1e-12); ++polls) {
+    ASSERT_LT(polls, 100000000) << "the re-integrated map was never swapped in";
+    ASSERT_FALSE(repair.poll()) << "committed while mapping again was held";
+    std::this_thread::yield();
+  }
+  EXPECT_EQ(mapper->serialize(), reintegrated);
+  EXPECT_EQ(repair.framesDone(), 0);
+  const std::vector<StampedPose> stored = store.trajectory();
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_TRUE(stored[k].T_W_C.isApprox(corrected.poses[k].T_W_C, 1e-15)) << k;
+  }
+
+  gate.open();
+  const std::optional<MapRepairResult> done = repair.finish();
+  ASSERT_TRUE(done);
+  ASSERT_TRUE(done->reintegration.completed) << done->failure;
+  EXPECT_TRUE(done->reintegration.reassociated);
+  EXPECT_GE(done->map_swapped_s, 0.0);
+  EXPECT_EQ(done->occupancy_swapped_s, done->map_swapped_s);
+  EXPECT_NE(describe(*done).find("re-integrated map swapped in after"), std::string::npos)
+      << describe(*done);
+
+  // Mapping again from the map as it was gives the same geometry.
+  test::TempDir third;
+  FrameStore third_store(storeConfig(third.path("store")));
+  auto plain = std::make_unique<Mapper>(config());
+  for (int k = 0; k < 6; ++k) integrateWithMasks(plain.get(), k, &third_store);
+  ASSERT_TRUE(repairMap(plain.get(), &third_store, correction).reintegration.reassociated);
+  EXPECT_EQ(geometryOf(mapper->map()), geometryOf(plain->map()));
+  EXPECT_EQ(mapper->occupancy()->toBinaryData(), plain->occupancy()->toBinaryData());
+}
+
 // A frame comes, is handed to the repair, and the mapping thread asks at once: the occupancy
 // pass is then busy with that frame every time. It hands its tree over anyway once at most
 // two frames behind (the first version waited for an idle pass, and at 5 Hz swapped the tree in

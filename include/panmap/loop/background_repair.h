@@ -25,8 +25,9 @@ namespace panmap {
 /// stored, maps again) the frames the map held when the correction came, at their corrected
 /// poses, then every frame integrated since, at the pose it was mapped with; once it has
 /// caught up, poll() swaps the repaired map in between two frames. Before it maps the frames
-/// again (MapRepairConfig::occupancy_first), it runs over them once for the occupancy tree
-/// alone, which poll() swaps in as soon as it has caught up.
+/// again, it runs over them once for an early swap, which poll() makes as soon as that pass
+/// has caught up: a re-integrated map (MapRepairConfig::reintegrate_first) or the occupancy
+/// tree alone (occupancy_first).
 /// A newer correction abandons a running repair and starts again from the map (superseded).
 ///
 /// Threads: every member function is called from the mapping thread (the one that calls
@@ -91,13 +92,18 @@ class BackgroundRepair {
   /// Loads one frame and adds it to the rebuild at the job's pose; throws Error.
   void reintegrate(const StampedPose& job, RgbdFrame* frame, LabelImage* labels,
                    PanopticFrame* panoptic, GeometricSegments* kept);
-  /// The occupancy pass: every job into occupancy_, until poll() takes the tree. Returns
+  /// The early pass: every job into occupancy_ or early_map_, until poll() takes it. Returns
   /// false when the worker must return (stopped or failed).
-  bool occupancyPass();
-  /// With mutex_ held by `lock`: when the occupancy pass is at most kFramesLeftToCommit frames
+  bool earlyPass();
+  /// Adds a frame loaded with its pixel labels to the early pass; throws Error.
+  void addEarly(const StampedPose& job, const RgbdFrame& frame, const LabelImage& labels);
+  /// With mutex_ held by `lock`: when the early pass is at most kFramesLeftToCommit frames
   /// behind, waits for the worker to finish the frame it is on, adds the rest itself, swaps the
-  /// tree into the mapper and lets the worker go on to map the frames again.
-  void takeOccupancyIfReady(std::unique_lock<std::mutex>* lock);
+  /// tree or the re-integrated map into the mapper and lets the worker go on to map the frames
+  /// again.
+  void takeEarlyIfReady(std::unique_lock<std::mutex>* lock);
+  /// Records the corrected poses of the frames that moved in the store (once per repair).
+  void recordPoses();
   /// Throws Error naming both utimes when `frame` is not the job's frame.
   static void checkFrameOf(const StampedPose& job, const RgbdFrame& frame);
   /// Adds a loaded frame at the job's pose; throws Error when it is another frame.
@@ -117,9 +123,13 @@ class BackgroundRepair {
   CorrectedTrajectory corrected_;
   std::unique_ptr<MapRebuild> rebuild_;
   bool remap_ = false;  // the running repair maps the frames again
-  // The occupancy pass (occupancy_first): the worker's until it waits with every job done.
+  // The early pass, one of the two (reintegrate_first, occupancy_first): the worker's until it
+  // waits with every job done.
   std::unique_ptr<OccupancyRebuild> occupancy_;
+  std::unique_ptr<MapRebuild> early_map_;
   double occupancy_swapped_s_ = -1.0;
+  double map_swapped_s_ = -1.0;
+  bool poses_recorded_ = false;
   std::chrono::steady_clock::time_point started_;
   size_t blocks_before_ = 0;
   int64_t superseded_ = 0;
@@ -127,14 +137,14 @@ class BackgroundRepair {
   std::thread worker_;
   mutable std::mutex mutex_;  // guards what follows
   std::condition_variable cv_;
-  std::vector<StampedPose> jobs_;    // frames to re-integrate, in order, with their poses
-  size_t next_ = 0;                  // jobs_ done by the worker
-  bool occupancy_pass_ = false;      // the worker builds occupancy_ (until poll() takes it)
-  bool occupancy_handover_ = false;  // poll() takes occupancy_ over: the worker stops at once
-  size_t occupancy_next_ = 0;        // jobs_ in occupancy_
-  bool idle_ = false;                // the worker waits for a job
-  bool stop_ = false;                // the worker must return
-  std::string failure_;              // why the worker gave up
+  std::vector<StampedPose> jobs_;  // frames to re-integrate, in order, with their poses
+  size_t next_ = 0;                // jobs_ done by the worker
+  bool early_pass_ = false;        // the worker runs the early pass (until poll() takes it)
+  bool early_handover_ = false;    // poll() takes the early pass over: the worker stops at once
+  size_t early_next_ = 0;          // jobs_ in the early pass
+  bool idle_ = false;              // the worker waits for a job
+  bool stop_ = false;              // the worker must return
+  std::string failure_;            // why the worker gave up
 };
 
 }  // namespace panmap

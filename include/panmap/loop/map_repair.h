@@ -27,6 +27,13 @@ struct MapRepairConfig {
   /// go after about 2 ms a frame instead of the whole pipeline's 10-20), then maps the frames
   /// again as before; the tree the repair commits is the same.
   bool occupancy_first = true;
+  /// A repair on its own thread that maps the frames again first re-integrates them (each
+  /// frame votes again for the super-points it voted for, as with reassociate off: about a
+  /// third of mapping them again) and swaps that map in, occupancy tree included, then maps the
+  /// frames again and swaps the result in at the end. The map is repaired in geometry, labels
+  /// and objects long before the association is done again; pixel labels naming super-points a
+  /// former repair retired vote for nothing until then. Takes the place of occupancy_first.
+  bool reintegrate_first = false;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -51,6 +58,9 @@ struct MapRepairResult {
   /// Seconds after the correction at which a background repair swapped in the occupancy tree
   /// it built first (MapRepairConfig::occupancy_first); negative: it did not.
   double occupancy_swapped_s = -1.0;
+  /// Seconds after the correction at which a background repair swapped in the re-integrated
+  /// map it built first (MapRepairConfig::reintegrate_first); negative: it did not.
+  double map_swapped_s = -1.0;
 };
 
 /// The repair after a loop closure (docs/LOOP_CLOSURE.md): spreads the correction over every
