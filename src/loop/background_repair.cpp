@@ -101,6 +101,8 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
   early_map_ = early_map ? mapper_->beginRebuild(&pool_, false) : nullptr;
   occupancy_swapped_s_ = -1.0;
   map_swapped_s_ = -1.0;
+  map_swapped_rejoined_ = 0;
+  map_swapped_rejoin_s_ = 0.0;
   poses_recorded_ = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -237,8 +239,11 @@ void BackgroundRepair::takeEarlyIfReady(std::unique_lock<std::mutex>* lock) {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
     if (map) {
-      mapper_->commitRebuild(std::move(early_map_), nullptr);
+      ReintegrationStats early;
+      mapper_->commitRebuild(std::move(early_map_), &early);
       map_swapped_s_ = seconds;
+      map_swapped_rejoined_ = early.superpoints_rejoined;
+      map_swapped_rejoin_s_ = early.rejoin_s;
       if (mapper_->occupancy()) occupancy_swapped_s_ = seconds;
       recordPoses();
     } else {
@@ -319,6 +324,8 @@ MapRepairResult BackgroundRepair::commit() {
   MapRepairResult result = std::move(result_);
   result.occupancy_swapped_s = occupancy_swapped_s_;
   result.map_swapped_s = map_swapped_s_;
+  result.map_swapped_rejoined = map_swapped_rejoined_;
+  result.map_swapped_rejoin_s = map_swapped_rejoin_s_;
   ReintegrationStats& stats = result.reintegration;
   stats.blocks_before = blocks_before_;
   stats.seconds =

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <utility>
 
 #include "panmap/core/error.h"
@@ -102,9 +103,11 @@ std::string describe(const MapRepairResult& r) {
            std::to_string(r.reintegration.frames_with_kept_segments) + " frames";
   }
   if (r.map_swapped_s >= 0.0) {
-    char early[80];
-    std::snprintf(early, sizeof(early), "; re-integrated map swapped in after %.2f s",
-                  r.map_swapped_s);
+    char early[160];
+    std::snprintf(early, sizeof(early),
+                  "; re-integrated map swapped in after %.2f s (%zu super-points rejoined in "
+                  "%.2f s)",
+                  r.map_swapped_s, r.map_swapped_rejoined, r.map_swapped_rejoin_s);
     out += early;
   } else if (r.occupancy_swapped_s >= 0.0) {
     char occupancy[80];
@@ -121,6 +124,12 @@ std::string describe(const MapRepairResult& r) {
                   100.0 * r.reintegration.instance_surface_kept, r.reintegration.superpoints_kept,
                   r.reintegration.superpoints, 100.0 * r.reintegration.superpoint_surface_kept);
     out += ids;
+  } else if (r.reintegration.superpoints_rejoined > 0) {
+    char rejoined[120];
+    std::snprintf(rejoined, sizeof(rejoined),
+                  "; %zu super-points rejoined the one they coincide with (%.2f s)",
+                  r.reintegration.superpoints_rejoined, r.reintegration.rejoin_s);
+    out += rejoined;
   }
   return out;
 }

@@ -8,6 +8,7 @@
 #include "panmap/mapper/frame_prefetcher.h"
 #include "panmap/mapper/instance_carry_over.h"
 #include "panmap/mapper/mapper.h"
+#include "panmap/mapper/superpoint_rejoin.h"
 
 namespace panmap {
 
@@ -77,10 +78,21 @@ void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild, ReintegrationSta
     if (static_cast<bool>(rebuild->occupancy_) != static_cast<bool>(occupancy_)) {
       throw Error("commitRebuild: the rebuild was made with another occupancy setting");
     }
+    // A surface that association missed under drift has two super-points; voting again at
+    // the corrected poses lays them over one another.
+    const auto rejoin_start = std::chrono::steady_clock::now();
+    const size_t rejoined = rejoinCoincidingSuperpoints(*rebuild->map_, map_.get(), tracker_.get());
+    graph_->applyMerges(*tracker_);
+    tracker_->labels().flatten();  // threads that label voxels only read the registry
     map_ = std::move(rebuild->map_);
     if (occupancy_) occupancy_ = std::move(rebuild->occupancy_);
     // The evictions of building this map, which replaces the old one and its history.
     vote_evictions_ = rebuild->votesEvicted();
+    if (stats) {
+      stats->superpoints_rejoined = rejoined;
+      stats->rejoin_s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - rejoin_start).count();
+    }
   }
   mesher_->invalidateAll();
   for (size_t i = 0; i < poses.size(); ++i) trajectory_[i].T_W_C = poses[i].T_W_C;

@@ -1,6 +1,7 @@
 #include "panmap/superpoint/superpoint_tracker.h"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <string>
 #include <tuple>
@@ -159,7 +160,25 @@ void SuperpointTracker::mergeLabels(int32_t a, int32_t b, FrameAssociation* out)
     for (const auto& [key, count] : moved) (*counts)[key] += count;
   }
   merge_log_.push_back({keep, gone, frames_});
-  ++out->merges;
+  if (out) ++out->merges;
+}
+
+bool SuperpointTracker::rejoin(int32_t a, int32_t b, double share) {
+  const int32_t ra = labels_.resolve(a), rb = labels_.resolve(b);
+  if (ra == rb || !consistent(ra, rb)) return false;
+  const auto key = std::minmax(ra, rb);
+  const auto co = co_observed_.find(key);
+  // Every frame that saw the one seen less saw the other's surface too, where they coincide.
+  const auto frames = [this](int32_t label) {
+    const auto it = states_.find(label);
+    return it == states_.end() ? 0.0 : it->second.voidFrames().second;
+  };
+  const double together = std::clamp(share, 0.0, 1.0) * std::min(frames(ra), frames(rb));
+  const int m =
+      (co == co_observed_.end() ? 0 : co->second) + static_cast<int>(std::lround(together));
+  if (seenApart(key, m)) return false;
+  mergeLabels(ra, rb, nullptr);
+  return true;
 }
 
 size_t SuperpointTracker::memoryBytes() const {

@@ -391,6 +391,44 @@ TEST_F(Reintegration, ARemapKeepsTheIdsOfTheObjectsItFindsAgain) {
   EXPECT_EQ(computeObjects(mapper), after);
 }
 
+// Re-integrated at the corrected poses, the ghosts' frames vote again on the real cabinet and
+// fridge, for the super-points association gave them 1.6 m away: two super-points (and two
+// objects) on one surface, until they rejoin. Then each object is there once, with its class,
+// and the super-points of the ghosts resolve to those of the real objects.
+TEST_F(Reintegration, ReintegratedSuperpointsRejoinTheOnesTheyCoincideWith) {
+  std::vector<StampedPose> corrected;
+  const std::unique_ptr<Mapper> recorded = recordWithGhosts(&corrected);
+  Mapper& mapper = *recorded;
+  const std::vector<MappedObject> before = computeObjects(mapper);
+  const int32_t ghost = objectNear(before, 3, ghostOffset() * cabinet_W);
+  ASSERT_GT(ghost, 0) << "no ghost: nothing to show";
+  const size_t superpoints_before = mapper.superpoints().states().size();
+
+  const ReintegrationStats stats = mapper.reintegrate(corrected, loader());
+  ASSERT_TRUE(stats.completed);
+  EXPECT_GT(stats.superpoints_rejoined, 0u);
+  EXPECT_EQ(mapper.superpoints().states().size(), superpoints_before - stats.superpoints_rejoined);
+  const std::vector<MappedObject> after = computeObjects(mapper);
+  const auto count = [&after](int32_t c) {
+    return std::count_if(after.begin(), after.end(), [c](const MappedObject& o) {
+      return o.class_id == c && o.num_voxels >= 50;
+    });
+  };
+  EXPECT_EQ(count(3), 1);
+  EXPECT_EQ(count(24), 1);
+  EXPECT_GT(objectNear(after, 3, cabinet_W), 0);
+  EXPECT_GT(objectNear(after, 24, fridge_W), 0);
+  EXPECT_EQ(objectNear(after, 3, ghostOffset() * cabinet_W), 0);
+  // The graph follows: no score is left on a super-point that rejoined another.
+  for (const auto& [label, scores] : mapper.graphAccumulator().snapshot().scores) {
+    EXPECT_EQ(mapper.superpoints().labels().resolve(label), label) << label;
+  }
+  // Saved and loaded, the map is the same map.
+  const std::unique_ptr<Mapper> loaded =
+      Mapper::deserialize(mapper.serialize(), "the re-integrated map");
+  EXPECT_EQ(computeObjects(*loaded), after);
+}
+
 // The super-point holding most mesh vertices within 0.35 m of p_W (0: none there): of an
 // object's centroid, its front face.
 int32_t superpointNear(const LabelledMesh& mesh, const Eigen::Vector3d& p_W) {

@@ -138,6 +138,9 @@ class GraphAccumulator {
   };
   /// Copies the state out.
   Snapshot snapshot() const { return Snapshot{scores_, edges_.toOrdered(), merges_applied_}; }
+  /// Moves the scores and edges of super-points merged since the last call to the survivors
+  /// (every update does it first; call it after merges made outside association).
+  void applyMerges(const SuperpointTracker& tracker);
   /// Replaces the state.
   void restore(const Snapshot& s) {
     scores_ = s.scores;
@@ -146,7 +149,6 @@ class GraphAccumulator {
   }
 
  private:
-  void applyMerges(const SuperpointTracker& tracker);
   /// Sum of a super-point's P_nu^C over its classes (0 if never seen).
   double scoreTotal(int32_t label) const;
   /// Per label below `size`: scoreTotal(label), for the many lookups of a whole-table pass.

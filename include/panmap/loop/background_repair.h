@@ -129,6 +129,8 @@ class BackgroundRepair {
   std::unique_ptr<MapRebuild> early_map_;
   double occupancy_swapped_s_ = -1.0;
   double map_swapped_s_ = -1.0;
+  size_t map_swapped_rejoined_ = 0;
+  double map_swapped_rejoin_s_ = 0.0;
   bool poses_recorded_ = false;
   std::chrono::steady_clock::time_point started_;
   size_t blocks_before_ = 0;

@@ -61,6 +61,9 @@ struct MapRepairResult {
   /// Seconds after the correction at which a background repair swapped in the re-integrated
   /// map it built first (MapRepairConfig::reintegrate_first); negative: it did not.
   double map_swapped_s = -1.0;
+  /// Super-points that joined another at that swap (ReintegrationStats::superpoints_rejoined).
+  size_t map_swapped_rejoined = 0;
+  double map_swapped_rejoin_s = 0.0;  ///< and the time that took
 };
 
 /// The repair after a loop closure (docs/LOOP_CLOSURE.md): spreads the correction over every

@@ -182,6 +182,10 @@ struct ReintegrationStats {
   /// found the same id in both: how much of the surface kept its object's (super-point's) id.
   double instance_surface_kept = 0.0;
   double superpoint_surface_kept = 0.0;  ///< (see instance_surface_kept)
+  /// A re-integration's super-points that joined another whose surface they now coincide
+  /// with (rejoinCoincidingSuperpoints()).
+  size_t superpoints_rejoined = 0;
+  double rejoin_s = 0.0;  ///< wall time of finding and making those merges
 };
 
 class BinaryReader;

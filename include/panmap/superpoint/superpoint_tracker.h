@@ -158,6 +158,14 @@ class SuperpointTracker {
   /// live label, two keys with one id, an id outside 1..size, a super-point with a state and
   /// no id.
   void checkSuperpointIds(const std::map<int32_t, int32_t>& ids, int32_t size) const;
+  /// Joins two super-points whose surfaces a repair laid over one another
+  /// (rejoinCoincidingSuperpoints(), mapper/superpoint_rejoin.h) where III-B's merge rule
+  /// allows it: semantically consistent, and not shown as two objects by the network in as
+  /// many frames as together. Where they coincide, each frame that saw the one seen in fewer
+  /// frames saw the other's surface too, so those frames times `share` (the part of it that
+  /// coincides) count as frames together, besides the co-observations. Returns whether they
+  /// merged (false also when they already are one).
+  bool rejoin(int32_t a, int32_t b, double share);
   /// Co-observation counts M(L1, L2) of live super-points (L1 < L2).
   const std::map<std::pair<int32_t, int32_t>, int>& coObservations() const { return co_observed_; }
   /// Frames that showed two live super-points (L1 < L2) as two objects: each significant in a
@@ -197,7 +205,7 @@ class SuperpointTracker {
   /// The network showed the pair (a < b) as two objects in at least as many frames as it
   /// co-observed them in one surface (m): no merge (semantic consistency only).
   bool seenApart(const std::pair<int32_t, int32_t>& key, int m) const;
-  void mergeLabels(int32_t a, int32_t b, FrameAssociation* out);
+  void mergeLabels(int32_t a, int32_t b, FrameAssociation* out);  // out: null or counts it
   void associateInstances(const FrameSegmentation& segmentation, FrameAssociation* out);
 
   SuperpointConfig config_;
