@@ -49,6 +49,34 @@ uint64_t fingerprint(const Image& image) {
          static_cast<uint64_t>(image.height());
 }
 
+// Times FrameStore::load of every frame of an existing store, whole and without the
+// segmentation, alternating frame by frame so that both see the same page cache and host load.
+void timeLoads(const std::string& folder) {
+  const auto store = panmap::FrameStore::open(folder);
+  const std::vector<int64_t> utimes = store->utimes();
+  if (utimes.empty()) throw panmap::Error(folder + ": no frames");
+  std::vector<double> whole_ms, without_ms;
+  for (const int64_t utime : utimes) store->load(utime);  // into the page cache
+  panmap::ProgressLine progress("loads", "frames");
+  for (size_t i = 0; i < utimes.size(); ++i) {
+    progress.update(i + 1, utimes.size());
+    auto start = Clock::now();
+    store->load(utimes[i]);
+    whole_ms.push_back(msSince(start));
+    start = Clock::now();
+    store->load(utimes[i], panmap::FrameStore::Parts::kWithoutSegmentation);
+    without_ms.push_back(msSince(start));
+  }
+  progress.finish();
+  const panmap::ValueSpread whole = panmap::spreadOf(whole_ms);
+  const panmap::ValueSpread without = panmap::spreadOf(without_ms);
+  std::printf("load() of %zu frames of %s (%zu with a segmentation):\n", utimes.size(),
+              folder.c_str(), store->sizeWithPanoptic());
+  std::printf("  whole frame              median %6.2f  p95 %6.2f ms\n", whole.median, whole.p95);
+  std::printf("  without the segmentation median %6.2f  p95 %6.2f ms\n", without.median,
+              without.p95);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -80,8 +108,22 @@ int main(int argc, char** argv) {
   app.add_option("--store", store_dir,
                  "store folder (must not hold a store yet; kept). Default: a temporary folder "
                  "under TMPDIR, removed at the end");
+  std::string loads_of;
+  app.add_option("--time-loads", loads_of,
+                 "instead: time load() of every frame of the existing store DIR (for example a "
+                 "labelled run's, panmap-mapper --frame-store), whole and without the "
+                 "segmentation (what a re-integration reads), alternating");
   CLI11_PARSE(app, argc, argv);
   namespace fs = std::filesystem;
+  if (!loads_of.empty()) {
+    try {
+      timeLoads(loads_of);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "panmap-bench-frame-store: error: %s\n", e.what());
+      return 1;
+    }
+    return 0;
+  }
   std::string temp_dir;
   try {
     if (store_dir.empty()) {

@@ -121,8 +121,9 @@ int main(int argc, char** argv) {
                "with --room: the background repair swaps the occupancy tree in with the rest of "
                "the map instead of first (MapRepairConfig::occupancy_first off)");
   app.add_flag("--reintegrate-first", reintegrate_first,
-               "with --room: the background repair first re-integrates the frames and swaps that "
-               "map in, then maps them again (MapRepairConfig::reintegrate_first)");
+               "with --room: the background repair re-integrates the frames and swaps that map "
+               "in (after the occupancy tree, unless --occupancy-last), then maps them again "
+               "(MapRepairConfig::reintegrate_first)");
   app.add_option("--frames", frames, "frames in the map when the correction comes")
       ->capture_default_str();
   app.add_option("--voxel-size", voxel_size_m, "voxel size, metres")->capture_default_str();

@@ -293,9 +293,9 @@ int main(int argc, char** argv) {
                "over the stored depth)");
   bool repair_reintegrate_first = false;
   app.add_flag("--repair-reintegrate-first", repair_reintegrate_first,
-               "live repairs that map the frames again first re-integrate them and swap that "
-               "map in (geometry, labels, objects and occupancy repaired in about a third of "
-               "the time), then map them again (instead of the occupancy tree alone first)");
+               "live repairs that map the frames again re-integrate them and swap that map in "
+               "(geometry, labels, objects and occupancy repaired in about a third of the time; "
+               "after the occupancy tree unless --repair-occupancy-last), then map them again");
   std::vector<double> grid_shift;
   app.add_option("--grid-shift", grid_shift,
                  "X,Y,Z metres: move every pose by this before mapping, so the voxel grid falls "

@@ -90,12 +90,11 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
       holds_segmentations_ ? holds_segmentations_() : store_ && store_->sizeWithPanoptic() > 0;
   remap_ = config_.reassociate && panoptic_load_ && holds;
   rebuild_ = mapper_->beginRebuild(&pool_, remap_);
-  // Mapping the frames again takes the whole pipeline per frame. Re-integrating them with the
-  // super-points they voted for takes integration alone, and the occupancy tree a planner
-  // reads needs only the depth and the pose: either goes first.
+  // Mapping the frames again takes the whole pipeline per frame. The occupancy tree a planner
+  // reads needs only the depth and the pose, and re-integrating the frames with the
+  // super-points they voted for takes integration alone: those go first, in that order.
   const bool early_map = remap_ && config_.reintegrate_first;
-  const bool early_occupancy =
-      remap_ && !early_map && config_.occupancy_first && mapper_->occupancy();
+  const bool early_occupancy = remap_ && config_.occupancy_first && mapper_->occupancy();
   occupancy_ =
       early_occupancy ? std::make_unique<OccupancyRebuild>(mapper_->config(), &pool_) : nullptr;
   early_map_ = early_map ? mapper_->beginRebuild(&pool_, false) : nullptr;
@@ -109,6 +108,7 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
     jobs_ = corrected_.poses;
     next_ = 0;
     early_pass_ = early_occupancy || early_map;
+    early_stage_ = early_occupancy ? EarlyStage::kOccupancy : EarlyStage::kMap;
     early_handover_ = false;
     early_next_ = 0;
     idle_ = false;
@@ -158,10 +158,10 @@ void BackgroundRepair::addLoaded(const StampedPose& job, const RgbdFrame& frame,
   rebuild_->add(frame, job.T_W_C, &labels, panoptic, kept);
 }
 
-void BackgroundRepair::addEarly(const StampedPose& job, const RgbdFrame& frame,
+void BackgroundRepair::addEarly(EarlyStage stage, const StampedPose& job, const RgbdFrame& frame,
                                 const LabelImage& labels) {
   checkFrameOf(job, frame);
-  if (early_map_) {
+  if (stage == EarlyStage::kMap) {
     early_map_->add(frame, job.T_W_C, &labels);
   } else {
     occupancy_->add(frame, job.T_W_C);
@@ -169,10 +169,18 @@ void BackgroundRepair::addEarly(const StampedPose& job, const RgbdFrame& frame,
 }
 
 bool BackgroundRepair::earlyPass() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!early_pass_) return true;
+  for (;;) {
+    EarlyStage stage;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!early_pass_) return true;
+      stage = early_stage_;
+    }
+    if (!earlyStage(stage)) return false;
   }
+}
+
+bool BackgroundRepair::earlyStage(EarlyStage stage) {
   RgbdFrame frame;
   LabelImage labels;
   std::vector<int64_t> covered;
@@ -187,13 +195,14 @@ bool BackgroundRepair::earlyPass() {
         // Caught up, or poll() takes the pass over with the last few frames: wait.
         idle_ = true;
         cv_.notify_all();
-        cv_.wait(lock, [this] {
-          return stop_ || !early_pass_ || (!early_handover_ && early_next_ < jobs_.size());
+        cv_.wait(lock, [this, stage] {
+          return stop_ || !early_pass_ || early_stage_ != stage ||
+                 (!early_handover_ && early_next_ < jobs_.size());
         });
         idle_ = false;
       }
       if (stop_) return false;
-      if (!early_pass_) return true;
+      if (!early_pass_ || early_stage_ != stage) return true;
       index = early_next_;
       job = jobs_[index];
     }
@@ -204,7 +213,7 @@ bool BackgroundRepair::earlyPass() {
         frame = RgbdFrame();
         load_(job.utime, &frame, &labels);
       }
-      addEarly(job, frame, labels);
+      addEarly(stage, job, frame, labels);
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex_);
       failure_ = e.what();
@@ -227,14 +236,15 @@ void BackgroundRepair::takeEarlyIfReady(std::unique_lock<std::mutex>* lock) {
   cv_.wait(*lock, [this] { return !failure_.empty() || idle_; });
   if (!failure_.empty()) return;
   // The worker waits: the pass is this thread's until it ends.
-  const bool map = static_cast<bool>(early_map_);
+  const EarlyStage stage = early_stage_;
+  const bool map = stage == EarlyStage::kMap;
   try {
     RgbdFrame frame;
     LabelImage labels;
     for (; early_next_ < jobs_.size(); ++early_next_) {
       const StampedPose& job = jobs_[early_next_];
       load_(job.utime, &frame, &labels);
-      addEarly(job, frame, labels);
+      addEarly(stage, job, frame, labels);
     }
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
@@ -244,7 +254,7 @@ void BackgroundRepair::takeEarlyIfReady(std::unique_lock<std::mutex>* lock) {
       map_swapped_s_ = seconds;
       map_swapped_rejoined_ = early.superpoints_rejoined;
       map_swapped_rejoin_s_ = early.rejoin_s;
-      if (mapper_->occupancy()) occupancy_swapped_s_ = seconds;
+      if (mapper_->occupancy() && occupancy_swapped_s_ < 0.0) occupancy_swapped_s_ = seconds;
       recordPoses();
     } else {
       const std::vector<StampedPose> poses = occupancy_->poses();
@@ -256,9 +266,18 @@ void BackgroundRepair::takeEarlyIfReady(std::unique_lock<std::mutex>* lock) {
     std::fprintf(stderr, "panmap: the repair's early %s not swapped in: %s\n",
                  map ? "re-integrated map" : "occupancy tree", e.what());
   }
-  occupancy_.reset();
-  early_map_.reset();
-  early_pass_ = false;
+  if (map) {
+    early_map_.reset();
+  } else {
+    occupancy_.reset();
+  }
+  // After the tree, the re-integrated map when there is one: a pass over every frame again.
+  if (early_map_) {
+    early_stage_ = EarlyStage::kMap;
+    early_next_ = 0;
+  } else {
+    early_pass_ = false;
+  }
   early_handover_ = false;
   cv_.notify_all();
 }

@@ -626,7 +626,7 @@ void FrameStore::updatePose(int64_t utime, const Eigen::Isometry3d& T_W_C) {
   it->second.T_W_C = T_W_C;
 }
 
-StoredFrame FrameStore::load(int64_t utime) const {
+StoredFrame FrameStore::load(int64_t utime, Parts parts) const {
   Entry entry;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -683,7 +683,8 @@ StoredFrame FrameStore::load(int64_t utime) const {
     return ids;
   };
   out.labels = readPlanes(sfx.labels, entry.labels, sfx.labels_hi, entry.labels_hi, "labels");
-  if (entry.masks.size > 0) {
+  const bool segmentation = parts == Parts::kAll;
+  if (segmentation && entry.masks.size > 0) {
     out.has_panoptic = true;
     out.panoptic.utime = utime;
     out.panoptic.segment_ids =
@@ -711,7 +712,7 @@ StoredFrame FrameStore::load(int64_t utime) const {
       out.panoptic.segments.push_back(seg);
     }
   }
-  if (entry.geometric.size > 0) {
+  if (segmentation && entry.geometric.size > 0) {
     const std::vector<uint8_t> bytes = read(kGeometricSuffix, entry.geometric);
     out.geometric.ids = decodeLabelPlane(bytes.data(), bytes.size(), name + "geometric segments");
     out.geometric.config_key = entry.geometric_key;

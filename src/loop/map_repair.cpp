@@ -16,7 +16,8 @@ void MapRepairConfig::check() const {
 FrameLoader storeLoader(const FrameStore* store) {
   if (!store) throw Error("frame loader: no frame store");
   return [store](int64_t utime, RgbdFrame* frame, LabelImage* labels) {
-    StoredFrame stored = store->load(utime);
+    // A re-integration votes with the stored labels: the segmentation is not decoded.
+    StoredFrame stored = store->load(utime, FrameStore::Parts::kWithoutSegmentation);
     *frame = std::move(stored.rgbd);
     *labels = std::move(stored.labels);
   };
@@ -102,6 +103,13 @@ std::string describe(const MapRepairResult& r) {
     out += "; kept geometric segments of " +
            std::to_string(r.reintegration.frames_with_kept_segments) + " frames";
   }
+  if (r.occupancy_swapped_s >= 0.0 &&
+      (r.map_swapped_s < 0.0 || r.occupancy_swapped_s < r.map_swapped_s)) {
+    char occupancy[80];
+    std::snprintf(occupancy, sizeof(occupancy), "; occupancy swapped in after %.2f s",
+                  r.occupancy_swapped_s);
+    out += occupancy;
+  }
   if (r.map_swapped_s >= 0.0) {
     char early[160];
     std::snprintf(early, sizeof(early),
@@ -109,11 +117,6 @@ std::string describe(const MapRepairResult& r) {
                   "%.2f s)",
                   r.map_swapped_s, r.map_swapped_rejoined, r.map_swapped_rejoin_s);
     out += early;
-  } else if (r.occupancy_swapped_s >= 0.0) {
-    char occupancy[80];
-    std::snprintf(occupancy, sizeof(occupancy), "; occupancy swapped in after %.2f s",
-                  r.occupancy_swapped_s);
-    out += occupancy;
   }
   if (r.reintegration.reassociated) {
     char ids[160];

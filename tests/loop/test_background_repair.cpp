@@ -324,66 +324,90 @@ TEST_F(BackgroundRepairTest, TheOccupancyTreeIsSwappedInBeforeTheFramesAreMapped
 // With reintegrate_first the repair first re-integrates the frames at their corrected poses
 // with the super-points they voted for, and swaps that map in while mapping them again is still
 // held: the map is then, bit for bit, what a blocking re-integration gives, and the store
-// already has the new poses. The repair then maps the frames again and swaps in the same
-// geometry as one without the early map.
+// already has the new poses. With occupancy_first too, the tree of the corrected poses comes
+// before that map, the label-TSDF and the poses still the old ones. The repair then maps the
+// frames again and swaps in the same geometry as one without the early map.
 TEST_F(BackgroundRepairTest, TheReintegratedMapIsSwappedInBeforeTheFramesAreMappedAgain) {
-  test::TempDir dir;
-  FrameStore store(storeConfig(dir.path("store")));
-  auto mapper = std::make_unique<Mapper>(config());
-  test::TempDir other;
-  FrameStore other_store(storeConfig(other.path("store")));
-  auto reference = std::make_unique<Mapper>(config());
-  for (int k = 0; k < 6; ++k) {
-    integrateWithMasks(mapper.get(), k, &store);
-    integrateWithMasks(reference.get(), k, &other_store);
-  }
-  ASSERT_EQ(mapper->serialize(), reference->serialize());
-  const PoseCorrection correction =
-      keyframeCorrection(*mapper, 3, move(0.03, {0.05, -0.03, 0.01}), 7);
-  const CorrectedTrajectory corrected = applyCorrection(mapper->trajectory(), correction);
-  ASSERT_TRUE(reference->reintegrate(corrected.poses, storeLoader(&store)).completed);
-  const std::vector<uint8_t> reintegrated = reference->serialize();
-  ASSERT_NE(mapper->serialize(), reintegrated);
+  for (const bool occupancy_first : {false, true}) {
+    SCOPED_TRACE(occupancy_first ? "the tree first" : "the re-integrated map alone");
+    test::TempDir dir;
+    FrameStore store(storeConfig(dir.path("store")));
+    auto mapper = std::make_unique<Mapper>(config());
+    test::TempDir other;
+    FrameStore other_store(storeConfig(other.path("store")));
+    auto reference = std::make_unique<Mapper>(config());
+    for (int k = 0; k < 6; ++k) {
+      integrateWithMasks(mapper.get(), k, &store);
+      integrateWithMasks(reference.get(), k, &other_store);
+    }
+    ASSERT_EQ(mapper->serialize(), reference->serialize());
+    const std::vector<uint8_t> unrepaired = mapper->serialize();
+    const PoseCorrection correction =
+        keyframeCorrection(*mapper, 3, move(0.03, {0.05, -0.03, 0.01}), 7);
+    const CorrectedTrajectory corrected = applyCorrection(mapper->trajectory(), correction);
+    ASSERT_TRUE(reference->reintegrate(corrected.poses, storeLoader(&store)).completed);
+    const std::vector<uint8_t> reintegrated = reference->serialize();
+    ASSERT_NE(unrepaired, reintegrated);
+    const std::string repaired_tree = reference->occupancy()->toBinaryData();
 
-  MapRepairConfig repair_config;
-  repair_config.reintegrate_first = true;
-  Gate gate;
-  const std::unique_ptr<BackgroundRepair> held =
-      gatedRepair(mapper.get(), &store, repair_config, &gate);
-  BackgroundRepair& repair = *held;
-  const OpenAtExit open_at_exit{&gate};
-  repair.start(correction);
-  // The poses change with the swap (the frame the correction names moved by 5 cm).
-  for (int64_t polls = 0; mapper->trajectory()[3].T_W_C.isApprox(pose(3), 1e-12); ++polls) {
-    ASSERT_LT(polls, 100000000) << "the re-integrated map was never swapped in";
-    ASSERT_FALSE(repair.poll()) << "committed while mapping again was held";
-    std::this_thread::yield();
-  }
-  EXPECT_EQ(mapper->serialize(), reintegrated);
-  EXPECT_EQ(repair.framesDone(), 0);
-  const std::vector<StampedPose> stored = store.trajectory();
-  for (int k = 0; k < 6; ++k) {
-    EXPECT_TRUE(stored[k].T_W_C.isApprox(corrected.poses[k].T_W_C, 1e-15)) << k;
-  }
+    MapRepairConfig repair_config;
+    repair_config.occupancy_first = occupancy_first;
+    repair_config.reintegrate_first = true;
+    Gate gate;
+    const std::unique_ptr<BackgroundRepair> held =
+        gatedRepair(mapper.get(), &store, repair_config, &gate);
+    BackgroundRepair& repair = *held;
+    const OpenAtExit open_at_exit{&gate};
+    repair.start(correction);
+    const OccupancyMap* tree_before = mapper->occupancy();
+    bool tree_alone = false;  // seen: the repaired tree with the old poses
+    // The poses change with the swap (the frame the correction names moved by 5 cm).
+    for (int64_t polls = 0; mapper->trajectory()[3].T_W_C.isApprox(pose(3), 1e-12); ++polls) {
+      ASSERT_LT(polls, 100000000) << "the re-integrated map was never swapped in";
+      ASSERT_FALSE(repair.poll()) << "committed while mapping again was held";
+      if (mapper->occupancy() != tree_before &&
+          mapper->trajectory()[3].T_W_C.isApprox(pose(3), 1e-12)) {
+        if (!tree_alone) {
+          EXPECT_EQ(mapper->occupancy()->toBinaryData(), repaired_tree);
+        }
+        tree_alone = true;
+      }
+      std::this_thread::yield();
+    }
+    EXPECT_EQ(tree_alone, occupancy_first);
+    EXPECT_EQ(mapper->serialize(), reintegrated);
+    EXPECT_EQ(repair.framesDone(), 0);
+    const std::vector<StampedPose> stored = store.trajectory();
+    for (int k = 0; k < 6; ++k) {
+      EXPECT_TRUE(stored[k].T_W_C.isApprox(corrected.poses[k].T_W_C, 1e-15)) << k;
+    }
 
-  gate.open();
-  const std::optional<MapRepairResult> done = repair.finish();
-  ASSERT_TRUE(done);
-  ASSERT_TRUE(done->reintegration.completed) << done->failure;
-  EXPECT_TRUE(done->reintegration.reassociated);
-  EXPECT_GE(done->map_swapped_s, 0.0);
-  EXPECT_EQ(done->occupancy_swapped_s, done->map_swapped_s);
-  EXPECT_NE(describe(*done).find("re-integrated map swapped in after"), std::string::npos)
-      << describe(*done);
+    gate.open();
+    const std::optional<MapRepairResult> done = repair.finish();
+    ASSERT_TRUE(done);
+    ASSERT_TRUE(done->reintegration.completed) << done->failure;
+    EXPECT_TRUE(done->reintegration.reassociated);
+    EXPECT_GE(done->map_swapped_s, 0.0);
+    EXPECT_GE(done->occupancy_swapped_s, 0.0);
+    if (occupancy_first) {
+      EXPECT_LT(done->occupancy_swapped_s, done->map_swapped_s);
+    } else {
+      EXPECT_EQ(done->occupancy_swapped_s, done->map_swapped_s);
+    }
+    const std::string line = describe(*done);
+    EXPECT_NE(line.find("re-integrated map swapped in after"), std::string::npos) << line;
+    EXPECT_EQ(line.find("occupancy swapped in after") != std::string::npos, occupancy_first)
+        << line;
 
-  // Mapping again from the map as it was gives the same geometry.
-  test::TempDir third;
-  FrameStore third_store(storeConfig(third.path("store")));
-  auto plain = std::make_unique<Mapper>(config());
-  for (int k = 0; k < 6; ++k) integrateWithMasks(plain.get(), k, &third_store);
-  ASSERT_TRUE(repairMap(plain.get(), &third_store, correction).reintegration.reassociated);
-  EXPECT_EQ(geometryOf(mapper->map()), geometryOf(plain->map()));
-  EXPECT_EQ(mapper->occupancy()->toBinaryData(), plain->occupancy()->toBinaryData());
+    // Mapping again from the map as it was gives the same geometry.
+    test::TempDir third;
+    FrameStore third_store(storeConfig(third.path("store")));
+    auto plain = std::make_unique<Mapper>(config());
+    for (int k = 0; k < 6; ++k) integrateWithMasks(plain.get(), k, &third_store);
+    ASSERT_TRUE(repairMap(plain.get(), &third_store, correction).reintegration.reassociated);
+    EXPECT_EQ(geometryOf(mapper->map()), geometryOf(plain->map()));
+    EXPECT_EQ(mapper->occupancy()->toBinaryData(), plain->occupancy()->toBinaryData());
+  }
 }
 
 // A frame comes, is handed to the repair, and the mapping thread asks at once: the occupancy

@@ -610,6 +610,37 @@ TEST(FrameStore, GeometricSegmentsRoundTripWithTheirKey) {
   EXPECT_TRUE(f.geometric.ids.empty());
 }
 
+// A re-integration votes with depth and labels only: loading without the segmentation gives
+// them bit for bit and never reads the segmentation's files (a damaged one does not matter).
+TEST(FrameStore, LoadingWithoutTheSegmentationReadsDepthAndLabelsOnly) {
+  TempDir dir;
+  const PanopticFrame p = segmentation();
+  const GeometricSegments g{labels(4), 0x0123456789abcdefull};
+  const LabelImage votes = labels(2);
+  {
+    FrameStore store(configIn(dir));
+    store.add(10, pose(0.5), camera(), 0.001, depth(3), votes, nullptr, &p, &g);
+  }
+  const auto store = FrameStore::open(dir.path("store"));
+  const StoredFrame all = store->load(10);
+  ASSERT_TRUE(all.has_panoptic);
+  ASSERT_FALSE(all.geometric.ids.empty());
+  for (const char* file : {"10.masks.zst", "10.segments.txt", "10.geometric.zst"}) {
+    flipByte(dir.path(std::string("store/frames/") + file), 3);
+  }
+  const StoredFrame f = store->load(10, FrameStore::Parts::kWithoutSegmentation);
+  EXPECT_FALSE(f.has_panoptic);
+  EXPECT_TRUE(f.panoptic.segment_ids.empty());
+  EXPECT_TRUE(f.panoptic.segments.empty());
+  EXPECT_TRUE(f.geometric.ids.empty());
+  EXPECT_TRUE(f.rgbd.depth == all.rgbd.depth);
+  EXPECT_TRUE(f.labels == votes);
+  expectSamePose(f.T_W_C, all.T_W_C);
+  EXPECT_EQ(f.rgbd.camera.fx, all.rgbd.camera.fx);
+  // The whole frame still checks every file.
+  expectError([&] { store->load(10); }, {"frame 10", "differs"});
+}
+
 TEST(FrameStore, ThreadsAddingAtOnceLoseNoFrame) {
   TempDir dir;
   FrameStore store(configIn(dir));

@@ -25,9 +25,9 @@ namespace panmap {
 /// stored, maps again) the frames the map held when the correction came, at their corrected
 /// poses, then every frame integrated since, at the pose it was mapped with; once it has
 /// caught up, poll() swaps the repaired map in between two frames. Before it maps the frames
-/// again, it runs over them once for an early swap, which poll() makes as soon as that pass
-/// has caught up: a re-integrated map (MapRepairConfig::reintegrate_first) or the occupancy
-/// tree alone (occupancy_first).
+/// again, it runs over them for early swaps, each of which poll() makes as soon as its pass has
+/// caught up: first the occupancy tree alone (MapRepairConfig::occupancy_first), then a
+/// re-integrated map (reintegrate_first).
 /// A newer correction abandons a running repair and starts again from the map (superseded).
 ///
 /// Threads: every member function is called from the mapping thread (the one that calls
@@ -92,15 +92,20 @@ class BackgroundRepair {
   /// Loads one frame and adds it to the rebuild at the job's pose; throws Error.
   void reintegrate(const StampedPose& job, RgbdFrame* frame, LabelImage* labels,
                    PanopticFrame* panoptic, GeometricSegments* kept);
-  /// The early pass: every job into occupancy_ or early_map_, until poll() takes it. Returns
-  /// false when the worker must return (stopped or failed).
+  /// What an early pass builds.
+  enum class EarlyStage { kOccupancy, kMap };
+  /// The early passes: each stage's jobs into occupancy_ or early_map_, until poll() takes the
+  /// last. Returns false when the worker must return (stopped or failed).
   bool earlyPass();
-  /// Adds a frame loaded with its pixel labels to the early pass; throws Error.
-  void addEarly(const StampedPose& job, const RgbdFrame& frame, const LabelImage& labels);
-  /// With mutex_ held by `lock`: when the early pass is at most kFramesLeftToCommit frames
+  /// One stage of it, until poll() takes it (true) or the worker must return (false).
+  bool earlyStage(EarlyStage stage);
+  /// Adds a frame loaded with its pixel labels to the stage's pass; throws Error.
+  void addEarly(EarlyStage stage, const StampedPose& job, const RgbdFrame& frame,
+                const LabelImage& labels);
+  /// With mutex_ held by `lock`: when the early stage is at most kFramesLeftToCommit frames
   /// behind, waits for the worker to finish the frame it is on, adds the rest itself, swaps the
-  /// tree or the re-integrated map into the mapper and lets the worker go on to map the frames
-  /// again.
+  /// tree or the re-integrated map into the mapper and lets the worker go on to the next stage
+  /// or to map the frames again.
   void takeEarlyIfReady(std::unique_lock<std::mutex>* lock);
   /// Records the corrected poses of the frames that moved in the store (once per repair).
   void recordPoses();
@@ -123,8 +128,8 @@ class BackgroundRepair {
   CorrectedTrajectory corrected_;
   std::unique_ptr<MapRebuild> rebuild_;
   bool remap_ = false;  // the running repair maps the frames again
-  // The early pass, one of the two (reintegrate_first, occupancy_first): the worker's until it
-  // waits with every job done.
+  // The early passes (occupancy_first, then reintegrate_first): the worker's until it waits
+  // with every job of its stage done.
   std::unique_ptr<OccupancyRebuild> occupancy_;
   std::unique_ptr<MapRebuild> early_map_;
   double occupancy_swapped_s_ = -1.0;
@@ -147,6 +152,8 @@ class BackgroundRepair {
   bool idle_ = false;              // the worker waits for a job
   bool stop_ = false;              // the worker must return
   std::string failure_;            // why the worker gave up
+  // Which early pass runs: the tree's first, then the re-integrated map's.
+  EarlyStage early_stage_ = EarlyStage::kOccupancy;
 };
 
 }  // namespace panmap

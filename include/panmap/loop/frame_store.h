@@ -141,9 +141,17 @@ class FrameStore {
   /// @param T_W_C camera-to-world pose (optical frame) of the re-integration
   void updatePose(int64_t utime, const Eigen::Isometry3d& T_W_C);
 
+  /// What load() reads.
+  enum class Parts {
+    kAll,  ///< every file of the frame
+    /// Depth, labels and colour: what a re-integration votes with. The segmentation and the
+    /// geometric segments, a third of the decoding, stay on disk (has_panoptic false).
+    kWithoutSegmentation,
+  };
+
   /// Reads and decodes one frame. Throws Error naming the utime when it is not stored, and
-  /// naming the file when one is missing, corrupt or differs from its checksum.
-  StoredFrame load(int64_t utime) const;
+  /// naming the file when one it reads is missing, corrupt or differs from its checksum.
+  StoredFrame load(int64_t utime, Parts parts = Parts::kAll) const;
 
   /// Number of frames stored.
   size_t size() const;

@@ -32,13 +32,15 @@ struct MapRepairConfig {
   /// third of mapping them again) and swaps that map in, occupancy tree included, then maps the
   /// frames again and swaps the result in at the end. The map is repaired in geometry, labels
   /// and objects long before the association is done again; pixel labels naming super-points a
-  /// former repair retired vote for nothing until then. Takes the place of occupancy_first.
+  /// former repair retired vote for nothing until then. With occupancy_first too, the tree
+  /// comes first and this map after it (a second pass over the frames).
   bool reintegrate_first = false;
   /// Throws Error naming the bad field.
   void check() const;
 };
 
-/// A FrameLoader that gives back the frames of `store` (FrameStore::load; callable from any
+/// A FrameLoader that gives back the frames of `store` (FrameStore::load without the
+/// segmentation, which a re-integration does not use; callable from any
 /// thread). Throws Error when `store` is null.
 FrameLoader storeLoader(const FrameStore* store);
 
