@@ -15,9 +15,9 @@
 #include <benchmark/benchmark.h>
 
 #include "panmap/occupancy/occupancy_map.h"
+#include "panmap/render/renderer.h"
 #include "panmap/sim/depth_noise.h"
 #include "panmap/sim/procedural_room.h"
-#include "panmap/sim/renderer.h"
 #include "panmap/sim/trajectory.h"
 
 namespace {

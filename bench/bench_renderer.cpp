@@ -2,8 +2,8 @@
 // <= 30 ms). A tessellated 9 x 7 x 3 m box room with furniture-sized boxes, 5 cm triangles.
 #include <benchmark/benchmark.h>
 
+#include "panmap/render/renderer.h"
 #include "panmap/sim/procedural_room.h"
-#include "panmap/sim/renderer.h"
 
 namespace {
 

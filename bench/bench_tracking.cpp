@@ -15,9 +15,9 @@
 
 #include "panmap/core/thread_pool.h"
 #include "panmap/map/projective_integrator.h"
+#include "panmap/render/renderer.h"
 #include "panmap/sim/depth_noise.h"
 #include "panmap/sim/procedural_room.h"
-#include "panmap/sim/renderer.h"
 #include "panmap/sim/trajectory.h"
 #include "panmap/tracking/frame_to_model_aligner.h"
 

@@ -3,13 +3,15 @@
 # its seed corpus (fuzz/corpus/<target>; the committed corpus never grows).
 #
 #   scripts/fuzz.sh [--time SECONDS] [--runs N] [--targets a,b] [--jobs N] [--report FILE]
-#                   [--no-build]
+#                   [--opt LEVEL] [--no-build]
 #     --time     seconds per target (default 60); with --runs, whichever comes first
 #     --runs     executions per target (default: no limit)
 #     --targets  comma-separated subset of: image_codec ply text_files dataset coco_panoptic
 #                scannet_gt config map_file lcm_messages lcm_session (default: all)
 #     --jobs     targets run side by side (default 1; each target is one process)
 #     --report   rewrite the generated table of this Markdown file (e.g. docs/FUZZING.md)
+#     --opt      clang's -O level for the build (default 3, as Release; CI's brief runs use 0,
+#                which halves the clean build and runs each input more slowly)
 #     --no-build run what build-fuzz/ holds
 # Prints one line per target: executions, exec/s, seconds, corpus size, result. Exits 1 when
 # a target crashed (the crash input's path is in its line), 2 on bad usage.
@@ -24,8 +26,8 @@ declare -A max_len=(
   [image_codec]=4096 [ply]=4096 [text_files]=2048 [dataset]=8192 [coco_panoptic]=4096
   [scannet_gt]=4096 [config]=8192 [map_file]=65536 [lcm_messages]=4096 [lcm_session]=8192)
 
-seconds=60 runs=0 targets= jobs=1 report= build=1
-usage() { sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; }
+seconds=60 runs=0 targets= jobs=1 report= build=1 opt=3
+usage() { sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --time) seconds="$2"; shift ;;
@@ -33,16 +35,18 @@ while [ $# -gt 0 ]; do
     --targets) targets="$2"; shift ;;
     --jobs) jobs="$2"; shift ;;
     --report) report="$2"; shift ;;
+    --opt) opt="$2"; shift ;;
     --no-build) build=0 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "fuzz.sh: unknown option $1" >&2; usage >&2; exit 2 ;;
   esac
   shift
 done
-for n in "$seconds" "$runs" "$jobs"; do
+for n in "$seconds" "$runs" "$jobs" "$opt"; do
   [[ "$n" =~ ^[0-9]+$ ]] || { echo "fuzz.sh: '$n' is not a number" >&2; exit 2; }
 done
 [ "$jobs" -ge 1 ] || jobs=1
+[ "$opt" -le 3 ] || { echo "fuzz.sh: --opt takes 0 to 3, not $opt" >&2; exit 2; }
 if [ -n "$targets" ]; then
   IFS=, read -r -a selected <<<"$targets"
   for t in "${selected[@]}"; do
@@ -60,7 +64,8 @@ if [ "$build" -eq 1 ]; then
   # Only what the targets link is built: no tests, benchmarks, Java jar or tools.
   if ! CC=clang CXX=clang++ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release \
       -DPANMAP_BUILD_FUZZERS=ON -DPANMAP_BUILD_TESTS=OFF -DPANMAP_BUILD_BENCHMARKS=OFF \
-      -DPANMAP_BUILD_JAVA=OFF >"$build_dir/configure.log" 2>&1; then
+      -DPANMAP_BUILD_JAVA=OFF -DCMAKE_CXX_FLAGS_RELEASE="-O$opt -DNDEBUG" \
+      -DCMAKE_C_FLAGS_RELEASE="-O$opt -DNDEBUG" >"$build_dir/configure.log" 2>&1; then
     cat "$build_dir/configure.log"; echo "fuzz.sh: configure failed" >&2; exit 1
   fi
   build_jobs=$(nproc 2>/dev/null || echo 2)
@@ -70,7 +75,7 @@ if [ "$build" -eq 1 ]; then
     grep -E -B2 -A6 "error" "$build_dir/build.log" | head -60
     echo "fuzz.sh: build failed (full log: $build_dir/build.log)" >&2; exit 1
   fi
-  echo "fuzz.sh: built ${#selected[@]} targets in $(( $(date +%s) - start )) s"
+  echo "fuzz.sh: built ${#selected[@]} targets at -O$opt in $(( $(date +%s) - start )) s"
 fi
 
 work=$(mktemp -d /tmp/panmap-fuzz-run.XXXXXX)
@@ -133,6 +138,7 @@ if [ -n "$report" ]; then
   model=$(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -1)
   limit="$seconds s"
   [ "$runs" -gt 0 ] && limit="$runs executions or $seconds s, whichever first"
+  [ "$opt" -eq 3 ] || limit="$limit, -O$opt"
   day=$(date -u '+%Y-%m-%d')
   [ -f "$report" ] || printf '<!-- fuzz-table:begin -->\n<!-- fuzz-table:end -->\n' >"$report"
   table="$work/table.md"

@@ -11,7 +11,7 @@
 #include "panmap/mapper/config_file.h"
 #include "panmap/mapper/objects.h"
 #include "panmap/mesh/mesh_export.h"
-#include "panmap/sim/overview.h"
+#include "panmap/render/overview.h"
 
 namespace panmap {
 

@@ -8,8 +8,8 @@
 #include "panmap/core/error.h"
 #include "panmap/graph/graph_accumulator.h"
 #include "panmap/map/projective_integrator.h"
+#include "panmap/render/renderer.h"
 #include "panmap/sim/depth_noise.h"
-#include "panmap/sim/renderer.h"
 #include "panmap/superpoint/vote_split.h"
 #include "test_meshes.h"
 

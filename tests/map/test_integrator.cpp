@@ -6,8 +6,8 @@
 #include "panmap/core/error.h"
 #include "panmap/map/interpolation.h"
 #include "panmap/map/projective_integrator.h"
+#include "panmap/render/renderer.h"
 #include "panmap/sim/depth_noise.h"
-#include "panmap/sim/renderer.h"
 #include "test_meshes.h"
 
 namespace panmap {

@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 
 #include "panmap/mapper/mapper.h"
+#include "panmap/render/renderer.h"
 #include "panmap/sim/depth_noise.h"
-#include "panmap/sim/renderer.h"
 #include "panmap/sim/segmenter_noise.h"
 #include "test_helpers.h"
 #include "test_meshes.h"

@@ -3,10 +3,10 @@
 // noise model broke it.
 #include <gtest/gtest.h>
 
+#include "panmap/render/renderer.h"
 #include "panmap/segmentation/panoptic_geometric.h"
 #include "panmap/sim/depth_noise.h"
 #include "panmap/sim/procedural_room.h"
-#include "panmap/sim/renderer.h"
 #include "panmap/sim/trajectory.h"
 #include "test_meshes.h"
 

@@ -8,8 +8,8 @@
 
 #include "panmap/core/error.h"
 #include "panmap/occupancy/occupancy_map.h"
+#include "panmap/render/renderer.h"
 #include "panmap/sim/depth_noise.h"
-#include "panmap/sim/renderer.h"
 #include "test_helpers.h"
 #include "test_meshes.h"
 

@@ -9,9 +9,9 @@
 #include "panmap/core/binary_io.h"
 #include "panmap/core/nearest_point.h"
 #include "panmap/occupancy/occupancy_map.h"
+#include "panmap/render/renderer.h"
 #include "panmap/sim/depth_noise.h"
 #include "panmap/sim/procedural_room.h"
-#include "panmap/sim/renderer.h"
 #include "panmap/sim/trajectory.h"
 
 namespace panmap {

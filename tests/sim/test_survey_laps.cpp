@@ -11,8 +11,8 @@
 #include "fingerprint.h"
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
+#include "panmap/render/renderer.h"
 #include "panmap/sim/procedural_room.h"
-#include "panmap/sim/renderer.h"
 #include "panmap/sim/sequence.h"
 #include "panmap/sim/trajectory.h"
 

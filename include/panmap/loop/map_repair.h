@@ -57,8 +57,10 @@ struct MapRepairResult {
   double max_rotation_rad = 0.0;        ///< largest turn of a camera
   ReintegrationStats reintegration;     ///< completed = false: abandoned, map unchanged
   std::string failure;                  ///< why a background repair gave up (empty: it did not)
-  /// Seconds after the correction at which a background repair swapped in the occupancy tree
-  /// it built first (MapRepairConfig::occupancy_first); negative: it did not.
+  /// Seconds after the correction at which a background repair's early pass first swapped in
+  /// a repaired occupancy tree: the tree it built first (MapRepairConfig::occupancy_first), or,
+  /// with the re-integrated map alone, the map's own tree (then equal to map_swapped_s);
+  /// negative: neither was swapped in early.
   double occupancy_swapped_s = -1.0;
   /// Seconds after the correction at which a background repair swapped in the re-integrated
   /// map it built first (MapRepairConfig::reintegrate_first); negative: it did not.

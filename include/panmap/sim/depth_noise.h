@@ -3,7 +3,7 @@
 #include <cstdint>
 
 #include "panmap/core/image.h"
-#include "panmap/sim/renderer.h"
+#include "panmap/render/renderer.h"
 
 namespace panmap {
 

@@ -9,9 +9,9 @@
 #include "panmap/core/camera.h"
 #include "panmap/core/frame.h"
 #include "panmap/core/labelled_mesh.h"
+#include "panmap/render/renderer.h"
 #include "panmap/sim/depth_noise.h"
 #include "panmap/sim/pose_drift.h"
-#include "panmap/sim/renderer.h"
 #include "panmap/sim/segmenter_noise.h"
 #include "panmap/sim/trajectory.h"
 

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "panmap/core/error.h"
-#include "panmap/sim/renderer.h"
+#include "panmap/render/renderer.h"
 
 namespace panmap {
 namespace {

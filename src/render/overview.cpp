@@ -1,10 +1,10 @@
-#include "panmap/sim/overview.h"
+#include "panmap/render/overview.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "panmap/core/error.h"
-#include "panmap/sim/renderer.h"
+#include "panmap/render/renderer.h"
 
 namespace panmap {
 

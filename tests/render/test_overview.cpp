@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "panmap/sim/overview.h"
+#include "panmap/render/overview.h"
 #include "test_meshes.h"
 
 namespace panmap {

@@ -1,4 +1,4 @@
-#include "panmap/sim/renderer.h"
+#include "panmap/render/renderer.h"
 
 #include <algorithm>
 #include <cmath>
