@@ -10,8 +10,8 @@
 #                scannet_gt config map_file lcm_messages lcm_session (default: all)
 #     --jobs     targets run side by side (default 1; each target is one process)
 #     --report   rewrite the generated table of this Markdown file (e.g. docs/FUZZING.md)
-#     --opt      clang's -O level for the build (default 3, as Release; CI's brief runs use 0,
-#                which halves the clean build and runs each input more slowly)
+#     --opt      clang's -O level for the build (default 3, as Release; CI's brief runs use 1,
+#                a quicker clean build with about as many executions a second)
 #     --no-build run what build-fuzz/ holds
 # Prints one line per target: executions, exec/s, seconds, corpus size, result. Exits 1 when
 # a target crashed (the crash input's path is in its line), 2 on bad usage.
