@@ -138,7 +138,10 @@ if [ -n "$report" ]; then
   model=$(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -1)
   limit="$seconds s"
   [ "$runs" -gt 0 ] && limit="$runs executions or $seconds s, whichever first"
-  [ "$opt" -eq 3 ] || limit="$limit, -O$opt"
+  # The level build-fuzz/ was built at (with --no-build, not necessarily --opt's).
+  built_opt=$(sed -n 's/^CMAKE_CXX_FLAGS_RELEASE:STRING=-O\([0-9]\).*/\1/p' \
+              "$build_dir/CMakeCache.txt" 2>/dev/null)
+  [ "${built_opt:-3}" = 3 ] || limit="$limit, -O$built_opt"
   day=$(date -u '+%Y-%m-%d')
   [ -f "$report" ] || printf '<!-- fuzz-table:begin -->\n<!-- fuzz-table:end -->\n' >"$report"
   table="$work/table.md"
