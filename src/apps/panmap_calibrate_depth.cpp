@@ -12,6 +12,7 @@
 
 #include "panmap/calibration/depth_calibrator.h"
 #include "panmap/core/error.h"
+#include "panmap/core/progress.h"
 #include "panmap/io/tum_trajectory.h"
 #include "panmap/lcm/offline_mapping.h"
 #include "panmap/mapper/config_file.h"
@@ -51,14 +52,14 @@ Round mapOnce(const std::string& log, const panmap::MapperConfig& config, int64_
     c.T_W_C = at_given_poses ? f.T_W_C : stats.T_W_C;
     round.frames.push_back(std::move(c));
   };
+  // The shared line: in place on a terminal, every 10 % in a log, nothing for an empty log.
+  panmap::ProgressLine line("  mapping", "MiB", !quiet);
   auto progress = [&](size_t done, size_t total) {
-    if (!quiet) {
-      std::fprintf(stderr, "\r  mapping: %3.0f %%, %lld frames", 100.0 * done / total,
-                   static_cast<long long>(round.integrated));
-    }
+    line.setNote(std::to_string(round.integrated) + " frames");
+    line.update(done >> 20, total >> 20);
   };
   panmap::mapLog(log, options, &mapper, progress, hook);
-  if (!quiet) std::fprintf(stderr, "\n");
+  line.finish();
   return round;
 }
 
@@ -160,11 +161,12 @@ int main(int argc, char** argv) {
                  std::lround(cal.cells_x * static_cast<double>(camera.height) / camera.width)));
       const panmap::DepthCalibrator calibrator(cal);
       std::vector<panmap::CalibrationPass> passes;
+      panmap::ProgressLine line("  calibrating", "passes", !quiet);
       calibration = std::make_shared<const panmap::DepthCalibration>(
           calibrator.calibrate(round.frames, &pool, &passes, [&](int done, int total) {
-            if (!quiet) std::fprintf(stderr, "\r  calibrating: pass %d/%d", done, total);
+            line.update(static_cast<size_t>(done), static_cast<size_t>(total));
           }));
-      if (!quiet) std::fprintf(stderr, "\n");
+      line.finish();
       std::printf(
           "round %d: %lld frames mapped (%lld tracked, %lld corrected), %zu learnt from; depth "
           "disagreement %.2f mm RMS before, calibration %.2f mm RMS\n",

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "panmap/core/error.h"
+#include "panmap/core/progress.h"
 #include "panmap/eval/photometric_consistency.h"
 #include "panmap/io/dataset_reader.h"
 #include "panmap/io/tum_trajectory.h"
@@ -48,6 +49,7 @@ int main(int argc, char** argv) {
     const auto reader = panmap::openDataset(data_dir, options);
     std::vector<panmap::PhotometricFrame> frames;
     frames.reserve(reader->size());
+    panmap::ProgressLine progress("read", "frames");
     for (size_t i = 0; i < reader->size(); ++i) {
       panmap::DatasetFrame frame = reader->read(i);
       if (frame.rgbd.color.empty()) {
@@ -60,11 +62,9 @@ int main(int argc, char** argv) {
       f.depth = std::move(frame.rgbd.depth);
       f.grey = panmap::toGrey(frame.rgbd.color);
       frames.push_back(std::move(f));
-      if ((i + 1) % 50 == 0 || i + 1 == reader->size()) {
-        std::fprintf(stderr, "\rread %zu / %zu frames", i + 1, reader->size());
-      }
+      progress.update(i + 1, reader->size());
     }
-    std::fprintf(stderr, "\n");
+    progress.finish();
     const std::vector<panmap::PhotometricResult> results =
         panmap::photometricConsistency(frames, poses, config);
     nlohmann::json out = nlohmann::json::array();
