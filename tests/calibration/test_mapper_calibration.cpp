@@ -189,6 +189,15 @@ TEST(CalibrateDepthCli, LearnsFromALogAndRefusesBadInput) {
   EXPECT_EQ(no_frames.exit_code, 1);
   EXPECT_NE(no_frames.output.find("no frames to learn from"), std::string::npos)
       << no_frames.output;
+  // An empty log: the same one-line reason, and no progress line made of a division by zero.
+  const std::string empty = dir.path("empty.lcmlog");
+  std::ofstream(empty).close();
+  const auto empty_log = test::runCommand(test::binPath("panmap-calibrate-depth") + " --log " +
+                                          empty + " --out " + out);
+  EXPECT_EQ(empty_log.exit_code, 1);
+  EXPECT_NE(empty_log.output.find("no frames to learn from"), std::string::npos)
+      << empty_log.output;
+  EXPECT_EQ(empty_log.output.find("nan"), std::string::npos) << empty_log.output;
   const auto help = test::runCommand(test::binPath("panmap-calibrate-depth") + " --help");
   EXPECT_EQ(help.exit_code, 0);
 }
