@@ -451,6 +451,35 @@ def pose_gap_note(rows):
                 near, changed))
 
 
+def bridge_list(rows):
+    """Every bridging super-point of the full method (ground-truth poses, `m2f` masks): the run,
+    its GT objects (panmap-eval's `gt_instances`, what trace_object.py --instance follows; the
+    class mix where a results file predates them) and its reach."""
+    items = []
+    for key in rows.keys:
+        for name, run in zip(rows.names.get(key + ("gt", "m2f"), []),
+                             rows.by.get(key + ("gt", "m2f"), [])):
+            full = run["results"].get("full")
+            for b in (full or {}).get("diagnostics", {}).get("bridges", []):
+                names = {c["class_id"]: c["name"] for c in b.get("classes", [])}
+                if b.get("gt_instances"):
+                    # A stuff class counts as one object, instance 0: named by its class.
+                    parts = ", ".join("%s%s %d" % (
+                        "GT %d " % p["instance"] if p["instance"] else "",
+                        names.get(p["class_id"], "class %d" % p["class_id"]), p["vertices"])
+                        for p in b["gt_instances"])
+                else:
+                    parts = ", ".join("%s %.0f %%" % (c["name"], 100 * c["share"])
+                                      for c in b.get("classes", []))
+                items.append("`%s` super-point %d: %d vertices, %s; reach %.1f cm" % (
+                    name, b["superpoint"], b["vertices"], parts, 100 * b.get("reach_m", 0.0)))
+    if not items:
+        return ""
+    return ("Bridging super-points of the full method, run by run (ground-truth poses, `m2f` "
+            "masks; vertices beyond the band by GT object, or by class): " + "; ".join(items) +
+            ". docs/MAPPING.md (III-B) traces those of 2026-12-02 vote by vote.")
+
+
 def acceptance(rows):
     """Issue 19's acceptance lines per (scene, annotation) and as the mean."""
     points = lambda v: "%.1f" % (100 * v)  # noqa: E731
@@ -790,6 +819,9 @@ def main():
         pose_gaps = pose_gap_note(rows)
         if pose_gaps:
             md += [pose_gaps, ""]
+        bridges = bridge_list(rows)
+        if bridges:
+            md += [bridges, ""]
     suites = [Rows(s, results) for s in (real, likes) if s]
     if suites:
         md += ["## Confidence reliability", "",

@@ -127,9 +127,15 @@ json toJson(const panmap::SceneDiagnostics& d) {
     for (const auto& [cls, share] : b.class_mix) {
       classes.push_back({{"class_id", cls}, {"name", panmap::nyu40Name(cls)}, {"share", share}});
     }
+    json parts = json::array();
+    for (const auto& p : b.parts) {
+      parts.push_back(
+          {{"class_id", p.class_id}, {"instance", p.instance}, {"vertices", p.vertices}});
+    }
     bridges.push_back({{"superpoint", b.superpoint},
                        {"vertices", b.vertices},
                        {"classes", classes},
+                       {"gt_instances", parts},
                        {"reach_m", b.reach_m}});
   }
   json things = json::array();

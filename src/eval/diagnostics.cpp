@@ -94,6 +94,19 @@ std::pair<std::vector<std::pair<int32_t, double>>, int64_t> classMix(
   return {mix, sum};
 }
 
+// A bridge's GT objects by vertex count, most first (ties: smaller class, then instance).
+std::vector<SceneDiagnostics::Bridge::Part> bridgeParts(
+    const std::map<std::pair<int32_t, int32_t>, int64_t>& identities) {
+  std::vector<SceneDiagnostics::Bridge::Part> parts;
+  for (const auto& [id, count] : identities) parts.push_back({id.first, id.second, count});
+  std::stable_sort(parts.begin(), parts.end(),
+                   [](const auto& a, const auto& b) { return a.vertices > b.vertices; });
+  if (parts.size() > SceneDiagnostics::kBridgeInstances) {
+    parts.resize(SceneDiagnostics::kBridgeInstances);
+  }
+  return parts;
+}
+
 // Bridge::reach_m of every bridge: one pass over the GT vertices collects each bridge's
 // two classes' points, a k-d tree per class involved answers the distances.
 void measureReach(const LabelledMesh& gt, const TransferredLabels& pred,
@@ -160,6 +173,7 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
 
   // Super-points: identities and classes of their annotated vertices.
   std::map<int32_t, std::map<std::pair<int32_t, int32_t>, int64_t>> sp_identities;
+  std::map<int32_t, std::map<std::pair<int32_t, int32_t>, int64_t>> sp_identities_away;
   std::map<int32_t, std::map<int32_t, int64_t>> sp_classes, sp_classes_away;
   std::map<int32_t, std::pair<int64_t, int64_t>> sp_size;  // all, unannotated
   for (size_t v = 0; v < n; ++v) {
@@ -173,7 +187,10 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
     }
     ++sp_identities[s][identity(gt.semantic[v], gt.instance[v])];
     ++sp_classes[s][gt.semantic[v]];
-    if (away[v]) ++sp_classes_away[s][gt.semantic[v]];
+    if (away[v]) {
+      ++sp_classes_away[s][gt.semantic[v]];
+      ++sp_identities_away[s][identity(gt.semantic[v], gt.instance[v])];
+    }
   }
   int64_t total = 0, majority = 0, class_majority = 0;
   for (const auto& [s, ids] : sp_identities) {
@@ -194,7 +211,7 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
       d.worst_second_class_share = std::max(d.worst_second_class_share, mix[1].second);
       if (mix[1].second > d.bridge_share) {
         ++d.num_bridging_superpoints;
-        d.bridges.push_back({s, sum_away, mix, 0.0});
+        d.bridges.push_back({s, sum_away, mix, 0.0, bridgeParts(sp_identities_away[s])});
       }
     }
   }

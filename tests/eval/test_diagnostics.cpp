@@ -225,6 +225,14 @@ TEST(Diagnostics, ASuperPointReachingWellIntoTheWallStillBridges) {
   // picture's (10, 10)); its picture lies at most 10 cm from the wall (the centre, (19, 19) to
   // (9, 19)). The smaller of the two.
   EXPECT_NEAR(d.bridges[0].reach_m, 0.05 * std::sqrt(2.0), 1e-6);
+  // Its objects, most vertices first: the wall as a whole (stuff: instance 0), the picture.
+  ASSERT_EQ(d.bridges[0].parts.size(), 2u);
+  EXPECT_EQ(d.bridges[0].parts[0].class_id, 1);
+  EXPECT_EQ(d.bridges[0].parts[0].instance, 0);
+  EXPECT_EQ(d.bridges[0].parts[0].vertices, 416);
+  EXPECT_EQ(d.bridges[0].parts[1].class_id, 11);
+  EXPECT_EQ(d.bridges[0].parts[1].instance, 2);
+  EXPECT_EQ(d.bridges[0].parts[1].vertices, 324);
   EXPECT_THROW(diagnose(wide.gt, wide.pred, {}, 5, -0.01), Error);
 }
 

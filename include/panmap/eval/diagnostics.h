@@ -51,7 +51,17 @@ struct SceneDiagnostics {
     /// metres); one that takes a few centimetres of a neighbour's surface at their boundary
     /// reaches that far into it, whatever the share those centimetres make of a small object.
     double reach_m = 0.0;
+    /// The GT objects those vertices belong to, the most vertices first, at most
+    /// kBridgeInstances: what to trace frame by frame (scripts/bench/trace_object.py
+    /// --instance); a stuff class counts as one object, instance 0.
+    struct Part {
+      int32_t class_id = 0;
+      int32_t instance = 0;
+      int64_t vertices = 0;
+    };
+    std::vector<Part> parts;
   };
+  static constexpr size_t kBridgeInstances = 4;
   std::vector<Bridge> bridges;  ///< the bridging super-points, largest first
 
   /// The super-point on the most GT vertices (annotated or not).
