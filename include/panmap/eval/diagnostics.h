@@ -55,14 +55,14 @@ struct SceneDiagnostics {
     /// kBridgeInstances: what to trace frame by frame (scripts/bench/trace_object.py
     /// --instance); a stuff class counts as one object, instance 0.
     struct Part {
-      int32_t class_id = 0;
-      int32_t instance = 0;
-      int64_t vertices = 0;
+      int32_t class_id = 0;  ///< NYU40 class
+      int32_t instance = 0;  ///< GT instance id (0: a stuff class as a whole)
+      int64_t vertices = 0;  ///< its GT vertices here, beyond the boundary band
     };
-    std::vector<Part> parts;
+    std::vector<Part> parts;  ///< most vertices first, at most kBridgeInstances
   };
-  static constexpr size_t kBridgeInstances = 4;
-  std::vector<Bridge> bridges;  ///< the bridging super-points, largest first
+  static constexpr size_t kBridgeInstances = 4;  ///< GT objects listed per bridge, at most
+  std::vector<Bridge> bridges;                   ///< the bridging super-points, largest first
 
   /// The super-point on the most GT vertices (annotated or not).
   int32_t largest_superpoint = 0;
