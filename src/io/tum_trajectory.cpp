@@ -3,39 +3,31 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <sstream>
+#include <string>
 
 #include "panmap/core/error.h"
+#include "panmap/io/text_files.h"
 
 namespace panmap {
 
 std::vector<StampedPose> readTumTrajectory(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error("cannot read trajectory " + path);
+  if (!isRegularFile(path)) throw Error("cannot read trajectory " + path);
   std::vector<StampedPose> out;
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    double v[8];
-    for (double& x : v) {
-      if (!(fields >> x)) {
-        throw Error(path + ":" + std::to_string(line_no) + ": expected 't tx ty tz qx qy qz qw'");
-      }
+  for (const NumberLine& line : readNumberLines(path)) {
+    const std::string where = path + ":" + std::to_string(line.line);
+    const std::vector<double>& v = line.values;
+    if (v.size() < 8) throw Error(where + ": expected 't tx ty tz qx qy qz qw'");
+    for (size_t k = 0; k < 8; ++k) {
+      if (!std::isfinite(v[k])) throw Error(where + ": non-finite pose");
     }
     const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
     if (!std::isfinite(q.norm()) || std::abs(q.norm() - 1.0) > 1e-3) {
-      throw Error(path + ":" + std::to_string(line_no) + ": quaternion is not unit length");
+      throw Error(where + ": quaternion is not unit length");
     }
     StampedPose pose;
     pose.utime = static_cast<int64_t>(std::llround(v[0] * 1e6));
     pose.T_W_C.linear() = q.normalized().toRotationMatrix();
     pose.T_W_C.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
-    if (!pose.T_W_C.matrix().allFinite()) {
-      throw Error(path + ":" + std::to_string(line_no) + ": non-finite pose");
-    }
     out.push_back(pose);
   }
   if (out.empty()) throw Error("trajectory " + path + " has no poses");

@@ -1,5 +1,6 @@
 #include <cmath>
 #include <fstream>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -200,6 +201,31 @@ TEST(Survey, TumRoundTrip) {
   }
   std::ofstream(dir.path("bad.txt")) << "0 1 2 3 0 0 0 1\n1 2 3 nan 0 0 0 1\n";
   EXPECT_THROW(readTumTrajectory(dir.path("bad.txt")), Error);
+}
+
+// The line and what is wrong with it, for each kind of bad line; comments and blank lines are
+// skipped and the line numbers count them.
+TEST(Survey, TumReaderNamesTheBadLine) {
+  test::TempDir dir;
+  auto message = [&](const std::string& text) {
+    std::ofstream(dir.path("t.txt")) << text;
+    try {
+      readTumTrajectory(dir.path("t.txt"));
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string path = dir.path("t.txt");
+  EXPECT_EQ(message("# header\n\n0.5 1 2 3 0 0 0 1\n1 2 3 nan 0 0 0 1\n"),
+            path + ":4: non-finite pose");
+  EXPECT_EQ(message("0.5 1 2 3 0 0 1\n"), path + ":1: expected 't tx ty tz qx qy qz qw'");
+  EXPECT_EQ(message("0.5 1 2 3 0 0 0 2\n"), path + ":1: quaternion is not unit length");
+  EXPECT_EQ(message("0.5 1 2 x 0 0 0 1\n"), path + ":1: 'x' is not a number");
+  EXPECT_EQ(message("# only a comment\n"), "trajectory " + path + " has no poses");
+  EXPECT_EQ(message("0.5 1 2 3 0 0 0 1\n"), "no error");
+  EXPECT_EQ(readTumTrajectory(path)[0].utime, 500000);
+  EXPECT_THROW(readTumTrajectory(dir.path("missing.txt")), Error);
 }
 
 }  // namespace
