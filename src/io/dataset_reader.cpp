@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "panmap/core/error.h"
+#include "panmap/io/image_codec.h"
 #include "panmap/io/internal/readers.h"
 #include "panmap/io/text_files.h"
 
@@ -241,6 +242,24 @@ void checkImageSize(const std::string& path, const char* kind, int width, int he
   msg << path << ": " << kind << " image is " << width << "x" << height << ", expected "
       << expected_width << "x" << expected_height;
   throw Error(msg.str());
+}
+
+void readDepthPng(const std::string& path, int width, int height, DatasetFrame* frame) {
+  frame->depth_png = readFileBytes(path);
+  frame->rgbd.depth = decodeDepthPng(frame->depth_png.data(), frame->depth_png.size(), path);
+  checkImageSize(path, "depth", frame->rgbd.depth.width(), frame->rgbd.depth.height(), width,
+                 height);
+}
+
+void readRegisteredColor(const std::string& path, int width, int height, DatasetFrame* frame) {
+  const std::vector<uint8_t> bytes = readFileBytes(path);
+  frame->rgbd.color = decodeColor(bytes.data(), bytes.size(), path);
+  checkImageSize(path, "colour", frame->rgbd.color.width(), frame->rgbd.color.height(), width,
+                 height);
+  if (isCompleteJpeg(bytes.data(), bytes.size())) frame->color_jpeg = bytes;
+  frame->color_stem = fileStem(path);
+  frame->color_source_width = width;
+  frame->color_source_height = height;
 }
 
 }  // namespace internal

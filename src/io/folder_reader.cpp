@@ -171,10 +171,7 @@ class FolderReader : public DatasetReader {
     const Frame& f = frames_.at(index);
     DatasetFrame frame;
     const std::string depth_path = depth_dir_ + "/" + f.depth.name;
-    frame.depth_png = readFileBytes(depth_path);
-    frame.rgbd.depth = decodeDepthPng(frame.depth_png.data(), frame.depth_png.size(), depth_path);
-    checkImageSize(depth_path, "depth", frame.rgbd.depth.width(), frame.rgbd.depth.height(),
-                   camera_.width, camera_.height);
+    readDepthPng(depth_path, camera_.width, camera_.height, &frame);
     const std::string color_path = color_dir_ + "/" + f.color.name;
     const std::vector<uint8_t> color_bytes = readFileBytes(color_path);
     ColorImage color = decodeColor(color_bytes.data(), color_bytes.size(), color_path);

@@ -117,10 +117,7 @@ class ScanNetReader : public DatasetReader {
     DatasetFrame frame;
     const long long number = frames_.at(index).first;
     const std::string depth_path = depthPath(index);
-    frame.depth_png = readFileBytes(depth_path);
-    frame.rgbd.depth = decodeDepthPng(frame.depth_png.data(), frame.depth_png.size(), depth_path);
-    checkImageSize(depth_path, "depth", frame.rgbd.depth.width(), frame.rgbd.depth.height(),
-                   depth_camera_.width, depth_camera_.height);
+    readDepthPng(depth_path, depth_camera_.width, depth_camera_.height, &frame);
     const std::string color_path = colorPath(index);
     const ColorImage color = readColorFile(color_path);
     checkImageSize(color_path, "colour", color.width(), color.height(), color_camera_.width,

@@ -47,23 +47,13 @@ class SevenScenesReader : public DatasetReader {
     const long long number = frames_.at(index).first;
     const std::string prefix = dir_ + "/" + stemOf(index);
     const std::string depth_path = depthPath(index);
-    frame.depth_png = readFileBytes(depth_path);
-    frame.rgbd.depth = decodeDepthPng(frame.depth_png.data(), frame.depth_png.size(), depth_path);
-    checkImageSize(depth_path, "depth", frame.rgbd.depth.width(), frame.rgbd.depth.height(),
-                   camera_.width, camera_.height);
+    readDepthPng(depth_path, camera_.width, camera_.height, &frame);
 
     std::string color_path = prefix + ".color.jpg";
     if (!isRegularFile(color_path) && isRegularFile(prefix + ".color.png")) {
       color_path = prefix + ".color.png";
     }
-    const std::vector<uint8_t> color_bytes = readFileBytes(color_path);
-    frame.rgbd.color = decodeColor(color_bytes.data(), color_bytes.size(), color_path);
-    checkImageSize(color_path, "colour", frame.rgbd.color.width(), frame.rgbd.color.height(),
-                   camera_.width, camera_.height);
-    if (isCompleteJpeg(color_bytes.data(), color_bytes.size())) frame.color_jpeg = color_bytes;
-    frame.color_stem = fileStem(color_path);
-    frame.color_source_width = camera_.width;
-    frame.color_source_height = camera_.height;
+    readRegisteredColor(color_path, camera_.width, camera_.height, &frame);
 
     frame.rgbd.utime = frameUtime(number, options_.frame_rate_hz);
     frame.rgbd.frame_id = number;

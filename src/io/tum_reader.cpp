@@ -109,19 +109,8 @@ class TumReader : public DatasetReader {
     const Pair& p = pairs_.at(index);
     DatasetFrame frame;
     const std::string depth_path = dir_ + "/" + p.depth.file;
-    frame.depth_png = readFileBytes(depth_path);
-    frame.rgbd.depth = decodeDepthPng(frame.depth_png.data(), frame.depth_png.size(), depth_path);
-    checkImageSize(depth_path, "depth", frame.rgbd.depth.width(), frame.rgbd.depth.height(),
-                   camera_.width, camera_.height);
-    const std::string color_path = dir_ + "/" + p.color.file;
-    const std::vector<uint8_t> color_bytes = readFileBytes(color_path);
-    frame.rgbd.color = decodeColor(color_bytes.data(), color_bytes.size(), color_path);
-    checkImageSize(color_path, "colour", frame.rgbd.color.width(), frame.rgbd.color.height(),
-                   camera_.width, camera_.height);
-    if (isCompleteJpeg(color_bytes.data(), color_bytes.size())) frame.color_jpeg = color_bytes;
-    frame.color_stem = fileStem(color_path);
-    frame.color_source_width = camera_.width;
-    frame.color_source_height = camera_.height;
+    readDepthPng(depth_path, camera_.width, camera_.height, &frame);
+    readRegisteredColor(dir_ + "/" + p.color.file, camera_.width, camera_.height, &frame);
 
     frame.rgbd.utime = static_cast<int64_t>(std::llround(p.depth.t * 1e6));
     frame.rgbd.frame_id = static_cast<int64_t>(index);

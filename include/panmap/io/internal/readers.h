@@ -61,5 +61,14 @@ std::string fileStem(const std::string& path);
 void checkImageSize(const std::string& path, const char* kind, int width, int height,
                     int expected_width, int expected_height);
 
+/// Reads the depth PNG at path into frame->depth_png (its bytes) and frame->rgbd.depth; throws
+/// Error naming the file when it cannot be read or decoded or is not width x height.
+void readDepthPng(const std::string& path, int width, int height, DatasetFrame* frame);
+
+/// Reads a colour image taken with the depth camera's size and viewpoint into
+/// frame->rgbd.color, with color_stem, the source size, and color_jpeg when the file is a
+/// complete JPEG (sent on as it is); throws Error naming the file like readDepthPng.
+void readRegisteredColor(const std::string& path, int width, int height, DatasetFrame* frame);
+
 }  // namespace internal
 }  // namespace panmap
