@@ -182,6 +182,8 @@ json toJson(const panmap::SceneDiagnostics& d) {
           {"num_objects", d.num_objects},
           {"num_gt_things", d.gt_things.size()},
           {"objects_per_gt_instance", number(d.objects_per_gt_instance)},
+          {"num_checkable_objects", d.num_checkable_objects},
+          {"checkable_objects_per_gt_instance", number(d.checkable_objects_per_gt_instance)},
           {"confident_objects", d.confident_objects},
           {"confident_precision", number(d.confident_precision)},
           {"confident_recall", number(d.confident_recall)},

@@ -354,8 +354,14 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
     d.objects.push_back(o);
   }
   d.num_objects = static_cast<int>(d.objects.size());
-  d.objects_per_gt_instance =
-      d.gt_things.empty() ? kNaN : static_cast<double>(d.num_objects) / d.gt_things.size();
+  d.num_checkable_objects = static_cast<int>(
+      std::count_if(d.objects.begin(), d.objects.end(),
+                    [](const SceneDiagnostics::ObjectMatch& o) { return !o.unverifiable; }));
+  const auto perThing = [&d](int n) {
+    return d.gt_things.empty() ? kNaN : static_cast<double>(n) / d.gt_things.size();
+  };
+  d.objects_per_gt_instance = perThing(d.num_objects);
+  d.checkable_objects_per_gt_instance = perThing(d.num_checkable_objects);
 
   d.reliability.resize(num_bins);
   for (int b = 0; b < num_bins; ++b) {
@@ -447,9 +453,11 @@ std::string formatDiagnostics(const SceneDiagnostics& d) {
                 mix.c_str());
   out += line;
   std::snprintf(line, sizeof(line),
-                "objects: %d for %zu GT thing instances (%.2f each); confidence >= 0.5: %d, "
-                "%.2f of them match, covering %.2f of the GT things\n",
-                d.num_objects, d.gt_things.size(), d.objects_per_gt_instance, d.confident_objects,
+                "objects: %d for %zu GT thing instances (%.2f each; %d on annotated GT, %.2f "
+                "each); confidence >= 0.5: %d, %.2f of them match, covering %.2f of the GT "
+                "things\n",
+                d.num_objects, d.gt_things.size(), d.objects_per_gt_instance,
+                d.num_checkable_objects, d.checkable_objects_per_gt_instance, d.confident_objects,
                 d.confident_precision, d.confident_recall);
   out += line;
   int causes[6] = {0, 0, 0, 0, 0, 0};

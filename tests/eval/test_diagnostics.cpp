@@ -136,6 +136,12 @@ TEST(Diagnostics, HandComputedCase) {
   ASSERT_EQ(d.gt_things.size(), 2u);
   EXPECT_EQ(d.num_objects, 5);
   EXPECT_NEAR(d.objects_per_gt_instance, 2.5, 1e-12);
+  // Object 10 lies on unannotated GT only: 4 can be checked against the 2 GT things.
+  EXPECT_EQ(d.num_checkable_objects, 4);
+  EXPECT_NEAR(d.checkable_objects_per_gt_instance, 2.0, 1e-12);
+  EXPECT_NE(formatDiagnostics(d).find("objects: 5 for 2 GT thing instances (2.50 each; 4 on "
+                                      "annotated GT, 2.00 each)"),
+            std::string::npos);
   std::map<int32_t, SceneDiagnostics::ObjectMatch> by_id;
   for (const auto& o : d.objects) by_id[o.id] = o;
   // Object 7: 190 vertices (10 void), IoU with chair A = 180 / (200 + 190 - 180).

@@ -126,6 +126,12 @@ struct SceneDiagnostics {
   int num_objects = 0;  ///< predicted objects (object list entries, else mesh instances)
   /// num_objects / gt_things.size() (NaN without GT things).
   double objects_per_gt_instance = 0.0;
+  /// Objects that are not unverifiable: the ones a count against the annotated GT things can
+  /// judge. Where a quarter of a scene is unannotated and the network labels it, the objects
+  /// found there are the scene's real objects, not fragments of annotated ones.
+  int num_checkable_objects = 0;
+  /// num_checkable_objects / gt_things.size() (NaN without GT things).
+  double checkable_objects_per_gt_instance = 0.0;
 
   /// Reliability of the confidences: objects (verifiable ones) binned by confidence.
   struct ReliabilityBin {
