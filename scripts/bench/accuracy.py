@@ -501,7 +501,8 @@ def bridge_list(rows):
         return ""
     return ("Bridging super-points of the full method, run by run (ground-truth poses, `m2f` "
             "masks; vertices beyond the band by GT object, or by class): " + "; ".join(items) +
-            ". docs/MAPPING.md (III-B) traces those of 2026-12-02 vote by vote.")
+            ". docs/MAPPING.md (III-B) says how such bridges arise: the main suite's of "
+            "2026-12-02 (docs/RESULTS.md) traced vote by vote.")
 
 
 def acceptance(rows):
