@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -326,6 +327,16 @@ int main(int argc, char** argv) {
     } else {
       trajectory = panmap::planSurvey(mesh, survey, seed);
     }
+    panmap::SurveyPath walk;
+    if (trajectory_file.empty()) {
+      walk = building_stops.empty() ? panmap::planSurveyPath(mesh, survey, seed)
+                                    : panmap::planSurveyPathThrough(mesh, survey, building_stops);
+      if (walk.clearance_m < survey.clearance_m) {
+        std::cerr << "panmap-synth: under 1 m^2 of floor is " << survey.clearance_m
+                  << " m clear of surfaces; the survey walks " << walk.clearance_m
+                  << " m from them\n";
+      }
+    }
 
     fs::create_directories(out_dir + "/gt");
     panmap::SequenceSynthesizer synth(mesh, trajectory, config);
@@ -395,11 +406,8 @@ int main(int argc, char** argv) {
         {"trajectory",
          {{"source", trajectory_file.empty() ? "survey" : trajectory_file},
           {"laps", trajectory_file.empty() ? laps : 0},
-          {"walk_length_m",
-           !trajectory_file.empty() ? 0.0
-           : building_stops.empty()
-               ? panmap::planSurveyPath(mesh, survey, seed).length_m
-               : panmap::planSurveyPathThrough(mesh, survey, building_stops).length_m},
+          {"walk_length_m", walk.length_m},
+          {"planned_clearance_m", walk.clearance_m},
           {"min_clearance_m", panmap::minClearance(synth.groundTruthTrajectory(), mesh)}}},
         {"masks", masksJson(config.masks)},
         {"unannotation",

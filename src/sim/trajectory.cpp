@@ -22,6 +22,7 @@ void SurveyConfig::check() const {
   if (!(rate_hz > 0)) throw Error("survey rate_hz must be > 0");
   if (!(speed_mps > 0)) throw Error("survey speed_mps must be > 0");
   if (!(clearance_m >= 0)) throw Error("survey clearance_m must be >= 0");
+  if (!(min_clearance_m >= 0)) throw Error("survey min_clearance_m must be >= 0");
   if (!(min_height_m > 0 && max_height_m >= min_height_m)) {
     throw Error("survey heights need 0 < min_height_m <= max_height_m");
   }
@@ -42,6 +43,8 @@ struct FreeSpace {
   cv::Mat clearance_m;  // CV_32F, distance to the nearest obstacle cell, metres
   cv::Mat walls;        // CV_8U, 1 where a wall crosses the camera's height band (or empty)
   double floor_z = 0.0;
+  double keep_m = 0.0;   // the clearance the walk keeps (SurveyPath::clearance_m)
+  double area_m2 = 0.0;  // floor of the safe region
 
   // Cell of a world point, or false when it is off the grid.
   bool cellOf(const Eigen::Vector2d& p, int* i, int* j) const {
@@ -55,8 +58,17 @@ struct FreeSpace {
   }
 };
 
-FreeSpace buildFreeSpace(const LabelledMesh& mesh, const SurveyConfig& config) {
+// A walk needs this much floor at the configured clearance; below it the clearance is lowered.
+constexpr double kWalkArea_m2 = 1.0;
+// Where even min_clearance_m leaves less than kWalkArea_m2, at least this much (a person turning
+// on the spot in a toilet room) still gives a survey.
+constexpr double kSmallestWalkArea_m2 = 0.25;
+
+// The free space at one clearance: the largest connected region of the floor where the camera
+// stays `clearance` from every surface of its height band (area_m2 0 when there is none).
+FreeSpace freeSpaceAt(const LabelledMesh& mesh, const SurveyConfig& config, double clearance) {
   FreeSpace fs;
+  fs.keep_m = clearance;
   fs.cell = config.grid_m;
   std::vector<float> zs;
   zs.reserve(mesh.vertices.size());
@@ -76,8 +88,8 @@ FreeSpace buildFreeSpace(const LabelledMesh& mesh, const SurveyConfig& config) {
   cv::Mat floor = cv::Mat::zeros(ny, nx, CV_8U);
   if (config.walls_block_view) fs.walls = cv::Mat::zeros(ny, nx, CV_8U);
   bool wall_face = false;
-  const double band_lo = fs.floor_z + config.min_height_m - config.clearance_m;
-  const double band_hi = fs.floor_z + config.max_height_m + config.clearance_m;
+  const double band_lo = fs.floor_z + config.min_height_m - clearance;
+  const double band_hi = fs.floor_z + config.max_height_m + clearance;
   auto mark = [&](const Eigen::Vector3f& p) {
     const int i = static_cast<int>((p.x() - fs.origin.x()) / fs.cell);
     const int j = static_cast<int>((p.y() - fs.origin.y()) / fs.cell);
@@ -113,7 +125,7 @@ FreeSpace buildFreeSpace(const LabelledMesh& mesh, const SurveyConfig& config) {
   cv::Mat free_cells = (occupied == 0) / 255;
   cv::distanceTransform(free_cells, fs.clearance_m, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   fs.clearance_m *= fs.cell;
-  const double margin = config.clearance_m + fs.cell;  // the grid hides up to a cell
+  const double margin = clearance + fs.cell;  // the grid hides up to a cell
   fs.safe = (fs.clearance_m >= margin) & (inside > 0) & (occupied == 0);
   fs.safe /= 255;
   // Keep the largest connected free region: the room the camera walks in.
@@ -126,16 +138,36 @@ FreeSpace buildFreeSpace(const LabelledMesh& mesh, const SurveyConfig& config) {
       best = k;
     }
   }
-  const double area_m2 = best_area * fs.cell * fs.cell;
-  if (best < 0 || area_m2 < 1.0) {
-    std::ostringstream msg;
-    msg << "survey: only " << area_m2 << " m^2 of floor is " << config.clearance_m
-        << " m clear of surfaces at heights " << config.min_height_m << "-" << config.max_height_m
-        << " m; no room to walk";
-    throw Error(msg.str());
-  }
+  if (best < 0) return fs;
+  fs.area_m2 = best_area * fs.cell * fs.cell;
   fs.safe = (labels == best) / 255;
   return fs;
+}
+
+// The free space at clearance_m, or, in a room too small to walk at it (a 2 x 1.5 m bathroom
+// leaves 1 m^2 at 0.3 m), at the largest clearance down to min_clearance_m that leaves
+// kWalkArea_m2: a scanner walks closer to the walls in a small room rather than not at all.
+FreeSpace buildFreeSpace(const LabelledMesh& mesh, const SurveyConfig& config) {
+  FreeSpace fs = freeSpaceAt(mesh, config, config.clearance_m);
+  if (fs.area_m2 >= kWalkArea_m2) return fs;
+  const double first_area = fs.area_m2;
+  // Steps of a third: 0.3, 0.2, 0.13, then min_clearance_m (directly once within 1 cm of it).
+  for (double c = config.clearance_m; c > config.min_clearance_m;) {
+    c *= 2.0 / 3.0;
+    if (c < config.min_clearance_m + 0.01) c = config.min_clearance_m;
+    fs = freeSpaceAt(mesh, config, c);
+    if (fs.area_m2 >= kWalkArea_m2) return fs;
+  }
+  if (fs.area_m2 >= kSmallestWalkArea_m2) return fs;
+  std::ostringstream msg;
+  msg << "survey: only " << first_area << " m^2 of floor is " << config.clearance_m
+      << " m clear of surfaces at heights " << config.min_height_m << "-" << config.max_height_m
+      << " m";
+  if (config.min_clearance_m < config.clearance_m) {
+    msg << " (" << fs.area_m2 << " m^2 at " << config.min_clearance_m << " m)";
+  }
+  msg << "; no room to walk";
+  throw Error(msg.str());
 }
 
 using Cell = std::pair<int, int>;  // (i, j) = (column, row)
@@ -287,6 +319,7 @@ SurveyPath planWalk(const FreeSpace& fs, const std::vector<Cell>& stops, int lap
     arc.push_back(arc.back() + (path.points[k % path.points.size()] - path.points[k - 1]).norm());
   }
   path.length_m = arc.back();
+  path.clearance_m = fs.keep_m;
   for (size_t begin : lap_begin) {
     const size_t k = std::lower_bound(origin.begin(), origin.end(), begin) - origin.begin();
     path.lap_start_m.push_back(arc[k]);

@@ -109,7 +109,7 @@ INSTANTIATE_TEST_SUITE_P(Seeds, SurveyOfRoom, ::testing::Values(1, 2, 3));
 
 TEST(Survey, NoRoomToWalkIsAClearError) {
   LabelledMesh mesh;
-  mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  mesh.vertices = {{0, 0, 0}, {0.5, 0, 0}, {0, 0.5, 0}};  // 0.125 m^2 of floor
   mesh.faces = {{0, 1, 2}};
   try {
     planSurvey(mesh, SurveyConfig(), 1);
@@ -181,6 +181,69 @@ TEST(Survey, WallsHideObjectsBehindThemWhenAsked) {
   for (const StampedPose& p : blocked) ASSERT_LT(p.T_W_C.translation().x(), 3.5);
   EXPECT_GT(looksAt(seen_through, chair), 30);
   EXPECT_EQ(looksAt(blocked, chair), 0);
+}
+
+// A bathroom of w x d metres (walls 2.5 m high) with a 0.4 m wide cabinet 1.8 m tall in one
+// corner: within the camera's height band, as a shelf or a shower cabin would be.
+LabelledMesh bathroom(float w, float d) {
+  const Eigen::Vector3f x = Eigen::Vector3f::UnitX(), y = Eigen::Vector3f::UnitY(),
+                        z = Eigen::Vector3f::UnitZ();
+  LabelledMesh mesh;
+  addRect(&mesh, Eigen::Vector3f::Zero(), w * x, d * y, 2, 2);  // floor
+  addRect(&mesh, Eigen::Vector3f::Zero(), w * x, 2.5f * z, 1, 1);
+  addRect(&mesh, d * y, w * x, 2.5f * z, 1, 1);
+  addRect(&mesh, Eigen::Vector3f::Zero(), d * y, 2.5f * z, 1, 1);
+  addRect(&mesh, w * x, d * y, 2.5f * z, 1, 1);
+  const Eigen::Vector3f lo(w - 0.4f, d - 0.4f, 0.0f);
+  for (int i = 0; i < 2; ++i) {
+    addRect(&mesh, lo + i * 0.4f * x, 0.4f * y, 1.8f * z, 10, 39);
+    addRect(&mesh, lo + i * 0.4f * y, 0.4f * x, 1.8f * z, 10, 39);
+    addRect(&mesh, lo + i * 1.8f * z, 0.4f * x, 0.4f * y, 10, 39);
+  }
+  return mesh;
+}
+
+// Smallest distance from every pose to every triangle of the mesh.
+double exactClearance(const std::vector<StampedPose>& poses, const LabelledMesh& mesh) {
+  double clearance = 1e9;
+  for (const StampedPose& pose : poses) {
+    for (const Eigen::Vector3i& f : mesh.faces) {
+      clearance = std::min(clearance, pointTriangleDistance(pose.T_W_C.translation(),
+                                                            mesh.vertices[f[0]].cast<double>(),
+                                                            mesh.vertices[f[1]].cast<double>(),
+                                                            mesh.vertices[f[2]].cast<double>()));
+    }
+  }
+  return clearance;
+}
+
+TEST(Survey, ASmallRoomIsWalkedCloserToItsWalls) {
+  SurveyConfig config;
+  config.num_frames = 400;
+  config.rate_hz = 5.0;
+  config.laps = 2;
+  // 2 x 1.5 m leaves 0.98 m^2 at 0.3 m: walked at 0.2 m.
+  const LabelledMesh small = bathroom(2.0f, 1.5f);
+  const SurveyPath path = planSurveyPath(small, config, 1);
+  EXPECT_NEAR(path.clearance_m, 0.2, 1e-9);
+  const std::vector<StampedPose> poses = planSurvey(small, config, 1);
+  ASSERT_EQ(poses.size(), 400u);
+  EXPECT_GE(exactClearance(poses, small), path.clearance_m);
+  // 1.2 x 1.5 m needs min_clearance_m itself.
+  const LabelledMesh smaller = bathroom(1.2f, 1.5f);
+  EXPECT_NEAR(planSurveyPath(smaller, config, 1).clearance_m, config.min_clearance_m, 1e-9);
+  EXPECT_GE(exactClearance(planSurvey(smaller, config, 1), smaller), config.min_clearance_m);
+  // A room that has the floor keeps the configured clearance.
+  EXPECT_EQ(planSurveyPath(bathroom(2.4f, 2.5f), config, 1).clearance_m, config.clearance_m);
+  // Without a lower clearance to fall back to, a room with under 0.25 m^2 clear at 0.3 m is a
+  // clear error.
+  config.min_clearance_m = config.clearance_m;
+  try {
+    planSurvey(bathroom(1.2f, 1.2f), config, 1);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no room to walk"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Survey, TumRoundTrip) {

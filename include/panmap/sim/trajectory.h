@@ -14,10 +14,13 @@ namespace panmap {
 
 /// Parameters of the survey path planner.
 struct SurveyConfig {
-  int num_frames = 300;       ///< poses to produce
-  double rate_hz = 30.0;      ///< frame rate
-  double speed_mps = 0.35;    ///< walking speed along the path, metres per second
-  double clearance_m = 0.3;   ///< minimum distance of the camera to any surface, metres
+  int num_frames = 300;      ///< poses to produce
+  double rate_hz = 30.0;     ///< frame rate
+  double speed_mps = 0.35;   ///< walking speed along the path, metres per second
+  double clearance_m = 0.3;  ///< minimum distance of the camera to any surface, metres
+  /// In a room with under 1 m^2 of floor clearance_m from its surfaces (ScanNet bathrooms), the
+  /// survey walks closer to them, down to this (SurveyPath::clearance_m says how close).
+  double min_clearance_m = 0.1;
   double min_height_m = 1.2;  ///< camera height band above the floor, metres
   double max_height_m = 1.7;
   double max_yaw_rate_dps = 45.0;    ///< head-like turning rate limit, degrees per second
@@ -46,6 +49,9 @@ struct SurveyPath {
   std::vector<Eigen::Vector2d> points;
   std::vector<double> lap_start_m;  ///< arc length at which each lap starts, metres (0 first)
   double length_m = 0.0;            ///< arc length of the whole walk, back to its start, metres
+  /// Distance the walk keeps from every surface, metres: SurveyConfig::clearance_m, less in a
+  /// room too small to walk at it.
+  double clearance_m = 0.0;
 };
 
 /// Plans a smooth survey of a labelled mesh (z up): a loop through free space at least
@@ -53,7 +59,7 @@ struct SurveyPath {
 /// the labelled objects from several sides. The camera walks planSurveyPath's walk at
 /// speed_mps from its start and starts over at its end: laps the frames do not reach are left
 /// out. Deterministic for a seed. Throws Error when the mesh has no free space large enough to
-/// walk in.
+/// walk in, even at min_clearance_m.
 std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& config,
                                     uint64_t seed);
 
