@@ -33,21 +33,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 // The one file in `dir` whose name ends with `suffix`.
-std::string findOne(const std::string& dir, const std::string& suffix) {
-  std::string found;
-  for (const auto& e : fs::directory_iterator(dir)) {
-    const std::string name = e.path().filename().string();
-    if (name.size() > suffix.size() &&
-        name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
-        name.find(".labels.") == std::string::npos) {
-      if (!found.empty()) throw panmap::Error(dir + ": more than one *" + suffix);
-      found = e.path().string();
-    }
-  }
-  if (found.empty()) throw panmap::Error(dir + ": no *" + suffix + " file");
-  return found;
-}
-
 json masksJson(const panmap::SegmenterNoiseConfig& c) {
   return {{"preset", c.preset},
           {"window_frames", c.window_frames},
@@ -271,9 +256,9 @@ int main(int argc, char** argv) {
           {"type", "procedural_room"}, {"room_seed", room_seed}, {"room_style", room_style}};
     } else {
       const auto table = panmap::ScanNetLabelTable::load(scannet_labels);
-      const auto gt = panmap::loadScanNetGroundTruth(
-          findOne(scannet_dir, "_vh_clean_2.ply"), findOne(scannet_dir, ".aggregation.json"),
-          findOne(scannet_dir, "_vh_clean_2.0.010000.segs.json"), table);
+      const panmap::ScanNetSceneFiles files = panmap::findScanNetSceneFiles(scannet_dir);
+      const auto gt = panmap::loadScanNetGroundTruth(files.mesh_ply, files.aggregation_json,
+                                                     files.segs_json, table);
       mesh = gt.mesh;
       source_json = {
           {"type", "scannet"}, {"dir", scannet_dir}, {"unknown_labels", gt.unknown_labels}};

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <set>
@@ -21,6 +22,13 @@ namespace panmap {
 namespace {
 
 using nlohmann::json;
+
+constexpr char kScanNetMeshSuffix[] = "_vh_clean_2.ply";
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
 
 std::vector<std::string> splitTabs(const std::string& line) {
   std::vector<std::string> fields;
@@ -178,6 +186,41 @@ ScanNetGroundTruth loadScanNetGroundTruth(const std::string& mesh_ply,
   for (const Group& group : groups) gt.num_instances += group.vertices > 0;
   gt.unknown_labels.assign(unknown.begin(), unknown.end());
   return gt;
+}
+
+ScanNetSceneFiles findScanNetSceneFiles(const std::string& scene_dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(scene_dir, ec)) throw Error(scene_dir + ": not a folder");
+  const fs::path dir(scene_dir);
+  // "scene0000_00/" has an empty filename: its parent_path's is the name.
+  std::string scene = (dir.has_filename() ? dir : dir.parent_path()).filename().string();
+  if (!fs::is_regular_file(dir / (scene + kScanNetMeshSuffix), ec)) {
+    std::vector<std::string> found;
+    for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+      const std::string name = e.path().filename().string();
+      if (endsWith(name, kScanNetMeshSuffix)) found.push_back(name);
+    }
+    if (found.size() != 1) {
+      throw Error(scene_dir + ": expected one *" + kScanNetMeshSuffix + " mesh, found " +
+                  std::to_string(found.size()));
+    }
+    scene = found[0].substr(0, found[0].size() - std::string(kScanNetMeshSuffix).size());
+  }
+  ScanNetSceneFiles files;
+  files.scene = scene;
+  files.mesh_ply = (dir / (scene + kScanNetMeshSuffix)).string();
+  files.aggregation_json = (dir / (scene + ".aggregation.json")).string();
+  files.segs_json = (dir / (scene + "_vh_clean_2.0.010000.segs.json")).string();
+  for (const std::string* f : {&files.aggregation_json, &files.segs_json}) {
+    if (!fs::is_regular_file(*f, ec)) {
+      throw Error(*f + ": missing (ScanNet scene " + scene + ")" +
+                  (f == &files.aggregation_json
+                       ? "; a *_vh_clean.aggregation.json annotates the high-resolution mesh"
+                       : ""));
+    }
+  }
+  return files;
 }
 
 std::vector<int32_t> readScanNetLabelsPly(const std::string& labels_ply,

@@ -1,7 +1,4 @@
-// Ground-truth inputs of panmap-eval: ScanNet scene folders, benchmark id files, class lists.
-#include <filesystem>
-#include <fstream>
-
+// Ground-truth inputs of panmap-eval: benchmark id files, class lists.
 #include <gtest/gtest.h>
 
 #include "panmap/core/error.h"
@@ -11,50 +8,7 @@
 namespace panmap {
 namespace {
 
-namespace fs = std::filesystem;
 using test::expectError;
-
-const char* const kSceneFiles[] = {"_vh_clean_2.ply", ".aggregation.json",
-                                   "_vh_clean_2.0.010000.segs.json"};
-
-TEST(GroundTruthInput, FindsTheScanNetFilesOfAFolder) {
-  // The fixture folder is not named after its scene: the only *_vh_clean_2.ply names it (the
-  // labels PLY beside it does not count).
-  const std::string tiny = test::fixtureDir("scannet_gt_tiny");
-  const ScanNetSceneFiles files = findScanNetSceneFiles(tiny);
-  EXPECT_EQ(files.scene, "scene0000_00");
-  EXPECT_EQ(files.mesh_ply, tiny + "/scene0000_00_vh_clean_2.ply");
-  EXPECT_EQ(files.aggregation_json, tiny + "/scene0000_00.aggregation.json");
-  EXPECT_EQ(files.segs_json, tiny + "/scene0000_00_vh_clean_2.0.010000.segs.json");
-
-  // A folder named after its scene wins even beside another scene's mesh, trailing slash or not.
-  test::TempDir dir;
-  fs::create_directory(dir.path("scene0707_00"));
-  for (const char* f : kSceneFiles) {
-    fs::create_symlink(tiny + "/scene0000_00" + f, dir.path("scene0707_00/scene0707_00") + f);
-  }
-  fs::create_symlink(tiny + "/scene0000_00_vh_clean_2.ply",
-                     dir.path("scene0707_00/scene0001_00_vh_clean_2.ply"));
-  EXPECT_EQ(findScanNetSceneFiles(dir.path("scene0707_00")).scene, "scene0707_00");
-  EXPECT_EQ(findScanNetSceneFiles(dir.path("scene0707_00/")).segs_json,
-            dir.path("scene0707_00/scene0707_00_vh_clean_2.0.010000.segs.json"));
-}
-
-TEST(GroundTruthInput, MissingScanNetFilesAreNamed) {
-  test::TempDir dir;
-  expectError([&] { findScanNetSceneFiles(dir.path("absent")); }, {"absent", "not a folder"});
-  fs::create_directory(dir.path("empty"));
-  expectError([&] { findScanNetSceneFiles(dir.path("empty")); },
-              {"empty", "expected one *_vh_clean_2.ply mesh, found 0"});
-  fs::create_directory(dir.path("s"));
-  const std::string tiny = test::fixtureDir("scannet_gt_tiny/scene0000_00");
-  fs::create_symlink(tiny + "_vh_clean_2.ply", dir.path("s/scene0000_00_vh_clean_2.ply"));
-  fs::create_symlink(tiny + ".aggregation.json", dir.path("s/scene0000_00.aggregation.json"));
-  expectError([&] { findScanNetSceneFiles(dir.path("s")); },
-              {"scene0000_00_vh_clean_2.0.010000.segs.json", "missing"});
-  fs::create_symlink(tiny + "_vh_clean_2.ply", dir.path("s/scene0001_00_vh_clean_2.ply"));
-  expectError([&] { findScanNetSceneFiles(dir.path("s")); }, {"found 2"});
-}
 
 TEST(GroundTruthInput, BenchmarkIdsReplaceTheMeshLabels) {
   LabelledMesh mesh;

@@ -1,3 +1,4 @@
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -14,6 +15,7 @@
 namespace panmap {
 namespace {
 
+namespace fs = std::filesystem;
 using test::expectError;
 
 const char kTable[] = "scannet-meta/scannetv2-labels.combined.tsv";
@@ -159,6 +161,81 @@ TEST(ScanNetGroundTruth, BadAggregationNamesTheFile) {
   expectError(
       [&] { loadScanNetGroundTruth(tiny("_vh_clean_2.ply"), dir.path("cut.json"), segs, table); },
       {"cut.json", "malformed JSON"});
+}
+
+const char* const kSceneFiles[] = {"_vh_clean_2.ply", ".aggregation.json",
+                                   "_vh_clean_2.0.010000.segs.json"};
+
+TEST(ScanNetGroundTruth, FindsTheScanNetFilesOfAFolder) {
+  // The fixture folder is not named after its scene: the only *_vh_clean_2.ply names it (the
+  // labels PLY beside it does not count).
+  const std::string tiny = test::fixtureDir("scannet_gt_tiny");
+  const ScanNetSceneFiles files = findScanNetSceneFiles(tiny);
+  EXPECT_EQ(files.scene, "scene0000_00");
+  EXPECT_EQ(files.mesh_ply, tiny + "/scene0000_00_vh_clean_2.ply");
+  EXPECT_EQ(files.aggregation_json, tiny + "/scene0000_00.aggregation.json");
+  EXPECT_EQ(files.segs_json, tiny + "/scene0000_00_vh_clean_2.0.010000.segs.json");
+
+  // A folder named after its scene wins even beside another scene's mesh, trailing slash or not.
+  test::TempDir dir;
+  fs::create_directory(dir.path("scene0707_00"));
+  for (const char* f : kSceneFiles) {
+    fs::create_symlink(tiny + "/scene0000_00" + f, dir.path("scene0707_00/scene0707_00") + f);
+  }
+  fs::create_symlink(tiny + "/scene0000_00_vh_clean_2.ply",
+                     dir.path("scene0707_00/scene0001_00_vh_clean_2.ply"));
+  EXPECT_EQ(findScanNetSceneFiles(dir.path("scene0707_00")).scene, "scene0707_00");
+  EXPECT_EQ(findScanNetSceneFiles(dir.path("scene0707_00/")).segs_json,
+            dir.path("scene0707_00/scene0707_00_vh_clean_2.0.010000.segs.json"));
+}
+
+TEST(ScanNetGroundTruth, MissingScanNetFilesAreNamed) {
+  test::TempDir dir;
+  expectError([&] { findScanNetSceneFiles(dir.path("absent")); }, {"absent", "not a folder"});
+  fs::create_directory(dir.path("empty"));
+  expectError([&] { findScanNetSceneFiles(dir.path("empty")); },
+              {"empty", "expected one *_vh_clean_2.ply mesh, found 0"});
+  fs::create_directory(dir.path("s"));
+  const std::string tiny = test::fixtureDir("scannet_gt_tiny/scene0000_00");
+  fs::create_symlink(tiny + "_vh_clean_2.ply", dir.path("s/scene0000_00_vh_clean_2.ply"));
+  fs::create_symlink(tiny + ".aggregation.json", dir.path("s/scene0000_00.aggregation.json"));
+  expectError([&] { findScanNetSceneFiles(dir.path("s")); },
+              {"scene0000_00_vh_clean_2.0.010000.segs.json", "missing"});
+  fs::create_symlink(tiny + "_vh_clean_2.ply", dir.path("s/scene0001_00_vh_clean_2.ply"));
+  expectError([&] { findScanNetSceneFiles(dir.path("s")); }, {"found 2"});
+}
+
+TEST(ScanNetGroundTruth, SceneFilesOfAFullDownload) {
+  // A scene folder as ScanNet's download script leaves it: the high-resolution mesh's
+  // annotation (*_vh_clean.aggregation.json, *_vh_clean.segs.json) and the labels mesh stand
+  // beside the three files the ground truth is read from.
+  test::TempDir dir;
+  for (const char* name :
+       {"scene0011_00_vh_clean_2.ply", "scene0011_00_vh_clean_2.labels.ply",
+        "scene0011_00.aggregation.json", "scene0011_00_vh_clean.aggregation.json",
+        "scene0011_00_vh_clean_2.0.010000.segs.json", "scene0011_00_vh_clean.segs.json",
+        "scene0011_00_vh_clean.ply", "scene0011_00.txt"}) {
+    std::ofstream(dir.path(name)) << "x";
+  }
+  const ScanNetSceneFiles files = findScanNetSceneFiles(dir.path());
+  EXPECT_EQ(files.mesh_ply, dir.path("scene0011_00_vh_clean_2.ply"));
+  EXPECT_EQ(files.aggregation_json, dir.path("scene0011_00.aggregation.json"));
+  EXPECT_EQ(files.segs_json, dir.path("scene0011_00_vh_clean_2.0.010000.segs.json"));
+  // Only the high-resolution annotation: named, not taken (its segments are another mesh's).
+  std::filesystem::remove(dir.path("scene0011_00.aggregation.json"));
+  expectError([&] { findScanNetSceneFiles(dir.path()); },
+              {"scene0011_00.aggregation.json: missing", "high-resolution"});
+  std::ofstream(dir.path("scene0011_00.aggregation.json")) << "x";
+  std::filesystem::remove(dir.path("scene0011_00_vh_clean_2.0.010000.segs.json"));
+  expectError([&] { findScanNetSceneFiles(dir.path()); },
+              {"scene0011_00_vh_clean_2.0.010000.segs.json: missing"});
+}
+
+TEST(ScanNetGroundTruth, SceneFilesOfTheSharedScene) {
+  PANMAP_REQUIRE_DATA("scannet-gt");
+  const ScanNetSceneFiles files = findScanNetSceneFiles(test::dataDir("scannet-gt/scene0470_00"));
+  EXPECT_EQ(std::filesystem::path(files.aggregation_json).filename(),
+            "scene0470_00.aggregation.json");
 }
 
 }  // namespace

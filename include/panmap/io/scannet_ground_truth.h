@@ -53,6 +53,21 @@ ScanNetGroundTruth loadScanNetGroundTruth(const std::string& mesh_ply,
                                           const std::string& segs_json,
                                           const ScanNetLabelTable& table);
 
+/// The ground-truth files of one ScanNet scene folder.
+struct ScanNetSceneFiles {
+  std::string scene;             ///< e.g. "scene0000_00"
+  std::string mesh_ply;          ///< <scene>_vh_clean_2.ply
+  std::string aggregation_json;  ///< <scene>.aggregation.json (segGroups of the vh_clean_2 mesh)
+  std::string segs_json;         ///< <scene>_vh_clean_2.0.010000.segs.json
+};
+
+/// Finds a ScanNet scene's ground-truth files in `scene_dir`: the scene name is the folder's
+/// name when <name>_vh_clean_2.ply exists there, else the prefix of the only *_vh_clean_2.ply
+/// in it; the files beside it that annotate the high-resolution mesh (a full download's
+/// *_vh_clean.aggregation.json, *_vh_clean.segs.json) are not taken. Throws Error naming the
+/// folder or the missing file.
+ScanNetSceneFiles findScanNetSceneFiles(const std::string& scene_dir);
+
 /// Per-vertex NYU40 ids of ScanNet's *_vh_clean_2.labels.ply: its `label` property (ScanNet
 /// label ids) mapped through the table. Throws Error naming the file.
 std::vector<int32_t> readScanNetLabelsPly(const std::string& labels_ply,
