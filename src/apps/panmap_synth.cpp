@@ -32,7 +32,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// The one file in `dir` whose name ends with `suffix`.
 json masksJson(const panmap::SegmenterNoiseConfig& c) {
   return {{"preset", c.preset},
           {"window_frames", c.window_frames},
