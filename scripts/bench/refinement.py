@@ -30,6 +30,7 @@ import suite
 
 BEGIN = "<!-- refinement:begin (scripts/bench/refinement.py) -->"
 END = "<!-- refinement:end -->"
+DEFAULT_DATA = "../shared/data"  # as the report names the default --data
 MIN_FRAMES = 30  # shorter folders (format fixtures) have no trajectory to speak of
 REFERENCES = {"7scenes": "KinectFusion (7-Scenes' recorded poses)",
               "scannet": "BundleFusion (ScanNet's recorded poses)",
@@ -203,10 +204,16 @@ def limits(rows):
     return " / ".join("%g mm" % v for v in values) or "its limit"
 
 
-def render(rows, skipped, layouts, seconds):
+def data_label(data_dir):
+    """How the report names the data folder: DEFAULT_DATA for the default one."""
+    default = os.path.join(suite.ROOT, "..", "shared", "data")
+    return DEFAULT_DATA if os.path.abspath(data_dir) == os.path.abspath(default) else data_dir
+
+
+def render(rows, skipped, layouts, seconds, data=DEFAULT_DATA):
     md = [BEGIN, "## Pose refinement on real depth", "",
-          "`python3 scripts/bench/refinement.py` (%.1f min on this machine): every real sequence "
-          "in `../shared/data` with at least %d frames, its recorded poses replaced by "
+          "`python3 scripts/bench/refinement.py%s` (%.1f min on this machine): every real "
+          "sequence in `%s` with at least %d frames, its recorded poses replaced by "
           "`panmap-import --drift LEVEL --seed N` (none; light: 1 %%/m, 0.5 deg/m; heavy: 3x), "
           "mapped geometry-only (the poses are flagged SLAM) four ways: `auto`, the default "
           "(`tracking: auto`: the first 30 aligned frames judge the depth; a fixed depth error "
@@ -221,7 +228,8 @@ def render(rows, skipped, layouts, seconds):
           "estimates**: %s.%s Corrected / kept: frames integrated at a corrected pose / at the "
           "given or predicted one (after the 5 warm-up frames). ms: median of the tracking "
           "stage per frame, runs two at a time on 2 cores." % (
-              seconds / 60.0, MIN_FRAMES, limits(rows),
+              "" if data == DEFAULT_DATA else " --data " + data, seconds / 60.0, data,
+              MIN_FRAMES, limits(rows),
               "; ".join("%s: %s" % (n, REFERENCES.get(l, l)) for n, l in layouts),
               SEVEN_SCENES_NOTE if any(l == "7scenes" for _, l in layouts) else ""), "",
           "Two reference-free figures judge a trajectory without trusting the recorded one. "
@@ -385,7 +393,7 @@ def main():
         found, skipped = sequences(args.data)
         add_independent(saved["rows"], args.work, independent_files(args.independent))
         splice(args.out, render(saved["rows"], skipped, [(f[0], f[2]) for f in found],
-                                saved["seconds"]))
+                                saved["seconds"], data_label(args.data)))
         print("refinement: rewrote %s from %s" % (args.out, args.work), file=sys.stderr)
         return
     suite.run(["cmake", "--build", suite.BUILD, "--target", "panmap-import", "panmap-mapper",
@@ -433,7 +441,7 @@ def main():
     add_independent(rows, args.work, independent_files(args.independent))
     with open(os.path.join(args.work, "results.json"), "w") as f:
         json.dump({"rows": rows, "seconds": seconds}, f, indent=1)
-    section = render(rows, skipped, [(f[0], f[2]) for f in found], seconds)
+    section = render(rows, skipped, [(f[0], f[2]) for f in found], seconds, data_label(args.data))
     splice(args.out, section)
     print(section)
     print("refinement: wrote %s" % args.out, file=sys.stderr)
