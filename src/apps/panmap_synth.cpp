@@ -316,9 +316,9 @@ int main(int argc, char** argv) {
       walk = building_stops.empty() ? panmap::planSurveyPath(mesh, survey, seed)
                                     : panmap::planSurveyPathThrough(mesh, survey, building_stops);
       if (walk.clearance_m < survey.clearance_m) {
-        std::cerr << "panmap-synth: under 1 m^2 of floor is " << survey.clearance_m
-                  << " m clear of surfaces; the survey walks " << walk.clearance_m
-                  << " m from them\n";
+        std::cerr << "panmap-synth: the survey walks " << walk.clearance_m
+                  << " m from surfaces, not " << survey.clearance_m
+                  << " m: the room is small or the way to a stop narrow\n";
       }
     }
 

@@ -13,6 +13,10 @@ SurveyConfig buildingSurveyConfig() {
   // Doors are 0.8-0.9 m wide and the open panel takes its thickness: 0.3 m would leave no
   // free cell in the doorway.
   config.clearance_m = 0.25;
+  // An opened door can leave a narrower way into its room than the closed one did (its panel
+  // beside a shower curtain or a tall cabinet): the walk squeezes past, down to this, rather
+  // than leaving the room out (planSurveyThrough lowers the clearance only where it must).
+  config.min_clearance_m = 0.05;
   config.walls_block_view = true;
   return config;
 }

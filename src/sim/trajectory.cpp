@@ -7,6 +7,7 @@
 #include <map>
 #include <queue>
 #include <sstream>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
 
@@ -147,14 +148,20 @@ FreeSpace freeSpaceAt(const LabelledMesh& mesh, const SurveyConfig& config, doub
 // The free space at clearance_m, or, in a room too small to walk at it (a 2 x 1.5 m bathroom
 // leaves 1 m^2 at 0.3 m), at the largest clearance down to min_clearance_m that leaves
 // kWalkArea_m2: a scanner walks closer to the walls in a small room rather than not at all.
+// The clearance to try after c: a third less (0.3, 0.2, 0.13), then min_clearance_m (directly
+// once within 1 cm of it); c itself when there is none lower.
+double lowerClearance(double c, const SurveyConfig& config) {
+  if (c <= config.min_clearance_m) return c;
+  const double next = c * 2.0 / 3.0;
+  return next < config.min_clearance_m + 0.01 ? config.min_clearance_m : next;
+}
+
 FreeSpace buildFreeSpace(const LabelledMesh& mesh, const SurveyConfig& config) {
   FreeSpace fs = freeSpaceAt(mesh, config, config.clearance_m);
   if (fs.area_m2 >= kWalkArea_m2) return fs;
   const double first_area = fs.area_m2;
-  // Steps of a third: 0.3, 0.2, 0.13, then min_clearance_m (directly once within 1 cm of it).
-  for (double c = config.clearance_m; c > config.min_clearance_m;) {
-    c *= 2.0 / 3.0;
-    if (c < config.min_clearance_m + 0.01) c = config.min_clearance_m;
+  for (double c = config.clearance_m; lowerClearance(c, config) < c;) {
+    c = lowerClearance(c, config);
     fs = freeSpaceAt(mesh, config, c);
     if (fs.area_m2 >= kWalkArea_m2) return fs;
   }
@@ -534,6 +541,34 @@ std::vector<Cell> stopCells(const FreeSpace& fs, const std::vector<Eigen::Vector
   return cells;
 }
 
+// The walk through given stops, at the configured clearance or, where a stop has no free
+// floor within 0.5 m or cannot be reached from the one before at it, at the largest lower one
+// that has and can (down to min_clearance_m): a doorway that an opened door and a tall object
+// beside it narrow, a stop in a corner. The free space it was planned on goes to `fs`. Throws
+// the error of the configured clearance when none works.
+SurveyPath walkThrough(const LabelledMesh& mesh, const SurveyConfig& config,
+                       const std::vector<Eigen::Vector2d>& stops, FreeSpace* fs) {
+  *fs = buildFreeSpace(mesh, config);
+  try {
+    return planWalk(*fs, stopCells(*fs, stops), config.laps);
+  } catch (const Error&) {
+    for (double c = fs->keep_m; lowerClearance(c, config) < c;) {
+      c = lowerClearance(c, config);
+      FreeSpace lower = freeSpaceAt(mesh, config, c);
+      if (lower.area_m2 < kSmallestWalkArea_m2) continue;
+      try {
+        SurveyPath path = planWalk(lower, stopCells(lower, stops), config.laps);
+        *fs = std::move(lower);
+        return path;
+      } catch (const Error&) {
+        // Not at this clearance either; stops that none can help (not finite, far outside the
+        // mesh) end with the error of the first.
+      }
+    }
+    throw;
+  }
+}
+
 }  // namespace
 
 std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig& config,
@@ -553,8 +588,8 @@ std::vector<StampedPose> planSurveyThrough(const LabelledMesh& mesh, SurveyConfi
   if (once) config.num_frames = 1;
   config.check();
   Rng rng(hashSeed(seed, 0x5u));
-  const FreeSpace fs = buildFreeSpace(mesh, config);
-  const SurveyPath path = planWalk(fs, stopCells(fs, stops), config.laps);
+  FreeSpace fs;
+  const SurveyPath path = walkThrough(mesh, config, stops, &fs);
   if (once) {
     config.num_frames =
         std::max(2, static_cast<int>(std::ceil(path.length_m / config.speed_mps * config.rate_hz)));
@@ -567,8 +602,8 @@ SurveyPath planSurveyPathThrough(const LabelledMesh& mesh, const SurveyConfig& c
   SurveyConfig checked = config;
   if (checked.num_frames == 0) checked.num_frames = 1;
   checked.check();
-  const FreeSpace fs = buildFreeSpace(mesh, checked);
-  return planWalk(fs, stopCells(fs, stops), checked.laps);
+  FreeSpace fs;
+  return walkThrough(mesh, checked, stops, &fs);
 }
 
 SurveyPath planSurveyPath(const LabelledMesh& mesh, const SurveyConfig& config, uint64_t seed) {

@@ -246,6 +246,44 @@ TEST(Survey, ASmallRoomIsWalkedCloserToItsWalls) {
   }
 }
 
+TEST(Survey, ANarrowWayToAStopIsWalkedCloserToItsSides) {
+  // Two 3 x 3 m rooms joined by a 0.6 m gap in the wall between them at x = 3: at 0.3 m from
+  // every surface the gap is shut (0.3 m and a cell on each side).
+  const Eigen::Vector3f x = Eigen::Vector3f::UnitX(), y = Eigen::Vector3f::UnitY(),
+                        z = Eigen::Vector3f::UnitZ();
+  LabelledMesh mesh;
+  addRect(&mesh, Eigen::Vector3f::Zero(), 6.0f * x, 3.0f * y, 2, 2);  // floor
+  addRect(&mesh, Eigen::Vector3f::Zero(), 6.0f * x, 2.5f * z, 1, 1);
+  addRect(&mesh, 3.0f * y, 6.0f * x, 2.5f * z, 1, 1);
+  addRect(&mesh, Eigen::Vector3f::Zero(), 3.0f * y, 2.5f * z, 1, 1);
+  addRect(&mesh, 6.0f * x, 3.0f * y, 2.5f * z, 1, 1);
+  addRect(&mesh, 3.0f * x, 1.275f * y, 2.5f * z, 1, 1);               // wall, south part
+  addRect(&mesh, 3.0f * x + 1.725f * y, 1.275f * y, 2.5f * z, 1, 1);  // wall, north part
+  SurveyConfig config;
+  config.num_frames = 0;  // one pass
+  config.rate_hz = 5.0;
+  const std::vector<Eigen::Vector2d> stops = {{1.5, 1.5}, {4.5, 1.5}};
+  const SurveyPath path = planSurveyPathThrough(mesh, config, stops);
+  EXPECT_LT(path.clearance_m, config.clearance_m);
+  EXPECT_GE(path.clearance_m, config.min_clearance_m);
+  const std::vector<StampedPose> poses = planSurveyThrough(mesh, config, stops, 1);
+  ASSERT_GT(poses.size(), 10u);
+  double east = 0.0;
+  for (const StampedPose& p : poses) east = std::max(east, p.T_W_C.translation().x());
+  EXPECT_GT(east, 4.0);  // through the gap into the east room
+  EXPECT_GE(exactClearance(poses, mesh), path.clearance_m);
+  // Without a lower clearance a stop in the room the walk cannot reach is a clear error, as
+  // before.
+  config.min_clearance_m = config.clearance_m;
+  try {
+    planSurveyThrough(mesh, config, stops, 1);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not within 0.5 m of floor"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Survey, TumRoundTrip) {
   test::TempDir dir;
   std::vector<StampedPose> traj(3);
