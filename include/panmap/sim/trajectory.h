@@ -64,9 +64,10 @@ std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig
                                     uint64_t seed);
 
 /// planSurvey through given stops (world x, y, visited in order; the walk closes back to the
-/// first) instead of stops it spreads itself. num_frames = 0 walks the loop once. Throws Error
-/// naming the stop when one is not within 0.5 m of free space or cannot be reached from the
-/// one before.
+/// first) instead of stops it spreads itself. num_frames = 0 walks the loop once. Where a stop
+/// is not within 0.5 m of free space or cannot be reached from the one before at clearance_m,
+/// the walk keeps the largest lower clearance down to min_clearance_m at which every stop is
+/// (planSurveyPathThrough's clearance_m says which); throws Error naming the stop when none is.
 std::vector<StampedPose> planSurveyThrough(const LabelledMesh& mesh, SurveyConfig config,
                                            const std::vector<Eigen::Vector2d>& stops,
                                            uint64_t seed);
