@@ -145,9 +145,6 @@ FreeSpace freeSpaceAt(const LabelledMesh& mesh, const SurveyConfig& config, doub
   return fs;
 }
 
-// The free space at clearance_m, or, in a room too small to walk at it (a 2 x 1.5 m bathroom
-// leaves 1 m^2 at 0.3 m), at the largest clearance down to min_clearance_m that leaves
-// kWalkArea_m2: a scanner walks closer to the walls in a small room rather than not at all.
 // The clearance to try after c: a third less (0.3, 0.2, 0.13), then min_clearance_m (directly
 // once within 1 cm of it); c itself when there is none lower.
 double lowerClearance(double c, const SurveyConfig& config) {
@@ -156,6 +153,9 @@ double lowerClearance(double c, const SurveyConfig& config) {
   return next < config.min_clearance_m + 0.01 ? config.min_clearance_m : next;
 }
 
+// The free space at clearance_m, or, in a room too small to walk at it (a 2 x 1.5 m bathroom
+// leaves 1 m^2 at 0.3 m), at the largest clearance down to min_clearance_m that leaves
+// kWalkArea_m2: a scanner walks closer to the walls in a small room rather than not at all.
 FreeSpace buildFreeSpace(const LabelledMesh& mesh, const SurveyConfig& config) {
   FreeSpace fs = freeSpaceAt(mesh, config, config.clearance_m);
   if (fs.area_m2 >= kWalkArea_m2) return fs;
@@ -541,11 +541,11 @@ std::vector<Cell> stopCells(const FreeSpace& fs, const std::vector<Eigen::Vector
   return cells;
 }
 
-// The walk through given stops, at the configured clearance or, where a stop has no free
-// floor within 0.5 m or cannot be reached from the one before at it, at the largest lower one
-// that has and can (down to min_clearance_m): a doorway that an opened door and a tall object
-// beside it narrow, a stop in a corner. The free space it was planned on goes to `fs`. Throws
-// the error of the configured clearance when none works.
+// The walk through given stops at the configured clearance or, where a stop has no free floor
+// within 0.5 m or cannot be reached from the one before at it, at the largest lower clearance
+// (down to min_clearance_m) at which every stop has and can: a doorway that an opened door
+// and a tall object beside it narrow, a stop in a corner. The free space it was planned on
+// goes to `fs`. Throws the error of the configured clearance when no clearance works.
 SurveyPath walkThrough(const LabelledMesh& mesh, const SurveyConfig& config,
                        const std::vector<Eigen::Vector2d>& stops, FreeSpace* fs) {
   *fs = buildFreeSpace(mesh, config);
