@@ -452,8 +452,10 @@ def one_import(work, name, folder, drift, seed, calibrate_from=None):
     from the log's frames from that index on (one thread: imports run two at a time)."""
     tag = "%s_%s_s%d" % (name, drift, seed)
     log = os.path.join(work, tag + ".lcmlog")
+    # Frames without a recorded pose (TUM's motion capture can start late or drop out) have
+    # no place in an ATE against it: left out, as TUM's own tools leave them.
     suite.run([suite.tool("panmap-import"), "-q", folder, log, "--drift",
-               "gt" if drift == "none" else drift, "--seed", str(seed)])
+               "gt" if drift == "none" else drift, "--seed", str(seed), "--invalid-poses", "skip"])
     if calibrate_from is not None:
         suite.run([suite.tool("panmap-calibrate-depth"), "-q", "--log", log, "--out",
                    calibration_path(work, tag), "--first", str(calibrate_from), "--threads", "1"],

@@ -55,7 +55,11 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
         continue;
       }
       if (!frame.T_W_C) {
-        if (!skip_invalid) throw Error(frame.pose_problem);
+        if (!skip_invalid) {
+          throw Error(frame.pose_problem +
+                      " (to leave such frames out: ImportOptions::InvalidPose::kSkip, "
+                      "panmap-import --invalid-poses skip)");
+        }
         if (stats.first_skip_reason.empty()) stats.first_skip_reason = frame.pose_problem;
         ++stats.skipped_invalid_pose;
         if (progress) progress(i + 1, total);
@@ -92,6 +96,10 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
         ++stats.frames_without_mask;
       }
       if (progress) progress(i + 1, total);
+    }
+    if (stats.frames_written == 0 && stats.skipped_invalid_pose > 0) {
+      throw Error("no frame has a valid pose: all " + std::to_string(stats.skipped_invalid_pose) +
+                  " were left out (first: " + stats.first_skip_reason + ")");
     }
     stats.bytes_written = writer.bytes();
   } catch (...) {

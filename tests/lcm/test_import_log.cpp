@@ -206,6 +206,25 @@ TEST(Import, ScanNetSkipsInvalidPosesWithACount) {
   EXPECT_FALSE(fs::exists(dir.path("t.lcmlog.partial")));
 }
 
+TEST(Import, NoFrameWithAPoseIsAnErrorEvenWhenSkipping) {
+  // tum_tiny with its ground truth an hour later than every frame: skipping leaves nothing.
+  test::TempDir dir;
+  fs::copy(test::fixtureDir("tum_tiny"), dir.path("t"), fs::copy_options::recursive);
+  std::ofstream(dir.path("t/groundtruth.txt"), std::ios::trunc)
+      << "3600.0 0 0 0 0 0 0 1\n3600.1 0 0 0 0 0 0 1\n";
+  ImportOptions skip;
+  skip.invalid_pose = ImportOptions::InvalidPose::kSkip;
+  try {
+    importDataset(dir.path("t"), dir.path("t.lcmlog"), skip);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no frame has a valid pose: all 3"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir.path("t.lcmlog")));
+  EXPECT_FALSE(fs::exists(dir.path("t.lcmlog.partial")));
+}
+
 TEST(Import, TumStopsOnAMissingPoseUnlessAskedToSkip) {
   test::TempDir dir;
   try {
@@ -213,6 +232,7 @@ TEST(Import, TumStopsOnAMissingPoseUnlessAskedToSkip) {
     FAIL();
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("groundtruth.txt"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--invalid-poses skip"), std::string::npos) << e.what();
   }
   ImportOptions skip;
   skip.invalid_pose = ImportOptions::InvalidPose::kSkip;
