@@ -37,6 +37,20 @@ double pointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
   return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
 }
 
+// Smallest distance from every pose to every triangle of the mesh.
+double exactClearance(const std::vector<StampedPose>& poses, const LabelledMesh& mesh) {
+  double clearance = 1e9;
+  for (const StampedPose& pose : poses) {
+    for (const Eigen::Vector3i& f : mesh.faces) {
+      clearance = std::min(clearance, pointTriangleDistance(pose.T_W_C.translation(),
+                                                            mesh.vertices[f[0]].cast<double>(),
+                                                            mesh.vertices[f[1]].cast<double>(),
+                                                            mesh.vertices[f[2]].cast<double>()));
+    }
+  }
+  return clearance;
+}
+
 class SurveyOfRoom : public ::testing::TestWithParam<int> {};
 
 TEST_P(SurveyOfRoom, StaysClearSmoothAndAtHeadHeight) {
@@ -67,18 +81,9 @@ TEST_P(SurveyOfRoom, StaysClearSmoothAndAtHeadHeight) {
   const double max_rate = (config.max_yaw_rate_dps + config.max_pitch_rate_dps) * M_PI / 180.0 * dt;
   EXPECT_LE(max_turn, max_rate + 1e-9);
   // Exact clearance against every triangle, for every 30th pose.
-  double clearance = 1e9;
   std::vector<StampedPose> sampled;
-  for (size_t k = 0; k < traj.size(); k += 30) {
-    sampled.push_back(traj[k]);
-    const Eigen::Vector3d p = traj[k].T_W_C.translation();
-    for (const Eigen::Vector3i& f : room.mesh.faces) {
-      clearance =
-          std::min(clearance, pointTriangleDistance(p, room.mesh.vertices[f[0]].cast<double>(),
-                                                    room.mesh.vertices[f[1]].cast<double>(),
-                                                    room.mesh.vertices[f[2]].cast<double>()));
-    }
-  }
+  for (size_t k = 0; k < traj.size(); k += 30) sampled.push_back(traj[k]);
+  const double clearance = exactClearance(sampled, room.mesh);
   EXPECT_GE(clearance, config.clearance_m);
   EXPECT_GE(minClearance(sampled, room.mesh),
             clearance - 1e-6);  // vertices are never nearer than faces
@@ -201,20 +206,6 @@ LabelledMesh bathroom(float w, float d) {
     addRect(&mesh, lo + i * 1.8f * z, 0.4f * x, 0.4f * y, 10, 39);
   }
   return mesh;
-}
-
-// Smallest distance from every pose to every triangle of the mesh.
-double exactClearance(const std::vector<StampedPose>& poses, const LabelledMesh& mesh) {
-  double clearance = 1e9;
-  for (const StampedPose& pose : poses) {
-    for (const Eigen::Vector3i& f : mesh.faces) {
-      clearance = std::min(clearance, pointTriangleDistance(pose.T_W_C.translation(),
-                                                            mesh.vertices[f[0]].cast<double>(),
-                                                            mesh.vertices[f[1]].cast<double>(),
-                                                            mesh.vertices[f[2]].cast<double>()));
-    }
-  }
-  return clearance;
 }
 
 TEST(Survey, ASmallRoomIsWalkedCloserToItsWalls) {
