@@ -45,6 +45,30 @@ void wallFrame(const RoomShape& shape, int wall, DoorSpec* spec) {
   spec->inward = Vector2f(-spec->along.y(), spec->along.x());
 }
 
+// Width of the way a walker needs past a door's open panel, metres.
+constexpr float kWayM = 0.6f;
+
+// Whether the walker can pass through the strip [s_lo, s_hi] x [t_lo, t_hi] of a wall frame
+// (s along the wall, t into the room): it lies on the room's floor and no item other than the
+// door stands in it below head height.
+bool wayOpen(const RoomShape& shape, const std::vector<Item>& items, const Item& door,
+             const Frame& frame, float s_lo, float s_hi, float t_lo, float t_hi) {
+  constexpr float kHeadM = 2.0f;
+  const Box2 strip = internal::room::xy(
+      frame.apply(Box3(Vector3f(s_lo, t_lo, 0.0f), Vector3f(s_hi, t_hi, kHeadM))));
+  if (!shape.containsRect(strip)) return false;
+  for (const Item& item : items) {
+    if (&item == &door) continue;
+    for (const internal::room::Part& part : item.parts) {
+      if (part.box.min().z() < kHeadM &&
+          internal::room::overlaps2(internal::room::xy(part.box), strip, 0.0f)) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
 // Opens the room's door (class door, the compulsory one): the panel turns 90 degrees on its
 // hinge into its swing, which the room keeps free, and the wall behind it becomes a doorway.
 std::vector<Doorway> openDoor(const RoomShape& shape, std::vector<Item>* items, DoorSpec* spec) {
@@ -78,9 +102,20 @@ std::vector<Doorway> openDoor(const RoomShape& shape, std::vector<Item>* items, 
   const float width = s1 - s0, thick = std::min(size.x(), size.y());
   const float height = panel.max().z();
   const float s_handle = (handle.center().head<2>() - spec->start).dot(spec->along);
-  const bool hinge_at_end = s_handle < 0.5f * (s0 + s1);
+  bool hinge_at_end = s_handle < 0.5f * (s0 + s1);
   // Wall frame: x along the wall from its first corner, y into the room.
   const Frame frame{spec->start, spec->along, spec->inward};
+  // The room keeps the swing free, not a way out of it: furniture just beyond the swing and a
+  // corner on its open side would leave the open panel closing a pocket (building seed 15, a
+  // door into a corner with two beds in front). Such a door is hung the other way, as a
+  // builder would, when the way past its other side is free; every other door keeps the
+  // handle's side, so buildings that had a way in stay as they were.
+  if (!wayOpen(shape, *items, *door, frame, s0, s1, width, width + kWayM)) {
+    const bool start_open = wayOpen(shape, *items, *door, frame, s0 - kWayM, s0, 0.0f, width);
+    const bool end_open = wayOpen(shape, *items, *door, frame, s1, s1 + kWayM, 0.0f, width);
+    if (hinge_at_end && !start_open && end_open) hinge_at_end = false;
+    if (!hinge_at_end && !end_open && start_open) hinge_at_end = true;
+  }
   const float p0 = hinge_at_end ? s1 - thick : s0, p1 = hinge_at_end ? s1 : s0 + thick;
   const float h0 = hinge_at_end ? p0 - 0.05f : p1, h1 = hinge_at_end ? p0 : p1 + 0.05f;
   door->parts[0].box =
