@@ -118,6 +118,7 @@ int main(int argc, char** argv) {
   int frames = 300;
   uint64_t seed = 1;
   bool quiet = false, no_depth_noise = false;
+  double image_scale = 1.0;
   int preview_every = 0;
   panmap::UnannotateConfig unannotate_config;
   std::string unannotated_masks = "painted";
@@ -173,6 +174,10 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "seed of trajectory, noise, masks and drift")
       ->capture_default_str();
   app.add_flag("--no-depth-noise", no_depth_noise, "exact depth (quantised to 1 mm)");
+  app.add_option("--image-scale", image_scale,
+                 "images this many times 640x480 (same field of view; the noise models' pixel "
+                 "sizes scale with them, docs/SIMULATION.md)")
+      ->check(CLI::Range(0.25, 4.0));
   std::string depth_pattern_file;
   double depth_pattern_scale = 1.0;
   app.add_option("--depth-pattern", depth_pattern_file,
@@ -286,6 +291,7 @@ int main(int argc, char** argv) {
     config.masks = panmap::SegmenterNoiseConfig::fromPreset(masks);
     config.poses = panmap::PoseDriftConfig::fromPreset(poses);
     config.depth.enabled = !no_depth_noise;
+    if (image_scale != 1.0) config = panmap::scaledImage(config, image_scale);
     if (!depth_pattern_file.empty()) {
       config.depth_pattern = panmap::sensorDepthPattern(
           panmap::DepthCalibration::load(depth_pattern_file), depth_pattern_scale);

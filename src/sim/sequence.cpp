@@ -1,5 +1,6 @@
 #include "panmap/sim/sequence.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "panmap/core/classes.h"
@@ -24,6 +25,38 @@ void SynthConfig::check() const {
                 std::to_string(depth_pattern.height()) + " images, the camera's are " +
                 std::to_string(camera.width) + "x" + std::to_string(camera.height));
   }
+}
+
+SynthConfig scaledImage(SynthConfig config, double scale) {
+  if (!(scale >= 0.25 && scale <= 4.0)) throw Error("synth image scale must be in [0.25, 4]");
+  if (!config.depth_pattern.empty()) {
+    throw Error("synth image scale: a depth pattern is made for one image size");
+  }
+  auto length = [scale](int px) { return std::max(1, static_cast<int>(std::lround(px * scale))); };
+  auto area = [scale](int px) {
+    return std::max(1, static_cast<int>(std::lround(px * scale * scale)));
+  };
+  PinholeCamera& c = config.camera;
+  c.width = static_cast<int>(std::lround(c.width * scale));
+  c.height = static_cast<int>(std::lround(c.height * scale));
+  c.fx *= scale;
+  c.fy *= scale;
+  // Pixel centres: pixel u covers [u - 0.5, u + 0.5], so the image edge -0.5 stays fixed.
+  c.cx = (c.cx + 0.5) * scale - 0.5;
+  c.cy = (c.cy + 0.5) * scale - 0.5;
+  config.depth.lateral_sigma_px *= scale;
+  config.depth.correlation_px = length(config.depth.correlation_px);
+  SegmenterNoiseConfig& m = config.masks;
+  m.miss_small_px = area(m.miss_small_px);
+  m.miss_large_px = area(m.miss_large_px);
+  m.boundary_mean_px *= scale;
+  m.boundary_grid_px = length(m.boundary_grid_px);
+  m.merge_min_contact_px = length(m.merge_min_contact_px);
+  m.false_positive_min_area_px = area(m.false_positive_min_area_px);
+  m.false_positive_max_area_px = area(m.false_positive_max_area_px);
+  m.stats_min_px = area(m.stats_min_px);
+  config.min_view_px = area(config.min_view_px);
+  return config;
 }
 
 DepthCalibration sensorDepthPattern(const DepthCalibration& calibration, double scale) {

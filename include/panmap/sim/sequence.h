@@ -36,6 +36,14 @@ struct SynthConfig {
   void check() const;
 };
 
+/// The same scene, sensor and segmenter seen at `scale` times the image size with the same field
+/// of view: the camera's size and focal lengths times scale, every pixel length of the depth
+/// and segmenter noise (edge jitter, outline displacement, its control grid, contact) times
+/// scale and every pixel area (miss sizes, false positives, statistics, min_view_px) times
+/// scale^2, so each error keeps its angular size (docs/SIMULATION.md, "Other image sizes").
+/// Throws Error for a scale outside [0.25, 4] or with a depth pattern (made for one size).
+SynthConfig scaledImage(SynthConfig config, double scale);
+
 /// The fixed-pattern depth error of the sensor that `calibration` corrects, times `scale`: a
 /// calibration's offsets are added to a reading to correct it, so the sensor's error is their
 /// negative. For SynthConfig::depth_pattern. Throws Error on a non-finite or negative scale.
