@@ -103,6 +103,14 @@ def report(rows, commit_id, minutes):
     spread = max(max(v for (s, _), v in full.items() if s == scene) -
                  min(v for (s, _), v in full.items() if s == scene)
                  for scene in {s for s, _ in full})
+    base = sorted((r for r in rows if r["method"] != "full"),
+                  key=lambda r: (r["scene"], r["scale"]))
+    baseline = "; ".join(
+        "%s %s" % (scene, " / ".join("%.1f (purity %.2f)" % (r["map50"], r["purity"])
+                                     for r in base if r["scene"] == scene))
+        for scene in sorted({r["scene"] for r in base}))
+    lines += ["", "The Voxblox++-like baseline's mAP50 by image size, smallest first: %s. Its "
+              "spatial-only merging is what moves with the size." % baseline]
     lines += ["", "Largest spread of the full method's mAP50 over the image sizes of one "
               "scene: %.1f points. The cost grows with the pixel count; the 2D stages' pixel "
               "sizes are not scaled with the image (scaling them, tried on the ScanNet-like "

@@ -106,8 +106,8 @@ std::vector<Doorway> openDoor(const RoomShape& shape, std::vector<Item>* items, 
   // Wall frame: x along the wall from its first corner, y into the room.
   const Frame frame{spec->start, spec->along, spec->inward};
   // The room keeps the swing free, not a way out of it: furniture just beyond the swing and a
-  // corner on its open side would leave the open panel closing a pocket (building seed 15, a
-  // door into a corner with two beds in front). Such a door is hung the other way, as a
+  // corner on its open side would leave the open panel closing a pocket (ScanNet-like building
+  // seed 15: a door by a corner, two beds in front). Such a door is hung the other way, as a
   // builder would, when the way past its other side is free; every other door keeps the
   // handle's side, so buildings that had a way in stay as they were.
   if (!wayOpen(shape, *items, *door, frame, s0, s1, width, width + kWayM)) {
