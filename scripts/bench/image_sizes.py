@@ -4,7 +4,7 @@ field of view; the noise models' pixel sizes scale with the image, `panmap-synth
 --image-scale`), mapped with the default configuration by the full method and the
 Voxblox++-like baseline (ground-truth poses, `m2f` masks, 2 cm, one thread), scored as the
 accuracy suite scores; writes docs/IMAGE_SIZES.md. The defaults were chosen on 640x480 frames:
-this shows whether they hold for a camera of another resolution. About 25 minutes on 2 cores.
+this shows whether they hold for a camera of another resolution. About 12 minutes on 2 cores.
 
   scripts/bench/image_sizes.py [--work DIR] [--scales 0.5 1 2] [--report-only]
 """
