@@ -31,12 +31,16 @@ BASELINE = ["--spatial-only", "--no-mask-edge-fill", "--no-mask-only-surfaces",
 def render(work, spec, scale):
     folder = os.path.join(work, "seq", "%s_x%g" % (spec.name(), scale))
     if not os.path.exists(os.path.join(folder, "info.json")):
+        print("image_sizes: rendering %s" % os.path.basename(folder), file=sys.stderr,
+              flush=True)
         suite.run([suite.tool("panmap-synth"), "-q", "--out", folder, "--image-scale",
                    "%g" % scale] + spec.synth_args())
     return folder
 
 
 def map_and_score(work, seq, method, flags):
+    print("image_sizes: mapping %s, %s" % (os.path.basename(seq), method), file=sys.stderr,
+          flush=True)
     out = os.path.join(work, "runs", os.path.basename(seq), method)
     suite.run([suite.tool("panmap-mapper"), "-q", "--voxel-size", "0.02", "--threads", "1",
                "--no-snapshots", "--tracking", "off", "--log",
@@ -63,8 +67,6 @@ def measure(work, scales):
         seqs = {(s.scene(), k): pool.submit(render, work, s, k) for s in SCENES for k in scales}
         for (scene, scale), seq in seqs.items():
             for method, flags in (("full", []), ("Voxblox++-like", BASELINE)):
-                print("image_sizes: %s at %gx, %s" % (scene, scale, method), file=sys.stderr,
-                      flush=True)
                 jobs.append(((scene, scale, method),
                              pool.submit(lambda q=seq, m=method, f=flags:
                                          map_and_score(work, q.result(), m, f))))
