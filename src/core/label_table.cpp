@@ -33,6 +33,8 @@ LabelTable LabelTable::load(const std::string& path) {
     entry.panmap_class = static_cast<int32_t>(panmap_class);
     entry.is_thing = is_thing == 1;
     std::getline(row >> std::ws, entry.name);
+    // A comment after the name leaves the whitespace before it.
+    entry.name.erase(entry.name.find_last_not_of(" \t\r") + 1);
     table.set(static_cast<int32_t>(source_id), entry);
   }
   if (table.size() == 0) throw Error("label table " + path + " has no rows");

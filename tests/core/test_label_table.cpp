@@ -1,4 +1,6 @@
 #include <fstream>
+#include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -33,6 +35,35 @@ TEST(LabelTable, MalformedRowNamesFileAndLine) {
   std::ofstream(path) << "1 41 0 beyond nyu40\n";
   EXPECT_THROW(LabelTable::load(path), Error);
   EXPECT_THROW(LabelTable::load(dir.path("missing.tsv")), Error);
+}
+
+TEST(LabelTable, ShippedCocoPanopticTableHasEveryCategoryOnce) {
+  const std::string path = test::fixtureDir("../../configs/labels/coco_panoptic_nyu40.tsv");
+  const LabelTable table = LabelTable::load(path);
+  // A repeated source id would replace a row and leave fewer than COCO's 133 categories.
+  EXPECT_EQ(table.size(), 133u);
+  std::ifstream in(path);
+  int rows = 0;
+  for (std::string line; std::getline(in, line);) rows += !line.empty() && line[0] != '#';
+  EXPECT_EQ(rows, 133);
+  // COCO numbers its 80 things 1-90 and its 53 stuff classes 92-200.
+  for (int32_t id = 1; id <= 200; ++id) {
+    const auto row = table.lookup(id);
+    if (row) EXPECT_EQ(row->is_thing, id <= 90) << id;
+  }
+  const std::pair<int32_t, int32_t> expected[] = {
+      {1, 31},   {62, 5},  {63, 6},   {65, 4},   {67, 7},  {70, 33},  {72, 25},  {81, 34},
+      {82, 24},  {84, 23}, {107, 12}, {109, 16}, {112, 8}, {141, 18}, {156, 15}, {168, 27},
+      {180, 13}, {181, 9}, {186, 22}, {188, 3},  {189, 7}, {190, 2},  {199, 1},  {118, 2},
+      {3, 0},    {17, 0},  {187, 0},  {44, 40},  {200, 40}};
+  for (const auto& [coco, nyu40] : expected) {
+    const auto row = table.lookup(coco);
+    ASSERT_TRUE(row.has_value()) << coco;
+    EXPECT_EQ(row->panmap_class, nyu40) << coco << " " << row->name;
+  }
+  EXPECT_EQ(table.lookup(62)->name, "chair");
+  EXPECT_EQ(table.lookup(188)->name, "cabinet-merged");
+  EXPECT_FALSE(table.lookup(12).has_value());  // a gap in COCO's numbering
 }
 
 TEST(LabelTable, Nyu40IdentityKnowsStuff) {
