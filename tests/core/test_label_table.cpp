@@ -32,6 +32,17 @@ TEST(LabelTable, MalformedRowNamesFileAndLine) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find(path + ":3"), std::string::npos) << e.what();
   }
+  std::ofstream(path) << "62 5 1 chair\n1 1 0 wall\n62 6 1 couch\n";
+  try {
+    LabelTable::load(path);
+    FAIL() << "a repeated source id was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ":3: source id 62 already on line 1"),
+              std::string::npos)
+        << e.what();
+  }
+  std::ofstream(path) << "4294967358 5 1 chair past int32\n";
+  EXPECT_THROW(LabelTable::load(path), Error);
   std::ofstream(path) << "1 41 0 beyond nyu40\n";
   EXPECT_THROW(LabelTable::load(path), Error);
   EXPECT_THROW(LabelTable::load(dir.path("missing.tsv")), Error);
@@ -49,7 +60,9 @@ TEST(LabelTable, ShippedCocoPanopticTableHasEveryCategoryOnce) {
   // COCO numbers its 80 things 1-90 and its 53 stuff classes 92-200.
   for (int32_t id = 1; id <= 200; ++id) {
     const auto row = table.lookup(id);
-    if (row) EXPECT_EQ(row->is_thing, id <= 90) << id;
+    if (row) {
+      EXPECT_EQ(row->is_thing, id <= 90) << id;
+    }
   }
   const std::pair<int32_t, int32_t> expected[] = {
       {1, 31},   {62, 5},  {63, 6},   {65, 4},   {67, 7},  {70, 33},  {72, 25},  {81, 34},
