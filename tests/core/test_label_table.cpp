@@ -79,6 +79,23 @@ TEST(LabelTable, ShippedCocoPanopticTableHasEveryCategoryOnce) {
   EXPECT_FALSE(table.lookup(12).has_value());  // a gap in COCO's numbering
 }
 
+TEST(LabelTable, ShippedAde20kTableHasEveryCategoryOnce) {
+  const LabelTable table =
+      LabelTable::load(test::fixtureDir("../../configs/labels/ade20k_nyu40.tsv"));
+  EXPECT_EQ(table.size(), 150u);
+  for (int32_t id = 0; id < 150; ++id) EXPECT_TRUE(table.lookup(id).has_value()) << id;
+  const std::pair<int32_t, int32_t> expected[] = {
+      {0, 1},    {3, 2},   {5, 22},  {7, 4},   {8, 9},   {10, 3},  {14, 8},  {15, 7},
+      {19, 5},   {23, 6},  {30, 5},  {33, 14}, {37, 36}, {44, 17}, {47, 34}, {50, 24},
+      {57, 18},  {62, 10}, {63, 13}, {65, 33}, {67, 23}, {75, 5},  {81, 27}, {89, 25},
+      {115, 37}, {1, 0},   {2, 0},   {20, 0},  {147, 40}};
+  for (const auto& [ade, nyu40] : expected) {
+    EXPECT_EQ(table.lookup(ade)->panmap_class, nyu40) << ade << " " << table.lookup(ade)->name;
+  }
+  EXPECT_TRUE(table.lookup(19)->is_thing);
+  EXPECT_FALSE(table.lookup(0)->is_thing);
+}
+
 TEST(LabelTable, Nyu40IdentityKnowsStuff) {
   const LabelTable table = LabelTable::nyu40Identity();
   EXPECT_EQ(table.size(), 40u);
