@@ -90,7 +90,9 @@ TEST(LabelTable, ShippedAde20kTableHasEveryCategoryOnce) {
       {57, 18},  {62, 10}, {63, 13}, {65, 33}, {67, 23}, {75, 5},  {81, 27}, {89, 25},
       {115, 37}, {1, 0},   {2, 0},   {20, 0},  {147, 40}};
   for (const auto& [ade, nyu40] : expected) {
-    EXPECT_EQ(table.lookup(ade)->panmap_class, nyu40) << ade << " " << table.lookup(ade)->name;
+    const auto row = table.lookup(ade);
+    ASSERT_TRUE(row.has_value()) << ade;
+    EXPECT_EQ(row->panmap_class, nyu40) << ade << " " << row->name;
   }
   EXPECT_TRUE(table.lookup(19)->is_thing);
   EXPECT_FALSE(table.lookup(0)->is_thing);
