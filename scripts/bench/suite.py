@@ -65,6 +65,27 @@ def tool(name):
     return os.path.join(BUILD, name)
 
 
+def git_commit():
+    """The short id of the checkout's HEAD, for a report's header."""
+    return subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
+                          stdout=subprocess.PIPE, text=True).stdout.strip()
+
+
+def cpu_name():
+    """This machine's CPU model, for a report's header."""
+    with open("/proc/cpuinfo") as f:
+        return next((line.split(":", 1)[1].strip() for line in f
+                     if line.startswith("model name")), "unknown CPU")
+
+
+def write_doc(name, lines, label):
+    """Writes docs/NAME from a report's lines and says where on stderr."""
+    path = os.path.join(ROOT, "docs", name)
+    with open(path, "w") as f:
+        f.write("\n".join(lines))
+    print("%s: wrote %s" % (label, path), file=sys.stderr)
+
+
 def mean(values):
     values = [v for v in values if v is not None and v == v]  # missing runs: None or NaN
     return sum(values) / len(values) if values else float("nan")

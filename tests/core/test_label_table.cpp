@@ -48,6 +48,16 @@ TEST(LabelTable, MalformedRowNamesFileAndLine) {
   EXPECT_THROW(LabelTable::load(dir.path("missing.tsv")), Error);
 }
 
+// Each (source id, NYU40 class) pair is a row of the table.
+template <size_t N>
+void expectClasses(const LabelTable& table, const std::pair<int32_t, int32_t> (&expected)[N]) {
+  for (const auto& [source, nyu40] : expected) {
+    const auto row = table.lookup(source);
+    ASSERT_TRUE(row.has_value()) << source;
+    EXPECT_EQ(row->panmap_class, nyu40) << source << " " << row->name;
+  }
+}
+
 TEST(LabelTable, ShippedCocoPanopticTableHasEveryCategoryOnce) {
   const std::string path = test::fixtureDir("../../configs/labels/coco_panoptic_nyu40.tsv");
   const LabelTable table = LabelTable::load(path);
@@ -69,11 +79,7 @@ TEST(LabelTable, ShippedCocoPanopticTableHasEveryCategoryOnce) {
       {82, 24},  {84, 23}, {107, 12}, {109, 16}, {112, 8}, {141, 18}, {156, 15}, {168, 27},
       {180, 13}, {181, 9}, {186, 22}, {188, 3},  {189, 7}, {190, 2},  {199, 1},  {118, 2},
       {3, 0},    {17, 0},  {187, 0},  {44, 40},  {200, 40}};
-  for (const auto& [coco, nyu40] : expected) {
-    const auto row = table.lookup(coco);
-    ASSERT_TRUE(row.has_value()) << coco;
-    EXPECT_EQ(row->panmap_class, nyu40) << coco << " " << row->name;
-  }
+  expectClasses(table, expected);
   EXPECT_EQ(table.lookup(62)->name, "chair");
   EXPECT_EQ(table.lookup(188)->name, "cabinet-merged");
   EXPECT_FALSE(table.lookup(12).has_value());  // a gap in COCO's numbering
@@ -89,11 +95,7 @@ TEST(LabelTable, ShippedAde20kTableHasEveryCategoryOnce) {
       {19, 5},   {23, 6},  {30, 5},  {33, 14}, {37, 36}, {44, 17}, {47, 34}, {50, 24},
       {57, 18},  {62, 10}, {63, 13}, {65, 33}, {67, 23}, {75, 5},  {81, 27}, {89, 25},
       {115, 37}, {1, 0},   {2, 0},   {20, 0},  {147, 40}};
-  for (const auto& [ade, nyu40] : expected) {
-    const auto row = table.lookup(ade);
-    ASSERT_TRUE(row.has_value()) << ade;
-    EXPECT_EQ(row->panmap_class, nyu40) << ade << " " << row->name;
-  }
+  expectClasses(table, expected);
   EXPECT_TRUE(table.lookup(19)->is_thing);
   EXPECT_FALSE(table.lookup(0)->is_thing);
 }
