@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -279,6 +280,42 @@ TEST(Import, PanopticMasksBecomeMessages) {
   ASSERT_EQ(p.segments.size(), 2u);
   EXPECT_EQ(p.segments[1], (PanopticSegment{300, 5, 62, true, 0.9f}));
   EXPECT_TRUE(inspectLog(dir.path("m.lcmlog"), true).allDecoded());
+}
+
+TEST(Import, CocoNetworkMasksTakeTheShippedTablesClasses) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  // What Detectron2's COCOPanopticEvaluator writes for a COCO-trained network: COCO category
+  // ids, an isthing flag per segment, a score per thing.
+  LabelImage mask(640, 480, 0);
+  const int32_t ids[] = {1, 2, 3, 4, 5};
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 640; ++u) mask(u, v) = ids[std::min(u / 128, 4)];
+  }
+  fs::create_directory(dir.path("masks"));
+  writeFileBytes(dir.path("masks/frame-000000.color.png"), encodeLabelPng(mask));
+  std::ofstream(dir.path("masks/frame-000000.color.json")) << R"({"segments_info": [
+      {"id": 1, "category_id": 199, "isthing": 0},
+      {"id": 2, "category_id": 190, "isthing": 0},
+      {"id": 3, "category_id": 62, "isthing": 1, "score": 0.8},
+      {"id": 4, "category_id": 188, "isthing": 0},
+      {"id": 5, "category_id": 3, "isthing": 1, "score": 0.6}]})";
+  ImportOptions options;
+  options.max_frames = 1;
+  options.mask_dir = dir.path("masks");
+  options.label_table = test::fixtureDir("../../configs/labels/coco_panoptic_nyu40.tsv");
+  const ImportStats s = importDataset(test::dataDir("7scenes-200"), dir.path("m.lcmlog"), options);
+  EXPECT_EQ(s.panoptic_written, 1u);
+  EXPECT_EQ(s.unknown_category_segments, 0u);  // a car is known: the table voids it
+  const auto events = readEvents(dir.path("m.lcmlog"));
+  ASSERT_EQ(events.size(), 3u);
+  const PanopticFrame p = fromMessage(decodeEvent<panoptic_t>(events[2]));
+  ASSERT_EQ(p.segments.size(), 5u);
+  EXPECT_EQ(p.segments[0], (PanopticSegment{1, 1, 199, false, 1.0f}));  // wall
+  EXPECT_EQ(p.segments[1], (PanopticSegment{2, 2, 190, false, 1.0f}));  // floor
+  EXPECT_EQ(p.segments[2], (PanopticSegment{3, 5, 62, true, 0.8f}));    // chair
+  EXPECT_EQ(p.segments[3], (PanopticSegment{4, 3, 188, false, 1.0f}));  // cabinet, as stuff
+  EXPECT_EQ(p.segments[4], (PanopticSegment{5, 0, 3, true, 0.6f}));     // car: void
 }
 
 }  // namespace
