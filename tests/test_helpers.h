@@ -29,6 +29,11 @@ inline std::string fixtureDir(const std::string& sub = "") {
   return std::string(PANMAP_FIXTURE_DIR) + (sub.empty() ? "" : "/" + sub);
 }
 
+/// A label table shipped in configs/labels/ (tests/fixtures is two levels below the checkout).
+inline std::string shippedLabelTable(const std::string& name) {
+  return fixtureDir("../../configs/labels/" + name);
+}
+
 /// A built executable of this build tree.
 inline std::string binPath(const std::string& name) {
   return std::string(PANMAP_BIN_DIR) + "/" + name;

@@ -59,7 +59,7 @@ void expectClasses(const LabelTable& table, const std::pair<int32_t, int32_t> (&
 }
 
 TEST(LabelTable, ShippedCocoPanopticTableHasEveryCategoryOnce) {
-  const std::string path = test::fixtureDir("../../configs/labels/coco_panoptic_nyu40.tsv");
+  const std::string path = test::shippedLabelTable("coco_panoptic_nyu40.tsv");
   const LabelTable table = LabelTable::load(path);
   // A repeated source id would replace a row and leave fewer than COCO's 133 categories.
   EXPECT_EQ(table.size(), 133u);
@@ -86,8 +86,7 @@ TEST(LabelTable, ShippedCocoPanopticTableHasEveryCategoryOnce) {
 }
 
 TEST(LabelTable, ShippedAde20kTableHasEveryCategoryOnce) {
-  const LabelTable table =
-      LabelTable::load(test::fixtureDir("../../configs/labels/ade20k_nyu40.tsv"));
+  const LabelTable table = LabelTable::load(test::shippedLabelTable("ade20k_nyu40.tsv"));
   EXPECT_EQ(table.size(), 150u);
   for (int32_t id = 0; id < 150; ++id) EXPECT_TRUE(table.lookup(id).has_value()) << id;
   const std::pair<int32_t, int32_t> expected[] = {

@@ -249,6 +249,21 @@ TEST(Import, TumStopsOnAMissingPoseUnlessAskedToSkip) {
   EXPECT_EQ(f.depth(3, 2), 5003);
 }
 
+// Imports the first max_frames frames of 7scenes-200 into DIR/m.lcmlog with one COCO panoptic
+// mask (PNG + its JSON) for the first frame, read through the given label table.
+ImportStats importWithFirstMask(const test::TempDir& dir, const LabelImage& mask,
+                                const std::string& segments_json, const std::string& label_table,
+                                size_t max_frames) {
+  fs::create_directory(dir.path("masks"));
+  writeFileBytes(dir.path("masks/frame-000000.color.png"), encodeLabelPng(mask));
+  std::ofstream(dir.path("masks/frame-000000.color.json")) << segments_json;
+  ImportOptions options;
+  options.max_frames = max_frames;
+  options.mask_dir = dir.path("masks");
+  options.label_table = label_table;
+  return importDataset(test::dataDir("7scenes-200"), dir.path("m.lcmlog"), options);
+}
+
 TEST(Import, PanopticMasksBecomeMessages) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   test::TempDir dir;
@@ -260,15 +275,10 @@ TEST(Import, PanopticMasksBecomeMessages) {
   for (int v = 100; v < 200; ++v) {
     for (int u = 400; u < 500; ++u) mask(u, v) = 300;
   }
-  fs::create_directory(dir.path("masks"));
-  writeFileBytes(dir.path("masks/frame-000000.color.png"), encodeLabelPng(mask));
-  std::ofstream(dir.path("masks/frame-000000.color.json"))
-      << R"({"segments_info": [{"id": 1, "category_id": 1}, {"id": 300, "category_id": 62, "score": 0.9}]})";
-  ImportOptions options;
-  options.max_frames = 2;
-  options.mask_dir = dir.path("masks");
-  options.label_table = test::fixtureDir("coco_tiny/labels.tsv");
-  const ImportStats s = importDataset(test::dataDir("7scenes-200"), dir.path("m.lcmlog"), options);
+  const ImportStats s = importWithFirstMask(
+      dir, mask,
+      R"({"segments_info": [{"id": 1, "category_id": 1}, {"id": 300, "category_id": 62, "score": 0.9}]})",
+      test::fixtureDir("coco_tiny/labels.tsv"), 2);
   EXPECT_EQ(s.panoptic_written, 1u);
   EXPECT_EQ(s.frames_without_mask, 1u);
   const auto events = readEvents(dir.path("m.lcmlog"));
@@ -292,19 +302,13 @@ TEST(Import, CocoNetworkMasksTakeTheShippedTablesClasses) {
   for (int v = 0; v < 480; ++v) {
     for (int u = 0; u < 640; ++u) mask(u, v) = ids[std::min(u / 128, 4)];
   }
-  fs::create_directory(dir.path("masks"));
-  writeFileBytes(dir.path("masks/frame-000000.color.png"), encodeLabelPng(mask));
-  std::ofstream(dir.path("masks/frame-000000.color.json")) << R"({"segments_info": [
+  const ImportStats s = importWithFirstMask(dir, mask, R"({"segments_info": [
       {"id": 1, "category_id": 199, "isthing": 0},
       {"id": 2, "category_id": 190, "isthing": 0},
       {"id": 3, "category_id": 62, "isthing": 1, "score": 0.8},
       {"id": 4, "category_id": 188, "isthing": 0},
-      {"id": 5, "category_id": 3, "isthing": 1, "score": 0.6}]})";
-  ImportOptions options;
-  options.max_frames = 1;
-  options.mask_dir = dir.path("masks");
-  options.label_table = test::fixtureDir("../../configs/labels/coco_panoptic_nyu40.tsv");
-  const ImportStats s = importDataset(test::dataDir("7scenes-200"), dir.path("m.lcmlog"), options);
+      {"id": 5, "category_id": 3, "isthing": 1, "score": 0.6}]})",
+                                            test::shippedLabelTable("coco_panoptic_nyu40.tsv"), 1);
   EXPECT_EQ(s.panoptic_written, 1u);
   EXPECT_EQ(s.unknown_category_segments, 0u);  // a car is known: the table voids it
   const auto events = readEvents(dir.path("m.lcmlog"));
