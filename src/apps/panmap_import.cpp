@@ -58,6 +58,10 @@ int main(int argc, char** argv) {
                  "COCO panoptic JSON for --masks (default: <stem>.json beside each PNG)");
   app.add_option("--label-table", options.label_table,
                  "segmenter category -> NYU40 class table (default: NYU40 identity)");
+  app.add_flag("--contiguous-ids", options.contiguous_ids,
+               "the masks' category ids are a network's raw class indices (0 to N-1, the label "
+               "table's rows in id order), as Mask2Former, OneFormer and Hugging Face "
+               "transformers give them; not for Panoptic FPN's separate thing and stuff indices");
   app.add_flag("--raw", raw, "store images raw instead of JPEG colour + PNG depth");
   app.add_option("--jpeg-quality", options.encoding.jpeg_quality,
                  "quality when colour must be re-encoded")
@@ -208,6 +212,11 @@ int main(int argc, char** argv) {
           "%zu frames without a mask; %zu segments of categories unknown to the label "
           "table (class 0)\n",
           s.frames_without_mask, s.unknown_category_segments);
+      if (s.unknown_category_segments > 0 && !options.contiguous_ids) {
+        std::printf(
+            "  if the masks number categories from 0 as a network's raw output does, import "
+            "again with --contiguous-ids\n");
+      }
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-import: error: %s\n", e.what());

@@ -58,6 +58,13 @@ LabelTable LabelTable::nyu40Identity() {
   return table;
 }
 
+LabelTable LabelTable::contiguous() const {
+  LabelTable table;
+  int32_t index = 0;
+  for (const auto& [source_id, entry] : entries_) table.set(index++, entry);
+  return table;
+}
+
 std::optional<LabelTable::Entry> LabelTable::lookup(int32_t source_id) const {
   const auto it = entries_.find(source_id);
   if (it == entries_.end()) return std::nullopt;

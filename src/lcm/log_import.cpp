@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <utility>
 
 #include "panmap/core/error.h"
 #include "panmap/io/coco_panoptic_reader.h"
@@ -16,9 +17,10 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
   const std::unique_ptr<DatasetReader> reader = openDataset(dataset_dir, options.dataset);
   std::optional<CocoPanopticReader> masks;
   if (!options.mask_dir.empty()) {
-    masks.emplace(options.mask_dir, options.mask_json,
-                  options.label_table.empty() ? LabelTable::nyu40Identity()
-                                              : LabelTable::load(options.label_table));
+    LabelTable table = options.label_table.empty() ? LabelTable::nyu40Identity()
+                                                   : LabelTable::load(options.label_table);
+    if (options.contiguous_ids) table = table.contiguous();
+    masks.emplace(options.mask_dir, options.mask_json, std::move(table));
   }
   bool skip_invalid = reader->invalidPosesExpected();
   if (options.invalid_pose == ImportOptions::InvalidPose::kSkip) skip_invalid = true;

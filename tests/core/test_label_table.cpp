@@ -99,6 +99,41 @@ TEST(LabelTable, ShippedAde20kTableHasEveryCategoryOnce) {
   EXPECT_FALSE(table.lookup(0)->is_thing);
 }
 
+TEST(LabelTable, ContiguousIdsCountTheRowsInIdOrder) {
+  LabelTable tiny;
+  tiny.set(9, {40, true, "lamp"});
+  tiny.set(1, {1, false, "wall"});
+  tiny.set(5, {5, true, "chair"});
+  const LabelTable renumbered = tiny.contiguous();
+  EXPECT_EQ(renumbered.size(), 3u);
+  const std::pair<int32_t, int32_t> tiny_expected[] = {{0, 1}, {1, 5}, {2, 40}};
+  expectClasses(renumbered, tiny_expected);
+  EXPECT_EQ(renumbered.lookup(1).value_or(LabelTable::Entry{}).name, "chair");
+  EXPECT_TRUE(renumbered.lookup(2).value_or(LabelTable::Entry{}).is_thing);
+  EXPECT_FALSE(renumbered.lookup(3).has_value());
+  EXPECT_FALSE(renumbered.lookup(9).has_value());
+
+  // Mask2Former's COCO panoptic indices: person 0, car 2, chair 56, the first stuff class
+  // (banner) 80, wall 131, the last (rug) 132.
+  const LabelTable coco =
+      LabelTable::load(test::shippedLabelTable("coco_panoptic_nyu40.tsv")).contiguous();
+  const std::pair<int32_t, int32_t> expected[] = {{0, 31},  {2, 0},   {56, 5},  {80, 40},
+                                                  {120, 3}, {122, 2}, {131, 1}, {132, 40}};
+  expectClasses(coco, expected);
+  EXPECT_EQ(coco.lookup(56).value_or(LabelTable::Entry{}).name, "chair");
+  EXPECT_FALSE(coco.lookup(133).has_value());
+
+  // ADE20K's ids are its indices already.
+  const LabelTable ade = LabelTable::load(test::shippedLabelTable("ade20k_nyu40.tsv"));
+  const LabelTable ade_contiguous = ade.contiguous();
+  for (int32_t id = 0; id < 150; ++id) {
+    const auto row = ade_contiguous.lookup(id), original = ade.lookup(id);
+    ASSERT_TRUE(row.has_value() && original.has_value()) << id;
+    EXPECT_EQ(row->panmap_class, original->panmap_class) << id;
+    EXPECT_EQ(row->name, original->name) << id;
+  }
+}
+
 TEST(LabelTable, Nyu40IdentityKnowsStuff) {
   const LabelTable table = LabelTable::nyu40Identity();
   EXPECT_EQ(table.size(), 40u);

@@ -253,7 +253,7 @@ TEST(Import, TumStopsOnAMissingPoseUnlessAskedToSkip) {
 // mask (PNG + its JSON) for the first frame, read through the given label table.
 ImportStats importWithFirstMask(const test::TempDir& dir, const LabelImage& mask,
                                 const std::string& segments_json, const std::string& label_table,
-                                size_t max_frames) {
+                                size_t max_frames, bool contiguous_ids = false) {
   fs::create_directory(dir.path("masks"));
   writeFileBytes(dir.path("masks/frame-000000.color.png"), encodeLabelPng(mask));
   std::ofstream(dir.path("masks/frame-000000.color.json")) << segments_json;
@@ -261,6 +261,7 @@ ImportStats importWithFirstMask(const test::TempDir& dir, const LabelImage& mask
   options.max_frames = max_frames;
   options.mask_dir = dir.path("masks");
   options.label_table = label_table;
+  options.contiguous_ids = contiguous_ids;
   return importDataset(test::dataDir("7scenes-200"), dir.path("m.lcmlog"), options);
 }
 
@@ -320,6 +321,44 @@ TEST(Import, CocoNetworkMasksTakeTheShippedTablesClasses) {
   EXPECT_EQ(p.segments[2], (PanopticSegment{3, 5, 62, true, 0.8f}));    // chair
   EXPECT_EQ(p.segments[3], (PanopticSegment{4, 3, 188, false, 1.0f}));  // cabinet, as stuff
   EXPECT_EQ(p.segments[4], (PanopticSegment{5, 0, 3, true, 0.6f}));     // car: void
+}
+
+TEST(Import, ContiguousIdsOfANetworksRawOutputTakeTheSameClasses) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  // The frame above as Mask2Former's post-processing numbers it: class indices 0-132 in
+  // COCO's order instead of COCO's ids (wall 131, floor 122, chair 56, cabinet 120, car 2).
+  const std::string segments = R"({"segments_info": [
+      {"id": 1, "category_id": 131, "isthing": 0},
+      {"id": 2, "category_id": 122, "isthing": 0},
+      {"id": 3, "category_id": 56, "isthing": 1, "score": 0.8},
+      {"id": 4, "category_id": 120, "isthing": 0},
+      {"id": 5, "category_id": 2, "isthing": 1, "score": 0.6}]})";
+  LabelImage mask(640, 480, 0);
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 640; ++u) mask(u, v) = 1 + std::min(u / 128, 4);
+  }
+  const std::string table = test::shippedLabelTable("coco_panoptic_nyu40.tsv");
+  test::TempDir dir;
+  const ImportStats s = importWithFirstMask(dir, mask, segments, table, 1, true);
+  EXPECT_EQ(s.unknown_category_segments, 0u);
+  const auto events = readEvents(dir.path("m.lcmlog"));
+  ASSERT_EQ(events.size(), 3u);
+  const PanopticFrame p = fromMessage(decodeEvent<panoptic_t>(events[2]));
+  ASSERT_EQ(p.segments.size(), 5u);
+  const int32_t classes[] = {1, 2, 5, 3, 0};  // wall, floor, chair, cabinet, void
+  for (size_t i = 0; i < 5; ++i) EXPECT_EQ(p.segments[i].category, classes[i]) << i;
+  EXPECT_EQ(p.segments[2].source_category, 56);  // the network's own id is kept
+
+  // Read as COCO ids, the same indices are other classes or none: 56 is broccoli (otherprop),
+  // 131 and 122 are gaps in COCO's numbering.
+  test::TempDir as_coco;
+  const ImportStats t = importWithFirstMask(as_coco, mask, segments, table, 1, false);
+  EXPECT_EQ(t.unknown_category_segments, 2u);
+  const auto coco_events = readEvents(as_coco.path("m.lcmlog"));
+  ASSERT_EQ(coco_events.size(), 3u);
+  const PanopticFrame q = fromMessage(decodeEvent<panoptic_t>(coco_events[2]));
+  ASSERT_EQ(q.segments.size(), 5u);
+  EXPECT_EQ(q.segments[2].category, 40);
 }
 
 }  // namespace

@@ -27,6 +27,12 @@ class LabelTable {
   /// The identity table over NYU40 (for segmenters trained on ScanNet labels).
   static LabelTable nyu40Identity();
 
+  /// The same rows renumbered 0..size()-1 in increasing source id: the contiguous class
+  /// indices a network's raw output uses when its dataset's categories are listed in id order
+  /// (Mask2Former, OneFormer and Hugging Face transformers number COCO panoptic's 133
+  /// categories so; ADE20K's 0-149 are contiguous already).
+  LabelTable contiguous() const;
+
   /// Adds or replaces one row.
   void set(int32_t source_id, const Entry& entry) { entries_[source_id] = entry; }
 

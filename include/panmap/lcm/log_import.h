@@ -20,6 +20,9 @@ struct ImportOptions {
   std::string mask_dir;     ///< COCO panoptic PNGs; "" for no PANOPTIC channel
   std::string mask_json;    ///< COCO panoptic JSON; "" for per-frame JSON files
   std::string label_table;  ///< segmenter -> panmap classes; "" = NYU40 identity
+  /// The masks' category ids are the label table's rows counted from 0 in id order (a
+  /// network's raw contiguous class indices, LabelTable::contiguous), not its source ids.
+  bool contiguous_ids = false;
   /// What to do with a frame whose pose is invalid: skip it (counted) or stop with an error.
   /// kAuto skips where the layout documents invalid poses (ScanNet) and stops elsewhere.
   enum class InvalidPose { kAuto, kSkip, kError } invalid_pose = InvalidPose::kAuto;
