@@ -62,6 +62,9 @@ int main(int argc, char** argv) {
                "the masks' category ids are a network's raw class indices (0 to N-1, the label "
                "table's rows in id order), as Mask2Former, OneFormer and Hugging Face "
                "transformers give them; not for Panoptic FPN's separate thing and stuff indices");
+  app.add_flag("--resize-masks", options.resize_masks,
+               "scale masks of another size than their colour image, but of its shape, to it "
+               "(nearest pixel): a network run on a scaled image");
   app.add_flag("--raw", raw, "store images raw instead of JPEG colour + PNG depth");
   app.add_option("--jpeg-quality", options.encoding.jpeg_quality,
                  "quality when colour must be re-encoded")
@@ -212,6 +215,9 @@ int main(int argc, char** argv) {
           "%zu frames without a mask; %zu segments of categories unknown to the label "
           "table (class 0)\n",
           s.frames_without_mask, s.unknown_category_segments);
+      if (s.masks_resized > 0) {
+        std::printf("%zu masks scaled to their colour image\n", s.masks_resized);
+      }
       if (s.unknown_category_segments > 0 && !options.contiguous_ids) {
         std::printf(
             "  if the masks number categories from 0 as a network's raw output does, import "

@@ -1,16 +1,54 @@
 #include "panmap/lcm/log_import.h"
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <utility>
+
+#include <opencv2/imgproc.hpp>
 
 #include "panmap/core/error.h"
 #include "panmap/io/coco_panoptic_reader.h"
+#include "panmap/io/opencv_image.h"
 #include "panmap/io/text_files.h"
 #include "panmap/lcm/log_writer.h"
 
 namespace panmap {
+
+namespace {
+
+// A mask of its colour image's size is kept. One of the same shape (within 1 %: a network run
+// on a scaled image, its output not scaled back) is scaled to it with `resize`, each pixel
+// taking the label under its centre; otherwise, or without `resize`, the sizes are an error.
+// Returns whether the mask was scaled.
+bool fitMaskToColour(LabelImage* mask, const DatasetFrame& frame, bool resize,
+                     const std::string& what) {
+  const int w = frame.color_source_width, h = frame.color_source_height;
+  if (mask->width() == w && mask->height() == h) return false;
+  std::ostringstream msg;
+  msg << what << ": mask is " << mask->width() << "x" << mask->height()
+      << " but its colour image is " << w << "x" << h;
+  const double shape =
+      static_cast<double>(mask->width()) * h / (static_cast<double>(w) * mask->height());
+  if (std::abs(shape - 1.0) > 0.01) {
+    msg << " (another shape: have the network's post-processing return masks at the image's "
+           "size)";
+    throw Error(msg.str());
+  }
+  if (!resize) {
+    msg << " (--resize-masks scales such masks to the image)";
+    throw Error(msg.str());
+  }
+  cv::Mat scaled;
+  cv::resize(asMat(*mask), scaled, cv::Size(w, h), 0, 0, cv::INTER_NEAREST_EXACT);
+  *mask = labelsFromMat(scaled);
+  return true;
+}
+
+}  // namespace
+
 ImportStats importDataset(const std::string& dataset_dir, const std::string& log_path,
                           const ImportOptions& options,
                           const std::function<void(size_t, size_t)>& progress) {
@@ -47,8 +85,11 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
         frame = reader->read(i);
         if (frame.T_W_C && masks && masks->has(frame.color_stem)) {
           panoptic = masks->read(frame.color_stem);
-          panoptic->segment_ids =
-              registerLabelsToDepth(panoptic->segment_ids, frame, "mask of " + frame.color_stem);
+          const std::string what = "mask of " + frame.color_stem;
+          if (fitMaskToColour(&panoptic->segment_ids, frame, options.resize_masks, what)) {
+            ++stats.masks_resized;
+          }
+          panoptic->segment_ids = registerLabelsToDepth(panoptic->segment_ids, frame, what);
         }
       } catch (const Error& e) {
         if (!options.skip_bad) throw;

@@ -253,7 +253,8 @@ TEST(Import, TumStopsOnAMissingPoseUnlessAskedToSkip) {
 // mask (PNG + its JSON) for the first frame, read through the given label table.
 ImportStats importWithFirstMask(const test::TempDir& dir, const LabelImage& mask,
                                 const std::string& segments_json, const std::string& label_table,
-                                size_t max_frames, bool contiguous_ids = false) {
+                                size_t max_frames, bool contiguous_ids = false,
+                                bool resize_masks = false) {
   fs::create_directory(dir.path("masks"));
   writeFileBytes(dir.path("masks/frame-000000.color.png"), encodeLabelPng(mask));
   std::ofstream(dir.path("masks/frame-000000.color.json")) << segments_json;
@@ -262,6 +263,7 @@ ImportStats importWithFirstMask(const test::TempDir& dir, const LabelImage& mask
   options.mask_dir = dir.path("masks");
   options.label_table = label_table;
   options.contiguous_ids = contiguous_ids;
+  options.resize_masks = resize_masks;
   return importDataset(test::dataDir("7scenes-200"), dir.path("m.lcmlog"), options);
 }
 
@@ -359,6 +361,46 @@ TEST(Import, ContiguousIdsOfANetworksRawOutputTakeTheSameClasses) {
   const PanopticFrame q = fromMessage(decodeEvent<panoptic_t>(coco_events[2]));
   ASSERT_EQ(q.segments.size(), 5u);
   EXPECT_EQ(q.segments[2].category, 40);
+}
+
+TEST(Import, MasksOfAScaledImageAreScaledToItOnRequest) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  // A network run on the 640x480 frame scaled to 160x120: columns of 4 pixels each, so the
+  // mask scaled back is known pixel for pixel (7-Scenes' colour is registered to its depth).
+  LabelImage small(160, 120, 0);
+  for (int v = 0; v < 120; ++v) {
+    for (int u = 0; u < 160; ++u) small(u, v) = u < 40 ? 1 : (v < 60 ? 2 : 0);
+  }
+  const std::string segments =
+      R"({"segments_info": [{"id": 1, "category_id": 1}, {"id": 2, "category_id": 5}]})";
+  test::TempDir refused;
+  try {
+    importWithFirstMask(refused, small, segments, "", 1);
+    FAIL() << "a mask of another size was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("mask is 160x120 but its colour image is 640x480"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("--resize-masks"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(refused.path("m.lcmlog")));
+
+  test::TempDir dir;
+  const ImportStats s = importWithFirstMask(dir, small, segments, "", 1, false, true);
+  EXPECT_EQ(s.masks_resized, 1u);
+  const auto events = readEvents(dir.path("m.lcmlog"));
+  ASSERT_EQ(events.size(), 3u);
+  const PanopticFrame p = fromMessage(decodeEvent<panoptic_t>(events[2]));
+  LabelImage expected(640, 480, 0);
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 640; ++u) expected(u, v) = small(u / 4, v / 4);
+  }
+  EXPECT_EQ(p.segment_ids, expected);
+
+  // Another shape (a square network input, padded) cannot be scaled back: an error.
+  test::TempDir square;
+  EXPECT_THROW(importWithFirstMask(square, LabelImage(120, 120, 1), segments, "", 1, false, true),
+               Error);
 }
 
 }  // namespace

@@ -23,6 +23,9 @@ struct ImportOptions {
   /// The masks' category ids are the label table's rows counted from 0 in id order (a
   /// network's raw contiguous class indices, LabelTable::contiguous), not its source ids.
   bool contiguous_ids = false;
+  /// Masks of another size than their colour image but of its shape (a network run on a
+  /// scaled image) are scaled to it, nearest pixel; otherwise such a mask is an error.
+  bool resize_masks = false;
   /// What to do with a frame whose pose is invalid: skip it (counted) or stop with an error.
   /// kAuto skips where the layout documents invalid poses (ScanNet) and stops elsewhere.
   enum class InvalidPose { kAuto, kSkip, kError } invalid_pose = InvalidPose::kAuto;
@@ -49,6 +52,7 @@ struct ImportStats {
   size_t skipped_invalid_pose = 0;
   size_t frames_without_mask = 0;
   size_t unknown_category_segments = 0;
+  size_t masks_resized = 0;     ///< with resize_masks: masks scaled to their colour image
   size_t unmatched_frames = 0;  ///< e.g. TUM depth without colour in time
   size_t bytes_written = 0;
   std::string first_skip_reason;
