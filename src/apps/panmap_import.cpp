@@ -54,6 +54,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--masks", options.mask_dir,
                  "folder of COCO panoptic PNGs (segment id = R + 256 G + 65536 B)");
+  std::string mask_format = "panoptic";
+  app.add_option("--masks-format", mask_format,
+                 "panoptic (COCO panoptic PNG + JSON) or semantic (greyscale PNG of class ids "
+                 "from a network without instances: each stuff class one segment, each "
+                 "connected region of a thing class one instance)")
+      ->check(CLI::IsMember({"panoptic", "semantic"}))
+      ->capture_default_str();
   app.add_option("--masks-json", options.mask_json,
                  "COCO panoptic JSON for --masks (default: <stem>.json beside each PNG)");
   app.add_option("--label-table", options.label_table,
@@ -126,6 +133,9 @@ int main(int argc, char** argv) {
 
   try {
     options.dataset.layout = panmap::parseDatasetLayout(layout);
+    options.mask_format = mask_format == "semantic"
+                              ? panmap::ImportOptions::MaskFormat::kSemantic
+                              : panmap::ImportOptions::MaskFormat::kCocoPanoptic;
     if (!intrinsics.empty()) {
       options.dataset.intrinsics = parseIntrinsics(intrinsics);
       if (!options.dataset.intrinsics) options.dataset.intrinsics_file = intrinsics;

@@ -12,6 +12,7 @@
 #include "panmap/core/error.h"
 #include "panmap/io/coco_panoptic_reader.h"
 #include "panmap/io/opencv_image.h"
+#include "panmap/io/semantic_mask_reader.h"
 #include "panmap/io/text_files.h"
 #include "panmap/lcm/log_writer.h"
 
@@ -53,12 +54,20 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
                           const ImportOptions& options,
                           const std::function<void(size_t, size_t)>& progress) {
   const std::unique_ptr<DatasetReader> reader = openDataset(dataset_dir, options.dataset);
-  std::optional<CocoPanopticReader> masks;
+  std::unique_ptr<MaskReader> masks;
   if (!options.mask_dir.empty()) {
     LabelTable table = options.label_table.empty() ? LabelTable::nyu40Identity()
                                                    : LabelTable::load(options.label_table);
     if (options.contiguous_ids) table = table.contiguous();
-    masks.emplace(options.mask_dir, options.mask_json, std::move(table));
+    if (options.mask_format == ImportOptions::MaskFormat::kSemantic) {
+      if (!options.mask_json.empty()) {
+        throw Error("semantic masks have no JSON (" + options.mask_json + ")");
+      }
+      masks = std::make_unique<SemanticMaskReader>(options.mask_dir, std::move(table));
+    } else {
+      masks = std::make_unique<CocoPanopticReader>(options.mask_dir, options.mask_json,
+                                                   std::move(table));
+    }
   }
   bool skip_invalid = reader->invalidPosesExpected();
   if (options.invalid_pose == ImportOptions::InvalidPose::kSkip) skip_invalid = true;

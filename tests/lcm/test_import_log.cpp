@@ -403,5 +403,41 @@ TEST(Import, MasksOfAScaledImageAreScaledToItOnRequest) {
                Error);
 }
 
+TEST(Import, SemanticMasksBecomePanopticMessages) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  // A semantic network's output for the first frame: ADE20K ids, wall (0) on the left half,
+  // two chairs (19) apart on the right, floor (3) below them.
+  cv::Mat ids(480, 640, CV_8UC1, cv::Scalar(3));
+  ids(cv::Rect(0, 0, 320, 480)).setTo(0);
+  ids(cv::Rect(360, 100, 80, 80)).setTo(19);
+  ids(cv::Rect(500, 100, 80, 80)).setTo(19);
+  test::TempDir dir;
+  fs::create_directory(dir.path("masks"));
+  ASSERT_TRUE(cv::imwrite(dir.path("masks/frame-000000.color.png"), ids));
+  ImportOptions options;
+  options.max_frames = 1;
+  options.mask_dir = dir.path("masks");
+  options.mask_format = ImportOptions::MaskFormat::kSemantic;
+  options.label_table = test::shippedLabelTable("ade20k_nyu40.tsv");
+  const ImportStats s = importDataset(test::dataDir("7scenes-200"), dir.path("m.lcmlog"), options);
+  EXPECT_EQ(s.panoptic_written, 1u);
+  EXPECT_EQ(s.unknown_category_segments, 0u);
+  const auto events = readEvents(dir.path("m.lcmlog"));
+  ASSERT_EQ(events.size(), 3u);
+  const PanopticFrame p = fromMessage(decodeEvent<panoptic_t>(events[2]));
+  ASSERT_EQ(p.segments.size(), 4u);
+  EXPECT_EQ(p.segments[0], (PanopticSegment{1, 1, 0, false, 1.0f}));  // wall
+  EXPECT_EQ(p.segments[1], (PanopticSegment{2, 2, 3, false, 1.0f}));  // floor
+  EXPECT_EQ(p.segments[2], (PanopticSegment{3, 5, 19, true, 1.0f}));  // chair, left
+  EXPECT_EQ(p.segments[3], (PanopticSegment{4, 5, 19, true, 1.0f}));  // chair, right
+  EXPECT_EQ(p.segment_ids(400, 140), 3);
+  EXPECT_EQ(p.segment_ids(540, 140), 4);
+  EXPECT_EQ(p.segment_ids(10, 10), 1);
+
+  // A COCO JSON means the masks are not semantic: the options contradict each other.
+  options.mask_json = dir.path("masks/panoptic.json");
+  EXPECT_THROW(importDataset(test::dataDir("7scenes-200"), dir.path("n.lcmlog"), options), Error);
+}
+
 }  // namespace
 }  // namespace panmap

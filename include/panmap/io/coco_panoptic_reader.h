@@ -6,6 +6,7 @@
 
 #include "panmap/core/frame.h"
 #include "panmap/core/label_table.h"
+#include "panmap/io/mask_reader.h"
 
 namespace panmap {
 
@@ -15,29 +16,19 @@ namespace panmap {
 /// Two JSON arrangements are accepted: one COCO file for the whole folder (its "annotations"
 /// each with file_name, image_id and segments_info, "images" mapping image_id to a file
 /// name), or one JSON per PNG (<stem>.json holding segments_info or an object with it).
-class CocoPanopticReader {
+class CocoPanopticReader : public MaskReader {
  public:
-  /// Counts of what happened while reading masks.
-  struct Stats {
-    size_t frames_with_masks = 0;
-    size_t segments = 0;
-    size_t unknown_category_segments = 0;  ///< category absent from the label table
-  };
-
   /// @param mask_dir folder with the PNGs (and per-frame JSONs)
   /// @param json_path COCO panoptic JSON, or "" for per-frame JSONs
   /// @param table the segmenter's categories -> panmap classes
   CocoPanopticReader(const std::string& mask_dir, const std::string& json_path, LabelTable table);
 
   /// True when a mask exists for the colour image with this file stem.
-  bool has(const std::string& color_stem) const;
+  bool has(const std::string& color_stem) const override;
 
-  /// Reads the mask of a colour image at the colour image's resolution (segment ids) and its
-  /// segments with panmap classes. Throws Error naming the file on bad input.
-  PanopticFrame read(const std::string& color_stem);
-
-  /// What has been read so far.
-  const Stats& stats() const { return stats_; }
+  /// Reads the mask of a colour image (segment ids) and its segments with panmap classes.
+  /// Throws Error naming the file on bad input.
+  PanopticFrame read(const std::string& color_stem) override;
 
  private:
   struct Entry {
@@ -48,7 +39,6 @@ class CocoPanopticReader {
   std::string mask_dir_;
   LabelTable table_;
   std::map<std::string, Entry> entries_;  // by colour stem
-  Stats stats_;
 };
 
 }  // namespace panmap

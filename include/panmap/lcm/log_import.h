@@ -16,9 +16,12 @@ namespace panmap {
 /// Options of panmap-import.
 struct ImportOptions {
   DatasetOptions dataset;
-  ImageEncoding encoding;   ///< JPEG colour + PNG depth unless --raw
-  std::string mask_dir;     ///< COCO panoptic PNGs; "" for no PANOPTIC channel
-  std::string mask_json;    ///< COCO panoptic JSON; "" for per-frame JSON files
+  ImageEncoding encoding;  ///< JPEG colour + PNG depth unless --raw
+  std::string mask_dir;    ///< COCO panoptic PNGs; "" for no PANOPTIC channel
+  std::string mask_json;   ///< COCO panoptic JSON; "" for per-frame JSON files
+  /// kCocoPanoptic: CocoPanopticReader; kSemantic: greyscale class-id PNGs of a semantic
+  /// network, SemanticMaskReader (no mask_json).
+  enum class MaskFormat { kCocoPanoptic, kSemantic } mask_format = MaskFormat::kCocoPanoptic;
   std::string label_table;  ///< segmenter -> panmap classes; "" = NYU40 identity
   /// The masks' category ids are the label table's rows counted from 0 in id order (a
   /// network's raw contiguous class indices, LabelTable::contiguous), not its source ids.

@@ -1,0 +1,37 @@
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "panmap/core/frame.h"
+
+namespace panmap {
+
+/// Counts of what a mask reader has read so far.
+struct MaskReaderStats {
+  size_t frames_with_masks = 0;
+  size_t segments = 0;
+  size_t unknown_category_segments = 0;  ///< category absent from the label table
+};
+
+/// A segmentation network's masks of a dataset's colour images, one per image, found by the
+/// image's file stem, with panmap classes from a label table.
+class MaskReader {
+ public:
+  virtual ~MaskReader() = default;
+
+  /// True when a mask exists for the colour image with this file stem.
+  virtual bool has(const std::string& color_stem) const = 0;
+
+  /// Reads the mask of a colour image (segment ids at the mask file's resolution) and its
+  /// segments with panmap classes. Throws Error naming the file on bad input.
+  virtual PanopticFrame read(const std::string& color_stem) = 0;
+
+  /// What has been read so far.
+  const MaskReaderStats& stats() const { return stats_; }
+
+ protected:
+  MaskReaderStats stats_;
+};
+
+}  // namespace panmap

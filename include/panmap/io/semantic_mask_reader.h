@@ -1,0 +1,37 @@
+#pragma once
+
+#include <map>
+#include <string>
+
+#include "panmap/core/label_table.h"
+#include "panmap/io/mask_reader.h"
+
+namespace panmap {
+
+/// Masks of a semantic segmentation network (no instances): one greyscale PNG (8 or 16 bit) per
+/// colour image, named after it, each pixel the class id in the network's numbering.
+///
+/// Each stuff class of a frame becomes one segment. Each connected region (8-neighbourhood) of
+/// a thing class becomes one segment: a guess at its instances that keeps apart the objects of
+/// a class that do not touch in the image and joins those that do. Pixels of ids the label
+/// table lacks stay unsegmented (0); each such id counts once per frame as an unknown
+/// segment.
+class SemanticMaskReader : public MaskReader {
+ public:
+  /// @param mask_dir folder with the PNGs
+  /// @param table the network's class ids -> panmap classes (is_thing decides instances)
+  SemanticMaskReader(const std::string& mask_dir, LabelTable table);
+
+  /// True when a mask exists for the colour image with this file stem.
+  bool has(const std::string& color_stem) const override;
+
+  /// Reads a mask and splits it into segments. Throws Error naming the file when it is not a
+  /// greyscale PNG.
+  PanopticFrame read(const std::string& color_stem) override;
+
+ private:
+  LabelTable table_;
+  std::map<std::string, std::string> files_;  // colour stem -> PNG path
+};
+
+}  // namespace panmap

@@ -1,0 +1,94 @@
+#include "panmap/io/semantic_mask_reader.h"
+
+#include <filesystem>
+#include <set>
+#include <utility>
+
+#include <opencv2/imgproc.hpp>
+
+#include "panmap/core/error.h"
+#include "panmap/io/image_codec.h"
+#include "panmap/io/opencv_image.h"
+#include "panmap/io/text_files.h"
+
+namespace panmap {
+
+namespace {
+
+// A PNG's colour type (IHDR byte 25): 0 is greyscale; colour and palette images would decode
+// to colours, not to the class ids a palette indexes.
+constexpr size_t kPngColourTypeByte = 25;
+
+}  // namespace
+
+SemanticMaskReader::SemanticMaskReader(const std::string& mask_dir, LabelTable table)
+    : table_(std::move(table)) {
+  if (!isDirectory(mask_dir)) throw Error("mask folder " + mask_dir + " does not exist");
+  std::error_code ec;
+  for (const auto& f : std::filesystem::directory_iterator(mask_dir, ec)) {
+    if (f.path().extension() == ".png") files_[f.path().stem().string()] = f.path().string();
+  }
+  if (files_.empty()) throw Error("mask folder " + mask_dir + " has no PNG masks");
+}
+
+bool SemanticMaskReader::has(const std::string& color_stem) const {
+  return files_.count(color_stem) > 0;
+}
+
+PanopticFrame SemanticMaskReader::read(const std::string& color_stem) {
+  const auto it = files_.find(color_stem);
+  if (it == files_.end()) throw Error("no semantic mask for colour image " + color_stem);
+  const std::string& path = it->second;
+  const auto bytes = readFileBytes(path);
+  if (bytes.size() > kPngColourTypeByte && bytes[kPngColourTypeByte] != 0) {
+    throw Error(path +
+                ": a semantic mask must be a greyscale PNG of class ids (8 or 16 bit), "
+                "not a colour or palette image");
+  }
+  const LabelImage classes = decodeLabelPng(bytes.data(), bytes.size(), path);
+
+  std::set<int32_t> present;
+  const int32_t* pixel = classes.data();
+  for (size_t i = 0; i < classes.size(); ++i) {
+    if (i == 0 || pixel[i] != pixel[i - 1]) present.insert(pixel[i]);  // runs: one insert each
+  }
+  PanopticFrame frame;
+  frame.segment_ids = LabelImage(classes.width(), classes.height(), 0);
+  const cv::Mat class_mat = asMat(classes);
+  cv::Mat region, components;
+  size_t unknown = 0;
+  int32_t next_id = 1;
+  for (const int32_t source : present) {
+    const auto entry = table_.lookup(source);
+    if (!entry) {
+      ++unknown;
+      continue;
+    }
+    region = class_mat == source;
+    // Stuff is one region whatever its shape; things are split where they do not touch.
+    int regions = 1;
+    if (entry->is_thing) {
+      regions = cv::connectedComponents(region, components, 8, CV_32S) - 1;
+    } else {
+      region.convertTo(components, CV_32S, 1.0 / 255.0);
+    }
+    for (int v = 0; v < classes.height(); ++v) {
+      const int32_t* in = components.ptr<int32_t>(v);
+      int32_t* out = frame.segment_ids.row(v);
+      for (int u = 0; u < classes.width(); ++u) {
+        if (in[u] > 0) out[u] = next_id + in[u] - 1;
+      }
+    }
+    for (int k = 0; k < regions; ++k) {
+      frame.segments.push_back(
+          PanopticSegment{next_id + k, entry->panmap_class, source, entry->is_thing, 1.0f});
+    }
+    next_id += regions;
+  }
+  ++stats_.frames_with_masks;
+  stats_.segments += frame.segments.size();
+  stats_.unknown_category_segments += unknown;
+  return frame;
+}
+
+}  // namespace panmap

@@ -1,0 +1,97 @@
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "panmap/core/error.h"
+#include "panmap/io/image_codec.h"
+#include "panmap/io/semantic_mask_reader.h"
+#include "test_helpers.h"
+
+namespace panmap {
+namespace {
+
+// Class ids of a semantic network, 8x6: a wall (1) down the left, three chair regions (5), of
+// which the lower two pixels touch only at a corner, a lamp (9) down the right, an unknown id
+// (7) and unlabelled pixels (0, also not in the table).
+cv::Mat classIds(int type) {
+  const int ids[6][8] = {{1, 1, 5, 5, 0, 5, 5, 9}, {1, 1, 5, 5, 0, 5, 5, 9},
+                         {1, 1, 0, 0, 0, 0, 0, 9}, {1, 1, 0, 0, 0, 0, 0, 9},
+                         {7, 1, 0, 5, 0, 0, 0, 9}, {7, 1, 5, 0, 0, 0, 0, 9}};
+  cv::Mat mat(6, 8, type);
+  for (int v = 0; v < 6; ++v) {
+    for (int u = 0; u < 8; ++u) {
+      if (type == CV_16UC1) {
+        mat.at<uint16_t>(v, u) = static_cast<uint16_t>(ids[v][u]);
+      } else {
+        mat.at<uint8_t>(v, u) = static_cast<uint8_t>(ids[v][u]);
+      }
+    }
+  }
+  return mat;
+}
+
+LabelTable tinyTable() {
+  LabelTable table;
+  table.set(1, {1, false, "wall"});
+  table.set(5, {5, true, "chair"});
+  table.set(9, {35, true, "lamp"});
+  return table;
+}
+
+void writePng(const std::string& path, const cv::Mat& mat) {
+  ASSERT_TRUE(cv::imwrite(path, mat)) << path;
+}
+
+TEST(SemanticMasks, StuffIsOneSegmentAndThingsSplitWhereTheyDoNotTouch) {
+  for (const int type : {CV_8UC1, CV_16UC1}) {
+    test::TempDir dir;
+    writePng(dir.path("frame-000000.color.png"), classIds(type));
+    SemanticMaskReader reader(dir.path(), tinyTable());
+    EXPECT_TRUE(reader.has("frame-000000.color"));
+    EXPECT_FALSE(reader.has("frame-000003.color"));
+    const PanopticFrame f = reader.read("frame-000000.color");
+    ASSERT_EQ(f.segments.size(), 5u) << type;
+    EXPECT_EQ(f.segments[0], (PanopticSegment{1, 1, 1, false, 1.0f}));
+    for (int k = 1; k <= 3; ++k) {
+      EXPECT_EQ(f.segments[k], (PanopticSegment{1 + k, 5, 5, true, 1.0f})) << k;
+    }
+    EXPECT_EQ(f.segments[4], (PanopticSegment{5, 35, 9, true, 1.0f}));
+    const int32_t expected[6][8] = {{1, 1, 2, 2, 0, 3, 3, 5}, {1, 1, 2, 2, 0, 3, 3, 5},
+                                    {1, 1, 0, 0, 0, 0, 0, 5}, {1, 1, 0, 0, 0, 0, 0, 5},
+                                    {0, 1, 0, 4, 0, 0, 0, 5}, {0, 1, 4, 0, 0, 0, 0, 5}};
+    ASSERT_EQ(f.segment_ids.width(), 8);
+    ASSERT_EQ(f.segment_ids.height(), 6);
+    for (int v = 0; v < 6; ++v) {
+      for (int u = 0; u < 8; ++u) EXPECT_EQ(f.segment_ids(u, v), expected[v][u]) << u << "," << v;
+    }
+    // Ids 0 and 7 are not in the table: counted once each.
+    EXPECT_EQ(reader.stats().unknown_category_segments, 2u);
+    EXPECT_EQ(reader.stats().segments, 5u);
+  }
+}
+
+TEST(SemanticMasks, ColourImagesAndMissingFoldersAreNamed) {
+  test::TempDir dir;
+  cv::Mat colour(6, 8, CV_8UC3, cv::Scalar(5, 0, 0));
+  const std::string path = dir.path("frame-000000.color.png");
+  writePng(path, colour);
+  SemanticMaskReader reader(dir.path(), tinyTable());
+  try {
+    reader.read("frame-000000.color");
+    FAIL() << "a colour PNG was read as class ids";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ": a semantic mask must be a greyscale PNG"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(SemanticMaskReader(dir.path("none"), tinyTable()), Error);
+  test::TempDir empty;
+  EXPECT_THROW(SemanticMaskReader(empty.path(), tinyTable()), Error);
+  writeFileBytes(dir.path("frame-000003.color.png"), {0x89, 'P', 'N', 'G'});
+  SemanticMaskReader cut(dir.path(), tinyTable());
+  EXPECT_THROW(cut.read("frame-000003.color"), Error);
+}
+
+}  // namespace
+}  // namespace panmap
