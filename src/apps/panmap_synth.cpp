@@ -18,6 +18,7 @@
 #include "panmap/io/image_codec.h"
 #include "panmap/io/ply.h"
 #include "panmap/io/scannet_ground_truth.h"
+#include "panmap/io/semantic_mask_reader.h"
 #include "panmap/lcm/channels.h"
 #include "panmap/lcm/conversions.h"
 #include "panmap/lcm/correction_conversions.h"
@@ -122,7 +123,7 @@ int main(int argc, char** argv) {
   int preview_every = 0;
   panmap::UnannotateConfig unannotate_config;
   std::string unannotated_masks = "painted";
-  bool join_parts = false;
+  bool join_parts = false, semantic_masks = false;
   auto* source = app.add_option_group("source", "ground-truth mesh (one of)");
   source->add_option("--room", room_seed, "procedural room with this seed");
   int64_t building_seed = -1;
@@ -216,6 +217,11 @@ int main(int argc, char** argv) {
                  "rates) or empty (no mask on anything unannotated)")
       ->capture_default_str()
       ->check(CLI::IsMember({"painted", "empty"}));
+  app.add_flag("--semantic-masks", semantic_masks,
+               "a semantic network instead of a panoptic one: each frame's masks keep their "
+               "classes and lose their instances, which come back as panmap-import "
+               "--masks-format semantic makes them (each connected region of a thing class one "
+               "instance)");
   app.add_flag("--join-parts", join_parts,
                "with --scannet: join same-class thing instances stacked above each other (a "
                "chair's seat and its star base) into one, where a derived annotation split one "
@@ -335,6 +341,7 @@ int main(int argc, char** argv) {
     const auto pose_source =
         poses == "gt" ? panmap::PoseSource::kGroundTruth : panmap::PoseSource::kSlam;
     panmap::ProgressLine progress("synth", "frames", !quiet);
+    const panmap::LabelTable nyu40 = panmap::LabelTable::nyu40Identity();
     for (size_t k = 0; k < synth.size(); ++k) {
       const panmap::SynthFrame f = synth.frame(k);
       const int64_t utime = f.rgbd.utime;
@@ -345,7 +352,10 @@ int main(int argc, char** argv) {
       pose.T_W_C = f.input_pose.T_W_C;
       pose.source = pose_source;
       log.write(panmap::kChannelPose, utime, panmap::toMessage(pose));
-      log.write(panmap::kChannelPanoptic, utime, panmap::toMessage(f.panoptic, encoding));
+      log.write(
+          panmap::kChannelPanoptic, utime,
+          panmap::toMessage(
+              semantic_masks ? panmap::withoutInstances(f.panoptic, nyu40) : f.panoptic, encoding));
       if (preview_every > 0 && k % static_cast<size_t>(preview_every) == 0)
         writePreview(out_dir, f);
       progress.update(k + 1, synth.size());
@@ -400,6 +410,7 @@ int main(int argc, char** argv) {
           {"planned_clearance_m", walk.clearance_m},
           {"min_clearance_m", panmap::minClearance(synth.groundTruthTrajectory(), mesh)}}},
         {"masks", masksJson(config.masks)},
+        {"semantic_masks", semantic_masks},
         {"unannotation",
          {{"fraction_requested", unannotate_config.fraction},
           {"fraction", scene.unannotated_fraction},

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <set>
+#include <unordered_map>
 #include <utility>
 
 #include <opencv2/imgproc.hpp>
@@ -20,6 +21,63 @@ namespace {
 constexpr size_t kPngColourTypeByte = 25;
 
 }  // namespace
+
+PanopticFrame panopticFromClasses(const LabelImage& classes, const LabelTable& table,
+                                  size_t* unknown_ids) {
+  std::set<int32_t> present;
+  const int32_t* pixel = classes.data();
+  for (size_t i = 0; i < classes.size(); ++i) {
+    if (i == 0 || pixel[i] != pixel[i - 1]) present.insert(pixel[i]);  // runs: one insert each
+  }
+  PanopticFrame frame;
+  frame.segment_ids = LabelImage(classes.width(), classes.height(), 0);
+  const cv::Mat class_mat = asMat(classes);
+  cv::Mat region, components;
+  int32_t next_id = 1;
+  for (const int32_t source : present) {
+    const auto entry = table.lookup(source);
+    if (!entry) {
+      ++*unknown_ids;
+      continue;
+    }
+    region = class_mat == source;
+    // Stuff is one region whatever its shape; things are split where they do not touch.
+    int regions = 1;
+    if (entry->is_thing) {
+      regions = cv::connectedComponents(region, components, 8, CV_32S) - 1;
+    } else {
+      region.convertTo(components, CV_32S, 1.0 / 255.0);
+    }
+    for (int v = 0; v < classes.height(); ++v) {
+      const int32_t* in = components.ptr<int32_t>(v);
+      int32_t* out = frame.segment_ids.row(v);
+      for (int u = 0; u < classes.width(); ++u) {
+        if (in[u] > 0) out[u] = next_id + in[u] - 1;
+      }
+    }
+    for (int k = 0; k < regions; ++k) {
+      frame.segments.push_back(
+          PanopticSegment{next_id + k, entry->panmap_class, source, entry->is_thing, 1.0f});
+    }
+    next_id += regions;
+  }
+  return frame;
+}
+
+PanopticFrame withoutInstances(const PanopticFrame& panoptic, const LabelTable& table) {
+  std::unordered_map<int32_t, int32_t> class_of;
+  for (const PanopticSegment& s : panoptic.segments) class_of[s.id] = s.category;
+  LabelImage classes(panoptic.segment_ids.width(), panoptic.segment_ids.height(), 0);
+  for (size_t i = 0; i < classes.size(); ++i) {
+    const auto it = class_of.find(panoptic.segment_ids.data()[i]);
+    if (it != class_of.end()) classes.data()[i] = it->second;
+  }
+  size_t unknown = 0;
+  PanopticFrame semantic = panopticFromClasses(classes, table, &unknown);
+  semantic.utime = panoptic.utime;
+  semantic.frame_id = panoptic.frame_id;
+  return semantic;
+}
 
 SemanticMaskReader::SemanticMaskReader(const std::string& mask_dir, LabelTable table)
     : table_(std::move(table)) {
@@ -46,45 +104,8 @@ PanopticFrame SemanticMaskReader::read(const std::string& color_stem) {
                 "not a colour or palette image");
   }
   const LabelImage classes = decodeLabelPng(bytes.data(), bytes.size(), path);
-
-  std::set<int32_t> present;
-  const int32_t* pixel = classes.data();
-  for (size_t i = 0; i < classes.size(); ++i) {
-    if (i == 0 || pixel[i] != pixel[i - 1]) present.insert(pixel[i]);  // runs: one insert each
-  }
-  PanopticFrame frame;
-  frame.segment_ids = LabelImage(classes.width(), classes.height(), 0);
-  const cv::Mat class_mat = asMat(classes);
-  cv::Mat region, components;
   size_t unknown = 0;
-  int32_t next_id = 1;
-  for (const int32_t source : present) {
-    const auto entry = table_.lookup(source);
-    if (!entry) {
-      ++unknown;
-      continue;
-    }
-    region = class_mat == source;
-    // Stuff is one region whatever its shape; things are split where they do not touch.
-    int regions = 1;
-    if (entry->is_thing) {
-      regions = cv::connectedComponents(region, components, 8, CV_32S) - 1;
-    } else {
-      region.convertTo(components, CV_32S, 1.0 / 255.0);
-    }
-    for (int v = 0; v < classes.height(); ++v) {
-      const int32_t* in = components.ptr<int32_t>(v);
-      int32_t* out = frame.segment_ids.row(v);
-      for (int u = 0; u < classes.width(); ++u) {
-        if (in[u] > 0) out[u] = next_id + in[u] - 1;
-      }
-    }
-    for (int k = 0; k < regions; ++k) {
-      frame.segments.push_back(
-          PanopticSegment{next_id + k, entry->panmap_class, source, entry->is_thing, 1.0f});
-    }
-    next_id += regions;
-  }
+  PanopticFrame frame = panopticFromClasses(classes, table_, &unknown);
   ++stats_.frames_with_masks;
   stats_.segments += frame.segments.size();
   stats_.unknown_category_segments += unknown;

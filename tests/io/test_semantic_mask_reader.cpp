@@ -93,5 +93,33 @@ TEST(SemanticMasks, ColourImagesAndMissingFoldersAreNamed) {
   EXPECT_THROW(cut.read("frame-000003.color"), Error);
 }
 
+TEST(SemanticMasks, APanopticFrameLosesItsInstancesWhereTheyTouch) {
+  // Three chairs (NYU40 5) of which two touch, on a floor (2); a void segment (0).
+  PanopticFrame panoptic;
+  panoptic.utime = 42;
+  panoptic.frame_id = 7;
+  panoptic.segment_ids = LabelImage(8, 2, 1);
+  const int32_t ids[2][8] = {{10, 10, 11, 11, 1, 12, 1, 9}, {10, 10, 11, 11, 1, 12, 1, 9}};
+  for (int v = 0; v < 2; ++v) {
+    for (int u = 0; u < 8; ++u) panoptic.segment_ids(u, v) = ids[v][u];
+  }
+  panoptic.segments = {{1, 2, 2, false, 1.0f},
+                       {9, 0, 0, true, 0.5f},
+                       {10, 5, 5, true, 0.9f},
+                       {11, 5, 5, true, 0.8f},
+                       {12, 5, 5, true, 0.7f}};
+  const PanopticFrame semantic = withoutInstances(panoptic, LabelTable::nyu40Identity());
+  EXPECT_EQ(semantic.utime, 42);
+  EXPECT_EQ(semantic.frame_id, 7);
+  ASSERT_EQ(semantic.segments.size(), 3u);
+  EXPECT_EQ(semantic.segments[0], (PanopticSegment{1, 2, 2, false, 1.0f}));  // floor
+  EXPECT_EQ(semantic.segments[1], (PanopticSegment{2, 5, 5, true, 1.0f}));   // chairs 10 + 11
+  EXPECT_EQ(semantic.segments[2], (PanopticSegment{3, 5, 5, true, 1.0f}));   // chair 12
+  const int32_t expected[8] = {2, 2, 2, 2, 1, 3, 1, 0};
+  for (int v = 0; v < 2; ++v) {
+    for (int u = 0; u < 8; ++u) EXPECT_EQ(semantic.segment_ids(u, v), expected[u]) << u;
+  }
+}
+
 }  // namespace
 }  // namespace panmap

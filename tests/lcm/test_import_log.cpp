@@ -325,6 +325,17 @@ TEST(Import, CocoNetworkMasksTakeTheShippedTablesClasses) {
   EXPECT_EQ(p.segments[4], (PanopticSegment{5, 0, 3, true, 0.6f}));     // car: void
 }
 
+// The one PANOPTIC message of a log of one frame (CAMERA_RGBD, CAMERA_POSE, PANOPTIC), or an
+// empty frame and a failure.
+PanopticFrame onlyPanoptic(const std::string& log) {
+  const auto events = readEvents(log);
+  if (events.size() != 3u || events[2].channel != "PANOPTIC") {
+    ADD_FAILURE() << log << ": " << events.size() << " events, not a frame and its mask";
+    return PanopticFrame{};
+  }
+  return fromMessage(decodeEvent<panoptic_t>(events[2]));
+}
+
 TEST(Import, ContiguousIdsOfANetworksRawOutputTakeTheSameClasses) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   // The frame above as Mask2Former's post-processing numbers it: class indices 0-132 in
@@ -343,9 +354,7 @@ TEST(Import, ContiguousIdsOfANetworksRawOutputTakeTheSameClasses) {
   test::TempDir dir;
   const ImportStats s = importWithFirstMask(dir, mask, segments, table, 1, true);
   EXPECT_EQ(s.unknown_category_segments, 0u);
-  const auto events = readEvents(dir.path("m.lcmlog"));
-  ASSERT_EQ(events.size(), 3u);
-  const PanopticFrame p = fromMessage(decodeEvent<panoptic_t>(events[2]));
+  const PanopticFrame p = onlyPanoptic(dir.path("m.lcmlog"));
   ASSERT_EQ(p.segments.size(), 5u);
   const int32_t classes[] = {1, 2, 5, 3, 0};  // wall, floor, chair, cabinet, void
   for (size_t i = 0; i < 5; ++i) EXPECT_EQ(p.segments[i].category, classes[i]) << i;
@@ -356,9 +365,7 @@ TEST(Import, ContiguousIdsOfANetworksRawOutputTakeTheSameClasses) {
   test::TempDir as_coco;
   const ImportStats t = importWithFirstMask(as_coco, mask, segments, table, 1, false);
   EXPECT_EQ(t.unknown_category_segments, 2u);
-  const auto coco_events = readEvents(as_coco.path("m.lcmlog"));
-  ASSERT_EQ(coco_events.size(), 3u);
-  const PanopticFrame q = fromMessage(decodeEvent<panoptic_t>(coco_events[2]));
+  const PanopticFrame q = onlyPanoptic(as_coco.path("m.lcmlog"));
   ASSERT_EQ(q.segments.size(), 5u);
   EXPECT_EQ(q.segments[2].category, 40);
 }
@@ -388,9 +395,7 @@ TEST(Import, MasksOfAScaledImageAreScaledToItOnRequest) {
   test::TempDir dir;
   const ImportStats s = importWithFirstMask(dir, small, segments, "", 1, false, true);
   EXPECT_EQ(s.masks_resized, 1u);
-  const auto events = readEvents(dir.path("m.lcmlog"));
-  ASSERT_EQ(events.size(), 3u);
-  const PanopticFrame p = fromMessage(decodeEvent<panoptic_t>(events[2]));
+  const PanopticFrame p = onlyPanoptic(dir.path("m.lcmlog"));
   LabelImage expected(640, 480, 0);
   for (int v = 0; v < 480; ++v) {
     for (int u = 0; u < 640; ++u) expected(u, v) = small(u / 4, v / 4);
@@ -422,9 +427,7 @@ TEST(Import, SemanticMasksBecomePanopticMessages) {
   const ImportStats s = importDataset(test::dataDir("7scenes-200"), dir.path("m.lcmlog"), options);
   EXPECT_EQ(s.panoptic_written, 1u);
   EXPECT_EQ(s.unknown_category_segments, 0u);
-  const auto events = readEvents(dir.path("m.lcmlog"));
-  ASSERT_EQ(events.size(), 3u);
-  const PanopticFrame p = fromMessage(decodeEvent<panoptic_t>(events[2]));
+  const PanopticFrame p = onlyPanoptic(dir.path("m.lcmlog"));
   ASSERT_EQ(p.segments.size(), 4u);
   EXPECT_EQ(p.segments[0], (PanopticSegment{1, 1, 0, false, 1.0f}));  // wall
   EXPECT_EQ(p.segments[1], (PanopticSegment{2, 2, 3, false, 1.0f}));  // floor

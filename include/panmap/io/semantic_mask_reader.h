@@ -8,6 +8,18 @@
 
 namespace panmap {
 
+/// Splits an image of class ids into panoptic segments, as SemanticMaskReader describes: each
+/// stuff class one segment, each connected region (8-neighbourhood) of a thing class one,
+/// numbered from 1 in order of class id, then of the region's first pixel in raster order.
+/// Pixels of ids `table` lacks are 0; their number of distinct ids is added to `unknown_ids`.
+PanopticFrame panopticFromClasses(const LabelImage& classes, const LabelTable& table,
+                                  size_t* unknown_ids);
+
+/// The masks a semantic network would have given for a panoptic frame: each pixel keeps its
+/// segment's class (NYU40 id, looked up in `table` as a source id) and loses its instance,
+/// then panopticFromClasses splits the classes again. Class 0 pixels stay unsegmented.
+PanopticFrame withoutInstances(const PanopticFrame& panoptic, const LabelTable& table);
+
 /// Masks of a semantic segmentation network (no instances): one greyscale PNG (8 or 16 bit) per
 /// colour image, named after it, each pixel the class id in the network's numbering.
 ///
