@@ -31,7 +31,7 @@ def run_one(work, spec, kind, flags):
     seq = os.path.join(work, "seq", name)
     out = os.path.join(work, "runs", name)
     shutil.rmtree(out, ignore_errors=True)
-    if not os.path.exists(os.path.join(seq, "info.json")):
+    if not os.path.exists(os.path.join(seq, "sequence.lcmlog")):  # dropped after each run
         shutil.rmtree(seq, ignore_errors=True)
         suite.run([suite.tool("panmap-synth"), "-q", "--out", seq] + spec.synth_args() + flags)
     suite.run([suite.tool("panmap-mapper"), "-q", "--voxel-size", "0.02", "--threads", "1",
