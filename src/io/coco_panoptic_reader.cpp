@@ -107,7 +107,9 @@ CocoPanopticReader::CocoPanopticReader(const std::string& mask_dir, const std::s
     }
   }
   if (entries_.empty()) {
-    throw Error("mask folder " + mask_dir + " has no masks (PNG + JSON) in COCO panoptic format");
+    throw Error("mask folder " + mask_dir +
+                " has no masks (PNG + JSON) in COCO panoptic format (class-id PNGs of a semantic "
+                "network: panmap-import --masks-format semantic)");
   }
 }
 
