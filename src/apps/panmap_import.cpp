@@ -53,7 +53,8 @@ int main(int argc, char** argv) {
   app.add_option("--layout", layout, "auto, 7scenes, scannet, tum or folder")
       ->capture_default_str();
   app.add_option("--masks", options.mask_dir,
-                 "folder of COCO panoptic PNGs (segment id = R + 256 G + 65536 B)");
+                 "folder of masks, one PNG per colour image named after it: COCO panoptic "
+                 "(segment id = R + 256 G + 65536 B) or, with --masks-format semantic, class ids");
   std::string mask_format = "panoptic";
   app.add_option("--masks-format", mask_format,
                  "panoptic (COCO panoptic PNG + JSON) or semantic (greyscale PNG of class ids "
