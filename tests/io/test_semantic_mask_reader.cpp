@@ -1,4 +1,5 @@
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -89,8 +90,16 @@ TEST(SemanticMasks, ColourImagesAndMissingFoldersAreNamed) {
   test::TempDir empty;
   EXPECT_THROW(SemanticMaskReader(empty.path(), tinyTable()), Error);
   writeFileBytes(dir.path("frame-000003.color.png"), {0x89, 'P', 'N', 'G'});
+  // Not a PNG at all, with a non-zero byte where a PNG keeps its colour type.
+  writeFileBytes(dir.path("frame-000006.color.png"), std::vector<uint8_t>(64, 'x'));
   SemanticMaskReader cut(dir.path(), tinyTable());
   EXPECT_THROW(cut.read("frame-000003.color"), Error);
+  try {
+    cut.read("frame-000006.color");
+    FAIL() << "a file that is no PNG was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("must be a PNG"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SemanticMasks, APanopticFrameLosesItsInstancesWhereTheyTouch) {
