@@ -109,12 +109,12 @@ bool isCompleteJpeg(const uint8_t* data, size_t size) {
   return false;
 }
 
-namespace {
-
 bool isPng(const uint8_t* data, size_t size) {
   static const uint8_t kMagic[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   return size >= 8 && std::equal(kMagic, kMagic + 8, data);
 }
+
+namespace {
 
 uint32_t bigEndian32(const uint8_t* p) {
   return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | p[3];

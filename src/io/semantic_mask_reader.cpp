@@ -1,8 +1,6 @@
 #include "panmap/io/semantic_mask_reader.h"
 
-#include <algorithm>
 #include <filesystem>
-#include <iterator>
 #include <set>
 #include <unordered_map>
 #include <utility>
@@ -100,11 +98,9 @@ PanopticFrame SemanticMaskReader::read(const std::string& color_stem) {
   if (it == files_.end()) throw Error("no semantic mask for colour image " + color_stem);
   const std::string& path = it->second;
   const auto bytes = readFileBytes(path);
-  static const uint8_t kPngSignature[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  const bool png = bytes.size() > kPngColourTypeByte &&
-                   std::equal(std::begin(kPngSignature), std::end(kPngSignature), bytes.begin());
-  // Anything else is left to decodeLabelPng, whose error says it is not a PNG.
-  if (png && bytes[kPngColourTypeByte] != 0) {
+  // Anything but a PNG is left to decodeLabelPng, whose error says it is not one.
+  if (isPng(bytes.data(), bytes.size()) && bytes.size() > kPngColourTypeByte &&
+      bytes[kPngColourTypeByte] != 0) {
     throw Error(path +
                 ": a semantic mask must be a greyscale PNG of class ids (8 or 16 bit), "
                 "not a colour or palette image");

@@ -36,6 +36,9 @@ std::vector<uint8_t> encodeDepthPng(const DepthImage& image, int compression = 1
 /// @param compression zlib level 0..9, as for encodeDepthPng()
 std::vector<uint8_t> encodeLabelPng(const LabelImage& image, int compression = 1);
 
+/// True when the bytes start with the PNG signature.
+bool isPng(const uint8_t* data, size_t size);
+
 /// True when JPEG bytes start with SOI and a marker and end with EOI (a truncated file does not;
 /// libjpeg would otherwise decode it with a grey tail and only a warning).
 bool isCompleteJpeg(const uint8_t* data, size_t size);
