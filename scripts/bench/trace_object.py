@@ -105,8 +105,24 @@ def agreeing(pixels, depth, width, scale, tolerance):
             if depth[v * width + u] > 0 and abs(depth[v * width + u] * scale - z) < tolerance]
 
 
-def top(counts, n=3):
-    return ", ".join("%d: %d" % kv for kv in counts.most_common(n))
+def top(counts, n=3, classes=None):
+    """The n largest counts; with classes ({mask id: class}), each mask named with its class."""
+    if classes is None:
+        return ", ".join("%d: %d" % kv for kv in counts.most_common(n))
+    return ", ".join("%d (class %d): %d" % (k, classes.get(k, 0), c) if k > 0 else "0: %d" % c
+                     for k, c in counts.most_common(n))
+
+
+def mask_classes(path):
+    """{segment id: class} of a frame's stored segment list (id, category, ...), {} without one."""
+    if not os.path.exists(path):
+        return {}
+    classes = {}
+    for line in open(path):
+        words = line.split()
+        if len(words) >= 2:
+            classes[int(words[0])] = int(words[1])
+    return classes
 
 
 def main():
@@ -152,6 +168,7 @@ def main():
             continue
         _, labels = read_plane(base + ".labels.zst")
         masks = geometric = None
+        classes = mask_classes(base + ".segments.txt")
         if os.path.exists(base + ".masks.zst"):
             _, masks = read_plane(base + ".masks.zst")
         if os.path.exists(base + ".geometric.zst"):
@@ -173,7 +190,7 @@ def main():
             if masks is not None:
                 counts = Counter(masks[v * width + u] for u, v in visible)
                 main_mask[i] = counts.most_common(1)[0][0]
-                line += ", masks %s" % top(counts)
+                line += ", masks %s" % top(counts, classes=classes)
             if geometric is not None:
                 edge = sum(1 for u, v in visible if geometric[v * width + u] == 0)
                 if i == args.instance:

@@ -8,6 +8,7 @@
 
 #include "panmap/core/error.h"
 #include "panmap/graph/internal/alpha_beta_swap.h"
+#include "panmap/graph/internal/class_consensus.h"
 #include "panmap/graph/internal/graph_check.h"
 #include "panmap/graph/internal/instance_clustering.h"
 #include "panmap/graph/internal/instance_refinement.h"
@@ -94,6 +95,12 @@ GraphLabels optimise(const SuperpointGraph& graph, const OptimiserConfig& config
   for (size_t i = 0; i < labels.size(); ++i) {
     classes[i] =
         internal::leftUnlabelled(graph.vertices[i], config) ? 0 : problem.labels[labels[i]];
+  }
+  if (config.regularise && config.class_consensus) {
+    internal::ClassConsensusStats consensus;
+    classes = internal::classConsensus(graph, classes, config, &consensus);
+    out.consensus_groups = consensus.groups;
+    out.consensus_superpoints = consensus.superpoints;
   }
 
   // III-D: instances.

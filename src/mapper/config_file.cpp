@@ -283,6 +283,7 @@ PanmapConfig loadConfig(const std::string& path) {
     Section s(root["optimiser"], "optimiser", path);
     s.read("regularise", &o.regularise);
     s.read("refine", &o.refine);
+    s.read("class_consensus", &o.class_consensus);
     s.read("K_C", &o.K_C);
     s.read("theta", &o.theta);
     s.read("max_sweeps", &o.max_sweeps);
@@ -513,6 +514,8 @@ std::string configToYaml(const PanmapConfig& c) {
   y << "optimiser:\n"
     << "   regularise: " << o.regularise << "   # III-C alpha-beta swap (0/1)\n"
     << "   refine: " << o.refine << "   # III-D instance refinement (0/1)\n"
+    << "   class_consensus: " << o.class_consensus
+    << "   # III-C: one class per group the network showed as one object (0/1)\n"
     << "   K_C: " << o.K_C << "\n"
     << "   theta: " << o.theta << "\n"
     << "   max_sweeps: " << o.max_sweeps << "\n"

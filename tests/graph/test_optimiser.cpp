@@ -25,6 +25,7 @@ OptimiserConfig handConfig() {
   config.link_half_observations = 0.0;  // the paper trusts every link fully
   config.refinement = OptimiserConfig::Refinement::kPaperRules;
   config.default_thresholds = {0.1, 0.1, 0.5};
+  config.class_consensus = false;  // the paper's III-C is the swap alone (test_class_consensus)
   return config;
 }
 

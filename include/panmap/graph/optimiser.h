@@ -11,8 +11,11 @@ namespace panmap {
 struct OptimiserConfig {
   bool regularise = true;  ///< III-C semantic regularisation (off: argmax of the scores)
   bool refine = true;      ///< III-D instance refinement (off: initial instances)
-  double K_C = 60.0;       ///< pairwise weight per voxel (Eq. 9, weighting; docs/TUNING.md)
-  double theta = 0.5;      ///< pairwise bandwidth (Eq. 9)
+  /// III-C, after the swap: super-points the network showed as one object take one class,
+  /// the one with the most evidence over them (internal/class_consensus.h; not in the paper).
+  bool class_consensus = true;
+  double K_C = 60.0;   ///< pairwise weight per voxel (Eq. 9, weighting; docs/TUNING.md)
+  double theta = 0.5;  ///< pairwise bandwidth (Eq. 9)
   /// Discount Eq. 9's co-observation sum_C P_eps^C by P_eps / (P_eps + P_apart): how often the
   /// two super-points were under one mask rather than two (not in the paper).
   bool discount_apart = true;

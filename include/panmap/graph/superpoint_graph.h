@@ -68,8 +68,10 @@ struct GraphLabels {
   /// instance id -> confidence in [0, 1] that it is a real object (OptimiserConfig::Objects)
   std::map<int32_t, float> instance_confidence;
   std::map<int32_t, ObjectEvidence> instance_evidence;  ///< instance id -> its evidence
-  int fragments_folded = 0;   ///< fragment instances folded into a neighbouring instance
-  int fragments_dropped = 0;  ///< fragment instances left out (their super-points: instance 0)
+  int fragments_folded = 0;       ///< fragment instances folded into a neighbouring instance
+  int fragments_dropped = 0;      ///< fragment instances left out (their super-points: instance 0)
+  int consensus_groups = 0;       ///< groups of several classes given one (class consensus)
+  int consensus_superpoints = 0;  ///< super-points whose class the consensus changed
   double solve_ms = 0.0;
 };
 

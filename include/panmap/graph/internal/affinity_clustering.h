@@ -1,0 +1,25 @@
+#pragma once
+
+#include <map>
+#include <vector>
+
+namespace panmap {
+namespace internal {
+
+/// Evidence between two clusters: of one object (seen under one mask) and of two.
+struct LinkEvidence {
+  double same = 0.0;
+  double apart = 0.0;
+};
+
+/// Agglomerative clustering by the network's verdicts (average linkage): clusters X, Y join
+/// when same / (same + apart) over the pairs between them reaches `join_affinity` and `same`
+/// is at least `min_coverage` of the smaller cluster's `observed`; highest affinity first,
+/// ties by larger `same`, then the smaller first member. `links[i]` holds vertex i's links
+/// (symmetric). Returns each vertex's cluster, named by a member's index. Deterministic.
+std::vector<int> clusterByAffinity(std::vector<std::map<int, LinkEvidence>> links,
+                                   std::vector<double> observed, double join_affinity,
+                                   double min_coverage);
+
+}  // namespace internal
+}  // namespace panmap

@@ -1,0 +1,79 @@
+#include "panmap/graph/internal/class_consensus.h"
+
+#include <map>
+#include <set>
+#include <utility>
+
+#include "panmap/graph/internal/affinity_clustering.h"
+#include "panmap/graph/internal/graph_check.h"
+
+namespace panmap {
+namespace internal {
+
+std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
+                                    const std::vector<int32_t>& classes,
+                                    const OptimiserConfig& config, ClassConsensusStats* stats) {
+  const int n = static_cast<int>(graph.vertices.size());
+  const ClassSet no_instance = noInstanceClasses(graph);
+  const ClassSet known(graph.classes);
+  const auto isThing = [&](int32_t c) {
+    return c > 0 && known.contains(c) && !no_instance.contains(c);
+  };
+  const VertexIndex index(graph);
+  std::vector<double> observed(n, 0.0);
+  for (int i = 0; i < n; ++i) {
+    if (!isThing(classes[i])) continue;
+    for (const auto& [c, s] : graph.vertices[i].scores) {
+      if (isThing(c)) observed[i] += s;
+    }
+  }
+  std::vector<std::map<int, LinkEvidence>> links(n);
+  for (const GraphEdge& e : graph.edges) {
+    const int a = index(e.a), b = index(e.b);
+    if (!isThing(classes[a]) || !isThing(classes[b])) continue;
+    LinkEvidence link;
+    for (const auto& [c, v] : e.confidences) {
+      if (isThing(c)) link.same += v;
+    }
+    link.apart = e.apart;
+    if (!(link.same > 0.0)) continue;
+    links[a][b] = link;
+    links[b][a] = link;
+  }
+  const std::vector<int> root = clusterByAffinity(std::move(links), std::move(observed),
+                                                  config.join_affinity, config.min_coverage);
+  std::map<int, std::set<int32_t>> group_classes;        // root -> classes of its members
+  std::map<int, std::map<int32_t, double>> group_score;  // root -> thing class -> score
+  for (int i = 0; i < n; ++i) {
+    if (!isThing(classes[i])) continue;
+    group_classes[root[i]].insert(classes[i]);
+    for (const auto& [c, s] : graph.vertices[i].scores) {
+      if (isThing(c)) group_score[root[i]][c] += s;
+    }
+  }
+  std::vector<int32_t> out = classes;
+  ClassConsensusStats counts;
+  std::map<int, int32_t> decided;
+  for (const auto& [r, members] : group_classes) {
+    if (members.size() < 2) continue;
+    int32_t best = 0;
+    double best_score = -1.0;
+    for (const auto& [c, s] : group_score[r]) {  // ascending class: ties keep the smaller
+      if (s > best_score) best = c, best_score = s;
+    }
+    decided[r] = best;
+    ++counts.groups;
+  }
+  for (int i = 0; i < n; ++i) {
+    if (!isThing(classes[i])) continue;
+    const auto it = decided.find(root[i]);
+    if (it == decided.end() || it->second == classes[i]) continue;
+    out[i] = it->second;
+    ++counts.superpoints;
+  }
+  if (stats) *stats = counts;
+  return out;
+}
+
+}  // namespace internal
+}  // namespace panmap
