@@ -12,7 +12,10 @@ the neighbours' size and observations per voxel: the mechanism docs/MAPPING.md d
       [--max-void-share 1]
 
 Super-points left unlabelled (void share above --max-void-share; 1: none) are not III-C's
-choice: they are left out of the group and their links cost nothing.
+choice: they are left out of the group and their links cost nothing. The class consensus that
+follows the swap (`optimiser.class_consensus`, docs/MAPPING.md) relabels whole groups the
+network showed as one object, which no energy here explains: export the graph with
+`optimiser.class_consensus: 0` to see the swap alone.
 """
 import argparse
 import json

@@ -500,7 +500,10 @@ int main(int argc, char** argv) {
                        {"solve_ms", labels.solve_ms},
                        {"fragments_folded", labels.fragments_folded},
                        {"fragments_dropped", labels.fragments_dropped},
+                       {"consensus_groups", labels.consensus_groups},
+                       {"consensus_superpoints", labels.consensus_superpoints},
                        {"regularise", optimiser.regularise},
+                       {"class_consensus", optimiser.class_consensus},
                        {"refine", optimiser.refine}};
       writeJson(out_dir + "/report.json", json);
       finishAutosave();

@@ -68,6 +68,13 @@ std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
     if (!isThing(classes[i])) continue;
     const auto it = decided.find(root[i]);
     if (it == decided.end() || it->second == classes[i]) continue;
+    // Only where its own views left it in doubt: a surface the network hardly ever called the
+    // group's class (a box beside a shelf, joined through the shelf mask's outline) keeps its own.
+    const auto own = graph.vertices[i].scores.find(classes[i]);
+    const auto group = graph.vertices[i].scores.find(it->second);
+    const double own_score = own == graph.vertices[i].scores.end() ? 0.0 : own->second;
+    const double group_score = group == graph.vertices[i].scores.end() ? 0.0 : group->second;
+    if (!(group_score >= config.consensus_min_ratio * own_score && group_score > 0.0)) continue;
     out[i] = it->second;
     ++counts.superpoints;
   }

@@ -41,6 +41,10 @@ void OptimiserConfig::check() const {
     throw Error("OptimiserConfig.max_void_share: " + std::to_string(max_void_share) +
                 " (must be in [0, 1])");
   }
+  if (!(std::isfinite(consensus_min_ratio) && consensus_min_ratio >= 0.0)) {
+    throw Error("OptimiserConfig.consensus_min_ratio: " + std::to_string(consensus_min_ratio) +
+                " (must be finite, >= 0)");
+  }
   if (!(std::isfinite(K_C) && K_C >= 0.0)) {
     throw Error("OptimiserConfig.K_C: " + std::to_string(K_C) + " (must be finite, >= 0)");
   }

@@ -284,6 +284,7 @@ PanmapConfig loadConfig(const std::string& path) {
     s.read("regularise", &o.regularise);
     s.read("refine", &o.refine);
     s.read("class_consensus", &o.class_consensus);
+    s.read("consensus_min_ratio", &o.consensus_min_ratio);
     s.read("K_C", &o.K_C);
     s.read("theta", &o.theta);
     s.read("max_sweeps", &o.max_sweeps);
@@ -516,6 +517,9 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   refine: " << o.refine << "   # III-D instance refinement (0/1)\n"
     << "   class_consensus: " << o.class_consensus
     << "   # III-C: one class per group the network showed as one object (0/1)\n"
+    << "   consensus_min_ratio: " << o.consensus_min_ratio
+    << "   # a super-point takes the group's class if its own score for it is this share of its "
+       "own class's\n"
     << "   K_C: " << o.K_C << "\n"
     << "   theta: " << o.theta << "\n"
     << "   max_sweeps: " << o.max_sweeps << "\n"

@@ -579,6 +579,10 @@ TEST(OptimiserConfig, RejectsBadFields) {
   expectBad([](OptimiserConfig& c) { c.theta = 0.0; }, "OptimiserConfig.theta");
   expectBad([](OptimiserConfig& c) { c.max_void_share = 1.5; }, "OptimiserConfig.max_void_share");
   expectBad([](OptimiserConfig& c) { c.max_void_share = NAN; }, "OptimiserConfig.max_void_share");
+  expectBad([](OptimiserConfig& c) { c.consensus_min_ratio = -0.1; },
+            "OptimiserConfig.consensus_min_ratio");
+  expectBad([](OptimiserConfig& c) { c.consensus_min_ratio = NAN; },
+            "OptimiserConfig.consensus_min_ratio");
   expectBad([](OptimiserConfig& c) { c.max_sweeps = 0; }, "OptimiserConfig.max_sweeps");
   expectBad([](OptimiserConfig& c) { c.score_floor = 0.0; }, "OptimiserConfig.score_floor");
   expectBad([](OptimiserConfig& c) { c.max_refine_iterations = 0; },

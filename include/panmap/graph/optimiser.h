@@ -14,6 +14,9 @@ struct OptimiserConfig {
   /// III-C, after the swap: super-points the network showed as one object take one class,
   /// the one with the most evidence over them (internal/class_consensus.h; not in the paper).
   bool class_consensus = true;
+  /// Class consensus: a super-point takes its group's class only if its own score for that
+  /// class is at least this share of its score for its own (its views left it in doubt).
+  double consensus_min_ratio = 0.5;
   double K_C = 60.0;   ///< pairwise weight per voxel (Eq. 9, weighting; docs/TUNING.md)
   double theta = 0.5;  ///< pairwise bandwidth (Eq. 9)
   /// Discount Eq. 9's co-observation sum_C P_eps^C by P_eps / (P_eps + P_apart): how often the
