@@ -40,6 +40,7 @@ std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
     links[a][b] = link;
     links[b][a] = link;
   }
+  const std::vector<std::map<int, LinkEvidence>> direct = links;
   const std::vector<int> root = clusterByAffinity(std::move(links), std::move(observed),
                                                   config.join_affinity, config.min_coverage);
   std::map<int, std::set<int32_t>> group_classes;        // root -> classes of its members
@@ -52,7 +53,6 @@ std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
     }
   }
   std::vector<int32_t> out = classes;
-  ClassConsensusStats counts;
   std::map<int, int32_t> decided;
   for (const auto& [r, members] : group_classes) {
     if (members.size() < 2) continue;
@@ -62,8 +62,9 @@ std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
       if (s > best_score) best = c, best_score = s;
     }
     decided[r] = best;
-    ++counts.groups;
   }
+  // Members in doubt, each with the class its group decided.
+  std::vector<std::pair<int, int32_t>> candidates;
   for (int i = 0; i < n; ++i) {
     if (!isThing(classes[i])) continue;
     const auto it = decided.find(root[i]);
@@ -75,8 +76,31 @@ std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
     const double own_score = own == graph.vertices[i].scores.end() ? 0.0 : own->second;
     const double group_score = group == graph.vertices[i].scores.end() ? 0.0 : group->second;
     if (!(group_score >= config.consensus_min_ratio * own_score && group_score > 0.0)) continue;
-    out[i] = it->second;
-    ++counts.superpoints;
+    candidates.emplace_back(i, it->second);
+  }
+  // And only where the network showed it in one mask with the members that hold that class
+  // more often than in two. Average linkage also joins through scraps of a few voxels that
+  // touch both (books on a shelf, joined through the shelf's slivers between them though views
+  // with both mostly split them), and a member must not take a class along such a chain. Sweeps
+  // in rounds, each against the classes of the round before (independent of order), so a
+  // class passes from member to member only along direct evidence.
+  ClassConsensusStats counts;
+  counts.groups = static_cast<int>(decided.size());
+  while (true) {
+    std::vector<std::pair<int, int32_t>> taken;
+    for (const auto& [i, target] : candidates) {
+      if (out[i] == target) continue;
+      LinkEvidence with_class;
+      for (const auto& [j, link] : direct[i]) {
+        if (root[j] != root[i] || out[j] != target) continue;
+        with_class.same += link.same;
+        with_class.apart += link.apart;
+      }
+      if (with_class.same > with_class.apart) taken.emplace_back(i, target);
+    }
+    if (taken.empty()) break;
+    for (const auto& [i, target] : taken) out[i] = target;
+    counts.superpoints += static_cast<int>(taken.size());
   }
   if (stats) *stats = counts;
   return out;

@@ -50,7 +50,8 @@ TEST(ClassConsensus, AnObjectSeenUnderTwoClassesTakesTheOneWithMoreEvidence) {
       internal::classConsensus(g, {kTable, kTable, kDesk}, OptimiserConfig(), &stats);
   // 1-2: 60 / (60 + 30) = 0.67 >= 0.6 and 60 >= 0.05 * min(160, 95): joined first; then
   // {1, 2} and 3: 90 / 140 = 0.64, 90 >= 0.05 * min(255, 300). Desk 405 against table 150;
-  // 1 and 2 each scored desk at least half as often as table (60 / 100, 45 / 50).
+  // 1 and 2 each scored desk at least half as often as table (60 / 100, 45 / 50). 2 takes desk
+  // from 3 (90 against 50 apart), then 1 from 2 (60 against 30).
   EXPECT_EQ(out, (std::vector<int32_t>{kDesk, kDesk, kDesk}));
   EXPECT_EQ(stats.groups, 1);
   EXPECT_EQ(stats.superpoints, 2);
@@ -84,6 +85,30 @@ TEST(ClassConsensus, ObjectsShownApartOrBarelyTogetherKeepTheirClasses) {
   g.edges[1] = edge(2, 3, {{kDesk, 4}}, 0);  // 4 < 0.05 * min(195, 300)
   EXPECT_EQ(internal::classConsensus(g, {kTable, kTable, kDesk}, OptimiserConfig()),
             (std::vector<int32_t>{kTable, kTable, kDesk}));
+}
+
+TEST(ClassConsensus, AMemberJoinedThroughScrapsNeedsItsOwnEvidence) {
+  constexpr int32_t kShelf = 10, kBooks = 23;
+  // Books (3) on a shelf (1), and a sliver of shelf (2) between them that one mask covered
+  // with each. Views with both split books from shelf (20 against 70), yet the books and the
+  // sliver join first (affinity 1 against 0.93) and then the shelf (150 / 230 = 0.65).
+  SuperpointGraph g;
+  g.classes = {kShelf, kBooks};
+  g.vertices = {vertex(1, {{kShelf, 1000}}), vertex(2, {{kShelf, 10}}),
+                vertex(3, {{kBooks, 70}, {kShelf, 45}})};
+  g.edges = {edge(1, 2, {{kShelf, 130}}, 10), edge(2, 3, {{kShelf, 5}}, 0),
+             edge(1, 3, {{kShelf, 20}}, 70)};
+  internal::ClassConsensusStats stats;
+  // One group, shelf by score, and the books in doubt (45 >= 0.5 * 70), but their own links
+  // to the shelf's members show two masks more often than one: 25 against 70.
+  EXPECT_EQ(internal::classConsensus(g, {kShelf, kShelf, kBooks}, OptimiserConfig(), &stats),
+            (std::vector<int32_t>{kShelf, kShelf, kBooks}));
+  EXPECT_EQ(stats.groups, 1);
+  EXPECT_EQ(stats.superpoints, 0);
+  // Shown under one mask with the shelf more often than apart, they follow: 25 + 50 > 70.
+  g.edges[1] = edge(2, 3, {{kShelf, 55}}, 0);
+  EXPECT_EQ(internal::classConsensus(g, {kShelf, kShelf, kBooks}, OptimiserConfig()),
+            (std::vector<int32_t>{kShelf, kShelf, kShelf}));
 }
 
 TEST(ClassConsensus, StuffAndUnlabelledSuperpointsAreLeftAlone) {

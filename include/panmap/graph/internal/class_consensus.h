@@ -23,8 +23,12 @@ struct ClassConsensusStats {
 /// masks of any classes (P_apart), with the III-D clustering's join_affinity and
 /// min_coverage (observations: the sum of the thing-class scores). Every group that holds
 /// two or more classes takes the class with the largest summed score over its members
-/// (ties: the smaller class id). Returns the classes per vertex index; stuff and unlabelled
-/// super-points (class 0 or background) are left as they are.
+/// (ties: the smaller class id). A member takes it only where its own views left it in doubt
+/// (its score for that class at least consensus_min_ratio times its score for its own) and
+/// where its own links to the members holding that class show one mask more often than two
+/// (sum of one-mask evidence above the sum of P_apart), in rounds until nothing changes.
+/// Returns the classes per vertex index; stuff and unlabelled super-points (class 0 or
+/// background) are left as they are.
 std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
                                     const std::vector<int32_t>& classes,
                                     const OptimiserConfig& config,
