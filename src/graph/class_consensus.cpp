@@ -79,11 +79,13 @@ std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
     candidates.emplace_back(i, it->second);
   }
   // And only where the network showed it in one mask with the members that hold that class
-  // more often than in two. Average linkage also joins through scraps of a few voxels that
-  // touch both (books on a shelf, joined through the shelf's slivers between them though views
-  // with both mostly split them), and a member must not take a class along such a chain. Sweeps
-  // in rounds, each against the classes of the round before (independent of order), so a
-  // class passes from member to member only along direct evidence.
+  // more often than in two, and more often than with the members that share its own class.
+  // Average linkage also joins through scraps of a few voxels that touch both (books on a
+  // shelf, joined through the shelf's slivers between them though views with both mostly split
+  // them), and a member must not take a class along such a chain; nor leave the books it was
+  // shown with far more often for a shelf whose mask outline it sat in now and then. Sweeps in
+  // rounds, each against the classes of the round before (independent of order), so a class
+  // passes from member to member only along direct evidence.
   ClassConsensusStats counts;
   counts.groups = static_cast<int>(decided.size());
   while (true) {
@@ -91,12 +93,17 @@ std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
     for (const auto& [i, target] : candidates) {
       if (out[i] == target) continue;
       LinkEvidence with_class;
+      double with_own = 0.0;
       for (const auto& [j, link] : direct[i]) {
-        if (root[j] != root[i] || out[j] != target) continue;
+        if (root[j] != root[i]) continue;
+        if (out[j] == out[i]) with_own += link.same;
+        if (out[j] != target) continue;
         with_class.same += link.same;
         with_class.apart += link.apart;
       }
-      if (with_class.same > with_class.apart) taken.emplace_back(i, target);
+      if (with_class.same > with_class.apart && with_class.same > with_own) {
+        taken.emplace_back(i, target);
+      }
     }
     if (taken.empty()) break;
     for (const auto& [i, target] : taken) out[i] = target;

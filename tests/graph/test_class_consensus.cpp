@@ -111,6 +111,30 @@ TEST(ClassConsensus, AMemberJoinedThroughScrapsNeedsItsOwnEvidence) {
             (std::vector<int32_t>{kShelf, kShelf, kShelf}));
 }
 
+TEST(ClassConsensus, AMemberStaysWithTheMembersItWasShownWithMost) {
+  constexpr int32_t kShelf = 10, kBooks = 23;
+  // A shelf (1, 2) and a row of books (3, 4), one group: the books' outline sat inside the
+  // shelf's mask now and then (never apart), and the shelf outweighs the books. Book 3 is in
+  // doubt (30 >= 0.5 * 50), but one mask covered it with book 4 far more often (60) than with
+  // the shelf (10 + 10): it stays books; book 4 is sure of its class (5 < 0.5 * 100).
+  SuperpointGraph g;
+  g.classes = {kShelf, kBooks};
+  g.vertices = {vertex(1, {{kShelf, 1000}}), vertex(2, {{kShelf, 500}}),
+                vertex(3, {{kBooks, 50}, {kShelf, 30}}), vertex(4, {{kBooks, 100}, {kShelf, 5}})};
+  g.edges = {edge(1, 2, {{kShelf, 300}}, 0), edge(1, 3, {{kShelf, 10}}, 0),
+             edge(2, 3, {{kShelf, 10}}, 0), edge(3, 4, {{kBooks, 60}}, 0)};
+  internal::ClassConsensusStats stats;
+  EXPECT_EQ(
+      internal::classConsensus(g, {kShelf, kShelf, kBooks, kBooks}, OptimiserConfig(), &stats),
+      (std::vector<int32_t>{kShelf, kShelf, kBooks, kBooks}));
+  EXPECT_EQ(stats.groups, 1);
+  EXPECT_EQ(stats.superpoints, 0);
+  // Shown with the shelf more often than with book 4 (70 > 60), it takes the shelf's class.
+  g.edges[1] = edge(1, 3, {{kShelf, 60}}, 0);
+  EXPECT_EQ(internal::classConsensus(g, {kShelf, kShelf, kBooks, kBooks}, OptimiserConfig()),
+            (std::vector<int32_t>{kShelf, kShelf, kShelf, kBooks}));
+}
+
 TEST(ClassConsensus, StuffAndUnlabelledSuperpointsAreLeftAlone) {
   SuperpointGraph g = desk();
   // A wall super-point under the desk's masks and an unlabelled one (class 0 after the

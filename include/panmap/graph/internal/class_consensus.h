@@ -26,7 +26,8 @@ struct ClassConsensusStats {
 /// (ties: the smaller class id). A member takes it only where its own views left it in doubt
 /// (its score for that class at least consensus_min_ratio times its score for its own) and
 /// where its own links to the members holding that class show one mask more often than two
-/// (sum of one-mask evidence above the sum of P_apart), in rounds until nothing changes.
+/// (sum of one-mask evidence above the sum of P_apart) and more often than its links to the
+/// members sharing its current class do, in rounds until nothing changes.
 /// Returns the classes per vertex index; stuff and unlabelled super-points (class 0 or
 /// background) are left as they are.
 std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
