@@ -37,6 +37,17 @@ double stuffIoU(const LabelledMesh& gt, const TransferredLabels& pred, int32_t c
   return tp + fp + fn > 0 ? static_cast<double>(tp) / static_cast<double>(tp + fp + fn) : kNaN;
 }
 
+// Share of class c's annotated GT vertices that found a predicted vertex (NaN: none of class c).
+double observedShare(const LabelledMesh& gt, const TransferredLabels& pred, int32_t c) {
+  int64_t total = 0, reached = 0;
+  for (size_t v = 0; v < gt.numVertices(); ++v) {
+    if (gt.semantic[v] != c) continue;
+    ++total;
+    reached += pred.reached.empty() || pred.reached[v];
+  }
+  return total > 0 ? static_cast<double>(reached) / static_cast<double>(total) : kNaN;
+}
+
 // Annotated GT vertices with no annotated vertex of another class within band_m: where the
 // class is certain at the map's resolution. A hash grid of band_m cells; the 27 cells around a
 // vertex hold every vertex within band_m of it.
@@ -245,6 +256,9 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
   d.wall_iou = stuffIoU(gt, pred, 1);
   d.floor_iou = stuffIoU(gt, pred, 2);
   d.ceiling_iou = stuffIoU(gt, pred, 22);
+  d.wall_observed = observedShare(gt, pred, 1);
+  d.floor_observed = observedShare(gt, pred, 2);
+  d.ceiling_observed = observedShare(gt, pred, 22);
 
   // GT things of at least ScanNet's minimum region size.
   std::map<std::pair<int32_t, int32_t>, int64_t> thing_size;
@@ -467,8 +481,11 @@ std::string formatDiagnostics(const SceneDiagnostics& d) {
                 "unlabelled, %d merged, %d split\n",
                 causes[0], causes[1], causes[2], causes[3], causes[4], causes[5]);
   out += line;
-  std::snprintf(line, sizeof(line), "stuff IoU: wall %.3f, floor %.3f, ceiling %.3f\n", d.wall_iou,
-                d.floor_iou, d.ceiling_iou);
+  std::snprintf(line, sizeof(line),
+                "stuff IoU (share observed): wall %.3f (%.3f), floor %.3f (%.3f), ceiling %.3f "
+                "(%.3f)\n",
+                d.wall_iou, d.wall_observed, d.floor_iou, d.floor_observed, d.ceiling_iou,
+                d.ceiling_observed);
   out += line;
   out += "reliability:";
   for (const SceneDiagnostics::ReliabilityBin& b : d.reliability) {

@@ -108,6 +108,28 @@ TEST(Diagnostics, MissedThingsGetTheCauseThatBoundsThem) {
   }
 }
 
+TEST(Diagnostics, StuffIoUComesWithTheShareTheMapObserved) {
+  Case c;
+  // Wall: 100, all reached, 90 labelled wall. Ceiling: 200, 40 reached and labelled ceiling,
+  // 160 never reached (a survey at head height): IoU 0.2 with 0.2 observed, no labelling error.
+  c.add(90, 1, 1, 1, 0, 1);
+  c.add(10, 1, 1, 2, 0, 2);
+  c.add(40, 22, 2, 22, 0, 3);
+  c.add(160, 22, 2, 0, 0, 0, false);
+  const SceneDiagnostics d = diagnose(c.gt, c.pred, {});
+  EXPECT_NEAR(d.wall_iou, 0.9, 1e-12);
+  EXPECT_NEAR(d.wall_observed, 1.0, 1e-12);
+  EXPECT_NEAR(d.ceiling_iou, 40.0 / 200.0, 1e-12);
+  EXPECT_NEAR(d.ceiling_observed, 40.0 / 200.0, 1e-12);
+  // Floor: no GT vertex of it (10 wall vertices labelled floor still make its IoU 0).
+  EXPECT_TRUE(std::isnan(d.floor_observed));
+  EXPECT_NE(formatDiagnostics(d).find("ceiling 0.200 (0.200)"), std::string::npos);
+  // Labels built without `reached` count every vertex as observed.
+  Case bare = c;
+  bare.pred.reached.clear();
+  EXPECT_NEAR(diagnose(bare.gt, bare.pred, {}).ceiling_observed, 1.0, 1e-12);
+}
+
 TEST(Diagnostics, HandComputedCase) {
   const Case c = makeCase();
   const std::map<int32_t, double> objects = {{7, 0.9}, {8, 0.7}, {9, 0.3}, {10, 0.95}, {11, 0.6}};

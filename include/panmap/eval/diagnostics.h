@@ -75,6 +75,10 @@ struct SceneDiagnostics {
   /// Per-vertex IoU of the stuff classes, over annotated GT vertices (NaN without GT vertex of
   /// the class).
   double wall_iou = 0.0, floor_iou = 0.0, ceiling_iou = 0.0;
+  /// Share of each stuff class's annotated GT vertices the map reached at all (NaN without GT
+  /// vertex of the class): an IoU far below it is a labelling error, an IoU near it a surface
+  /// the trajectory never looked at (the ceiling of a survey at head height).
+  double wall_observed = 0.0, floor_observed = 0.0, ceiling_observed = 0.0;
 
   /// One predicted object (an instance id on the predicted mesh or in the object list).
   struct ObjectMatch {
