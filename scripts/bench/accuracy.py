@@ -289,20 +289,32 @@ def regularisation_reach(rows, masks="m2f"):
     """What III-C could and did change at IoU 0.5: GT things paired across the full method and
     w/o III-C (same run, same GT instance)."""
     total = wrong = fixed = broken = 0
+    changed = []  # the GT things whose outcome III-C changed, named
     for key in rows.keys:
-        for full, without in zip(rows.runs(key, masks=masks),
-                                 rows.runs(key, masks=masks, variant="w/o III-C")):
-            cause = {t["instance_id"]: t.get("cause") for t in full["diagnostics"]["gt_things"]}
+        names = rows.names.get(key + ("gt", masks), [])
+        for k, (full, without) in enumerate(zip(rows.runs(key, masks=masks),
+                                                rows.runs(key, masks=masks,
+                                                          variant="w/o III-C"))):
+            after = {t["instance_id"]: t for t in full["diagnostics"]["gt_things"]}
+            scored = {c["class_id"]: c["name"] for c in full.get("classes", [])}
             for t in without["diagnostics"]["gt_things"]:
                 total += 1
-                was, now = t.get("cause"), cause.get(t["instance_id"])
+                now_t = after.get(t["instance_id"], {})
+                was, now = t.get("cause"), now_t.get("cause")
                 wrong += was == "wrong class"
                 fixed += was != "matched" and now == "matched"
                 broken += was == "matched" and now != "matched"
+                if (was == "matched") != (now == "matched"):
+                    cls = t.get("class_id")
+                    changed.append("`%s` GT %d (%s): %s at IoU %.2f -> %s at %.2f" % (
+                        names[k] if k < len(names) else key[0], t["instance_id"],
+                        scored.get(cls, "class %s, not one of the scored classes" % cls),
+                        was, t.get("best_iou", 0.0), now, now_t.get("best_iou", 0.0)))
     return ("III-C's reach: without it, %d of the %d GT things are missed for a wrong class, "
             "the cause a change of class addresses directly; III-C turned %d missed "
-            "GT things into matches and %d matched ones into misses." % (
-                wrong, total, fixed, broken))
+            "GT things into matches and %d matched ones into misses%s." % (
+                wrong, total, fixed, broken,
+                (" (without -> with III-C: %s)" % "; ".join(changed)) if changed else ""))
 
 
 def regularisation_effect(rows, work, masks="m2f"):
