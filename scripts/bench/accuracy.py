@@ -314,7 +314,8 @@ def regularisation_reach(rows, masks="m2f"):
             "the cause a change of class addresses directly; III-C turned %d missed "
             "GT things into matches and %d matched ones into misses%s." % (
                 wrong, total, fixed, broken,
-                (" (without -> with III-C: %s)" % "; ".join(changed)) if changed else ""))
+                (" (without -> with III-C, each with its IoU with the object that overlaps it most: %s)"
+                 % "; ".join(changed)) if changed else ""))
 
 
 def regularisation_effect(rows, work, masks="m2f"):
