@@ -1,7 +1,6 @@
 // MapRebuild: the maps of a repair, built aside from the live ones.
 #include "panmap/mapper/map_rebuild.h"
 
-#include <future>
 #include <string>
 
 #include "panmap/core/error.h"
@@ -21,7 +20,10 @@ MapRebuild::MapRebuild(const MapperConfig& config, ThreadPool* pool, bool remap)
   }
   integrator_ = std::make_unique<ProjectiveIntegrator>(config_->integrator, pool);
   map_ = std::make_unique<TsdfMap>(config_->map);
-  if (config_->occupancy_enabled) occupancy_ = std::make_unique<OccupancyMap>(config_->occupancy);
+  if (config_->occupancy_enabled) {
+    occupancy_ = std::make_unique<OccupancyMap>(config_->occupancy);
+    occupancy_lane_ = std::make_unique<OccupancyLane>(occupancy_.get());
+  }
 }
 
 MapRebuild::~MapRebuild() = default;
@@ -73,23 +75,29 @@ void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
                 std::to_string(labels->height()) + ", depth " + std::to_string(frame.camera.width) +
                 "x" + std::to_string(frame.camera.height));
   }
-  // The occupancy update needs only the frame and its pose. On a thread of its own it fills
-  // the gaps the integrator's parallel loops leave on the two cores (its serial parts, the
-  // ends of loops): a 1,000-frame repair went from 7.9 to 6.0 s (docs/LOOP_CLOSURE.md).
-  std::future<void> occupancy;
   if (occupancy_) {
-    occupancy = std::async(std::launch::async, [&] { occupancy_->integrate(f, T_W_C); });
+    try {
+      occupancy_->validate(f.depth, f.depth_scale_m, f.camera, T_W_C);
+    } catch (const Error& e) {
+      throw Error(name + ": " + e.what());
+    }
   }
-  IntegrationStats integration;
-  try {
-    integration = integrator_->integrate(f, T_W_C, labelled ? labels : nullptr, map_.get());
-  } catch (...) {
-    if (occupancy.valid()) occupancy.wait();  // it reads the frame
-    throw;
-  }
+  const IntegrationStats integration =
+      integrator_->integrate(f, T_W_C, labelled ? labels : nullptr, map_.get());
   votes_evicted_ += integration.votes_evicted;
-  if (occupancy.valid()) occupancy.get();  // rethrows its error, if any
+  // The tree follows a few frames behind on a thread of its own: its ray casting fills the
+  // gaps the integrator's parallel loops leave on the two cores. Waiting for it frame by frame
+  // (as until 2026-12-04) left them idle (docs/LOOP_CLOSURE.md).
+  if (occupancy_lane_) occupancy_lane_->push(f.depth, f.depth_scale_m, f.camera, T_W_C);
   poses_.push_back(pose);
+}
+
+std::unique_ptr<OccupancyMap> MapRebuild::takeOccupancy() {
+  if (occupancy_lane_) {
+    occupancy_lane_->finish();
+    occupancy_lane_.reset();
+  }
+  return std::move(occupancy_);
 }
 
 }  // namespace panmap

@@ -78,6 +78,8 @@ void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild, ReintegrationSta
     if (static_cast<bool>(rebuild->occupancy_) != static_cast<bool>(occupancy_)) {
       throw Error("commitRebuild: the rebuild was made with another occupancy setting");
     }
+    // First, as it may throw (its thread's error): nothing is swapped in before it.
+    std::unique_ptr<OccupancyMap> occupancy = rebuild->takeOccupancy();
     // A surface that association missed under drift has two super-points; voting again at
     // the corrected poses lays them over one another.
     const auto rejoin_start = std::chrono::steady_clock::now();
@@ -85,7 +87,7 @@ void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild, ReintegrationSta
     graph_->applyMerges(*tracker_);
     tracker_->labels().flatten();  // threads that label voxels only read the registry
     map_ = std::move(rebuild->map_);
-    if (occupancy_) occupancy_ = std::move(rebuild->occupancy_);
+    if (occupancy_) occupancy_ = std::move(occupancy);
     // The evictions of building this map, which replaces the old one and its history.
     vote_evictions_ = rebuild->votesEvicted();
     if (stats) {

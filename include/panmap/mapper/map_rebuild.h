@@ -14,6 +14,7 @@
 #include "panmap/map/projective_integrator.h"
 #include "panmap/map/tsdf_map.h"
 #include "panmap/mapper/instance_carry_over.h"
+#include "panmap/occupancy/occupancy_lane.h"
 #include "panmap/occupancy/occupancy_map.h"
 #include "panmap/segmentation/panoptic_geometric.h"
 
@@ -61,6 +62,11 @@ class MapRebuild {
   /// The label-TSDF built so far.
   const TsdfMap& map() const;
 
+  /// A re-integration's occupancy tree, once every frame added is in it (null for a remap or
+  /// when the mapper keeps none; null after the first call). Rethrows an error the tree's
+  /// thread met.
+  std::unique_ptr<OccupancyMap> takeOccupancy();
+
  private:
   friend class Mapper;
 
@@ -68,8 +74,9 @@ class MapRebuild {
   ThreadPool* pool_;  // not owned
   std::unique_ptr<ProjectiveIntegrator> integrator_;
   std::unique_ptr<TsdfMap> map_;
-  std::unique_ptr<OccupancyMap> occupancy_;  // null when the mapper keeps none
-  std::unique_ptr<Mapper> mapper_;           // a remap's mapper (then the three above are null)
+  std::unique_ptr<OccupancyMap> occupancy_;        // null when the mapper keeps none
+  std::unique_ptr<OccupancyLane> occupancy_lane_;  // fills occupancy_; after it: goes first
+  std::unique_ptr<Mapper> mapper_;  // a remap's mapper (then the three above are null)
   std::vector<StampedPose> poses_;
   // A remap's depth samples of every frame, for the instance ids it carries over.
   std::vector<InstanceSampleFrame> instance_samples_;

@@ -97,6 +97,12 @@ class OccupancyMap {
   /// @param T_W_C camera to world (optical frame)
   OccupancyUpdateStats integrate(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C);
 
+  /// Throws the Error integrate() would throw for these inputs, and changes nothing: for a
+  /// caller that checks a frame now and integrates it later, on another thread. Reads only the
+  /// configuration, so it may run while another thread integrates (OccupancyLane).
+  void validate(const DepthImage& depth, double depth_scale_m, const PinholeCamera& camera,
+                const Eigen::Isometry3d& T_W_C) const;
+
   /// State at a world point (metres); the exported tree answers the same. Throws Error when
   /// the point is not finite.
   Occupancy occupancyAt(const Eigen::Vector3d& p_W) const;
@@ -137,8 +143,6 @@ class OccupancyMap {
   void readState(BinaryReader* in);
 
  private:
-  void validate(const DepthImage& depth, double depth_scale_m, const PinholeCamera& camera,
-                const Eigen::Isometry3d& T_W_C) const;
   void addHits(const DepthImage& depth, double depth_scale_m, const PinholeCamera& camera,
                const Eigen::Isometry3d& T_W_C, OccupancyUpdateStats* stats);
   void addMisses(const DepthImage& depth, double depth_scale_m, const PinholeCamera& camera,
