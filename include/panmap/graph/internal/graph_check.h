@@ -15,7 +15,7 @@ namespace internal {
 void checkGraph(const SuperpointGraph& graph);
 
 /// Super-point id -> index in graph.vertices (sorted by id): a table when the ids are dense
-/// enough, else a binary search.
+/// enough, else a binary search over the ids alone.
 class VertexIndex {
  public:
   /// @param graph vertices sorted by id (checked by checkGraph).
@@ -24,8 +24,8 @@ class VertexIndex {
   int operator()(int32_t id) const;
 
  private:
-  const std::vector<GraphVertex>& vertices_;
-  std::vector<int> table_;  ///< id -> index (-1 none), empty when the ids are too sparse
+  std::vector<int> table_;    ///< id -> index (-1 none), empty when the ids are too sparse
+  std::vector<int32_t> ids_;  ///< the vertices' ids in order, when there is no table
 };
 
 /// A set of class ids with constant-time membership for the usual small ids.
