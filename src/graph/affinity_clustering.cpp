@@ -1,6 +1,6 @@
 #include "panmap/graph/internal/affinity_clustering.h"
 
-#include <queue>
+#include <algorithm>
 #include <tuple>
 #include <utility>
 
@@ -20,9 +20,8 @@ struct Candidate {
 
 }  // namespace
 
-std::vector<int> clusterByAffinity(std::vector<std::map<int, LinkEvidence>> links,
-                                   std::vector<double> observed, double join_affinity,
-                                   double min_coverage) {
+std::vector<int> clusterByAffinity(std::vector<Links> links, std::vector<double> observed,
+                                   double join_affinity, double min_coverage) {
   const int n = static_cast<int>(links.size());
   std::vector<int> parent(n);
   for (int i = 0; i < n; ++i) parent[i] = i;
@@ -31,47 +30,70 @@ std::vector<int> clusterByAffinity(std::vector<std::map<int, LinkEvidence>> link
   // out; an entry whose link changed since is stale (the link's newer entry is in the heap).
   // Re-pushing every link of a joined cluster instead filled the heap with entries stale by the
   // time they came out (docs/MAPPING.md: on a building's graph, about half of this stage).
-  std::priority_queue<Candidate> heap;
+  std::vector<Candidate> heap;  // a max-heap (std::push_heap / pop_heap)
+  std::vector<std::pair<int, LinkEvidence>> merged;
   const auto affinityOf = [](const LinkEvidence& link) {
     return link.same / (link.same + link.apart);
   };
   const auto covered = [&](const LinkEvidence& link, int a, int b) {
     return link.same >= min_coverage * std::min(observed[a], observed[b]);
   };
-  const auto consider = [&](int a, int b) {
-    if (a > b) std::swap(a, b);
-    const LinkEvidence& link = links[a].at(b);
-    if (!(link.same > 0.0)) return;
+  // Appends the pair's entry when its link qualifies; a < b.
+  const auto candidate = [&](int a, int b, const LinkEvidence& link) {
+    if (!(link.same > 0.0)) return false;
     const double affinity = affinityOf(link);
-    if (affinity < join_affinity || !covered(link, a, b)) return;
-    heap.push({affinity, link.same, a, b});
+    if (affinity < join_affinity || !covered(link, a, b)) return false;
+    heap.push_back({affinity, link.same, a, b});
+    return true;
   };
   for (int a = 0; a < n; ++a) {
-    for (const auto& [b, unused] : links[a]) {
-      if (a < b) consider(a, b);
+    for (const auto& [b, link] : links[a]) {
+      if (a < b) candidate(a, b, link);
     }
   }
+  std::make_heap(heap.begin(), heap.end());
   while (!heap.empty()) {
-    const Candidate top = heap.top();
-    heap.pop();
+    std::pop_heap(heap.begin(), heap.end());
+    const Candidate top = heap.back();
+    heap.pop_back();
     const int a = top.a, b = top.b;
     if (parent[a] != a || parent[b] != b) continue;  // a cluster joined another since
     const LinkEvidence& now = links[a].at(b);
     if (now.same != top.same || affinityOf(now) != top.affinity || !covered(now, a, b)) {
       continue;  // the link changed since, or the clusters grew past what it covers
     }
-    // Join b into a: links add up; each changed link gets a new entry.
+    // Join b into a: links add up (one merge of the two sorted lists); each changed link
+    // gets a new entry.
     parent[b] = a;
     observed[a] += observed[b];
-    links[a].erase(b);
-    for (const auto& [c, link] : links[b]) {
+    merged.clear();
+    merged.reserve(links[a].size() + links[b].size());
+    auto ia = links[a].begin(), ib = links[b].begin();
+    const auto ea = links[a].end(), eb = links[b].end();
+    while (ia != ea || ib != eb) {
+      if (ib == eb || (ia != ea && ia->first < ib->first)) {
+        if (ia->first != b) merged.push_back(*ia);
+        ++ia;
+      } else if (ia == ea || ib->first < ia->first) {
+        if (ib->first != a) merged.push_back(*ib);
+        ++ib;
+      } else {
+        merged.emplace_back(ia->first, LinkEvidence{ia->second.same + ib->second.same,
+                                                    ia->second.apart + ib->second.apart});
+        ++ia, ++ib;
+      }
+    }
+    links[a].clear();
+    links[a].insert(boost::container::ordered_unique_range, merged.begin(), merged.end());
+    for (const auto& [c, unused] : links[b]) {
       if (c == a) continue;
-      LinkEvidence& sum = links[a][c];
-      sum.same += link.same;
-      sum.apart += link.apart;
-      links[c][a] = sum;
-      links[c].erase(b);
-      consider(a, c);
+      Links& of_c = links[c];
+      of_c.erase(b);
+      const LinkEvidence& sum = links[a].at(c);
+      of_c[a] = sum;
+      if (candidate(std::min(a, c), std::max(a, c), sum)) {
+        std::push_heap(heap.begin(), heap.end());
+      }
     }
     links[b].clear();
   }

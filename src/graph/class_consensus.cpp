@@ -27,7 +27,7 @@ std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
       if (isThing(c)) observed[i] += s;
     }
   }
-  std::vector<std::map<int, LinkEvidence>> links(n);
+  std::vector<Links> links(n);
   for (const GraphEdge& e : graph.edges) {
     const int a = index(e.a), b = index(e.b);
     if (!isThing(classes[a]) || !isThing(classes[b])) continue;
@@ -37,10 +37,11 @@ std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
     }
     link.apart = e.apart;
     if (!(link.same > 0.0)) continue;
-    links[a][b] = link;
-    links[b][a] = link;
+    // Edges come sorted by (a, b): both lists grow at their ends.
+    links[a].emplace_hint(links[a].end(), b, link);
+    links[b].emplace_hint(links[b].end(), a, link);
   }
-  const std::vector<std::map<int, LinkEvidence>> direct = links;
+  const std::vector<Links> direct = links;
   const std::vector<int> root = clusterByAffinity(std::move(links), std::move(observed),
                                                   config.join_affinity, config.min_coverage);
   std::map<int, std::set<int32_t>> group_classes;        // root -> classes of its members

@@ -1,7 +1,8 @@
 #pragma once
 
-#include <map>
 #include <vector>
+
+#include <boost/container/flat_map.hpp>
 
 namespace panmap {
 namespace internal {
@@ -12,14 +13,18 @@ struct LinkEvidence {
   double apart = 0.0;
 };
 
+/// One vertex's links, by the other end's index. A flat map (one sorted array): a join
+/// rewrites a cluster's links in one pass, where std::map's node per link made the clustering
+/// allocation-bound on a building's graph (docs/PERFORMANCE.md).
+using Links = boost::container::flat_map<int, LinkEvidence>;
+
 /// Agglomerative clustering by the network's verdicts (average linkage): clusters X, Y join
 /// when same / (same + apart) over the pairs between them reaches `join_affinity` and `same`
 /// is at least `min_coverage` of the smaller cluster's `observed`; highest affinity first,
 /// ties by larger `same`, then the smaller first member. `links[i]` holds vertex i's links
 /// (symmetric). Returns each vertex's cluster, named by a member's index. Deterministic.
-std::vector<int> clusterByAffinity(std::vector<std::map<int, LinkEvidence>> links,
-                                   std::vector<double> observed, double join_affinity,
-                                   double min_coverage);
+std::vector<int> clusterByAffinity(std::vector<Links> links, std::vector<double> observed,
+                                   double join_affinity, double min_coverage);
 
 }  // namespace internal
 }  // namespace panmap
