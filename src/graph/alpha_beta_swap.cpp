@@ -45,8 +45,18 @@ struct PairLink {
 class SwapSolver {
  public:
   SwapSolver(const LabelProblem& problem, std::vector<int>& labels)
-      : problem_(problem), labels_(labels), L_(problem.numLabels()) {
-    const int n = problem.num_vertices;
+      : problem_(problem), labels_(labels), L_(problem.numLabels()), n_(problem.num_vertices) {
+    const int n = n_;
+    // Label-major copies: a move reads two labels' values for every vertex of each, which
+    // then lie in two runs of memory instead of scattered over the vertices' rows.
+    unary_.resize(static_cast<size_t>(n) * L_);
+    score_.resize(static_cast<size_t>(n) * L_);
+    for (int p = 0; p < n; ++p) {
+      for (int l = 0; l < L_; ++l) {
+        unary_[at(p, l)] = problem.unary[static_cast<size_t>(p) * L_ + l];
+        score_[at(p, l)] = problem.score[static_cast<size_t>(p) * L_ + l];
+      }
+    }
     local_.assign(n, -1);
     switch_cost_.assign(n, 0.0);
     gain_.assign(n, 0.0);
@@ -63,7 +73,7 @@ class SwapSolver {
         kc_total[p] += problem.adj_kc[e];
       }
       for (int l = 0; l < L_; ++l) {
-        if (problem.score[at(p, l)] > 0.0) scored_label_.push_back(l);
+        if (score_[at(p, l)] > 0.0) scored_label_.push_back(l);
       }
       scored_offset_[p + 1] = static_cast<int>(scored_label_.size());
     }
@@ -87,7 +97,7 @@ class SwapSolver {
   /// labelled alpha or beta, nor any neighbour of one, changed label since. (An accepted move
   /// leaves the pair optimal for itself.)
   bool stale(int alpha, int beta) const {
-    const int64_t when = evaluated_at_[at(alpha, beta)];
+    const int64_t when = evaluated_at_[static_cast<size_t>(alpha) * L_ + beta];
     return when < 0 || changed_at_[alpha] > when || changed_at_[beta] > when;
   }
 
@@ -119,17 +129,18 @@ class SwapSolver {
       for (int v : verts_) local_[v] = -1;
     }
     if (better) apply(alpha, beta);
-    evaluated_at_[at(alpha, beta)] = clock_;
+    evaluated_at_[static_cast<size_t>(alpha) * L_ + beta] = clock_;
     return better;
   }
 
  private:
-  size_t at(int row, int label) const { return static_cast<size_t>(row) * L_ + label; }
+  /// Index of (vertex, label) in the solver's per-vertex-and-label arrays (label-major).
+  size_t at(int vertex, int label) const { return static_cast<size_t>(label) * n_ + vertex; }
 
   /// psi_p(l, lq) of the edge at adjacency entry e from p to q (Eq. 9).
   double pairTo(int p, int l, int q, int lq, int e) const {
-    return pairwisePotential(l, lq, problem_.score[at(p, l)], problem_.score[at(q, lq)],
-                             problem_.adj_factor[e], problem_.adj_kc[e]);
+    return pairwisePotential(l, lq, score_[at(p, l)], score_[at(q, lq)], problem_.adj_factor[e],
+                             problem_.adj_kc[e]);
   }
 
   /// verts_: the vertices of the move that may change, ascending; the other vertices of P keep
@@ -149,9 +160,9 @@ class SwapSolver {
     verts_.clear();
     for (const auto& [own, other] : {std::make_pair(alpha, beta), std::make_pair(beta, alpha)}) {
       for (int v : members_[own]) {
-        const double stay = problem_.unary[at(v, own)] + pair_sum_[at(v, own)];
-        double swap = problem_.unary[at(v, other)] + pair_sum_[at(v, other)];
-        if (problem_.score[at(v, other)] > 0.0) {
+        const double stay = unary_[at(v, own)] + pair_sum_[at(v, own)];
+        double swap = unary_[at(v, other)] + pair_sum_[at(v, other)];
+        if (score_[at(v, other)] > 0.0) {
           for (int e = problem_.adj_offset[v]; e < problem_.adj_offset[v + 1]; ++e) {
             const int q = problem_.adj_vertex[e];
             if (labels_[q] == own) swap -= pairTo(v, other, q, own, e);
@@ -174,9 +185,8 @@ class SwapSolver {
       for (int e = problem_.adj_offset[v]; e < problem_.adj_offset[v + 1]; ++e) {
         const int q = problem_.adj_vertex[e];
         if (local_[q] >= 0 || labels_[q] != lv) continue;
-        gain_[q] +=
-            pairwisePotential(lv, other, problem_.score[at(q, lv)], problem_.score[at(v, other)],
-                              problem_.adj_factor[e], problem_.adj_kc[e]);
+        gain_[q] += pairwisePotential(lv, other, score_[at(q, lv)], score_[at(v, other)],
+                                      problem_.adj_factor[e], problem_.adj_kc[e]);
         if (gain_[q] > switch_cost_[q]) {
           local_[q] = 0;
           verts_.push_back(q);
@@ -195,8 +205,8 @@ class SwapSolver {
     cost_b_.resize(m);
     for (int k = 0; k < m; ++k) {
       const int p = verts_[k];
-      cost_a_[k] = problem_.unary[at(p, alpha)] + pair_sum_[at(p, alpha)];
-      cost_b_[k] = problem_.unary[at(p, beta)] + pair_sum_[at(p, beta)];
+      cost_a_[k] = unary_[at(p, alpha)] + pair_sum_[at(p, alpha)];
+      cost_b_[k] = unary_[at(p, beta)] + pair_sum_[at(p, beta)];
     }
     links_.clear();
     for (int k = 0; k < m; ++k) {
@@ -249,8 +259,8 @@ class SwapSolver {
           const int l = scored_label_[s];
           pair_sum_[at(q, l)] += pairTo(q, l, v, label, e) - pairTo(q, l, v, old, e);
         }
-        if (problem_.score[at(q, old)] <= 0.0) pair_sum_[at(q, old)] += problem_.adj_kc[e];
-        if (problem_.score[at(q, label)] <= 0.0) pair_sum_[at(q, label)] -= problem_.adj_kc[e];
+        if (score_[at(q, old)] <= 0.0) pair_sum_[at(q, old)] += problem_.adj_kc[e];
+        if (score_[at(q, label)] <= 0.0) pair_sum_[at(q, label)] -= problem_.adj_kc[e];
       }
     }
     merged_.clear();
@@ -264,9 +274,12 @@ class SwapSolver {
   const LabelProblem& problem_;
   std::vector<int>& labels_;
   const int L_;
+  const int n_;
+  std::vector<double> unary_;              ///< problem.unary, label-major (at())
+  std::vector<double> score_;              ///< problem.score, label-major
   std::vector<std::vector<int>> members_;  ///< vertices per label, ascending
-  std::vector<double> kc_with_;     ///< [vertex * L + label]: sum of the K of edges to that label
-  std::vector<double> pair_sum_;    ///< [vertex * L + label]: sum_q psi_p(label, l_q)
+  std::vector<double> kc_with_;     ///< at(vertex, label): sum of the K of edges to that label
+  std::vector<double> pair_sum_;    ///< at(vertex, label): sum_q psi_p(label, l_q)
   std::vector<int> scored_offset_;  ///< CSR of the labels each vertex has a score for
   std::vector<int> scored_label_;
   int64_t clock_ = 0;                  ///< counts solved and accepted moves
