@@ -45,18 +45,8 @@ struct PairLink {
 class SwapSolver {
  public:
   SwapSolver(const LabelProblem& problem, std::vector<int>& labels)
-      : problem_(problem), labels_(labels), L_(problem.numLabels()), n_(problem.num_vertices) {
-    const int n = n_;
-    // Label-major copies: a move reads two labels' values for every vertex of each, which
-    // then lie in two runs of memory instead of scattered over the vertices' rows.
-    unary_.resize(static_cast<size_t>(n) * L_);
-    score_.resize(static_cast<size_t>(n) * L_);
-    for (int p = 0; p < n; ++p) {
-      for (int l = 0; l < L_; ++l) {
-        unary_[at(p, l)] = problem.unary[static_cast<size_t>(p) * L_ + l];
-        score_[at(p, l)] = problem.score[static_cast<size_t>(p) * L_ + l];
-      }
-    }
+      : problem_(problem), labels_(labels), L_(problem.numLabels()) {
+    const int n = problem.num_vertices;
     local_.assign(n, -1);
     switch_cost_.assign(n, 0.0);
     gain_.assign(n, 0.0);
@@ -72,16 +62,27 @@ class SwapSolver {
         kc_with_[at(p, labels[problem.adj_vertex[e]])] += problem.adj_kc[e];
         kc_total[p] += problem.adj_kc[e];
       }
-      for (int l = 0; l < L_; ++l) {
-        if (score_[at(p, l)] > 0.0) scored_label_.push_back(l);
+    }
+    // Labels with a score per vertex, ascending, as CSR; read label by label (the arrays are
+    // label-major).
+    for (int l = 0; l < L_; ++l) {
+      for (int p = 0; p < n; ++p) scored_offset_[p + 1] += problem.score[at(p, l)] > 0.0;
+    }
+    for (int p = 0; p < n; ++p) scored_offset_[p + 1] += scored_offset_[p];
+    scored_label_.resize(scored_offset_[n]);
+    std::vector<int> fill(scored_offset_.begin(), scored_offset_.end() - 1);
+    for (int l = 0; l < L_; ++l) {
+      for (int p = 0; p < n; ++p) {
+        if (problem.score[at(p, l)] > 0.0) scored_label_[fill[p]++] = l;
       }
-      scored_offset_[p + 1] = static_cast<int>(scored_label_.size());
     }
     // pair_sum_: the edge's K per neighbour with another label, unless p has a score for l
     // (exp terms).
-    pair_sum_.assign(static_cast<size_t>(n) * L_, 0.0);
+    pair_sum_.resize(static_cast<size_t>(n) * L_);
+    for (int l = 0; l < L_; ++l) {
+      for (int p = 0; p < n; ++p) pair_sum_[at(p, l)] = kc_total[p] - kc_with_[at(p, l)];
+    }
     for (int p = 0; p < n; ++p) {
-      for (int l = 0; l < L_; ++l) pair_sum_[at(p, l)] = kc_total[p] - kc_with_[at(p, l)];
       for (int s = scored_offset_[p]; s < scored_offset_[p + 1]; ++s) {
         const int l = scored_label_[s];
         double sum = 0.0;
@@ -134,13 +135,14 @@ class SwapSolver {
   }
 
  private:
-  /// Index of (vertex, label) in the solver's per-vertex-and-label arrays (label-major).
-  size_t at(int vertex, int label) const { return static_cast<size_t>(label) * n_ + vertex; }
+  /// Index of (vertex, label) in the problem's and the solver's per-vertex-and-label arrays,
+  /// label-major (LabelProblem::at).
+  size_t at(int vertex, int label) const { return problem_.at(vertex, label); }
 
   /// psi_p(l, lq) of the edge at adjacency entry e from p to q (Eq. 9).
   double pairTo(int p, int l, int q, int lq, int e) const {
-    return pairwisePotential(l, lq, score_[at(p, l)], score_[at(q, lq)], problem_.adj_factor[e],
-                             problem_.adj_kc[e]);
+    return pairwisePotential(l, lq, problem_.score[at(p, l)], problem_.score[at(q, lq)],
+                             problem_.adj_factor[e], problem_.adj_kc[e]);
   }
 
   /// verts_: the vertices of the move that may change, ascending; the other vertices of P keep
@@ -160,9 +162,9 @@ class SwapSolver {
     verts_.clear();
     for (const auto& [own, other] : {std::make_pair(alpha, beta), std::make_pair(beta, alpha)}) {
       for (int v : members_[own]) {
-        const double stay = unary_[at(v, own)] + pair_sum_[at(v, own)];
-        double swap = unary_[at(v, other)] + pair_sum_[at(v, other)];
-        if (score_[at(v, other)] > 0.0) {
+        const double stay = problem_.unary[at(v, own)] + pair_sum_[at(v, own)];
+        double swap = problem_.unary[at(v, other)] + pair_sum_[at(v, other)];
+        if (problem_.score[at(v, other)] > 0.0) {
           for (int e = problem_.adj_offset[v]; e < problem_.adj_offset[v + 1]; ++e) {
             const int q = problem_.adj_vertex[e];
             if (labels_[q] == own) swap -= pairTo(v, other, q, own, e);
@@ -185,8 +187,9 @@ class SwapSolver {
       for (int e = problem_.adj_offset[v]; e < problem_.adj_offset[v + 1]; ++e) {
         const int q = problem_.adj_vertex[e];
         if (local_[q] >= 0 || labels_[q] != lv) continue;
-        gain_[q] += pairwisePotential(lv, other, score_[at(q, lv)], score_[at(v, other)],
-                                      problem_.adj_factor[e], problem_.adj_kc[e]);
+        gain_[q] +=
+            pairwisePotential(lv, other, problem_.score[at(q, lv)], problem_.score[at(v, other)],
+                              problem_.adj_factor[e], problem_.adj_kc[e]);
         if (gain_[q] > switch_cost_[q]) {
           local_[q] = 0;
           verts_.push_back(q);
@@ -205,8 +208,8 @@ class SwapSolver {
     cost_b_.resize(m);
     for (int k = 0; k < m; ++k) {
       const int p = verts_[k];
-      cost_a_[k] = unary_[at(p, alpha)] + pair_sum_[at(p, alpha)];
-      cost_b_[k] = unary_[at(p, beta)] + pair_sum_[at(p, beta)];
+      cost_a_[k] = problem_.unary[at(p, alpha)] + pair_sum_[at(p, alpha)];
+      cost_b_[k] = problem_.unary[at(p, beta)] + pair_sum_[at(p, beta)];
     }
     links_.clear();
     for (int k = 0; k < m; ++k) {
@@ -259,8 +262,8 @@ class SwapSolver {
           const int l = scored_label_[s];
           pair_sum_[at(q, l)] += pairTo(q, l, v, label, e) - pairTo(q, l, v, old, e);
         }
-        if (score_[at(q, old)] <= 0.0) pair_sum_[at(q, old)] += problem_.adj_kc[e];
-        if (score_[at(q, label)] <= 0.0) pair_sum_[at(q, label)] -= problem_.adj_kc[e];
+        if (problem_.score[at(q, old)] <= 0.0) pair_sum_[at(q, old)] += problem_.adj_kc[e];
+        if (problem_.score[at(q, label)] <= 0.0) pair_sum_[at(q, label)] -= problem_.adj_kc[e];
       }
     }
     merged_.clear();
@@ -274,7 +277,6 @@ class SwapSolver {
   const LabelProblem& problem_;
   std::vector<int>& labels_;
   const int L_;
-  const int n_;
   std::vector<double> unary_;              ///< problem.unary, label-major (at())
   std::vector<double> score_;              ///< problem.score, label-major
   std::vector<std::vector<int>> members_;  ///< vertices per label, ascending

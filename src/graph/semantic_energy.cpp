@@ -134,15 +134,18 @@ LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConf
   const auto labelIndex = [&](int32_t c) {
     return static_cast<int>(std::lower_bound(labels.begin(), labels.end(), c) - labels.begin());
   };
+  std::vector<double> unscored(n);  // the unary of a label without a score
+  for (int i = 0; i < n; ++i) {
+    unscored[i] = weight[i] * unaryPotential(0.0, score_sum[i], config.score_floor);
+  }
+  for (int l = 0; l < L; ++l) {
+    std::copy(unscored.begin(), unscored.end(), problem.unary.begin() + problem.at(0, l));
+  }
   for (int i = 0; i < n; ++i) {
     problem.initial[i] = labelIndex(initial_class[i]);
-    for (int l = 0; l < L; ++l) {
-      problem.unary[static_cast<size_t>(i) * L + l] =
-          weight[i] * unaryPotential(0.0, score_sum[i], config.score_floor);
-    }
     for (const auto& [c, s] : graph.vertices[i].scores) {
       if (s <= 0.0 || !label_set.contains(c)) continue;
-      const size_t at = static_cast<size_t>(i) * L + labelIndex(c);
+      const size_t at = problem.at(i, labelIndex(c));
       problem.unary[at] = weight[i] * unaryPotential(s, score_sum[i], config.score_floor);
       problem.score[at] = s / score_sum[i];
     }
@@ -181,18 +184,14 @@ LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConf
 }
 
 double labellingEnergy(const LabelProblem& problem, const std::vector<int>& labels) {
-  const int L = problem.numLabels();
   double energy = 0.0;
-  for (int i = 0; i < problem.num_vertices; ++i) {
-    energy += problem.unary[static_cast<size_t>(i) * L + labels[i]];
-  }
+  for (int i = 0; i < problem.num_vertices; ++i) energy += problem.unary[problem.at(i, labels[i])];
   for (size_t k = 0; k < problem.edge_a.size(); ++k) {
     const int a = problem.edge_a[k];
     const int b = problem.edge_b[k];
-    energy += pairwisePotential(labels[a], labels[b],
-                                problem.score[static_cast<size_t>(a) * L + labels[a]],
-                                problem.score[static_cast<size_t>(b) * L + labels[b]],
-                                problem.edge_factor[k], problem.edge_kc[k]);
+    energy += pairwisePotential(labels[a], labels[b], problem.score[problem.at(a, labels[a])],
+                                problem.score[problem.at(b, labels[b])], problem.edge_factor[k],
+                                problem.edge_kc[k]);
   }
   return energy;
 }
