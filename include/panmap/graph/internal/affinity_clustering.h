@@ -15,7 +15,7 @@ struct LinkEvidence {
 
 /// One vertex's links, by the other end's index. A flat map (one sorted array): a join
 /// rewrites a cluster's links in one pass, where std::map's node per link made the clustering
-/// allocation-bound on a building's graph (docs/PERFORMANCE.md).
+/// allocation-bound on a building's graph (docs/MAPPING.md, III-D).
 using Links = boost::container::flat_map<int, LinkEvidence>;
 
 /// Agglomerative clustering by the network's verdicts (average linkage): clusters X, Y join
