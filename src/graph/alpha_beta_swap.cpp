@@ -98,7 +98,7 @@ class SwapSolver {
   /// labelled alpha or beta, nor any neighbour of one, changed label since. (An accepted move
   /// leaves the pair optimal for itself.)
   bool stale(int alpha, int beta) const {
-    const int64_t when = evaluated_at_[static_cast<size_t>(alpha) * L_ + beta];
+    const int64_t when = evaluated_at_[pairAt(alpha, beta)];
     return when < 0 || changed_at_[alpha] > when || changed_at_[beta] > when;
   }
 
@@ -130,7 +130,7 @@ class SwapSolver {
       for (int v : verts_) local_[v] = -1;
     }
     if (better) apply(alpha, beta);
-    evaluated_at_[static_cast<size_t>(alpha) * L_ + beta] = clock_;
+    evaluated_at_[pairAt(alpha, beta)] = clock_;
     return better;
   }
 
@@ -138,6 +138,8 @@ class SwapSolver {
   /// Index of (vertex, label) in the problem's and the solver's per-vertex-and-label arrays,
   /// label-major (LabelProblem::at).
   size_t at(int vertex, int label) const { return problem_.at(vertex, label); }
+  /// Index of the label pair (alpha, beta) in evaluated_at_.
+  size_t pairAt(int alpha, int beta) const { return static_cast<size_t>(alpha) * L_ + beta; }
 
   /// psi_p(l, lq) of the edge at adjacency entry e from p to q (Eq. 9).
   double pairTo(int p, int l, int q, int lq, int e) const {
@@ -277,8 +279,6 @@ class SwapSolver {
   const LabelProblem& problem_;
   std::vector<int>& labels_;
   const int L_;
-  std::vector<double> unary_;              ///< problem.unary, label-major (at())
-  std::vector<double> score_;              ///< problem.score, label-major
   std::vector<std::vector<int>> members_;  ///< vertices per label, ascending
   std::vector<double> kc_with_;     ///< at(vertex, label): sum of the K of edges to that label
   std::vector<double> pair_sum_;    ///< at(vertex, label): sum_q psi_p(label, l_q)
