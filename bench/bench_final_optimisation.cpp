@@ -17,6 +17,7 @@
 #include <CLI/CLI.hpp>
 
 #include "panmap/core/fingerprint.h"
+#include "panmap/core/process_memory.h"
 #include "panmap/graph/optimiser.h"
 #include "panmap/lcm/graph_conversions.h"
 #include "panmap/mapper/mapper.h"
@@ -65,17 +66,23 @@ int main(int argc, char** argv) {
     size_t vertices = 0, edges = 0;
     uint64_t digest = 0;
     for (int r = 0; r < repeats; ++r) {
+      const long faults_before = panmap::minorPageFaults();
       auto start = std::chrono::steady_clock::now();
       const panmap::SuperpointGraph graph = mapper->graph();
       graph_ms.push_back(msSince(start));
+      const long faults_graph = panmap::minorPageFaults();
       start = std::chrono::steady_clock::now();
       const panmap::GraphLabels labels = panmap::optimise(graph, panmap::OptimiserConfig());
       solve_ms.push_back(msSince(start));
+      const long faults_solve = panmap::minorPageFaults();
       digest = labelsDigest(labels);
       vertices = graph.vertices.size();
       edges = graph.edges.size();
-      std::fprintf(stderr, "  run %d/%d: graph %.1f ms, solve %.1f ms\n", r + 1, repeats,
-                   graph_ms.back(), solve_ms.back());
+      std::fprintf(stderr,
+                   "  run %d/%d: graph %.1f ms, solve %.1f ms; pages touched first: graph %ld, "
+                   "solve %ld\n",
+                   r + 1, repeats, graph_ms.back(), solve_ms.back(), faults_graph - faults_before,
+                   faults_solve - faults_graph);
     }
     std::printf(
         "%s: %zu blocks, %zu vertices, %zu edges; median of %d: graph %.1f ms, solve %.1f ms, "

@@ -20,4 +20,10 @@ size_t peakResidentBytes() {
   return static_cast<size_t>(usage.ru_maxrss) * 1024;  // Linux reports kibibytes
 }
 
+long minorPageFaults() {
+  struct rusage usage;
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+  return usage.ru_minflt;
+}
+
 }  // namespace panmap
