@@ -1,7 +1,5 @@
 #include "panmap/graph/internal/class_consensus.h"
 
-#include <map>
-#include <set>
 #include <utility>
 
 #include "panmap/graph/internal/affinity_clustering.h"
@@ -27,57 +25,85 @@ std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
       if (isThing(c)) observed[i] += s;
     }
   }
+  // The one-mask and two-mask evidence of the edge between a and b, when both are things.
+  const auto linkOf = [&](const GraphEdge& e, int a, int b, LinkEvidence* link) {
+    if (!isThing(classes[a]) || !isThing(classes[b])) return false;
+    for (const auto& [c, v] : e.confidences) {
+      if (isThing(c)) link->same += v;
+    }
+    link->apart = e.apart;
+    return link->same > 0.0;
+  };
   std::vector<Links> links(n);
   for (const GraphEdge& e : graph.edges) {
     const int a = index(e.a), b = index(e.b);
-    if (!isThing(classes[a]) || !isThing(classes[b])) continue;
     LinkEvidence link;
-    for (const auto& [c, v] : e.confidences) {
-      if (isThing(c)) link.same += v;
-    }
-    link.apart = e.apart;
-    if (!(link.same > 0.0)) continue;
+    if (!linkOf(e, a, b, &link)) continue;
     // Edges come sorted by (a, b): both lists grow at their ends.
     links[a].emplace_hint(links[a].end(), b, link);
     links[b].emplace_hint(links[b].end(), a, link);
   }
-  const std::vector<Links> direct = links;
   const std::vector<int> root = clusterByAffinity(std::move(links), std::move(observed),
                                                   config.join_affinity, config.min_coverage);
-  std::map<int, std::set<int32_t>> group_classes;        // root -> classes of its members
-  std::map<int, std::map<int32_t, double>> group_score;  // root -> thing class -> score
+  // Groups of two or more classes, by root: per-root arrays, where maps of sets per group
+  // made this bookkeeping cost as much as the clustering on a building's graph.
+  constexpr int32_t kNone = -1;
+  std::vector<int32_t> first_class(n, kNone);
+  std::vector<char> mixed(n, 0);
   for (int i = 0; i < n; ++i) {
     if (!isThing(classes[i])) continue;
-    group_classes[root[i]].insert(classes[i]);
+    int32_t& first = first_class[root[i]];
+    if (first == kNone) {
+      first = classes[i];
+    } else if (first != classes[i]) {
+      mixed[root[i]] = 1;
+    }
+  }
+  std::vector<ClassValues> group_score(n);  // root -> thing class -> summed score, mixed only
+  for (int i = 0; i < n; ++i) {
+    if (!isThing(classes[i]) || !mixed[root[i]]) continue;
     for (const auto& [c, s] : graph.vertices[i].scores) {
       if (isThing(c)) group_score[root[i]][c] += s;
     }
   }
-  std::vector<int32_t> out = classes;
-  std::map<int, int32_t> decided;
-  for (const auto& [r, members] : group_classes) {
-    if (members.size() < 2) continue;
-    int32_t best = 0;
+  std::vector<int32_t> decided(n, 0);  // the class a mixed group decided (0: none)
+  int groups = 0;
+  for (int r = 0; r < n; ++r) {
+    if (!mixed[r]) continue;
+    ++groups;
     double best_score = -1.0;
     for (const auto& [c, s] : group_score[r]) {  // ascending class: ties keep the smaller
-      if (s > best_score) best = c, best_score = s;
+      if (s > best_score) decided[r] = c, best_score = s;
     }
-    decided[r] = best;
   }
   // Members in doubt, each with the class its group decided.
   std::vector<std::pair<int, int32_t>> candidates;
+  std::vector<char> in_doubt(n, 0);
   for (int i = 0; i < n; ++i) {
-    if (!isThing(classes[i])) continue;
-    const auto it = decided.find(root[i]);
-    if (it == decided.end() || it->second == classes[i]) continue;
+    if (!isThing(classes[i]) || !mixed[root[i]]) continue;
+    const int32_t target = decided[root[i]];
+    if (target == classes[i]) continue;
     // Only where its own views left it in doubt: a surface the network hardly ever called the
     // group's class (a box beside a shelf, joined through the shelf mask's outline) keeps its own.
     const auto own = graph.vertices[i].scores.find(classes[i]);
-    const auto group = graph.vertices[i].scores.find(it->second);
+    const auto group = graph.vertices[i].scores.find(target);
     const double own_score = own == graph.vertices[i].scores.end() ? 0.0 : own->second;
     const double group_score = group == graph.vertices[i].scores.end() ? 0.0 : group->second;
     if (!(group_score >= config.consensus_min_ratio * own_score && group_score > 0.0)) continue;
-    candidates.emplace_back(i, it->second);
+    candidates.emplace_back(i, target);
+    in_doubt[i] = 1;
+  }
+  // Their direct links, as the clustering started from them (it consumed its copy).
+  std::vector<Links> direct(n);
+  if (!candidates.empty()) {
+    for (const GraphEdge& e : graph.edges) {
+      const int a = index(e.a), b = index(e.b);
+      if (!in_doubt[a] && !in_doubt[b]) continue;
+      LinkEvidence link;
+      if (!linkOf(e, a, b, &link)) continue;
+      if (in_doubt[a]) direct[a].emplace_hint(direct[a].end(), b, link);
+      if (in_doubt[b]) direct[b].emplace_hint(direct[b].end(), a, link);
+    }
   }
   // And only where the network showed it in one mask with the members that hold that class
   // more often than in two, and more often than with the members that share its own class.
@@ -87,8 +113,9 @@ std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
   // shown with far more often for a shelf whose mask outline it sat in now and then. Sweeps in
   // rounds, each against the classes of the round before (independent of order), so a class
   // passes from member to member only along direct evidence.
+  std::vector<int32_t> out = classes;
   ClassConsensusStats counts;
-  counts.groups = static_cast<int>(decided.size());
+  counts.groups = groups;
   while (true) {
     std::vector<std::pair<int, int32_t>> taken;
     for (const auto& [i, target] : candidates) {
