@@ -53,34 +53,38 @@ class SwapSolver {
     members_.resize(L_);
     changed_at_.assign(L_, 0);
     evaluated_at_.assign(static_cast<size_t>(L_) * L_, -1);
-    kc_with_.assign(static_cast<size_t>(n) * L_, 0.0);
+    kc_with_.assign(n, L_, 0.0);
     std::vector<double> kc_total(n, 0.0);
     scored_offset_.assign(n + 1, 0);
     for (int p = 0; p < n; ++p) {
       members_[labels[p]].push_back(p);
       for (int e = problem.adj_offset[p]; e < problem.adj_offset[p + 1]; ++e) {
-        kc_with_[at(p, labels[problem.adj_vertex[e]])] += problem.adj_kc[e];
+        kc_with_(p, labels[problem.adj_vertex[e]]) += problem.adj_kc[e];
         kc_total[p] += problem.adj_kc[e];
       }
     }
     // Labels with a score per vertex, ascending, as CSR; read label by label (the arrays are
     // label-major).
     for (int l = 0; l < L_; ++l) {
-      for (int p = 0; p < n; ++p) scored_offset_[p + 1] += problem.score[at(p, l)] > 0.0;
+      const double* score = problem.score.row(l);
+      for (int p = 0; p < n; ++p) scored_offset_[p + 1] += score[p] > 0.0;
     }
     for (int p = 0; p < n; ++p) scored_offset_[p + 1] += scored_offset_[p];
     scored_label_.resize(scored_offset_[n]);
     std::vector<int> fill(scored_offset_.begin(), scored_offset_.end() - 1);
     for (int l = 0; l < L_; ++l) {
+      const double* score = problem.score.row(l);
       for (int p = 0; p < n; ++p) {
-        if (problem.score[at(p, l)] > 0.0) scored_label_[fill[p]++] = l;
+        if (score[p] > 0.0) scored_label_[fill[p]++] = l;
       }
     }
     // pair_sum_: the edge's K per neighbour with another label, unless p has a score for l
     // (exp terms).
-    pair_sum_.resize(static_cast<size_t>(n) * L_);
+    pair_sum_.assign(n, L_, 0.0);
     for (int l = 0; l < L_; ++l) {
-      for (int p = 0; p < n; ++p) pair_sum_[at(p, l)] = kc_total[p] - kc_with_[at(p, l)];
+      double* pair_sum = pair_sum_.row(l);
+      const double* kc_with = kc_with_.row(l);
+      for (int p = 0; p < n; ++p) pair_sum[p] = kc_total[p] - kc_with[p];
     }
     for (int p = 0; p < n; ++p) {
       for (int s = scored_offset_[p]; s < scored_offset_[p + 1]; ++s) {
@@ -89,7 +93,7 @@ class SwapSolver {
         for (int e = problem.adj_offset[p]; e < problem.adj_offset[p + 1]; ++e) {
           sum += pairTo(p, l, problem.adj_vertex[e], labels[problem.adj_vertex[e]], e);
         }
-        pair_sum_[at(p, l)] = sum;
+        pair_sum_(p, l) = sum;
       }
     }
   }
@@ -135,15 +139,12 @@ class SwapSolver {
   }
 
  private:
-  /// Index of (vertex, label) in the problem's and the solver's per-vertex-and-label arrays,
-  /// label-major (LabelProblem::at).
-  size_t at(int vertex, int label) const { return problem_.at(vertex, label); }
   /// Index of the label pair (alpha, beta) in evaluated_at_.
   size_t pairAt(int alpha, int beta) const { return static_cast<size_t>(alpha) * L_ + beta; }
 
   /// psi_p(l, lq) of the edge at adjacency entry e from p to q (Eq. 9).
   double pairTo(int p, int l, int q, int lq, int e) const {
-    return pairwisePotential(l, lq, problem_.score[at(p, l)], problem_.score[at(q, lq)],
+    return pairwisePotential(l, lq, problem_.score(p, l), problem_.score(q, lq),
                              problem_.adj_factor[e], problem_.adj_kc[e]);
   }
 
@@ -163,16 +164,22 @@ class SwapSolver {
   void selectVertices(int alpha, int beta) {
     verts_.clear();
     for (const auto& [own, other] : {std::make_pair(alpha, beta), std::make_pair(beta, alpha)}) {
+      const double* unary_own = problem_.unary.row(own);
+      const double* unary_other = problem_.unary.row(other);
+      const double* pair_own = pair_sum_.row(own);
+      const double* pair_other = pair_sum_.row(other);
+      const double* score_other = problem_.score.row(other);
+      const double* kc_own = kc_with_.row(own);
       for (int v : members_[own]) {
-        const double stay = problem_.unary[at(v, own)] + pair_sum_[at(v, own)];
-        double swap = problem_.unary[at(v, other)] + pair_sum_[at(v, other)];
-        if (problem_.score[at(v, other)] > 0.0) {
+        const double stay = unary_own[v] + pair_own[v];
+        double swap = unary_other[v] + pair_other[v];
+        if (score_other[v] > 0.0) {
           for (int e = problem_.adj_offset[v]; e < problem_.adj_offset[v + 1]; ++e) {
             const int q = problem_.adj_vertex[e];
             if (labels_[q] == own) swap -= pairTo(v, other, q, own, e);
           }
         } else {  // psi_p(other, own) = the edge's K without a score for `other`
-          swap -= kc_with_[at(v, own)];
+          swap -= kc_own[v];
         }
         switch_cost_[v] = swap - stay;
         gain_[v] = 0.0;
@@ -189,9 +196,8 @@ class SwapSolver {
       for (int e = problem_.adj_offset[v]; e < problem_.adj_offset[v + 1]; ++e) {
         const int q = problem_.adj_vertex[e];
         if (local_[q] >= 0 || labels_[q] != lv) continue;
-        gain_[q] +=
-            pairwisePotential(lv, other, problem_.score[at(q, lv)], problem_.score[at(v, other)],
-                              problem_.adj_factor[e], problem_.adj_kc[e]);
+        gain_[q] += pairwisePotential(lv, other, problem_.score(q, lv), problem_.score(v, other),
+                                      problem_.adj_factor[e], problem_.adj_kc[e]);
         if (gain_[q] > switch_cost_[q]) {
           local_[q] = 0;
           verts_.push_back(q);
@@ -208,10 +214,14 @@ class SwapSolver {
     const int m = static_cast<int>(verts_.size());
     cost_a_.resize(m);
     cost_b_.resize(m);
+    const double* unary_a = problem_.unary.row(alpha);
+    const double* unary_b = problem_.unary.row(beta);
+    const double* pair_a = pair_sum_.row(alpha);
+    const double* pair_b = pair_sum_.row(beta);
     for (int k = 0; k < m; ++k) {
       const int p = verts_[k];
-      cost_a_[k] = problem_.unary[at(p, alpha)] + pair_sum_[at(p, alpha)];
-      cost_b_[k] = problem_.unary[at(p, beta)] + pair_sum_[at(p, beta)];
+      cost_a_[k] = unary_a[p] + pair_a[p];
+      cost_b_[k] = unary_b[p] + pair_b[p];
     }
     links_.clear();
     for (int k = 0; k < m; ++k) {
@@ -255,17 +265,17 @@ class SwapSolver {
       labels_[v] = label;
       for (int e = problem_.adj_offset[v]; e < problem_.adj_offset[v + 1]; ++e) {
         const int q = problem_.adj_vertex[e];
-        kc_with_[at(q, old)] -= problem_.adj_kc[e];
-        kc_with_[at(q, label)] += problem_.adj_kc[e];
+        kc_with_(q, old) -= problem_.adj_kc[e];
+        kc_with_(q, label) += problem_.adj_kc[e];
         changed_at_[labels_[q]] = clock_;
         // pair_sum_[q][l] += psi(l, label) - psi(l, old): exp terms where q has a score for l,
         // else K [l != label] - K [l != old] with the edge's K.
         for (int s = scored_offset_[q]; s < scored_offset_[q + 1]; ++s) {
           const int l = scored_label_[s];
-          pair_sum_[at(q, l)] += pairTo(q, l, v, label, e) - pairTo(q, l, v, old, e);
+          pair_sum_(q, l) += pairTo(q, l, v, label, e) - pairTo(q, l, v, old, e);
         }
-        if (problem_.score[at(q, old)] <= 0.0) pair_sum_[at(q, old)] += problem_.adj_kc[e];
-        if (problem_.score[at(q, label)] <= 0.0) pair_sum_[at(q, label)] -= problem_.adj_kc[e];
+        if (problem_.score(q, old) <= 0.0) pair_sum_(q, old) += problem_.adj_kc[e];
+        if (problem_.score(q, label) <= 0.0) pair_sum_(q, label) -= problem_.adj_kc[e];
       }
     }
     merged_.clear();
@@ -280,9 +290,9 @@ class SwapSolver {
   std::vector<int>& labels_;
   const int L_;
   std::vector<std::vector<int>> members_;  ///< vertices per label, ascending
-  std::vector<double> kc_with_;     ///< at(vertex, label): sum of the K of edges to that label
-  std::vector<double> pair_sum_;    ///< at(vertex, label): sum_q psi_p(label, l_q)
-  std::vector<int> scored_offset_;  ///< CSR of the labels each vertex has a score for
+  LabelTable kc_with_;                     ///< (vertex, label): sum of the K of edges to that label
+  LabelTable pair_sum_;                    ///< (vertex, label): sum_q psi_p(label, l_q)
+  std::vector<int> scored_offset_;         ///< CSR of the labels each vertex has a score for
   std::vector<int> scored_label_;
   int64_t clock_ = 0;                  ///< counts solved and accepted moves
   std::vector<int64_t> changed_at_;    ///< per label: clock of the last change it depends on

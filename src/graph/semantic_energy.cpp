@@ -128,8 +128,8 @@ LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConf
   const int L = static_cast<int>(labels.size());
 
   // Dense unary (Eq. 8) and normalised scores.
-  problem.unary.assign(static_cast<size_t>(n) * L, 0.0);
-  problem.score.assign(static_cast<size_t>(n) * L, 0.0);
+  problem.unary.assign(n, L, 0.0);
+  problem.score.assign(n, L, 0.0);
   problem.initial.resize(n);
   const auto labelIndex = [&](int32_t c) {
     return static_cast<int>(std::lower_bound(labels.begin(), labels.end(), c) - labels.begin());
@@ -139,15 +139,15 @@ LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConf
     unscored[i] = weight[i] * unaryPotential(0.0, score_sum[i], config.score_floor);
   }
   for (int l = 0; l < L; ++l) {
-    std::copy(unscored.begin(), unscored.end(), problem.unary.begin() + problem.at(0, l));
+    std::copy(unscored.begin(), unscored.end(), problem.unary.row(l));
   }
   for (int i = 0; i < n; ++i) {
     problem.initial[i] = labelIndex(initial_class[i]);
     for (const auto& [c, s] : graph.vertices[i].scores) {
       if (s <= 0.0 || !label_set.contains(c)) continue;
-      const size_t at = problem.at(i, labelIndex(c));
-      problem.unary[at] = weight[i] * unaryPotential(s, score_sum[i], config.score_floor);
-      problem.score[at] = s / score_sum[i];
+      const int l = labelIndex(c);
+      problem.unary(i, l) = weight[i] * unaryPotential(s, score_sum[i], config.score_floor);
+      problem.score(i, l) = s / score_sum[i];
     }
   }
 
@@ -185,13 +185,13 @@ LabelProblem buildLabelProblem(const SuperpointGraph& graph, const OptimiserConf
 
 double labellingEnergy(const LabelProblem& problem, const std::vector<int>& labels) {
   double energy = 0.0;
-  for (int i = 0; i < problem.num_vertices; ++i) energy += problem.unary[problem.at(i, labels[i])];
+  for (int i = 0; i < problem.num_vertices; ++i) energy += problem.unary(i, labels[i]);
   for (size_t k = 0; k < problem.edge_a.size(); ++k) {
     const int a = problem.edge_a[k];
     const int b = problem.edge_b[k];
-    energy += pairwisePotential(labels[a], labels[b], problem.score[problem.at(a, labels[a])],
-                                problem.score[problem.at(b, labels[b])], problem.edge_factor[k],
-                                problem.edge_kc[k]);
+    energy +=
+        pairwisePotential(labels[a], labels[b], problem.score(a, labels[a]),
+                          problem.score(b, labels[b]), problem.edge_factor[k], problem.edge_kc[k]);
   }
   return energy;
 }

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "panmap/graph/internal/label_table.h"
 #include "panmap/graph/optimiser.h"
 #include "panmap/graph/superpoint_graph.h"
 
@@ -83,10 +84,8 @@ struct LabelProblem {
   /// lower E and is left out.
   std::vector<int32_t> labels;
   int num_vertices = 0;
-  /// Eq. 8 times the vertex weight, at(vertex, label). Label-major: a swap move reads two
-  /// labels' values for every vertex holding either, which then lie in two runs of memory.
-  std::vector<double> unary;
-  std::vector<double> score;       ///< normalised P_nu at(vertex, label) (0 if no scores)
+  LabelTable unary;                ///< Eq. 8 times the vertex weight, (vertex, label)
+  LabelTable score;                ///< normalised P_nu, (vertex, label) (0 if no scores)
   std::vector<int> adj_offset;     ///< CSR over edges with a positive confidence sum, n + 1
   std::vector<int> adj_vertex;     ///< neighbour vertex index
   std::vector<double> adj_factor;  ///< edgeFactor of that edge
@@ -98,10 +97,6 @@ struct LabelProblem {
   std::vector<int> initial;  ///< argmax labelling (label indices), see buildLabelProblem
   /// Number of labels L.
   int numLabels() const { return static_cast<int>(labels.size()); }
-  /// Index of (vertex, label) in unary and score.
-  size_t at(int vertex, int label) const {
-    return static_cast<size_t>(label) * static_cast<size_t>(num_vertices) + vertex;
-  }
 };
 
 /// The weight of a vertex's unary under `weighting`: 1 (kNone) or its voxels, at least 1
