@@ -45,8 +45,7 @@ std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
   }
   const std::vector<int> root = clusterByAffinity(std::move(links), std::move(observed),
                                                   config.join_affinity, config.min_coverage);
-  // Groups of two or more classes, by root: per-root arrays, where maps of sets per group
-  // made this bookkeeping cost as much as the clustering on a building's graph.
+  // Groups of two or more classes, by root, in per-root arrays (no map or set per group).
   constexpr int32_t kNone = -1;
   std::vector<int32_t> first_class(n, kNone);
   std::vector<char> mixed(n, 0);
