@@ -4,19 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include "graph_builders.h"
 #include "panmap/graph/internal/semantic_energy.h"
 
 namespace panmap {
 namespace internal {
 namespace {
 
-GraphVertex vertex(int32_t id, int32_t voxels, ClassValues scores) {
-  GraphVertex v;
-  v.id = id;
-  v.num_voxels = voxels;
-  v.scores = std::move(scores);
-  return v;
-}
+using test::vertex;
 
 TEST(LabelProblem, UnariesAndScoresPerVertexAndLabel) {
   SuperpointGraph graph;

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "graph_builders.h"
 #include "panmap/core/error.h"
 #include "panmap/graph/instance_evidence.h"
 #include "panmap/graph/internal/object_consolidation.h"
@@ -14,21 +15,8 @@
 namespace panmap {
 namespace {
 
-GraphVertex vertex(int32_t id, int32_t voxels, ClassValues scores) {
-  GraphVertex v;
-  v.id = id;
-  v.num_voxels = voxels;
-  v.scores = std::move(scores);
-  return v;
-}
-
-GraphEdge edge(int32_t a, int32_t b, ClassValues confidences) {
-  GraphEdge e;
-  e.a = a;
-  e.b = b;
-  e.confidences = std::move(confidences);
-  return e;
-}
+using test::edge;
+using test::vertex;
 
 // 2 cm voxels, min area 0.04 m2 = 100 voxels. Chairs (class 5): instance 1 = super-points
 // {1, 2} (150 + 100 voxels), fragment 2 = {3} (40) linked to 1 (3.0) and to fragment 3 (5.0),
