@@ -72,8 +72,7 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
                                       const LabelImage& labels, TsdfMap* map,
                                       IntegrationStats* stats) {
   const PinholeCamera& cam = frame.camera;
-  const internal::RowCamera row_cam{static_cast<float>(cam.fx), static_cast<float>(cam.fy),
-                                    static_cast<float>(cam.cx), static_cast<float>(cam.cy)};
+  const RowCamera row_cam = RowCamera::of(cam);
   const int stride = voteStride(config_, map->voxelSize(), cam.fx);
   const size_t cols = (cam.width + stride - 1) / stride, rows = (cam.height + stride - 1) / stride;
   const size_t owners = static_cast<size_t>(pool_->size());

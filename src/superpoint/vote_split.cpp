@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "panmap/core/error.h"
+#include "panmap/map/row_grid.h"
 #include "panmap/map/voxel.h"
 #include "panmap/map/voxel_lookup.h"
 
@@ -76,7 +77,10 @@ size_t applySplits(FrameAssociation* association, const FrameSegmentation& segme
   std::vector<size_t> split_count(splits.size(), 0), kept_count(kept.size(), 0);
   MutableVoxelLookup lookup(*map);
   size_t changed = 0;
+  const RowCamera row_cam = RowCamera::of(cam);
   for (int v = 0; v < h; ++v) {
+    // The voxels the pixels voted in, found as the votes were cast.
+    const RowGrid grid(T, row_cam, lookup.inverseVoxelSize(), v);
     for (int u = 0; u < w; ++u) {
       const int32_t sid = segmentation.surfaces(u, v);
       if (sid <= 0 || static_cast<size_t>(sid) > n) continue;
@@ -92,7 +96,8 @@ size_t applySplits(FrameAssociation* association, const FrameSegmentation& segme
       const size_t i = split_of[sid] - 1;
       split_sum[i] += p_W.cast<double>();
       ++split_count[i];
-      VoxelVotes* votes = lookup.findVotes(p_W);
+      VoxelVotes* votes = lookup.findGridVotes(grid.coordinate(0, u, d), grid.coordinate(1, u, d),
+                                               grid.coordinate(2, u, d));
       if (votes) changed += moveVotes(votes, from[i], splits[i].to, labels);
     }
   }

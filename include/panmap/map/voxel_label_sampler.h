@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "panmap/core/camera.h"
+#include "panmap/map/row_grid.h"
 #include "panmap/map/voxel.h"
 #include "panmap/map/voxel_lookup.h"
 
@@ -19,9 +20,9 @@ struct RowSample {
 };
 
 /// The super-point label (Eq. 2: argmaxLabel through `resolve`) of the voxel a depth pixel's
-/// point falls in, for loops over image samples. Neighbouring samples mostly share a voxel,
-/// whose label is then found once, so the map and the labels must not change while a sampler
-/// is in use. One per thread.
+/// point falls in (RowGrid: the voxel the pixel votes in), for loops over image samples.
+/// Neighbouring samples mostly share a voxel, whose label is then found once, so the map and the
+/// labels must not change while a sampler is in use. One per thread.
 template <typename Resolve>
 class VoxelLabelSampler {
  public:
@@ -30,15 +31,17 @@ class VoxelLabelSampler {
                     Resolve resolve)
       : lookup_(map),
         T_W_C_(T_W_C),
-        fx_(static_cast<float>(cam.fx)),
-        fy_(static_cast<float>(cam.fy)),
-        cx_(static_cast<float>(cam.cx)),
-        cy_(static_cast<float>(cam.cy)),
+        cam_(RowCamera::of(cam)),
+        grid_(T_W_C, cam_, lookup_.inverseVoxelSize(), 0),
         resolve_(std::move(resolve)) {}
 
   /// The label of the voxel that pixel (u, v) at depth d_m (> 0) sees; 0 when that voxel's
   /// block is not allocated or it has no votes.
-  int32_t label(int u, int v, float d_m) { return labelOf(lookup_.findVotes(point(u, v, d_m))); }
+  int32_t label(int u, int v, float d_m) {
+    const RowGrid& grid = row(v);
+    return labelOf(lookup_.findGridVotes(grid.coordinate(0, u, d_m), grid.coordinate(1, u, d_m),
+                                         grid.coordinate(2, u, d_m)));
+  }
 
   /// Global integer coordinates of the voxel the last label() call found.
   const Eigen::Vector3i& lastVoxel() const { return lookup_.lastVoxel(); }
@@ -54,8 +57,12 @@ class VoxelLabelSampler {
     row_blocks_.resize(n);
     row_index_.resize(n);
     row_votes_.resize(n);
+    const RowGrid& grid = row(v);
     for (size_t k = 0; k < n; ++k) {
-      const Voxel* voxel = lookup_.find(point(samples[k].u, v, samples[k].d_m));
+      const int u = samples[k].u;
+      const float d_m = samples[k].d_m;
+      const Voxel* voxel = lookup_.findGrid(grid.coordinate(0, u, d_m), grid.coordinate(1, u, d_m),
+                                            grid.coordinate(2, u, d_m));
       if (voxels) voxels[k] = lookup_.lastVoxel();
       const Block* block = voxel ? lookup_.lastBlock() : nullptr;
       row_blocks_[k] = block;
@@ -76,8 +83,13 @@ class VoxelLabelSampler {
   }
 
  private:
-  Eigen::Vector3f point(int u, int v, float d_m) const {
-    return T_W_C_ * Eigen::Vector3f((u - cx_) * d_m / fx_, (v - cy_) * d_m / fy_, d_m);
+  // Row v's grid constants, kept while calls stay on one row.
+  const RowGrid& row(int v) {
+    if (v != grid_row_) {
+      grid_ = RowGrid(T_W_C_, cam_, lookup_.inverseVoxelSize(), v);
+      grid_row_ = v;
+    }
+    return grid_;
   }
 
   int32_t labelOf(const VoxelVotes* votes) {
@@ -91,7 +103,9 @@ class VoxelLabelSampler {
 
   VoxelLookup lookup_;
   Eigen::Isometry3f T_W_C_;
-  float fx_, fy_, cx_, cy_;
+  RowCamera cam_;
+  RowGrid grid_;
+  int grid_row_ = 0;
   Resolve resolve_;
   const VoxelVotes* last_votes_ = nullptr;
   int32_t last_label_ = 0;

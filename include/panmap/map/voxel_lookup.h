@@ -39,6 +39,13 @@ class VoxelLookupT {
     return voxel ? last_->votes(last_->indexOf(*voxel)) : nullptr;
   }
 
+  /// The votes of the voxel with global integer coordinates (gx, gy, gz), or null when it has
+  /// none or its block is not allocated.
+  VotesPtr findGridVotes(int gx, int gy, int gz) {
+    const VoxelPtr voxel = findGrid(gx, gy, gz);
+    return voxel ? last_->votes(last_->indexOf(*voxel)) : nullptr;
+  }
+
   /// static_cast<int>(std::floor(x)) for |x| < 2^31, without the library call that baseline
   /// x86-64 (no SSE4.1 rounding) makes for std::floor: truncate, then step down below zero.
   static int floorToInt(float x) {

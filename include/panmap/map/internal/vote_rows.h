@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "panmap/core/image.h"
+#include "panmap/map/row_grid.h"
 #include "panmap/map/voxel_lookup.h"
 
 namespace panmap {
@@ -20,14 +21,9 @@ struct VoteRun {
 
 namespace internal {
 
-/// Pinhole intrinsics in single precision, pixels.
-struct RowCamera {
-  float fx, fy, cx, cy;
-};
-
 /// Phase 1 of the label votes for image row v: the voxel each labelled pixel's measured point
-/// falls in (pixels u = 0, stride, 2 stride, ...), as runs of consecutive votes for one voxel
-/// and label (n votes in a row add up exactly as one vote of n does, see addVotes). Pixels
+/// falls in (RowGrid; pixels u = 0, stride, 2 stride, ...), as runs of consecutive votes for one
+/// voxel and label (n votes in a row add up exactly as one vote of n does, see addVotes). Pixels
 /// without a label, depth or allocated voxel cast no vote. Writes at most width / stride runs
 /// to `out` and returns how many. Uses 8-wide AVX2 for stride 1 when the CPU has it, with
 /// bitwise the same result as findRowVotesScalar.
