@@ -7,6 +7,7 @@
 #include "panmap/core/error.h"
 #include "panmap/map/internal/block_integration.h"
 #include "panmap/map/internal/vote_rows.h"
+#include "panmap/map/row_grid.h"
 #include "panmap/map/voxel_lookup.h"
 
 namespace panmap {
@@ -178,6 +179,7 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
   // Blocks near the surface: sample the truncation band of every few pixels' rays (the
   // stride keeps neighbouring samples well under a block apart at the far range).
   const Eigen::Isometry3f T_W_Cf = T_W_C.cast<float>();
+  const RowCamera row_cam = RowCamera::of(cam);
   // Clamped before the conversion: a huge focal length would overflow int.
   const int stride =
       static_cast<int>(std::clamp(map->blockSize() * cam.fx / config_.max_depth_m / 2.0, 1.0, 8.0));
@@ -191,22 +193,19 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
   for (absl::flat_hash_set<uint64_t>& set : key_sets_) set.erase(set.begin(), set.end());
   pool_->parallelFor(sample_rows, [&](size_t r0, size_t r1, int thread) {
     absl::flat_hash_set<uint64_t>& set = key_sets_[thread];
-    auto addKey = [&](const Eigen::Vector3f& p_W) {
-      // floorToInt: std::floor is a library call on baseline x86-64.
-      set.insert(TsdfMap::key(BlockIndex(VoxelLookup::floorToInt(p_W.x() * inv_block),
-                                         VoxelLookup::floorToInt(p_W.y() * inv_block),
-                                         VoxelLookup::floorToInt(p_W.z() * inv_block))));
-    };
     for (int v = static_cast<int>(r0) * stride; v < static_cast<int>(r1) * stride; v += stride) {
+      // Block coordinates of a ray's points by RowGrid's chain, with blocks for voxels.
+      const RowGrid grid(T_W_Cf, row_cam, inv_block, v);
+      auto addKey = [&](int u, float z) {
+        set.insert(TsdfMap::key(BlockIndex(grid.coordinate(0, u, z), grid.coordinate(1, u, z),
+                                           grid.coordinate(2, u, z))));
+      };
       for (int u = 0; u < w; u += stride) {
         const float d = depth_m_(u, v);
         if (d <= 0.0f) continue;
-        const Eigen::Vector3f ray_C((u - static_cast<float>(cam.cx)) / static_cast<float>(cam.fx),
-                                    (v - static_cast<float>(cam.cy)) / static_cast<float>(cam.fy),
-                                    1.0f);
         const float near = config_.space_carving ? config_.min_depth_m : std::max(d - trunc, 0.0f);
-        for (float z = near; z < d + trunc; z += step) addKey(T_W_Cf * (ray_C * z));
-        addKey(T_W_Cf * (ray_C * (d + trunc)));
+        for (float z = near; z < d + trunc; z += step) addKey(u, z);
+        addKey(u, d + trunc);
       }
     }
   });
