@@ -37,16 +37,11 @@ inline void votePixel(const Image<float>& depth_m, const LabelImage& labels, int
 }
 
 #ifdef PANMAP_HAVE_AVX2_PATH
-__attribute__((target("avx2"))) inline __m256i notEqual(__m256i a, __m256i b) {
-  return _mm256_xor_si256(_mm256_cmpeq_epi32(a, b), _mm256_set1_epi32(-1));
-}
-
-// The lane before each lane of x, where lane 0's is lane 7 of `last` (previous_lane: 7, 0, 1,
-// ..., 6).
-__attribute__((target("avx2"))) inline __m256i laneBefore(__m256i x, __m256i last,
-                                                          __m256i previous_lane) {
-  return _mm256_blend_epi32(_mm256_permutevar8x32_epi32(x, previous_lane),
-                            _mm256_permutevar8x32_epi32(last, previous_lane), 1);
+// The lane before each lane of x, where lane 0's is lane 7 of the group before: `rotated` is
+// x with its lanes rotated up by one (previous_lane: 7, 0, 1, ..., 6), `last_rotated` the same
+// of the group before, whose lane 0 is that group's lane 7.
+__attribute__((target("avx2"))) inline __m256i laneBefore(__m256i rotated, __m256i last_rotated) {
+  return _mm256_blend_epi32(rotated, last_rotated, 1);
 }
 
 // Stride 1, eight pixels at a time: RowGrid's chain in AVX2, the same operations in the same
@@ -93,16 +88,18 @@ __attribute__((target("avx2"))) size_t findRowVotesAvx2(const Image<float>& dept
     }
     // Integers below 2^24 are exact in float: u + lane is static_cast<float>(u + lane).
     const __m256 uf = _mm256_add_ps(_mm256_set1_ps(static_cast<float>(u)), lanes);
-    // Lanes whose label or voxel differ from the lane before.
-    __m256i differs = notEqual(label, laneBefore(label, last[0], previous_lane));
-    last[0] = label;
+    // Lanes whose label and voxel equal the lane before's.
+    const __m256i label_rotated = _mm256_permutevar8x32_epi32(label, previous_lane);
+    __m256i same = _mm256_cmpeq_epi32(label, laneBefore(label_rotated, last[0]));
+    last[0] = label_rotated;
     for (int r = 0; r < 3; ++r) {
       const __m256 q = _mm256_add_ps(a[r], _mm256_mul_ps(uf, b[r]));
       const __m256 s = _mm256_add_ps(_mm256_mul_ps(d, q), t[r]);
       const __m256i g = _mm256_cvttps_epi32(_mm256_floor_ps(s));
       _mm256_store_si256(reinterpret_cast<__m256i*>(coordinate[r]), g);
-      differs = _mm256_or_si256(differs, notEqual(g, laneBefore(g, last[1 + r], previous_lane)));
-      last[1 + r] = g;
+      const __m256i g_rotated = _mm256_permutevar8x32_epi32(g, previous_lane);
+      same = _mm256_and_si256(same, _mm256_cmpeq_epi32(g, laneBefore(g_rotated, last[1 + r])));
+      last[1 + r] = g_rotated;
     }
     static_assert(kBlockSide == 8, "block index and offset assume 8 voxels per block side");
     // One lookup per stretch of voting lanes with the same voxel and label (voxels wider than
@@ -110,7 +107,7 @@ __attribute__((target("avx2"))) size_t findRowVotesAvx2(const Image<float>& dept
     // from the lane before or follows one that casts no vote, and ends before the next start
     // or non-voting lane; lane 0 continues the last group's lane 7 when both vote and agree.
     const int previous_votes = (valid << 1 | (continues ? 1 : 0)) & 0xFF;
-    int starts = (_mm256_movemask_ps(_mm256_castsi256_ps(differs)) | ~previous_votes) & valid;
+    int starts = ~(_mm256_movemask_ps(_mm256_castsi256_ps(same)) & previous_votes) & valid;
     const int stops = starts | (~valid & 0xFF);
     continues = (valid & 0x80) != 0;
     auto stretchEnd = [stops](int k) {

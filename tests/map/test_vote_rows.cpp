@@ -84,7 +84,7 @@ TEST(VoteRows, VectorPathMatchesScalarExactly) {
   size_t runs_compared = 0, votes_compared = 0, long_runs = 0;
   for (int trial = 0; trial < 60; ++trial) {
     // The last 40 trials: 5 mm voxels 60 m from the origin, where a different rounding of
-    // the transform's sums (an ulp there is 4 um) moves some points to a neighbouring voxel.
+    // RowGrid's sums (an ulp there is 4 um) moves some points to a neighbouring voxel.
     const bool far = trial >= 20;
     // Every fourth of the first 20: 25 cm voxels over smooth depth with long label runs, where
     // most groups of eight pixels vote for one voxel (the vector path's shortcut).
