@@ -196,10 +196,7 @@ IntegrationStats ProjectiveIntegrator::integrate(const RgbdFrame& frame,
     for (int v = static_cast<int>(r0) * stride; v < static_cast<int>(r1) * stride; v += stride) {
       // Block coordinates of a ray's points by RowGrid's chain, with blocks for voxels.
       const RowGrid grid(T_W_Cf, row_cam, inv_block, v);
-      auto addKey = [&](int u, float z) {
-        set.insert(TsdfMap::key(BlockIndex(grid.coordinate(0, u, z), grid.coordinate(1, u, z),
-                                           grid.coordinate(2, u, z))));
-      };
+      auto addKey = [&](int u, float z) { set.insert(TsdfMap::key(grid.voxel(u, z))); };
       for (int u = 0; u < w; u += stride) {
         const float d = depth_m_(u, v);
         if (d <= 0.0f) continue;

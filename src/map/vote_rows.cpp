@@ -28,8 +28,7 @@ inline void votePixel(const Image<float>& depth_m, const LabelImage& labels, int
   const int32_t label = labels(u, v);
   const float d = depth_m(u, v);
   if (label <= 0 || d <= 0.0f) return;
-  Voxel* voxel = lookup->findGrid(grid.coordinate(0, u, d), grid.coordinate(1, u, d),
-                                  grid.coordinate(2, u, d));
+  Voxel* voxel = lookup->findGrid(grid.voxel(u, d));
   if (voxel) {
     Block* block = lookup->lastBlock();
     addToRun(block, block->indexOf(*voxel), label, run, out);

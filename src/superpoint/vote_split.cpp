@@ -96,8 +96,7 @@ size_t applySplits(FrameAssociation* association, const FrameSegmentation& segme
       const size_t i = split_of[sid] - 1;
       split_sum[i] += p_W.cast<double>();
       ++split_count[i];
-      VoxelVotes* votes = lookup.findGridVotes(grid.coordinate(0, u, d), grid.coordinate(1, u, d),
-                                               grid.coordinate(2, u, d));
+      VoxelVotes* votes = lookup.findGridVotes(grid.voxel(u, d));
       if (votes) changed += moveVotes(votes, from[i], splits[i].to, labels);
     }
   }

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 
 #include "panmap/core/camera.h"
+#include "panmap/map/voxel_lookup.h"
 
 namespace panmap {
 
@@ -29,9 +30,7 @@ struct RowGrid {
   /// above, in this order (the AVX2 path repeats it exactly; nothing is fused into an FMA).
   int coordinate(int r, int u, float d_m) const {
     const float q = a[r] + static_cast<float>(u) * b[r];
-    const float s = d_m * q + t[r];
-    const int i = static_cast<int>(s);  // floor without baseline x86-64's library call
-    return i - (s < static_cast<float>(i) ? 1 : 0);
+    return VoxelLookup::floorToInt(d_m * q + t[r]);
   }
 
   /// Global voxel coordinates of pixel u at depth d_m.

@@ -39,8 +39,7 @@ class VoxelLabelSampler {
   /// block is not allocated or it has no votes.
   int32_t label(int u, int v, float d_m) {
     const RowGrid& grid = row(v);
-    return labelOf(lookup_.findGridVotes(grid.coordinate(0, u, d_m), grid.coordinate(1, u, d_m),
-                                         grid.coordinate(2, u, d_m)));
+    return labelOf(lookup_.findGridVotes(grid.voxel(u, d_m)));
   }
 
   /// Global integer coordinates of the voxel the last label() call found.
@@ -59,10 +58,7 @@ class VoxelLabelSampler {
     row_votes_.resize(n);
     const RowGrid& grid = row(v);
     for (size_t k = 0; k < n; ++k) {
-      const int u = samples[k].u;
-      const float d_m = samples[k].d_m;
-      const Voxel* voxel = lookup_.findGrid(grid.coordinate(0, u, d_m), grid.coordinate(1, u, d_m),
-                                            grid.coordinate(2, u, d_m));
+      const Voxel* voxel = lookup_.findGrid(grid.voxel(samples[k].u, samples[k].d_m));
       if (voxels) voxels[k] = lookup_.lastVoxel();
       const Block* block = voxel ? lookup_.lastBlock() : nullptr;
       row_blocks_[k] = block;

@@ -39,10 +39,10 @@ class VoxelLookupT {
     return voxel ? last_->votes(last_->indexOf(*voxel)) : nullptr;
   }
 
-  /// The votes of the voxel with global integer coordinates (gx, gy, gz), or null when it has
-  /// none or its block is not allocated.
-  VotesPtr findGridVotes(int gx, int gy, int gz) {
-    const VoxelPtr voxel = findGrid(gx, gy, gz);
+  /// The votes of the voxel with global integer coordinates g, or null when it has none or its
+  /// block is not allocated.
+  VotesPtr findGridVotes(const Eigen::Vector3i& g) {
+    const VoxelPtr voxel = findGrid(g);
     return voxel ? last_->votes(last_->indexOf(*voxel)) : nullptr;
   }
 
@@ -61,6 +61,9 @@ class VoxelLookupT {
     last_voxel_ = Eigen::Vector3i(gx, gy, gz);
     return block ? &block->at(gx & 7, gy & 7, gz & 7) : nullptr;
   }
+
+  /// findGrid(g.x(), g.y(), g.z()).
+  VoxelPtr findGrid(const Eigen::Vector3i& g) { return findGrid(g.x(), g.y(), g.z()); }
 
   /// The block with index (bx, by, bz), or null when it is not allocated.
   BlockPtr findBlock(int bx, int by, int bz) {
