@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "panmap/segmentation/internal/depth_edges.h"
+#include "panmap/core/cpu_features.h"
 #include "panmap/core/vector_clones.h"
+#include "panmap/segmentation/internal/depth_edges.h"
 
 namespace panmap {
 namespace internal {
@@ -62,6 +63,66 @@ void pairConvexityRow(const DepthGeometry& g, int v, int dx, int dy, int u_begin
   }
 }
 
+#ifdef PANMAP_HAVE_AVX2_PATH
+// Pixels per chunk of the AVX2 path: its pair values, one row per offset, stay in L1.
+constexpr int kChunkPx = 128;
+
+// Pairs of pixels i = (u, v) and j = (u + dx, v + dy) for every dx in [dx_first, dx_last], u in
+// [u_begin, u_end) (a multiple of 8 pixels, every u + dx inside the row; min_i and min_j are
+// rows v and v + dy, the same row when dy = 0, where dx_first > 0): pairConvexityRow's
+// arithmetic in the same order (nothing contracted into FMA), so every pair gets its bits.
+// Pixel i's seven planes are loaded once for all its pairs, whose minimum is kept in
+// a register; the pairs' values then reach the j pixels' minima (min_j + dx) one offset at a
+// time through `chunk`, a pass per offset: updating them right away would have each load of
+// min_j read the store of the offset before, one pixel over, which the CPU cannot forward.
+__attribute__((target("avx2"))) void pairConvexityRowsAvx2(const DepthGeometry& g, int v, int dy,
+                                                           int dx_first, int dx_last, int u_begin,
+                                                           int u_end, float* min_i, float* min_j,
+                                                           float* chunk) {
+  const size_t i0 = g.index(0, v);
+  const size_t j0 = g.index(0, v + dy);
+  const float* const planes[7] = {g.x_m.data(), g.y_m.data(), g.z_m.data(),       g.nx.data(),
+                                  g.ny.data(),  g.nz.data(),  g.has_normal.data()};
+  const __m256 one = _mm256_set1_ps(1.0f);
+  const __m256 zero = _mm256_setzero_ps();
+  for (int c0 = u_begin; c0 < u_end; c0 += kChunkPx) {
+    const int c1 = std::min(u_end, c0 + kChunkPx);
+    for (int u = c0; u < c1; u += 8) {
+      __m256 pi[7];
+      for (int k = 0; k < 7; ++k) pi[k] = _mm256_loadu_ps(planes[k] + i0 + u);
+      __m256 lowest = _mm256_loadu_ps(min_i + u);
+      for (int dx = dx_first; dx <= dx_last; ++dx) {
+        __m256 pj[7];
+        for (int k = 0; k < 7; ++k) pj[k] = _mm256_loadu_ps(planes[k] + j0 + u + dx);
+        const __m256 bend = _mm256_add_ps(
+            _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(pj[0], pi[0]), _mm256_sub_ps(pi[3], pj[3])),
+                          _mm256_mul_ps(_mm256_sub_ps(pj[1], pi[1]), _mm256_sub_ps(pi[4], pj[4]))),
+            _mm256_mul_ps(_mm256_sub_ps(pj[2], pi[2]), _mm256_sub_ps(pi[5], pj[5])));
+        const __m256 normals_cos =
+            _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(pi[3], pj[3]), _mm256_mul_ps(pi[4], pj[4])),
+                          _mm256_mul_ps(pi[5], pj[5]));
+        const __m256 concave = _mm256_and_ps(_mm256_cmp_ps(bend, zero, _CMP_GT_OQ), one);
+        const __m256 c =
+            _mm256_sub_ps(one, _mm256_mul_ps(concave, _mm256_sub_ps(one, normals_cos)));
+        const __m256 value =
+            _mm256_sub_ps(one, _mm256_mul_ps(_mm256_mul_ps(pi[6], pj[6]), _mm256_sub_ps(one, c)));
+        lowest = _mm256_min_ps(value, lowest);  // value < lowest ? value : lowest
+        _mm256_storeu_ps(chunk + (dx - dx_first) * kChunkPx + (u - c0), value);
+      }
+      _mm256_storeu_ps(min_i + u, lowest);
+    }
+    for (int dx = dx_first; dx <= dx_last; ++dx) {
+      const float* values = chunk + (dx - dx_first) * kChunkPx - c0;  // indexed by u
+      float* target = min_j + dx;
+      for (int u = c0; u < c1; u += 8) {
+        const __m256 now = _mm256_loadu_ps(target + u);
+        _mm256_storeu_ps(target + u, _mm256_min_ps(_mm256_loadu_ps(values + u), now));
+      }
+    }
+  }
+}
+#endif
+
 PANMAP_VECTOR_CLONES
 void minInto(const float* values, int begin, int end, float* target) {
   for (int u = begin; u < end; ++u) target[u] = values[u] < target[u] ? values[u] : target[u];
@@ -71,7 +132,7 @@ void minInto(const float* values, int begin, int end, float* target) {
 
 PANMAP_VECTOR_CLONES
 void computeEdgeRows(const DepthGeometry& g, const DepthSegmentationConfig& config, int v0, int v1,
-                     EdgeScratch* scratch, EdgeMaps* edges) {
+                     EdgeScratch* scratch, EdgeMaps* edges, EdgePath path) {
   const int width = g.width;
   const int height = g.height;
   const int rc = config.min_convexity_window_px / 2;
@@ -81,6 +142,16 @@ void computeEdgeRows(const DepthGeometry& g, const DepthSegmentationConfig& conf
   scratch->outside_i.resize(width);
   scratch->outside_j.resize(width + 2 * rc);
   float* pair = scratch->pair_convexity.data();
+  // The AVX2 path takes the pixels whose every pair lies inside the row, in whole vectors.
+  int fused_begin = 0, fused_end = 0;
+  static_cast<void>(path);  // one path only without AVX2 support in the compiler
+#ifdef PANMAP_HAVE_AVX2_PATH
+  if (path == EdgePath::kFastest && cpuHasAvx2() && width - 2 * rc >= 8) {
+    fused_begin = rc;
+    fused_end = rc + (width - 2 * rc) / 8 * 8;
+    scratch->chunk.resize(static_cast<size_t>(2 * rc + 1) * kChunkPx);
+  }
+#endif
 
   // Min convexity. A pair's convexity is symmetric, so only offsets of the lower half window
   // are computed and each result goes to both pixels; rows above the band contribute to it
@@ -90,22 +161,33 @@ void computeEdgeRows(const DepthGeometry& g, const DepthSegmentationConfig& conf
     for (int dy = 0; dy <= rc; ++dy) {
       const int vj = v + dy;
       if (vj >= height || vj < v0) continue;
-      for (int dx = -rc; dx <= rc; ++dx) {
-        if (dy == 0 && dx <= 0) continue;
+      float* min_i = v >= v0 ? edges->min_convexity.row(v) : scratch->outside_i.data();
+      float* min_j = vj < v1 ? edges->min_convexity.row(vj) : scratch->outside_j.data() + rc;
+      const int dx_first = dy == 0 ? 1 : -rc;
+      for (int dx = dx_first; dx <= rc; ++dx) {
+        // The pixels the AVX2 path leaves out: all of them, or those before and after it.
         const int u_begin = std::max(0, -dx);
         const int u_end = std::min(width, width - dx);
-        if (dy == 0) {
-          // Both ends in one row: the minima overlap, so through the pair row.
-          pairConvexityRow(g, v, dx, dy, u_begin, u_end, pair, nullptr, nullptr);
-          minInto(pair, u_begin, u_end, edges->min_convexity.row(v));
-          minInto(pair, u_begin, u_end, edges->min_convexity.row(v) + dx);
-          continue;
+        const bool split = fused_end > fused_begin;
+        for (const auto& [b, e] : {std::make_pair(u_begin, split ? fused_begin : u_end),
+                                   std::make_pair(split ? fused_end : u_end, u_end)}) {
+          if (b >= e) continue;
+          if (dy == 0) {
+            // Both ends in one row: the minima overlap, so through the pair row.
+            pairConvexityRow(g, v, dx, dy, b, e, pair, nullptr, nullptr);
+            minInto(pair, b, e, min_i);
+            minInto(pair, b, e, min_j + dx);
+          } else {
+            pairConvexityRow(g, v, dx, dy, b, e, nullptr, min_i, min_j + dx);
+          }
         }
-        float* min_i = v >= v0 ? edges->min_convexity.row(v) : scratch->outside_i.data();
-        float* min_j =
-            vj < v1 ? edges->min_convexity.row(vj) + dx : scratch->outside_j.data() + rc + dx;
-        pairConvexityRow(g, v, dx, dy, u_begin, u_end, nullptr, min_i, min_j);
       }
+#ifdef PANMAP_HAVE_AVX2_PATH
+      if (fused_end > fused_begin) {
+        pairConvexityRowsAvx2(g, v, dy, dx_first, rc, fused_begin, fused_end, min_i, min_j,
+                              scratch->chunk.data());
+      }
+#endif
     }
   }
 

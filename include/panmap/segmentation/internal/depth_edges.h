@@ -42,13 +42,20 @@ struct EdgeScratch {
   std::vector<float> pair_convexity;  ///< one row of pair convexities
   std::vector<float> outside_i;       ///< absorbs minima of pixels i outside the band
   std::vector<float> outside_j;       ///< absorbs minima of pixels j outside the band
+  std::vector<float> chunk;           ///< AVX2 path: one chunk's pair convexities per offset
 };
+
+/// How computeEdgeRows computes the pairs of one row offset: `kFastest` takes the AVX2 path
+/// where the CPU has it (all offsets of a row in one pass), `kScalar` one offset at a time;
+/// both give the same bits.
+enum class EdgePath { kFastest, kScalar };
 
 /// Edge maps of rows [v0, v1): min convexity over the min_convexity_window_px window, then
 /// the flags from it, from the discontinuities, invalid depth and missing normals. Reads the
 /// geometry of rows within the window's radius of the band; writes only rows [v0, v1).
 void computeEdgeRows(const DepthGeometry& geometry, const DepthSegmentationConfig& config, int v0,
-                     int v1, EdgeScratch* scratch, EdgeMaps* edges);
+                     int v1, EdgeScratch* scratch, EdgeMaps* edges,
+                     EdgePath path = EdgePath::kFastest);
 
 }  // namespace internal
 }  // namespace panmap
