@@ -20,7 +20,10 @@
 //  - pair_sum_[p][l] = sum over all neighbours q of psi_p(l, l_q) is kept up to date as labels
 //    change, so D_p needs only the neighbours inside the move, not an exp per outside neighbour;
 //  - a move is solved only over the vertices of P that can change (see selectVertices);
-//  - a move is skipped when nothing it depends on changed since it was last solved (stale()).
+//  - a move is skipped when nothing it depends on changed since it was last solved (stale());
+//  - a move computes the switch cost only of vertices that a lower bound does not rule out
+//    (see mayMove()): on a building's graph a sweep had computed over a million of them for
+//    a few hundred that switch, most of the time of the swap.
 #include "panmap/graph/internal/alpha_beta_swap.h"
 
 #include <algorithm>
@@ -44,12 +47,13 @@ struct PairLink {
 /// Swap moves over one labelling, with buffers reused across moves.
 class SwapSolver {
  public:
-  SwapSolver(const LabelProblem& problem, std::vector<int>& labels)
-      : problem_(problem), labels_(labels), L_(problem.numLabels()) {
+  SwapSolver(const LabelProblem& problem, std::vector<int>& labels, SwapSeeds seeds)
+      : problem_(problem), labels_(labels), L_(problem.numLabels()), seeds_(seeds) {
     const int n = problem.num_vertices;
     local_.assign(n, -1);
     switch_cost_.assign(n, 0.0);
     gain_.assign(n, 0.0);
+    costed_at_.assign(n, -1);
     members_.resize(L_);
     changed_at_.assign(L_, 0);
     evaluated_at_.assign(static_cast<size_t>(L_) * L_, -1);
@@ -96,7 +100,29 @@ class SwapSolver {
         pair_sum_(p, l) = sum;
       }
     }
+    kc_total_ = std::move(kc_total);
+    // The two smallest unaries of each vertex, and the label of the smallest.
+    lowest_unary_.assign(n, INFINITY);
+    second_unary_.assign(n, INFINITY);
+    lowest_label_.assign(n, -1);
+    for (int l = 0; l < L_; ++l) {
+      const double* unary = problem.unary.row(l);
+      for (int p = 0; p < n; ++p) {
+        if (unary[p] < lowest_unary_[p]) {
+          second_unary_[p] = lowest_unary_[p];
+          lowest_unary_[p] = unary[p];
+          lowest_label_[p] = l;
+        } else if (unary[p] < second_unary_[p]) {
+          second_unary_[p] = unary[p];
+        }
+      }
+    }
+    may_move_.resize(n);
+    for (int p = 0; p < n; ++p) may_move_[p] = mayMove(p);
   }
+
+  /// Vertices whose switch cost the moves computed.
+  long long costed() const { return costed_; }
 
   /// False when the move (alpha, beta) cannot have changed since it was last solved: no vertex
   /// labelled alpha or beta, nor any neighbour of one, changed label since. (An accepted move
@@ -162,27 +188,12 @@ class SwapSolver {
   /// vertices already added exceed c_p, the vertices left out can be dropped from any optimal
   /// move without raising E: an optimal move over the set is an optimal move.
   void selectVertices(int alpha, int beta) {
+    ++select_clock_;
     verts_.clear();
     for (const auto& [own, other] : {std::make_pair(alpha, beta), std::make_pair(beta, alpha)}) {
-      const double* unary_own = problem_.unary.row(own);
-      const double* unary_other = problem_.unary.row(other);
-      const double* pair_own = pair_sum_.row(own);
-      const double* pair_other = pair_sum_.row(other);
-      const double* score_other = problem_.score.row(other);
-      const double* kc_own = kc_with_.row(own);
       for (int v : members_[own]) {
-        const double stay = unary_own[v] + pair_own[v];
-        double swap = unary_other[v] + pair_other[v];
-        if (score_other[v] > 0.0) {
-          for (int e = problem_.adj_offset[v]; e < problem_.adj_offset[v + 1]; ++e) {
-            const int q = problem_.adj_vertex[e];
-            if (labels_[q] == own) swap -= pairTo(v, other, q, own, e);
-          }
-        } else {  // psi_p(other, own) = the edge's K without a score for `other`
-          swap -= kc_own[v];
-        }
-        switch_cost_[v] = swap - stay;
-        gain_[v] = 0.0;
+        if (seeds_ == SwapSeeds::kBounded && !may_move_[v]) continue;
+        costSwitch(v, own, other);
         if (switch_cost_[v] < 0.0) {
           local_[v] = 0;
           verts_.push_back(v);
@@ -196,6 +207,7 @@ class SwapSolver {
       for (int e = problem_.adj_offset[v]; e < problem_.adj_offset[v + 1]; ++e) {
         const int q = problem_.adj_vertex[e];
         if (local_[q] >= 0 || labels_[q] != lv) continue;
+        if (costed_at_[q] != select_clock_) costSwitch(q, lv, other);
         gain_[q] += pairwisePotential(lv, other, problem_.score(q, lv), problem_.score(v, other),
                                       problem_.adj_factor[e], problem_.adj_kc[e]);
         if (gain_[q] > switch_cost_[q]) {
@@ -208,6 +220,38 @@ class SwapSolver {
     std::sort(verts_.begin(), verts_.end());
   }
 
+  /// switch_cost_[v] = c_p of v labelled own for the move to `other` (selectVertices), and
+  /// gain_[v] = 0, for this move.
+  void costSwitch(int v, int own, int other) {
+    const double stay = problem_.unary(v, own) + pair_sum_(v, own);
+    double swap = problem_.unary(v, other) + pair_sum_(v, other);
+    if (problem_.score(v, other) > 0.0) {
+      for (int e = problem_.adj_offset[v]; e < problem_.adj_offset[v + 1]; ++e) {
+        const int q = problem_.adj_vertex[e];
+        if (labels_[q] == own) swap -= pairTo(v, other, q, own, e);
+      }
+    } else {  // psi_p(other, own) = the edge's K without a score for `other`
+      swap -= kc_with_(v, own);
+    }
+    switch_cost_[v] = swap - stay;
+    gain_[v] = 0.0;
+    costed_at_[v] = select_clock_;
+    ++costed_;
+  }
+
+  /// False when no move can make p a seed (switch cost < 0): its swap term is its unary for
+  /// the other label plus pair terms to neighbours not labelled as p is, each >= 0, so the
+  /// cost is at least the smallest unary of a label other than p's, less its stay term. The
+  /// margin covers the rounding of the sums (pair_sum_ is kept up to date by increments), so a
+  /// vertex is only ever skipped when the full computation would also find cost >= 0.
+  bool mayMove(int p) const {
+    const int own = labels_[p];
+    const double least_other = own == lowest_label_[p] ? second_unary_[p] : lowest_unary_[p];
+    const double stay = problem_.unary(p, own) + pair_sum_(p, own);
+    const double margin =
+        1e-9 * (1.0 + std::abs(least_other) + std::abs(stay) + std::abs(kc_total_[p]));
+    return !(least_other - stay >= margin);
+  }
   /// D_p(alpha), D_p(beta) of every vertex of the move and the pair terms between them:
   /// pair_sum_ minus the terms of the neighbours inside the move.
   void buildTerms(int alpha, int beta) {
@@ -278,6 +322,15 @@ class SwapSolver {
         if (problem_.score(q, label) <= 0.0) pair_sum_(q, label) -= problem_.adj_kc[e];
       }
     }
+    // Their stay terms changed (a vertex's label, its neighbours' pair sums).
+    for (size_t k = 0; k < verts_.size(); ++k) {
+      const int v = verts_[k];
+      may_move_[v] = mayMove(v);
+      for (int e = problem_.adj_offset[v]; e < problem_.adj_offset[v + 1]; ++e) {
+        const int q = problem_.adj_vertex[e];
+        may_move_[q] = mayMove(q);
+      }
+    }
     merged_.clear();
     std::merge(members_[alpha].begin(), members_[alpha].end(), members_[beta].begin(),
                members_[beta].end(), std::back_inserter(merged_));
@@ -289,6 +342,7 @@ class SwapSolver {
   const LabelProblem& problem_;
   std::vector<int>& labels_;
   const int L_;
+  const SwapSeeds seeds_;
   std::vector<std::vector<int>> members_;  ///< vertices per label, ascending
   LabelTable kc_with_;                     ///< (vertex, label): sum of the K of edges to that label
   LabelTable pair_sum_;                    ///< (vertex, label): sum_q psi_p(label, l_q)
@@ -297,10 +351,18 @@ class SwapSolver {
   int64_t clock_ = 0;                  ///< counts solved and accepted moves
   std::vector<int64_t> changed_at_;    ///< per label: clock of the last change it depends on
   std::vector<int64_t> evaluated_at_;  ///< per label pair: clock when last solved
+  std::vector<double> kc_total_;       ///< per vertex: the K of all its edges
+  std::vector<double> lowest_unary_;   ///< per vertex: its smallest unary
+  std::vector<double> second_unary_;   ///< per vertex: its second smallest unary
+  std::vector<int> lowest_label_;      ///< per vertex: the label of the smallest
+  std::vector<char> may_move_;         ///< per vertex: mayMove(), kept up to date
+  int64_t select_clock_ = 0;           ///< counts selectVertices calls
+  long long costed_ = 0;               ///< switch costs computed
   // Per-move buffers.
   std::vector<int> local_;           ///< vertex -> index in the move, -1 outside
   std::vector<double> switch_cost_;  ///< selectVertices: c_p of the non-seeds
   std::vector<double> gain_;         ///< selectVertices: links to vertices that joined
+  std::vector<int64_t> costed_at_;   ///< selectVertices: select_clock_ when switch_cost_ was set
   std::vector<int> verts_;
   std::vector<int> merged_;
   std::vector<double> cost_a_;
@@ -313,11 +375,12 @@ class SwapSolver {
 
 }  // namespace
 
-SwapStats alphaBetaSwap(const LabelProblem& problem, std::vector<int>& labels, int max_sweeps) {
+SwapStats alphaBetaSwap(const LabelProblem& problem, std::vector<int>& labels, int max_sweeps,
+                        SwapSeeds seeds) {
   SwapStats stats;
   const int L = problem.numLabels();
   if (L < 2 || problem.num_vertices == 0) return stats;
-  SwapSolver solver(problem, labels);
+  SwapSolver solver(problem, labels, seeds);
   for (int sweep = 0; sweep < max_sweeps; ++sweep) {
     ++stats.sweeps;
     bool improved = false;
@@ -333,6 +396,7 @@ SwapStats alphaBetaSwap(const LabelProblem& problem, std::vector<int>& labels, i
     }
     if (!improved) break;
   }
+  stats.costed = solver.costed();
   return stats;
 }
 
