@@ -20,6 +20,18 @@ struct Candidate {
 
 }  // namespace
 
+std::vector<Links> linksOf(int n, const std::vector<LinkPair>& pairs) {
+  std::vector<int> degree(n, 0);
+  for (const LinkPair& p : pairs) ++degree[p.a], ++degree[p.b];
+  std::vector<Links> links(n);
+  for (int i = 0; i < n; ++i) links[i].reserve(degree[i]);
+  for (const LinkPair& p : pairs) {
+    links[p.a].emplace_hint(links[p.a].end(), p.b, p.evidence);
+    links[p.b].emplace_hint(links[p.b].end(), p.a, p.evidence);
+  }
+  return links;
+}
+
 std::vector<int> clusterByAffinity(std::vector<Links> links, std::vector<double> observed,
                                    double join_affinity, double min_coverage) {
   const int n = static_cast<int>(links.size());
@@ -51,11 +63,23 @@ std::vector<int> clusterByAffinity(std::vector<Links> links, std::vector<double>
       if (a < b) candidate(a, b, link);
     }
   }
-  std::make_heap(heap.begin(), heap.end());
-  while (!heap.empty()) {
-    std::pop_heap(heap.begin(), heap.end());
-    const Candidate top = heap.back();
-    heap.pop_back();
+  // The first entries, one per link, are sorted once, best last, and taken from the back; the
+  // heap holds only the entries of links that joins changed. Each step takes the better of the
+  // two fronts, so entries come out in a single heap's order, with fewer sift operations over a
+  // smaller heap (the plain algorithm's order: test JoinsInTheOrderOfThePlainAlgorithm).
+  std::vector<Candidate> initial;
+  initial.swap(heap);
+  std::sort(initial.begin(), initial.end());
+  while (!initial.empty() || !heap.empty()) {
+    Candidate top;
+    if (heap.empty() || (!initial.empty() && heap.front() < initial.back())) {
+      top = initial.back();
+      initial.pop_back();
+    } else {
+      std::pop_heap(heap.begin(), heap.end());
+      top = heap.back();
+      heap.pop_back();
+    }
     const int a = top.a, b = top.b;
     if (parent[a] != a || parent[b] != b) continue;  // a cluster joined another since
     const LinkEvidence& now = links[a].at(b);

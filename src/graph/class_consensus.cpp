@@ -34,16 +34,14 @@ std::vector<int32_t> classConsensus(const SuperpointGraph& graph,
     link->apart = e.apart;
     return link->same > 0.0;
   };
-  std::vector<Links> links(n);
+  std::vector<LinkPair> pairs;
+  pairs.reserve(graph.edges.size());
   for (const GraphEdge& e : graph.edges) {
     const int a = index(e.a), b = index(e.b);
     LinkEvidence link;
-    if (!linkOf(e, a, b, &link)) continue;
-    // Edges come sorted by (a, b): both lists grow at their ends.
-    links[a].emplace_hint(links[a].end(), b, link);
-    links[b].emplace_hint(links[b].end(), a, link);
+    if (linkOf(e, a, b, &link)) pairs.push_back({a, b, link});  // edges come sorted by (a, b)
   }
-  const std::vector<int> root = clusterByAffinity(std::move(links), std::move(observed),
+  const std::vector<int> root = clusterByAffinity(linksOf(n, pairs), std::move(observed),
                                                   config.join_affinity, config.min_coverage);
   // Groups of two or more classes, by root, in per-root arrays (no map or set per group).
   constexpr int32_t kNone = -1;

@@ -20,7 +20,8 @@ InstanceLabels clusterInstances(const SuperpointGraph& graph, const std::vector<
     const auto s = graph.vertices[i].scores.find(classes[i]);
     observed[i] = s == graph.vertices[i].scores.end() ? 0.0 : s->second;
   }
-  std::vector<Links> links(n);  // one mask: P_eps^C; two: P_sep^C
+  std::vector<LinkPair> pairs;  // one mask: P_eps^C; two: P_sep^C
+  pairs.reserve(graph.edges.size());
   for (const GraphEdge& e : graph.edges) {
     const int a = index(e.a), b = index(e.b);
     if (classes[a] != classes[b] || background.contains(classes[a])) continue;
@@ -31,11 +32,9 @@ InstanceLabels clusterInstances(const SuperpointGraph& graph, const std::vector<
     link.same = same == e.confidences.end() ? 0.0 : same->second;
     link.apart = apart == e.separations.end() ? 0.0 : apart->second;
     if (link.same <= 0.0 && link.apart <= 0.0) continue;
-    // Edges come sorted by (a, b): both lists grow at their ends.
-    links[a].emplace_hint(links[a].end(), b, link);
-    links[b].emplace_hint(links[b].end(), a, link);
+    pairs.push_back({a, b, link});  // edges come sorted by (a, b)
   }
-  const std::vector<int> root = clusterByAffinity(std::move(links), std::move(observed),
+  const std::vector<int> root = clusterByAffinity(linksOf(n, pairs), std::move(observed),
                                                   config.join_affinity, config.min_coverage);
 
   // Output ids: the initial instance most of a cluster's voxels carry, when no larger cluster

@@ -1,5 +1,7 @@
 // clusterByAffinity on hand-made link lists: joins add the links of the two clusters, so a third
 // vertex that neither reached alone can join their union, and links to it follow the join.
+#include <algorithm>
+#include <random>
 #include <tuple>
 #include <vector>
 
@@ -43,6 +45,83 @@ TEST(AffinityClustering, LinksFollowAJoinToTheClustersFirstMember) {
   const auto links = linksOf(4, {{1, 2, 9.0, 0.0}, {0, 2, 3.0, 1.0}});
   const std::vector<int> root = clusterByAffinity(links, {3.0, 9.0, 9.0, 1.0}, 0.6, 0.5);
   EXPECT_EQ(root, (std::vector<int>{0, 0, 0, 3}));
+}
+
+/// Average linkage the plain way: every pair of clusters re-evaluated after every join, the best
+/// join taken first (highest affinity, then larger same, then smaller first and second member).
+std::vector<int> referenceClusters(int n,
+                                   const std::vector<std::tuple<int, int, double, double>>& rows,
+                                   std::vector<double> observed, double join_affinity,
+                                   double min_coverage) {
+  std::vector<int> root(n);
+  for (int i = 0; i < n; ++i) root[i] = i;
+  while (true) {
+    // Evidence between clusters, summed over their members' links.
+    std::vector<std::vector<LinkEvidence>> sum(n, std::vector<LinkEvidence>(n));
+    for (const auto& [a, b, same, apart] : rows) {
+      const int x = std::min(root[a], root[b]), y = std::max(root[a], root[b]);
+      if (x == y) continue;
+      sum[x][y].same += same;
+      sum[x][y].apart += apart;
+    }
+    bool found = false;
+    std::tuple<double, double, int, int> best;
+    for (int x = 0; x < n; ++x) {
+      for (int y = x + 1; y < n; ++y) {
+        const LinkEvidence& link = sum[x][y];
+        if (!(link.same > 0.0)) continue;
+        const double affinity = link.same / (link.same + link.apart);
+        if (affinity < join_affinity) continue;
+        if (link.same < min_coverage * std::min(observed[x], observed[y])) continue;
+        const auto key = std::make_tuple(affinity, link.same, -x, -y);
+        if (!found || key > std::make_tuple(std::get<0>(best), std::get<1>(best),
+                                            -std::get<2>(best), -std::get<3>(best))) {
+          best = std::make_tuple(affinity, link.same, x, y);
+          found = true;
+        }
+      }
+    }
+    if (!found) return root;
+    const int x = std::get<2>(best), y = std::get<3>(best);
+    observed[x] += observed[y];
+    for (int& r : root) {
+      if (r == y) r = x;
+    }
+  }
+}
+
+TEST(AffinityClustering, JoinsInTheOrderOfThePlainAlgorithm) {
+  // Random graphs with values on a coarse grid, so that equal affinities and ties are common.
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n = 3 + static_cast<int>(rng() % 14);
+    std::vector<std::tuple<int, int, double, double>> rows;
+    for (int a = 0; a < n; ++a) {
+      for (int b = a + 1; b < n; ++b) {
+        if (rng() % 3 != 0) continue;
+        rows.emplace_back(a, b, static_cast<double>(rng() % 4), static_cast<double>(rng() % 3));
+      }
+    }
+    std::vector<double> observed(n);
+    for (double& o : observed) o = static_cast<double>(1 + rng() % 6);
+    EXPECT_EQ(clusterByAffinity(linksOf(n, rows), observed, 0.5, 0.3),
+              referenceClusters(n, rows, observed, 0.5, 0.3))
+        << "trial " << trial;
+  }
+}
+
+TEST(AffinityClustering, LinksOfPairsListsBothDirectionsInOrder) {
+  const std::vector<Links> links = internal::linksOf(
+      4, std::vector<LinkPair>{{0, 2, {1.0, 0.5}}, {0, 3, {2.0, 0.0}}, {1, 2, {3.0, 1.0}}});
+  ASSERT_EQ(links.size(), 4u);
+  EXPECT_EQ(links[0].size(), 2u);
+  EXPECT_EQ(links[1].size(), 1u);
+  EXPECT_EQ(links[2].size(), 2u);
+  EXPECT_EQ(links[3].size(), 1u);
+  EXPECT_EQ(links[2].begin()->first, 0);  // ascending: 0, then 1
+  EXPECT_EQ(links[2].at(1).same, 3.0);
+  EXPECT_EQ(links[3].at(0).same, 2.0);
+  EXPECT_EQ(links[0].at(2).apart, 0.5);
 }
 
 TEST(AffinityClustering, NoLinksLeaveEveryVertexAlone) {

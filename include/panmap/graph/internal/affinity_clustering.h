@@ -18,6 +18,18 @@ struct LinkEvidence {
 /// allocation-bound on a building's graph (docs/MAPPING.md, III-D).
 using Links = boost::container::flat_map<int, LinkEvidence>;
 
+/// One link between vertices a and b of a graph (indices).
+struct LinkPair {
+  int a;
+  int b;
+  LinkEvidence evidence;
+};
+
+/// The links of n vertices, both directions of every pair: `pairs` sorted by (a, b), each pair
+/// once, so every vertex's list grows at its end. Each list is sized once (counted first): a
+/// list grown entry by entry reallocates several times, tens of thousands of lists a graph.
+std::vector<Links> linksOf(int n, const std::vector<LinkPair>& pairs);
+
 /// Agglomerative clustering by the network's verdicts (average linkage): clusters X, Y join
 /// when same / (same + apart) over the pairs between them reaches `join_affinity` and `same`
 /// is at least `min_coverage` of the smaller cluster's `observed`; highest affinity first,
