@@ -22,8 +22,8 @@
 //  - a move is solved only over the vertices of P that can change (see selectVertices);
 //  - a move is skipped when nothing it depends on changed since it was last solved (stale());
 //  - a move computes the switch cost only of vertices that a lower bound does not rule out
-//    (see mayMove()): on a building's graph a sweep had computed over a million of them for
-//    a few hundred that switch, most of the time of the swap.
+//    (see mayMove()): on a building's graph the moves of three sweeps had computed 1.2 million
+//    of them for 2,859 that switched, over half of the swap's time.
 #include "panmap/graph/internal/alpha_beta_swap.h"
 
 #include <algorithm>
@@ -252,6 +252,7 @@ class SwapSolver {
         1e-9 * (1.0 + std::abs(least_other) + std::abs(stay) + std::abs(kc_total_[p]));
     return !(least_other - stay >= margin);
   }
+
   /// D_p(alpha), D_p(beta) of every vertex of the move and the pair terms between them:
   /// pair_sum_ minus the terms of the neighbours inside the move.
   void buildTerms(int alpha, int beta) {
