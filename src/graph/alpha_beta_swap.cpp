@@ -123,6 +123,8 @@ class SwapSolver {
 
   /// Vertices whose switch cost the moves computed.
   long long costed() const { return costed_; }
+  /// Seeds the bound would have left out (counted with SwapSeeds::kEveryVertex).
+  long long boundMisses() const { return bound_misses_; }
 
   /// False when the move (alpha, beta) cannot have changed since it was last solved: no vertex
   /// labelled alpha or beta, nor any neighbour of one, changed label since. (An accepted move
@@ -194,6 +196,7 @@ class SwapSolver {
       for (int v : members_[own]) {
         if (seeds_ == SwapSeeds::kBounded && !may_move_[v]) continue;
         costSwitch(v, own, other);
+        if (switch_cost_[v] < 0.0 && !may_move_[v]) ++bound_misses_;  // kEveryVertex only
         if (switch_cost_[v] < 0.0) {
           local_[v] = 0;
           verts_.push_back(v);
@@ -321,16 +324,9 @@ class SwapSolver {
         }
         if (problem_.score(q, old) <= 0.0) pair_sum_(q, old) += problem_.adj_kc[e];
         if (problem_.score(q, label) <= 0.0) pair_sum_(q, label) -= problem_.adj_kc[e];
+        may_move_[q] = mayMove(q);  // its pair sums changed
       }
-    }
-    // Their stay terms changed (a vertex's label, its neighbours' pair sums).
-    for (size_t k = 0; k < verts_.size(); ++k) {
-      const int v = verts_[k];
-      may_move_[v] = mayMove(v);
-      for (int e = problem_.adj_offset[v]; e < problem_.adj_offset[v + 1]; ++e) {
-        const int q = problem_.adj_vertex[e];
-        may_move_[q] = mayMove(q);
-      }
+      may_move_[v] = mayMove(v);  // its label changed
     }
     merged_.clear();
     std::merge(members_[alpha].begin(), members_[alpha].end(), members_[beta].begin(),
@@ -359,6 +355,7 @@ class SwapSolver {
   std::vector<char> may_move_;         ///< per vertex: mayMove(), kept up to date
   int64_t select_clock_ = 0;           ///< counts selectVertices calls
   long long costed_ = 0;               ///< switch costs computed
+  long long bound_misses_ = 0;         ///< seeds with mayMove() false
   // Per-move buffers.
   std::vector<int> local_;           ///< vertex -> index in the move, -1 outside
   std::vector<double> switch_cost_;  ///< selectVertices: c_p of the non-seeds
@@ -398,6 +395,7 @@ SwapStats alphaBetaSwap(const LabelProblem& problem, std::vector<int>& labels, i
     if (!improved) break;
   }
   stats.costed = solver.costed();
+  stats.bound_misses = solver.boundMisses();
   return stats;
 }
 

@@ -389,6 +389,7 @@ TEST(AlphaBetaSwap, BoundedSeedsGiveTheLabelsOfEveryVertexSeeds) {
     EXPECT_EQ(a.moves, b.moves) << "seed " << seed;
     EXPECT_EQ(a.solved, b.solved) << "seed " << seed;
     EXPECT_LE(a.costed, b.costed) << "seed " << seed;
+    EXPECT_EQ(b.bound_misses, 0) << "seed " << seed;  // the bound, kept up to date, holds
     moves += a.moves;
     if (chain) {
       chain_bounded += a.costed;

@@ -15,6 +15,9 @@ struct SwapStats {
   /// Vertices whose switch cost a move computed, over all moves (the others were skipped as
   /// unable to switch, see alpha_beta_swap.cpp).
   long long costed = 0;
+  /// With SwapSeeds::kEveryVertex: seeds (switch cost < 0) whose lower bound said they could
+  /// not be one, which kBounded would have left out; 0 when the bound holds.
+  long long bound_misses = 0;
 };
 
 /// How a move finds the vertices that may switch: `kBounded` skips those a lower bound on
