@@ -263,7 +263,7 @@ def bridge_note(rows):
             "checks leave them out the same way.")
 
 
-CAUSES = ["unobserved", "wrong class", "unlabelled", "merged", "split"]
+CAUSES = ["unobserved", "partly observed", "wrong class", "unlabelled", "merged", "split"]
 
 
 def miss_table(rows):
@@ -855,7 +855,11 @@ def main():
                "Each GT thing instance is matched (an object of its class with IoU > 0.5) or "
                "missed for the first cause that holds: **unobserved**, at most half of its "
                "surface found a mapped vertex within 5 cm (the trajectory did not see it: no "
-               "labelling can match it); **wrong class**, at most half of it carries its class "
+               "labelling can match it); **partly observed**, more than half of it was seen and "
+               "the best object of its class would match had the rest been seen and mapped as "
+               "the part seen was (its IoU over the share seen is above 0.5: the survey's "
+               "coverage, not the labelling, is short); **wrong class**, at most half of it "
+               "carries its class "
                "and more of the rest another class (what semantic regularisation, III-C, can "
                "fix); **unlabelled**, the same but more of the rest carries no class; **merged**, one object of its "
                "class holds most of it but is too large (spans neighbours: III-B and III-D's "

@@ -333,6 +333,10 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
       t.cause = Cause::kMatched;
     } else if (t.observed_share <= 0.5) {
       t.cause = Cause::kUnobserved;
+    } else if (t.best_same_class_iou > 0.5 * t.observed_share) {
+      // The part never seen, mapped as the part seen was, adds to the overlap and to the
+      // object alike: IoU / observed_share.
+      t.cause = Cause::kPartlyObserved;
     } else if (t.class_share <= 0.5) {
       t.cause = t.other_class_share >= unlabelled ? Cause::kWrongClass : Cause::kUnlabelled;
     } else {
@@ -424,6 +428,8 @@ const char* missCauseName(SceneDiagnostics::MissCause cause) {
       return "merged";
     case SceneDiagnostics::MissCause::kSplit:
       return "split";
+    case SceneDiagnostics::MissCause::kPartlyObserved:
+      return "partly observed";
   }
   return "?";
 }
@@ -474,12 +480,12 @@ std::string formatDiagnostics(const SceneDiagnostics& d) {
                 d.num_checkable_objects, d.checkable_objects_per_gt_instance, d.confident_objects,
                 d.confident_precision, d.confident_recall);
   out += line;
-  int causes[6] = {0, 0, 0, 0, 0, 0};
+  int causes[7] = {0, 0, 0, 0, 0, 0, 0};
   for (const SceneDiagnostics::GtThing& t : d.gt_things) ++causes[static_cast<int>(t.cause)];
   std::snprintf(line, sizeof(line),
-                "GT things at IoU 0.5: %d matched; missed: %d unobserved, %d wrong class, %d "
-                "unlabelled, %d merged, %d split\n",
-                causes[0], causes[1], causes[2], causes[3], causes[4], causes[5]);
+                "GT things at IoU 0.5: %d matched; missed: %d unobserved, %d partly observed, %d "
+                "wrong class, %d unlabelled, %d merged, %d split\n",
+                causes[0], causes[1], causes[6], causes[2], causes[3], causes[4], causes[5]);
   out += line;
   std::snprintf(line, sizeof(line),
                 "stuff IoU (share observed): wall %.3f (%.3f), floor %.3f (%.3f), ceiling %.3f "

@@ -71,8 +71,18 @@ TEST(Diagnostics, MissedThingsGetTheCauseThatBoundsThem) {
   // Other furniture (200): 60 in object 8, 140 reached but unlabelled: unlabelled.
   c.add(60, 39, 7, 39, 8, 10);
   c.add(140, 39, 7, 0, 0, 0);
+  // Bookshelf (200): 110 seen, 100 of them its own object 9 and nothing else, 90 never seen:
+  // IoU 0.5, not a match; over the 0.55 seen 0.91: partly observed (by shares, unlabelled).
+  c.add(100, 10, 8, 10, 9, 11);
+  c.add(10, 10, 8, 0, 0, 12);
+  c.add(90, 10, 8, 0, 0, 0, false);
+  // Desk (200): 120 seen, 100 of them labelled table (object 10), 20 desk (object 11), 80 never
+  // seen: IoU 0.1, over the 0.6 seen 0.17: seen, and wrongly labelled.
+  c.add(100, 14, 9, 7, 10, 13);
+  c.add(20, 14, 9, 14, 11, 14);
+  c.add(80, 14, 9, 0, 0, 0, false);
   const SceneDiagnostics d = diagnose(c.gt, c.pred, {});
-  ASSERT_EQ(d.gt_things.size(), 7u);
+  ASSERT_EQ(d.gt_things.size(), 9u);
   std::map<int32_t, SceneDiagnostics::GtThing> by_instance;
   for (const auto& t : d.gt_things) by_instance[t.instance_id] = t;
   using Cause = SceneDiagnostics::MissCause;
@@ -96,9 +106,15 @@ TEST(Diagnostics, MissedThingsGetTheCauseThatBoundsThem) {
   EXPECT_EQ(by_instance[6].cause, Cause::kSplit);
   EXPECT_NEAR(by_instance[6].class_share, 0.8, 1e-12);
   EXPECT_NEAR(by_instance[6].best_same_class_cover, 0.4, 1e-12);
+  EXPECT_EQ(by_instance[8].cause, Cause::kPartlyObserved);
+  EXPECT_NEAR(by_instance[8].observed_share, 0.55, 1e-12);
+  EXPECT_NEAR(by_instance[8].best_same_class_iou, 0.5, 1e-12);
+  EXPECT_EQ(by_instance[9].cause, Cause::kWrongClass);
+  EXPECT_NEAR(by_instance[9].best_same_class_iou, 0.1, 1e-12);
   EXPECT_STREQ(missCauseName(Cause::kWrongClass), "wrong class");
-  EXPECT_NE(formatDiagnostics(d).find("1 matched; missed: 1 unobserved, 1 wrong class, 1 "
-                                      "unlabelled, 2 merged, 1 split"),
+  EXPECT_STREQ(missCauseName(Cause::kPartlyObserved), "partly observed");
+  EXPECT_NE(formatDiagnostics(d).find("1 matched; missed: 1 unobserved, 1 partly observed, 2 "
+                                      "wrong class, 1 unlabelled, 2 merged, 1 split"),
             std::string::npos);
   // Labels built without `reached` count every vertex as observed.
   Case bare = c;

@@ -96,7 +96,10 @@ struct SceneDiagnostics {
   std::vector<ObjectMatch> objects;
   /// Why a GT thing is not matched at IoU 0.5, in the order tested; each cause bounds what
   /// can fix it. kUnobserved: at most half of it found a predicted vertex in range, so no
-  /// labelling can reach IoU 0.5 (the trajectory did not see it). At most half of it carries
+  /// labelling can reach IoU 0.5 (the trajectory did not see it). kPartlyObserved: more than
+  /// half of it was seen, and the best object of its class would match had the rest been
+  /// seen and mapped as the part seen was (its IoU over the share observed is above 0.5): the
+  /// survey's coverage, not the labelling, is what it lacks. At most half of it carries
   /// its class, and more of the rest carries another class (kWrongClass: semantics, III-C's
   /// domain) or no class at all (kUnlabelled). kMerged: one object of its class covers more
   /// than half of it but is too large (it spans neighbours or background). kSplit: its class
@@ -107,7 +110,8 @@ struct SceneDiagnostics {
     kWrongClass,
     kUnlabelled,
     kMerged,
-    kSplit
+    kSplit,
+    kPartlyObserved  // tested second: after kUnobserved, before kWrongClass
   };
 
   /// GT thing instances of at least ScanNet's minimum region size: (class, instance id,
