@@ -242,6 +242,18 @@ int main(int argc, char** argv) {
                 load_total_ms / 1000.0, panmap::spreadOf(load_ms).median);
     std::printf("  per frame        %.1f ms (mapping a frame before: %.1f ms median)\n",
                 1000.0 * blocking.reintegration.seconds / static_cast<double>(n), map_median_ms);
+    if (!blocking.reintegration.stage_median_ms.empty()) {
+      // Where a remap's time goes (occupancy runs beside the super-point stage).
+      std::string stages;
+      for (const auto& [name, ms] : blocking.reintegration.stage_median_ms) {
+        char part[64];
+        std::snprintf(part, sizeof(part), "%s%s %.2f", stages.empty() ? "" : ", ", name.c_str(),
+                      ms);
+        stages += part;
+      }
+      std::printf("  stages, median ms per frame: %s; ids carried over in %.2f s\n", stages.c_str(),
+                  blocking.reintegration.carry_over_s);
+    }
 
     // On its own thread while frames keep coming at rate_hz.
     panmap::BackgroundRepair repair(&mapper, &store, repair_config);

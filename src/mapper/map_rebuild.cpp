@@ -1,9 +1,11 @@
 // MapRebuild: the maps of a repair, built aside from the live ones.
 #include "panmap/mapper/map_rebuild.h"
 
+#include <chrono>
 #include <string>
 
 #include "panmap/core/error.h"
+#include "panmap/core/value_spread.h"
 #include "panmap/mapper/mapper.h"
 
 namespace panmap {
@@ -28,6 +30,13 @@ MapRebuild::MapRebuild(const MapperConfig& config, ThreadPool* pool, bool remap)
 
 MapRebuild::~MapRebuild() = default;
 
+std::vector<std::pair<std::string, double>> MapRebuild::stageMedians() const {
+  std::vector<std::pair<std::string, double>> out;
+  for (size_t k = 0; k < stage_names_.size(); ++k)
+    out.emplace_back(stage_names_[k], spreadOf(stage_ms_[k]).median);
+  return out;
+}
+
 const TsdfMap& MapRebuild::map() const { return mapper_ ? mapper_->map() : *map_; }
 
 size_t MapRebuild::framesWithKeptSegments() const {
@@ -42,14 +51,30 @@ void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
   pose.utime = frame.utime;
   pose.T_W_C = T_W_C;
   if (mapper_) {
+    FrameStats stats;
     try {
-      mapper_->integrate(frame, T_W_C, panoptic, PoseSource::kUnknown, kept);
+      stats = mapper_->integrate(frame, T_W_C, panoptic, PoseSource::kUnknown, kept);
     } catch (const Error& e) {
       throw Error(name + ": " + e.what());
     }
     votes_evicted_ = mapper_->voteEvictions();
+    const auto start = std::chrono::steady_clock::now();
     instance_samples_.push_back(sampleFrame(frame, poses_.size(), T_W_C, kInstanceSampleStepPx,
                                             config_->depth_calibration.get()));
+    const double sample_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    std::vector<std::pair<const char*, double>> times = stats.stageTimes();
+    times.emplace_back("instance samples", sample_ms);
+    for (const auto& [stage, ms] : times) {
+      // By name, as a stage may be missing from a frame ("tracking" when refinement is off).
+      size_t k = 0;
+      while (k < stage_names_.size() && stage_names_[k] != stage) ++k;
+      if (k == stage_names_.size()) {
+        stage_names_.emplace_back(stage);
+        stage_ms_.emplace_back();
+      }
+      stage_ms_[k].push_back(ms);
+    }
     poses_.push_back(pose);
     return;
   }

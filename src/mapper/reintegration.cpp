@@ -38,6 +38,7 @@ void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild, ReintegrationSta
     // surface take its id, so objects keep the ids a planner knows them by and super-points the
     // ids the graph and the optimiser's labels know them by (docs/LOOP_CLOSURE.md).
     Mapper& fresh = *rebuild->mapper_;
+    const auto carry_start = std::chrono::steady_clock::now();
     const CarryOverlap overlap =
         countCarryOverlap(rebuild->instance_samples_, trajectory_, *map_, *tracker_, *fresh.map_,
                           *fresh.tracker_, pool_.get());
@@ -72,6 +73,9 @@ void Mapper::commitRebuild(std::unique_ptr<MapRebuild> rebuild, ReintegrationSta
       };
       stats->instance_surface_kept = sameId(overlap.instances, instance_ids);
       stats->superpoint_surface_kept = sameId(overlap.superpoints, superpoint_ids);
+      stats->stage_median_ms = rebuild->stageMedians();
+      stats->carry_over_s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - carry_start).count();
     }
     adoptRemapped(rebuild->mapper_.get());
   } else {

@@ -3,6 +3,7 @@
 #include <cstring>
 #include <map>
 #include <set>
+#include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -320,6 +321,16 @@ TEST_F(Reintegration, ARemapIsTheMapOfTheFramesMappedAtTheNewPoses) {
   EXPECT_EQ(stats.frames_moved, 6u);
   EXPECT_EQ(stats.frames_with_kept_segments, 6u);
   EXPECT_EQ(bytes(*mapper), bytes(*again));
+  // Where the remap's time went: every stage of a frame once, in the pipeline's order, with
+  // the samples for the carried-over ids last; no tracking (the poses are the back-end's).
+  std::vector<std::string> stages;
+  for (const auto& [name, ms] : stats.stage_median_ms) {
+    stages.push_back(name);
+    EXPECT_GE(ms, 0.0) << name;
+  }
+  EXPECT_EQ(stages, (std::vector<std::string>{"segmentation", "superpoints", "integration", "graph",
+                                              "occupancy", "total", "instance samples"}));
+  EXPECT_GE(stats.carry_over_s, 0.0);
 
   // The same map, but for the super-points' ids (the remap kept the old map's).
   Mapper reference(config());

@@ -3,6 +3,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -55,6 +57,10 @@ class MapRebuild {
   /// True for a remap.
   bool remaps() const { return static_cast<bool>(mapper_); }
 
+  /// A remap's median milliseconds per stage over the frames added so far (FrameStats::
+  /// stageTimes, then "instance samples"); empty for a re-integration.
+  std::vector<std::pair<std::string, double>> stageMedians() const;
+
   /// The frames added so far: utime and the pose each was integrated with, in order.
   const std::vector<StampedPose>& poses() const { return poses_; }
   /// Label votes that pushed out a weaker one while building.
@@ -80,6 +86,9 @@ class MapRebuild {
   std::vector<StampedPose> poses_;
   // A remap's depth samples of every frame, for the instance ids it carries over.
   std::vector<InstanceSampleFrame> instance_samples_;
+  // A remap's stage times of every frame, by stage (names in stage_names_, first-seen order).
+  std::vector<std::string> stage_names_;
+  std::vector<std::vector<double>> stage_ms_;
   uint64_t votes_evicted_ = 0;
   RgbdFrame calibrated_;  // scratch: a frame with the depth calibration applied
 };

@@ -186,6 +186,11 @@ struct ReintegrationStats {
   /// with (rejoinCoincidingSuperpoints()).
   size_t superpoints_rejoined = 0;
   double rejoin_s = 0.0;  ///< wall time of finding and making those merges
+  /// A remap's frames: the median milliseconds of each stage (FrameStats::stageTimes, then
+  /// "instance samples": the depth samples each frame keeps for the ids carried over), and the
+  /// seconds spent carrying ids over at the swap. Where a repair's time goes.
+  std::vector<std::pair<std::string, double>> stage_median_ms;
+  double carry_over_s = 0.0;  ///< (see stage_median_ms)
 };
 
 class BinaryReader;
