@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "panmap/core/memory_policy.h"
 #include "panmap/core/process_memory.h"
 #include "panmap/io/dataset_reader.h"
 #include "panmap/lcm/offline_mapping.h"
@@ -136,6 +137,7 @@ class Recorder {
 }  // namespace
 
 int main(int argc, char** argv) {
+  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
   CLI::App app{"Time the mapping pipeline (no network) on every frame of a dataset or log."};
   std::string data = "../shared/data/7scenes-200", json_path, log_path, config_path;
   panmap::MapperConfig config;

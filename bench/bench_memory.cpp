@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "panmap/core/error.h"
+#include "panmap/core/memory_policy.h"
 #include "panmap/core/process_memory.h"
 #include "panmap/mapper/config_file.h"
 #include "panmap/mapper/mapper.h"
@@ -53,6 +54,7 @@ size_t superpointsWithVotes(const panmap::Mapper& mapper) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
   CLI::App app{
       "Map a long synthetic walk through one room and report resident memory against the "
       "map's own size every few hundred frames."};

@@ -30,6 +30,7 @@
 #include <CLI/CLI.hpp>
 
 #include "panmap/core/error.h"
+#include "panmap/core/memory_policy.h"
 #include "panmap/core/progress.h"
 #include "panmap/core/value_spread.h"
 #include "panmap/io/dataset_reader.h"
@@ -92,6 +93,7 @@ struct InputFrame {
 }  // namespace
 
 int main(int argc, char** argv) {
+  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
   CLI::App app{
       "Time a loop-closure repair of N stored frames of a real sequence: blocking, and on its "
       "own thread while frames keep being mapped at a given rate."};

@@ -12,6 +12,7 @@
 
 #include "panmap/calibration/depth_calibrator.h"
 #include "panmap/core/error.h"
+#include "panmap/core/memory_policy.h"
 #include "panmap/core/progress.h"
 #include "panmap/io/tum_trajectory.h"
 #include "panmap/lcm/offline_mapping.h"
@@ -66,6 +67,7 @@ Round mapOnce(const std::string& log, const panmap::MapperConfig& config, int64_
 }  // namespace
 
 int main(int argc, char** argv) {
+  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
   CLI::App app{
       "Learns a depth sensor's fixed-pattern depth error from an LCM log of its frames and "
       "poses, and writes it for panmap-mapper --depth-calibration. The first round learns "

@@ -11,12 +11,14 @@
 #include <nlohmann/json.hpp>
 
 #include "panmap/core/error.h"
+#include "panmap/core/memory_policy.h"
 #include "panmap/core/progress.h"
 #include "panmap/eval/photometric_consistency.h"
 #include "panmap/io/dataset_reader.h"
 #include "panmap/io/tum_trajectory.h"
 
 int main(int argc, char** argv) {
+  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
   CLI::App app{
       "Photometric consistency of camera trajectories over an RGB-D dataset folder: the median "
       "grey-level difference between each frame's strongly textured pixels and where the "

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "panmap/core/error.h"
+#include "panmap/core/memory_policy.h"
 #include "panmap/core/progress.h"
 #include "panmap/io/tum_trajectory.h"
 #include "panmap/lcm/channels.h"
@@ -34,6 +35,7 @@ std::optional<Eigen::Vector4d> parseIntrinsics(const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
   CLI::App app{
       "Import an RGB-D dataset folder into an LCM log (channels CAMERA_RGBD, CAMERA_POSE and, "
       "with --masks, PANOPTIC).\nLayouts: 7scenes (frame-XXXXXX.{color.jpg,depth.png,pose.txt} "

@@ -14,6 +14,7 @@
 
 #include "panmap/building/building.h"
 #include "panmap/core/error.h"
+#include "panmap/core/memory_policy.h"
 #include "panmap/core/progress.h"
 #include "panmap/io/image_codec.h"
 #include "panmap/io/ply.h"
@@ -106,6 +107,7 @@ void writePreview(const std::string& out_dir, const panmap::SynthFrame& f) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
   CLI::App app{
       "Render a labelled mesh along a camera trajectory into an LCM log (CAMERA_RGBD, "
       "CAMERA_POSE, PANOPTIC) with sensor noise, segmenter errors and SLAM-like pose drift, "

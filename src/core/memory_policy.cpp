@@ -10,6 +10,7 @@ void returnLargeBuffersToTheSystem() {
 #ifdef __GLIBC__
   // Setting M_MMAP_THRESHOLD also turns off glibc's dynamic adjustment of it.
   mallopt(M_MMAP_THRESHOLD, static_cast<int>(kLargeBufferBytes));
+  mallopt(M_TRIM_THRESHOLD, static_cast<int>(kHeapKeepBytes));
 #endif
 }
 
