@@ -18,8 +18,8 @@ constexpr size_t kHeapKeepBytes = size_t{32} << 20;
 /// buffers go. Fixing it also fixes glibc's trim threshold at 128 kB, so every frame's freed
 /// images were handed back and faulted in again: about 700 page faults a frame decoding a
 /// log's colour, depth and masks, 20 % of the process's CPU time on this project's 2-core VM
-/// (docs/PERFORMANCE.md); the heap keeps kHeapKeepBytes free at its top instead. A no-op where
-/// the C library is not glibc. Call once, early in main().
+/// (docs/STATUS.md, 2026-12-05); the heap keeps kHeapKeepBytes free at its top instead. A
+/// no-op where the C library is not glibc. Call once, early in main().
 void returnLargeBuffersToTheSystem();
 
 }  // namespace panmap
