@@ -70,6 +70,8 @@ for f in mesh_semantic.ply mesh_instance.ply mesh_superpoint.ply objects.json oc
   [ -f "$out/$f" ] && printf '  %-24s %s\n' "$f" "$(du -h "$out/$f" | cut -f1)"
 done
 echo "demo: the map against the room's ground truth ($log_dir/gt/):"
+# The summary rows by name: panmap-eval's per-class table and diagnostics grow over time.
 build/panmap-eval --pred $out/mesh_instance.ply --gt $log_dir/gt/mesh.ply \
-  --confidences $out/objects.json | tail -n 2
+  --confidences $out/objects.json |
+  grep -E '^(class |average/sum|GT things at IoU|objects:|stuff IoU|reliability:)'
 echo "demo: query the occupancy like a planner: build/panmap-occupancy-probe --file $out/occupancy.bt --point X Y Z"
