@@ -1,6 +1,7 @@
 // MapRebuild: the maps of a repair, built aside from the live ones.
 #include "panmap/mapper/map_rebuild.h"
 
+#include <algorithm>
 #include <chrono>
 #include <string>
 
@@ -32,8 +33,7 @@ MapRebuild::~MapRebuild() = default;
 
 std::vector<std::pair<std::string, double>> MapRebuild::stageMedians() const {
   std::vector<std::pair<std::string, double>> out;
-  for (size_t k = 0; k < stage_names_.size(); ++k)
-    out.emplace_back(stage_names_[k], spreadOf(stage_ms_[k]).median);
+  for (const auto& [stage, ms] : stage_ms_) out.emplace_back(stage, spreadOf(ms).median);
   return out;
 }
 
@@ -67,13 +67,11 @@ void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
     times.emplace_back("instance samples", sample_ms);
     for (const auto& [stage, ms] : times) {
       // By name, as a stage may be missing from a frame ("tracking" when refinement is off).
-      size_t k = 0;
-      while (k < stage_names_.size() && stage_names_[k] != stage) ++k;
-      if (k == stage_names_.size()) {
-        stage_names_.emplace_back(stage);
-        stage_ms_.emplace_back();
-      }
-      stage_ms_[k].push_back(ms);
+      auto it = std::find_if(stage_ms_.begin(), stage_ms_.end(),
+                             [&](const auto& entry) { return entry.first == stage; });
+      if (it == stage_ms_.end())
+        it = stage_ms_.emplace(stage_ms_.end(), stage, std::vector<double>{});
+      it->second.push_back(ms);
     }
     poses_.push_back(pose);
     return;

@@ -86,9 +86,8 @@ class MapRebuild {
   std::vector<StampedPose> poses_;
   // A remap's depth samples of every frame, for the instance ids it carries over.
   std::vector<InstanceSampleFrame> instance_samples_;
-  // A remap's stage times of every frame, by stage (names in stage_names_, first-seen order).
-  std::vector<std::string> stage_names_;
-  std::vector<std::vector<double>> stage_ms_;
+  // A remap's stage times of every frame, by stage name in the order first seen.
+  std::vector<std::pair<std::string, std::vector<double>>> stage_ms_;
   uint64_t votes_evicted_ = 0;
   RgbdFrame calibrated_;  // scratch: a frame with the depth calibration applied
 };
