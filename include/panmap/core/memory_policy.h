@@ -16,10 +16,10 @@ constexpr size_t kHeapKeepBytes = size_t{32} << 20;
 /// that was never used again, 30-50 MiB with this policy. Fixing the threshold at
 /// kLargeBufferBytes keeps per-frame images (below it) in the heap and lets the rare large
 /// buffers go. Fixing it also fixes glibc's trim threshold at 128 kB, so every frame's freed
-/// images were handed back and faulted in again: about 700 page faults a frame decoding a
-/// log's colour, depth and masks, 20 % of the process's CPU time on this project's 2-core VM
-/// (docs/STATUS.md, 2026-12-05); the heap keeps kHeapKeepBytes free at its top instead. A
-/// no-op where the C library is not glibc. Call once, early in main().
+/// images were handed back and faulted in again: 700-1,000 page faults a frame decoding a
+/// log's colour, depth and masks, a fifth to a third of panmap-mapper's CPU time on this
+/// project's 2-core VM (docs/STATUS.md, 2026-12-05); the heap keeps kHeapKeepBytes free at
+/// its top instead. A no-op where the C library is not glibc. Call once, early in main().
 void returnLargeBuffersToTheSystem();
 
 }  // namespace panmap
