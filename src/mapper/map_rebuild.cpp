@@ -65,13 +65,15 @@ void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     std::vector<std::pair<const char*, double>> times = stats.stageTimes();
     times.emplace_back("instance samples", sample_ms);
-    for (const auto& [stage, ms] : times) {
+    for (const auto& time : times) {
       // By name, as a stage may be missing from a frame ("tracking" when refinement is off).
+      // Not a structured binding: C++17 lambdas (clang) cannot capture one.
+      const std::string stage = time.first;
       auto it = std::find_if(stage_ms_.begin(), stage_ms_.end(),
                              [&](const auto& entry) { return entry.first == stage; });
       if (it == stage_ms_.end())
         it = stage_ms_.emplace(stage_ms_.end(), stage, std::vector<double>{});
-      it->second.push_back(ms);
+      it->second.push_back(time.second);
     }
     poses_.push_back(pose);
     return;
