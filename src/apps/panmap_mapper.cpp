@@ -472,6 +472,17 @@ int main(int argc, char** argv) {
               progress.setNote(note);
             });
         progress.finish();
+        // Empty outputs and exit 0 would pass a wrong file or channel name off as a map.
+        if (report.frames_integrated == 0 && mapper->framesIntegrated() == 0) {
+          throw panmap::Error("no frame mapped from " + log_path + ": " +
+                              panmap::describeNothingMapped(report, options));
+        }
+        const std::string damage = panmap::describeLogDamage(report);
+        if (!damage.empty()) {
+          std::fprintf(stderr,
+                       "panmap-mapper: warning: log %s: %s; its readable events were mapped\n",
+                       log_path.c_str(), damage.c_str());
+        }
       }
       const auto optimise_start = std::chrono::steady_clock::now();
       const panmap::SuperpointGraph graph = mapper->graph();
@@ -490,6 +501,7 @@ int main(int argc, char** argv) {
       json["autosave"] = autosaveJson(autosaver.get(), autosave_s);
       json["resumed"] = resumeJson(resumed);
       json["events"] = report.events;
+      json["log_damage"] = panmap::describeLogDamage(report);
       json["wall_s"] = report.wall_s;
       json.update(mapJson(*mapper, outputs));
       json["graph"] = {{"vertices", graph.vertices.size()},

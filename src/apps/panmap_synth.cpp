@@ -127,13 +127,22 @@ int main(int argc, char** argv) {
   std::string unannotated_masks = "painted";
   bool join_parts = false, semantic_masks = false;
   auto* source = app.add_option_group("source", "ground-truth mesh (one of)");
-  source->add_option("--room", room_seed, "procedural room with this seed");
+  // CLI::NonNegativeNumber would print the double range up to 1.8e308 in its message.
+  const CLI::Validator seed_check(
+      [](const std::string& text) {
+        return !text.empty() && text[0] != '-' ? std::string()
+                                               : "a seed is an integer >= 0, not " + text;
+      },
+      "SEED");
+  source->add_option("--room", room_seed, "procedural room with this seed")->check(seed_check);
   int64_t building_seed = -1;
   panmap::BuildingConfig building_config;
-  source->add_option("--building", building_seed,
-                     "procedural building with this seed: rooms of --room-style along a "
-                     "corridor, walked once through every room at 5 Hz unless --frames or "
-                     "--rate-hz say otherwise");
+  source
+      ->add_option("--building", building_seed,
+                   "procedural building with this seed: rooms of --room-style along a "
+                   "corridor, walked once through every room at 5 Hz unless --frames or "
+                   "--rate-hz say otherwise")
+      ->check(seed_check);
   source->add_option("--scannet", scannet_dir,
                      "ScanNet scene folder (<scene>_vh_clean_2.ply, .aggregation.json, "
                      "_vh_clean_2.0.010000.segs.json)");

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "panmap/core/error.h"
+#include "panmap/lcm/log_bytes.h"
 #include "panmap/lcm/message_types.h"
 
 namespace panmap {
@@ -41,18 +42,11 @@ LogInfo inspectLog(const std::string& path, bool deep,
   LogInfo info;
   info.path = path;
   std::map<std::string, ChannelInfo> channels;
-  // LCM's reader skips leading garbage and stops quietly at a cut or corrupt event, so
-  // account for every byte: each event must start where the previous one ended.
-  size_t previous_end = 0;
+  LogByteAccount bytes;
   while (const lcm::LogEvent* event = log.readNextEvent()) {
     ++info.events;
-    const long pos = std::ftell(log.getFilePtr());
-    const size_t event_bytes = 28 + event->channel.size() + static_cast<size_t>(event->datalen);
-    if (pos >= 0 && static_cast<size_t>(pos) >= event_bytes) {
-      const size_t start = static_cast<size_t>(pos) - event_bytes;
-      if (start > previous_end) info.skipped_bytes += start - previous_end;
-      previous_end = static_cast<size_t>(pos);
-    }
+    bytes.addEvent(LogByteAccount::eventBytes(event->channel.size(), event->datalen),
+                   std::ftell(log.getFilePtr()));
     ChannelInfo& c = channels[event->channel];
     c.channel = event->channel;
     const MessageCheck check = checkMessage(event->data, static_cast<size_t>(event->datalen), deep);
@@ -75,8 +69,9 @@ LogInfo inspectLog(const std::string& path, bool deep,
       progress(static_cast<size_t>(std::ftell(log.getFilePtr())), file_size);
     }
   }
-  info.readable_bytes = previous_end;
-  info.truncated = previous_end < file_size;
+  info.readable_bytes = bytes.readableBytes();
+  info.skipped_bytes = bytes.skippedBytes();
+  info.truncated = bytes.truncated(file_size);
   for (auto& kv : channels) info.channels.push_back(kv.second);
   return info;
 }

@@ -75,6 +75,60 @@ TEST(Cli, MapperWithoutTheOptimisationSaysSo) {
   EXPECT_TRUE(optimised("b"));
 }
 
+// A log that gives no frame is an error, not an empty map: an empty file, bytes that are no LCM
+// log, and a log whose frames are on another channel than the one asked for.
+TEST(Cli, MapperRefusesALogWithoutFramesInOneLine) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  writeFileBytes(dir.path("empty.lcmlog"), {});
+  std::vector<uint8_t> noise(4096);
+  for (size_t i = 0; i < noise.size(); ++i)
+    noise[i] = static_cast<uint8_t>((i * 2654435761u) >> 13);
+  writeFileBytes(dir.path("noise.lcmlog"), noise);
+  const auto imp = runCommand(binPath("panmap-import") + " --quiet --max-frames 2 " +
+                              test::dataDir("7scenes-200") + " " + dir.path("s.lcmlog"));
+  ASSERT_EQ(imp.exit_code, 0) << imp.output;
+  const std::string mapper = binPath("panmap-mapper") + " -q --voxel-size 0.05 --no-snapshots ";
+  const std::pair<std::string, std::string> cases[] = {
+      {"--log " + dir.path("empty.lcmlog"), "the log is empty"},
+      {"--log " + dir.path("noise.lcmlog"), "no LCM event in the log"},
+      {"--channel-rgbd RGBD --log " + dir.path("s.lcmlog"),
+       "no event on the RGB-D channel RGBD; the log has CAMERA_POSE (2), CAMERA_RGBD (2)"}};
+  for (const auto& [arguments, reason] : cases) {
+    const auto r = runCommand(mapper + arguments + " --out " + dir.path("out"));
+    EXPECT_EQ(r.exit_code, 1) << arguments;
+    EXPECT_EQ(test::countLines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find("no frame mapped from"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(reason), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.path("out"))) << arguments;
+  }
+}
+
+// A cut log is mapped up to its last whole event, with a warning and the damage in report.json.
+TEST(Cli, MapperMapsTheReadablePartOfACutLogAndSaysSo) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  const auto imp = runCommand(binPath("panmap-import") + " --quiet --max-frames 3 " +
+                              test::dataDir("7scenes-200") + " " + dir.path("s.lcmlog"));
+  ASSERT_EQ(imp.exit_code, 0) << imp.output;
+  auto bytes = readFileBytes(dir.path("s.lcmlog"));
+  bytes.resize(bytes.size() - 1000);  // into the last frame's depth
+  writeFileBytes(dir.path("cut.lcmlog"), bytes);
+  const auto r =
+      runCommand(binPath("panmap-mapper") + " -q --voxel-size 0.05 --no-snapshots --log " +
+                 dir.path("cut.lcmlog") + " --out " + dir.path("out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("warning: log " + dir.path("cut.lcmlog") + ": unreadable after byte"),
+            std::string::npos)
+      << r.output;
+  std::ifstream in(dir.path("out/report.json"));
+  const auto report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["frames_integrated"], 2);
+  EXPECT_NE(report["log_damage"].get<std::string>().find("of " + std::to_string(bytes.size())),
+            std::string::npos)
+      << report["log_damage"];
+}
+
 TEST(Cli, ImportThenLogInfoJson) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   test::TempDir dir;

@@ -110,6 +110,11 @@ TEST(SynthCli, BadArgumentsFailClearly) {
                                dir.path("none.txt") + " --out " + dir.path("x"));
   EXPECT_EQ(traj.exit_code, 1);
   EXPECT_NE(traj.output.find("none.txt"), std::string::npos) << traj.output;
+  // A negative seed used to mean "no room" and fell through to a ScanNet scene with no folder.
+  const auto negative = runCommand(binPath("panmap-synth") + " --room -1 --out " + dir.path("x"));
+  EXPECT_NE(negative.exit_code, 0);
+  EXPECT_NE(negative.output.find("--room: a seed is an integer >= 0, not -1"), std::string::npos)
+      << negative.output;
   const auto join =
       runCommand(binPath("panmap-synth") + " --room 1 --join-parts --out " + dir.path("x"));
   EXPECT_EQ(join.exit_code, 1);
