@@ -32,9 +32,8 @@ bool LogInfo::allDecoded() const {
 LogInfo inspectLog(const std::string& path, bool deep,
                    const std::function<void(size_t, size_t)>& progress) {
   struct stat st;
-  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
-    throw Error("log " + path + " does not exist");
-  }
+  if (::stat(path.c_str(), &st) != 0) throw Error("log " + path + " does not exist");
+  if (!S_ISREG(st.st_mode)) throw Error("log " + path + " is not a regular file");
   const auto file_size = static_cast<size_t>(st.st_size);
   lcm::LogFile log(path, "r");
   if (!log.good()) throw Error("cannot open log " + path);
