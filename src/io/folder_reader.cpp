@@ -298,7 +298,37 @@ class FolderReader : public DatasetReader {
     if (color_width_ != camera_.width || color_height_ != camera_.height) {
       note << " (resized to the depth size)";
     }
+    if (!hasCentredPrincipalPoint(camera_, camera_.width, camera_.height)) {
+      // One intrinsics file for two image sizes is often the colour camera's: its principal
+      // point lies near the colour image's centre, far from a smaller depth image's. Mapped with
+      // it, every point would be shifted by half an image.
+      const double aspect_color = static_cast<double>(color_width_) / color_height_;
+      const double aspect_depth = static_cast<double>(camera_.width) / camera_.height;
+      if (!hasCentredPrincipalPoint(camera_, color_width_, color_height_) ||
+          std::abs(aspect_color / aspect_depth - 1.0) > 0.02) {
+        std::ostringstream why;
+        why << from << ": principal point (" << k(2) << ", " << k(3)
+            << ") lies outside the middle half of the " << camera_.width << "x" << camera_.height
+            << " depth image; give the depth camera's intrinsics (--intrinsics "
+            << "fx,fy,cx,cy)";
+        throw Error(why.str());
+      }
+      PinholeCamera color_camera = camera_;
+      color_camera.width = color_width_;
+      color_camera.height = color_height_;
+      camera_ = color_camera.resized(camera_.width, camera_.height);
+      note << "; the colour camera's (principal point at the colour image's centre), scaled to "
+           << "the depth size: fx " << camera_.fx << ", fy " << camera_.fy << ", cx " << camera_.cx
+           << ", cy " << camera_.cy;
+    }
     notes_.push_back(note.str());
+  }
+
+  // True when the principal point lies in the middle half of a width x height image, as it
+  // does for every camera's own images.
+  static bool hasCentredPrincipalPoint(const PinholeCamera& camera, int width, int height) {
+    return camera.cx > 0.25 * width && camera.cx < 0.75 * width && camera.cy > 0.25 * height &&
+           camera.cy < 0.75 * height;
   }
 
   void readPoses() {

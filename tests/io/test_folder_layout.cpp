@@ -179,6 +179,48 @@ TEST(FolderLayout, ResizesColourOfAnotherResolution) {
   EXPECT_FLOAT_EQ(f.color_map_u(0, 0), 0.5f);  // pixel centre 0.5 * 2 - 0.5
 }
 
+// The intrinsics of the colour camera given for a depth image of half its size: the principal
+// point sits at the colour image's centre and is scaled to the depth image.
+TEST(FolderLayout, ScalesTheColourCamerasIntrinsicsToTheDepthImage) {
+  test::TempDir dir;
+  makeIssueFolder(dir, 1);
+  writeFrame(dir.path("rgb/000000.png"), dir.path("depth/000000.png"), 0, 2000, 16, 12);
+  writeText(dir.path("intrinsic.txt"), "10 0 7.5\n0 12 5.5\n0 0 1\n");
+  const auto reader = openDataset(dir.path(), DatasetOptions{});
+  const PinholeCamera camera = reader->read(0).rgbd.camera;
+  EXPECT_DOUBLE_EQ(camera.fx, 5.0);
+  EXPECT_DOUBLE_EQ(camera.fy, 6.0);
+  EXPECT_DOUBLE_EQ(camera.cx, 3.5);  // pixel centres: (7.5 + 0.5) / 2 - 0.5
+  EXPECT_DOUBLE_EQ(camera.cy, 2.5);
+  bool said = false;
+  for (const std::string& note : reader->notes()) {
+    said |= note.find(
+                "the colour camera's (principal point at the colour image's centre), "
+                "scaled to the depth size: fx 5, fy 6, cx 3.5, cy 2.5") != std::string::npos;
+  }
+  EXPECT_TRUE(said);
+}
+
+// A principal point that fits neither image is an error naming the file, not a map shifted by
+// half an image; one that fits the depth image is taken as given.
+TEST(FolderLayout, RefusesIntrinsicsThatFitNeitherImage) {
+  test::TempDir dir;
+  makeIssueFolder(dir, 1);
+  writeText(dir.path("intrinsic.txt"), "5 0 7.9\n0 6 3\n0 0 1\n");
+  try {
+    openDataset(dir.path(), DatasetOptions{});
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "intrinsic.txt: principal point (7.9, 3) lies outside the middle half of the "
+                  "8x6 depth image; give the depth camera's intrinsics"),
+              std::string::npos)
+        << e.what();
+  }
+  writeText(dir.path("intrinsic.txt"), "5 0 5.9\n0 6 1.6\n0 0 1\n");
+  EXPECT_DOUBLE_EQ(openDataset(dir.path(), DatasetOptions{})->read(0).rgbd.camera.cx, 5.9);
+}
+
 TEST(FolderLayout, AutoDetectionListsEveryLayoutTried) {
   test::TempDir dir;
   fs::create_directory(dir.path("depth"));
