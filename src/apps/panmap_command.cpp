@@ -1,6 +1,7 @@
 // panmap-command: sends one PANMAP_COMMAND to a running panmap-mapper (finish, save, export,
-// optimise), e.g. at the end of an lcm-logplayer replay; `status` prints the mapper's next
-// PANMAP_STATUS as one JSON line (for scripts and monitoring).
+// optimise), e.g. at the end of an lcm-logplayer replay, and waits for the mapper's status that
+// shows it is listening; `status` prints the mapper's next PANMAP_STATUS as one JSON line (for
+// scripts and monitoring).
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -82,21 +83,26 @@ struct StatusCatcher {
   }
 };
 
+// Handles messages until `catcher` holds a status or `timeout_s` has passed.
+void waitForStatus(lcm::LCM* lcm, const StatusCatcher& catcher, double timeout_s) {
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::milliseconds(static_cast<int64_t>(timeout_s * 1000));
+  while (!catcher.received && std::chrono::steady_clock::now() < deadline) {
+    lcm->handleTimeout(100);
+  }
+}
+
 // Waits for one status message; prints it as JSON. 0 when one came, 1 otherwise.
 int printStatus(lcm::LCM* lcm, const std::string& channel, double timeout_s) {
   StatusCatcher catcher;
   lcm->subscribe(channel, &StatusCatcher::onMessage, &catcher);
-  std::optional<panmap::status_t>& received = catcher.received;
-  const int& malformed = catcher.malformed;
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::milliseconds(static_cast<int64_t>(timeout_s * 1000));
-  while (!received && std::chrono::steady_clock::now() < deadline) lcm->handleTimeout(100);
-  if (!received) {
+  waitForStatus(lcm, catcher, timeout_s);
+  if (!catcher.received) {
     std::fprintf(stderr, "panmap-command: error: no status on %s within %.1f s%s\n",
-                 channel.c_str(), timeout_s, malformed ? " (only malformed messages)" : "");
+                 channel.c_str(), timeout_s, catcher.malformed ? " (only malformed messages)" : "");
     return 1;
   }
-  std::printf("%s\n", statusJson(*received).dump().c_str());
+  std::printf("%s\n", statusJson(*catcher.received).dump().c_str());
   return 0;
 }
 
@@ -106,13 +112,20 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Sends a command to panmap-mapper on PANMAP_COMMAND: finish (optimise, write the "
       "outputs, exit), save [PATH] (map snapshot), export [DIR] (outputs now), optimise; or "
-      "status: print the mapper's next PANMAP_STATUS as one JSON line."};
+      "status: print the mapper's next PANMAP_STATUS as one JSON line. A command is confirmed by "
+      "the mapper's next status: exit 1 when none comes (no mapper listening)."};
   std::string url, channel = panmap::kChannelCommand, command, argument;
   bool self_test = false;
   app.add_option("command", command, "finish | save | export | optimise | status");
   double timeout_s = 5.0;
   std::string status_channel = panmap::kChannelStatus;
-  app.add_option("--timeout-s", timeout_s, "status: how long to wait")->capture_default_str();
+  app.add_option("--timeout-s", timeout_s,
+                 "how long to wait for the mapper's status (every command but with --no-wait)")
+      ->capture_default_str();
+  bool no_wait = false;
+  app.add_flag("--no-wait", no_wait,
+               "send the command and exit 0 without waiting for a status that shows a mapper "
+               "listening");
   app.add_option("--channel-status", status_channel)->capture_default_str();
   app.add_flag("--self-test", self_test,
                "send nothing; exit 0 when a message published on the URL comes back (UDP "
@@ -159,9 +172,26 @@ int main(int argc, char** argv) {
                   .count();
   msg.command = it->second;
   msg.argument = argument;
+  // Subscribed before sending: a finishing mapper publishes its status at once, then exits.
+  StatusCatcher catcher;
+  if (!no_wait) lcm.subscribe(status_channel, &StatusCatcher::onMessage, &catcher);
   if (lcm.publish(channel, &msg) != 0) {
     std::fprintf(stderr, "panmap-command: error: publishing on %s failed\n", channel.c_str());
     return 1;
   }
+  if (no_wait) return 0;
+  // LCM publishes whether or not anyone listens: only a mapper's status shows that one does.
+  waitForStatus(&lcm, catcher, timeout_s);
+  if (!catcher.received) {
+    std::fprintf(stderr,
+                 "panmap-command: error: sent %s on %s, but no panmap-mapper status came on %s "
+                 "within %.1f s: is a mapper running on this LCM URL? (--self-test checks "
+                 "multicast, --no-wait only sends)\n",
+                 command.c_str(), channel.c_str(), status_channel.c_str(), timeout_s);
+    return 1;
+  }
+  std::printf("panmap-command: sent %s; panmap-mapper is %s, %lld frames integrated\n",
+              command.c_str(), catcher.received->state.c_str(),
+              static_cast<long long>(catcher.received->frames_integrated));
   return 0;
 }

@@ -15,7 +15,6 @@
 
 #include "child_process.h"
 #include "lcm_udp.h"
-#include "panmap/command_t.hpp"
 #include "panmap/io/ply.h"
 #include "panmap/io/tum_trajectory.h"
 #include "panmap/mapper/mapper.h"
@@ -108,11 +107,12 @@ TEST_F(LiveCli, LogplayerToMapperAndOptimiserOverUdp) {
   EXPECT_TRUE(probe.output.find("\nblocked at") != std::string::npos ||
               probe.output.find("\nunknown at") != std::string::npos)
       << probe.output;
-  command_t finish;
-  finish.utime = 0;
-  finish.command = command_t::COMMAND_FINISH;
-  finish.argument = "";
-  lcm.publish("PANMAP_COMMAND", &finish);
+  // As a user ends a replay: the command is confirmed by the mapper's status.
+  const test::CommandResult finish =
+      test::runCommand(test::binPath("panmap-command") + " --lcm-url '" + kUrl + "' finish");
+  EXPECT_EQ(finish.exit_code, 0) << finish.output;
+  EXPECT_NE(finish.output.find("panmap-command: sent finish; panmap-mapper is "), std::string::npos)
+      << finish.output;
   ASSERT_TRUE(mapper.wait(120)) << test::fileBytes(dir_->path("mapper.log"));
   ASSERT_EQ(mapper.exitCode(), 0) << test::fileBytes(dir_->path("mapper.log"));
   optimiser.signal(SIGTERM);
@@ -132,6 +132,25 @@ TEST_F(LiveCli, LogplayerToMapperAndOptimiserOverUdp) {
   EXPECT_GE(instances.size(), 3u);  // with 0 (stuff)
   const std::unique_ptr<Mapper> map = Mapper::load(out + "/map.panmap");
   EXPECT_EQ(map->framesIntegrated(), report["frames_integrated"].get<int64_t>());
+}
+
+// LCM publishes whether anyone listens or not: a command nobody confirms is an error, unless
+// the user asked only to send it.
+TEST(CommandCli, ACommandNoMapperConfirmsFailsInOneLine) {
+  const std::string url = "udpm://239.255.76.67:7685?ttl=0";
+  if (!test::multicastWorks(url)) GTEST_SKIP() << test::kNoMulticast;
+  const std::string command =
+      test::binPath("panmap-command") + " --lcm-url '" + url + "' --timeout-s 1 optimise";
+  const test::CommandResult unheard = test::runCommand(command);
+  EXPECT_EQ(unheard.exit_code, 1);
+  EXPECT_EQ(test::countLines(unheard.output), 1) << unheard.output;
+  EXPECT_NE(unheard.output.find("sent optimise on PANMAP_COMMAND, but no panmap-mapper status "
+                                "came on PANMAP_STATUS within 1.0 s"),
+            std::string::npos)
+      << unheard.output;
+  const test::CommandResult sent = test::runCommand(command + " --no-wait");
+  EXPECT_EQ(sent.exit_code, 0) << sent.output;
+  EXPECT_EQ(sent.output, "");
 }
 
 TEST_F(LiveCli, DeadOptimiserCostsTheLabelsNotTheMap) {
