@@ -304,22 +304,28 @@ class FolderReader : public DatasetReader {
       // it, every point would be shifted by half an image.
       const double aspect_color = static_cast<double>(color_width_) / color_height_;
       const double aspect_depth = static_cast<double>(camera_.width) / camera_.height;
-      if (!hasCentredPrincipalPoint(camera_, color_width_, color_height_) ||
-          std::abs(aspect_color / aspect_depth - 1.0) > 0.02) {
+      const bool fits_color = hasCentredPrincipalPoint(camera_, color_width_, color_height_) &&
+                              std::abs(aspect_color / aspect_depth - 1.0) <= 0.02;
+      if (!fits_color && options_.intrinsics) {
+        // Given on the command line: a cropped sensor may really have it there.
+        note << "; the principal point lies outside the middle half of the depth image: taken "
+             << "as given";
+      } else if (!fits_color) {
         std::ostringstream why;
         why << from << ": principal point (" << k(2) << ", " << k(3)
             << ") lies outside the middle half of the " << camera_.width << "x" << camera_.height
             << " depth image; give the depth camera's intrinsics (--intrinsics "
             << "fx,fy,cx,cy)";
         throw Error(why.str());
+      } else {
+        PinholeCamera color_camera = camera_;
+        color_camera.width = color_width_;
+        color_camera.height = color_height_;
+        camera_ = color_camera.resized(camera_.width, camera_.height);
+        note << "; the colour camera's (principal point at the colour image's centre), scaled to "
+             << "the depth size: fx " << camera_.fx << ", fy " << camera_.fy << ", cx "
+             << camera_.cx << ", cy " << camera_.cy;
       }
-      PinholeCamera color_camera = camera_;
-      color_camera.width = color_width_;
-      color_camera.height = color_height_;
-      camera_ = color_camera.resized(camera_.width, camera_.height);
-      note << "; the colour camera's (principal point at the colour image's centre), scaled to "
-           << "the depth size: fx " << camera_.fx << ", fy " << camera_.fy << ", cx " << camera_.cx
-           << ", cy " << camera_.cy;
     }
     notes_.push_back(note.str());
   }

@@ -201,8 +201,8 @@ TEST(FolderLayout, ScalesTheColourCamerasIntrinsicsToTheDepthImage) {
   EXPECT_TRUE(said);
 }
 
-// A principal point that fits neither image is an error naming the file, not a map shifted by
-// half an image; one that fits the depth image is taken as given.
+// A principal point found in the folder that fits neither image is an error naming the file, not
+// a map shifted by half an image; one that fits the depth image is taken as given.
 TEST(FolderLayout, RefusesIntrinsicsThatFitNeitherImage) {
   test::TempDir dir;
   makeIssueFolder(dir, 1);
@@ -217,6 +217,10 @@ TEST(FolderLayout, RefusesIntrinsicsThatFitNeitherImage) {
               std::string::npos)
         << e.what();
   }
+  // Given on the command line, the same principal point is the user's word (a cropped sensor).
+  DatasetOptions given;
+  given.intrinsics = Eigen::Vector4d(5, 6, 7.9, 3);
+  EXPECT_DOUBLE_EQ(openDataset(dir.path(), given)->read(0).rgbd.camera.cx, 7.9);
   writeText(dir.path("intrinsic.txt"), "5 0 5.9\n0 6 1.6\n0 0 1\n");
   EXPECT_DOUBLE_EQ(openDataset(dir.path(), DatasetOptions{})->read(0).rgbd.camera.cx, 5.9);
 }
