@@ -14,6 +14,15 @@ namespace {
 using test::binPath;
 using test::runCommand;
 
+// Imports the first `frames` frames of 7scenes-200 into dir/s.lcmlog; a failed import fails the
+// test.
+void importSevenScenes(const test::TempDir& dir, int frames) {
+  const auto imp =
+      runCommand(binPath("panmap-import") + " --quiet --max-frames " + std::to_string(frames) +
+                 " " + test::dataDir("7scenes-200") + " " + dir.path("s.lcmlog"));
+  EXPECT_EQ(imp.exit_code, 0) << imp.output;
+}
+
 TEST(Cli, HelpExitsZero) {
   for (const char* tool : {"panmap-import", "panmap-loginfo"}) {
     const auto r = runCommand(binPath(tool) + " --help");
@@ -56,9 +65,8 @@ TEST(Cli, MapperRefusesNoOptimiseLiveInOneLine) {
 TEST(Cli, MapperWithoutTheOptimisationSaysSo) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   test::TempDir dir;
-  const auto imp = runCommand(binPath("panmap-import") + " --quiet --max-frames 3 " +
-                              test::dataDir("7scenes-200") + " " + dir.path("s.lcmlog"));
-  ASSERT_EQ(imp.exit_code, 0) << imp.output;
+  importSevenScenes(dir, 3);
+  if (HasFailure()) return;
   const std::string common = binPath("panmap-mapper") + " -q --voxel-size 0.05 --no-snapshots ";
   const auto mapped = runCommand(common + "--no-optimise --log " + dir.path("s.lcmlog") +
                                  " --out " + dir.path("a"));
@@ -85,9 +93,8 @@ TEST(Cli, MapperRefusesALogWithoutFramesInOneLine) {
   for (size_t i = 0; i < noise.size(); ++i)
     noise[i] = static_cast<uint8_t>((i * 2654435761u) >> 13);
   writeFileBytes(dir.path("noise.lcmlog"), noise);
-  const auto imp = runCommand(binPath("panmap-import") + " --quiet --max-frames 2 " +
-                              test::dataDir("7scenes-200") + " " + dir.path("s.lcmlog"));
-  ASSERT_EQ(imp.exit_code, 0) << imp.output;
+  importSevenScenes(dir, 2);
+  if (HasFailure()) return;
   const std::string mapper = binPath("panmap-mapper") + " -q --voxel-size 0.05 --no-snapshots ";
   const std::pair<std::string, std::string> cases[] = {
       {"--log " + dir.path("empty.lcmlog"), "the log is empty"},
@@ -108,9 +115,8 @@ TEST(Cli, MapperRefusesALogWithoutFramesInOneLine) {
 TEST(Cli, MapperMapsTheReadablePartOfACutLogAndSaysSo) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   test::TempDir dir;
-  const auto imp = runCommand(binPath("panmap-import") + " --quiet --max-frames 3 " +
-                              test::dataDir("7scenes-200") + " " + dir.path("s.lcmlog"));
-  ASSERT_EQ(imp.exit_code, 0) << imp.output;
+  importSevenScenes(dir, 3);
+  if (HasFailure()) return;
   auto bytes = readFileBytes(dir.path("s.lcmlog"));
   bytes.resize(bytes.size() - 1000);  // into the last frame's depth
   writeFileBytes(dir.path("cut.lcmlog"), bytes);
