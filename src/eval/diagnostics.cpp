@@ -487,12 +487,18 @@ std::string formatDiagnostics(const SceneDiagnostics& d) {
                 "wrong class, %d unlabelled, %d merged, %d split\n",
                 causes[0], causes[1], causes[6], causes[2], causes[3], causes[4], causes[5]);
   out += line;
-  std::snprintf(line, sizeof(line),
-                "stuff IoU (share observed): wall %.3f (%.3f), floor %.3f (%.3f), ceiling %.3f "
-                "(%.3f)\n",
-                d.wall_iou, d.wall_observed, d.floor_iou, d.floor_observed, d.ceiling_iou,
-                d.ceiling_observed);
-  out += line;
+  // A NaN share means the ground truth has no vertex of the class: said in words, not as "nan".
+  auto stuff = [&line](const char* name, double iou, double observed) {
+    if (std::isnan(observed)) {
+      std::snprintf(line, sizeof(line), "%s none in GT", name);
+    } else {
+      std::snprintf(line, sizeof(line), "%s %.3f (%.3f)", name, iou, observed);
+    }
+    return std::string(line);
+  };
+  out += "stuff IoU (share observed): " + stuff("wall", d.wall_iou, d.wall_observed) + ", " +
+         stuff("floor", d.floor_iou, d.floor_observed) + ", " +
+         stuff("ceiling", d.ceiling_iou, d.ceiling_observed) + "\n";
   out += "reliability:";
   for (const SceneDiagnostics::ReliabilityBin& b : d.reliability) {
     std::snprintf(line, sizeof(line), " [%.1f,%.1f) %d/%d", b.low, b.high, b.matched, b.count);

@@ -139,7 +139,10 @@ TEST(Diagnostics, StuffIoUComesWithTheShareTheMapObserved) {
   EXPECT_NEAR(d.ceiling_observed, 40.0 / 200.0, 1e-12);
   // Floor: no GT vertex of it (10 wall vertices labelled floor still make its IoU 0).
   EXPECT_TRUE(std::isnan(d.floor_observed));
-  EXPECT_NE(formatDiagnostics(d).find("ceiling 0.200 (0.200)"), std::string::npos);
+  EXPECT_NE(
+      formatDiagnostics(d).find("wall 0.900 (1.000), floor none in GT, ceiling 0.200 (0.200)"),
+      std::string::npos)
+      << formatDiagnostics(d);
   // Labels built without `reached` count every vertex as observed.
   Case bare = c;
   bare.pred.reached.clear();
