@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -70,9 +71,8 @@ class Section {
 // entry is a section name at column 0, with no "..." line. Control characters are refused as
 // well: OpenCV measures lines with strlen, and a NUL byte on the header line led to the same
 // loop. Checked before OpenCV parses the file.
-void checkConfigShape(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error("cannot read config " + path);
+void checkConfigShape(const std::string& path, const std::string& text) {
+  std::istringstream in(text);
   std::string line;
   int line_no = 0;
   bool root_seen = false;
@@ -125,10 +125,29 @@ const char* weightingName(OptimiserConfig::Weighting weighting) {
 }  // namespace
 
 PanmapConfig loadConfig(const std::string& path) {
-  checkConfigShape(path);
+  std::string text;
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error("cannot read config " + path);
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    if (in.bad()) throw Error("cannot read config " + path);
+  }
+  checkConfigShape(path, text);
+  // OpenCV reads YAML only after a "%YAML" directive on the first line, which plain YAML
+  // leaves out: such a file was refused as "Input file is invalid". The directive is added
+  // when the file has none; one below the first line is an error in YAML too.
+  if (text.compare(0, 5, "%YAML") != 0) {
+    if (text.find("\n%YAML") != std::string::npos) {
+      throw Error(path + ": the %YAML directive must be the first line");
+    }
+    text = "%YAML:1.0\n" + text;
+  }
   cv::FileStorage fs;
   try {
-    if (!fs.open(path, cv::FileStorage::READ)) throw Error("cannot read config " + path);
+    if (!fs.open(text,
+                 cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML)) {
+      throw Error("cannot read config " + path);
+    }
   } catch (const cv::Exception& e) {
     throw Error(path + ": not a YAML config (" + std::string(e.err) + ")");
   }

@@ -43,6 +43,26 @@ TEST(ConfigFile, PartialFilesKeepDefaults) {
   EXPECT_FLOAT_EQ(c.mapper.integrator.truncation_voxels, 4.0f);
 }
 
+// Plain YAML leaves OpenCV's "%YAML:1.0" directive out (it was refused as "Input file is
+// invalid"); "%YAML 1.2" and a bare "---" are plain YAML too. A directive below a comment is an
+// error in YAML as well, and is named.
+TEST(ConfigFile, PlainYamlWithoutOpenCvsDirectiveIsRead) {
+  test::TempDir dir;
+  for (const std::string& head : {std::string(), std::string("---\n"),
+                                  std::string("%YAML 1.2\n---\n"), std::string("%YAML:1.0\n")}) {
+    const PanmapConfig c = loadConfig(write(dir, head + "# mine\nmap:\n  voxel_size_m: 0.05\n"));
+    EXPECT_FLOAT_EQ(c.mapper.map.voxel_size_m, 0.05f) << head;
+  }
+  try {
+    loadConfig(write(dir, "# mine\n%YAML:1.0\nmap:\n  voxel_size_m: 0.05\n"));
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the %YAML directive must be the first line"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(ConfigFile, TrackingAndOccupancySections) {
   test::TempDir dir;
   const PanmapConfig c = loadConfig(write(dir,
