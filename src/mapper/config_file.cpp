@@ -127,6 +127,8 @@ const char* weightingName(OptimiserConfig::Weighting weighting) {
 PanmapConfig loadConfig(const std::string& path) {
   std::string text;
   {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) throw Error("config " + path + " is a folder");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error("cannot read config " + path);
     text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());

@@ -148,6 +148,13 @@ TEST(ConfigFile, BadKeysAndValuesNameTheKey) {
   EXPECT_NE(error("%YAML:1.0\n---\noptimiser:\n   weighting: \"voxels\"\n").find("not \"voxels\""),
             std::string::npos);
   EXPECT_THROW(loadConfig(dir.path("missing.yaml")), Error);
+  EXPECT_FLOAT_EQ(loadConfig(write(dir, "")).mapper.map.voxel_size_m, 0.01f);  // all defaults
+  try {
+    loadConfig(dir.path());
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "config " + dir.path() + " is a folder");
+  }
 }
 
 TEST(ConfigFile, EnergyWeightingReadsEveryValue) {
