@@ -232,7 +232,14 @@ panmap::LabelledMesh loadGroundTruth(const std::string& gt_path, const std::stri
   std::string source = gt_path;
   if (!scannet_dir.empty()) {
     const panmap::ScanNetSceneFiles files = panmap::findScanNetSceneFiles(scannet_dir);
-    const panmap::ScanNetLabelTable table = panmap::ScanNetLabelTable::load(scannet_labels);
+    const std::string table_path =
+        scannet_labels.empty() ? panmap::findScanNetLabelTable(scannet_dir) : scannet_labels;
+    if (table_path.empty()) {
+      throw panmap::Error("--gt-scannet " + scannet_dir +
+                          ": no scannetv2-labels.combined.tsv in it, its parent or its "
+                          "grandparent; give it with --scannet-labels");
+    }
+    const panmap::ScanNetLabelTable table = panmap::ScanNetLabelTable::load(table_path);
     panmap::ScanNetGroundTruth scene = panmap::loadScanNetGroundTruth(
         files.mesh_ply, files.aggregation_json, files.segs_json, table);
     if (!scene.unknown_labels.empty()) {
@@ -284,8 +291,9 @@ int main(int argc, char** argv) {
       "<scene>_vh_clean_2.0.010000.segs.json (instance = objectId + 1)");
   auto* labels_option = app.add_option(
       "--scannet-labels", scannet_labels,
-      "ScanNet's scannetv2-labels.combined.tsv (raw category -> NYU40), for --gt-scannet");
-  scannet_option->excludes(gt_option)->needs(labels_option);
+      "ScanNet's scannetv2-labels.combined.tsv (raw category -> NYU40), for --gt-scannet "
+      "(default: the one in the scene folder, its parent or its grandparent)");
+  scannet_option->excludes(gt_option);
   labels_option->needs(scannet_option);
   app.add_option("--gt-instances", gt_instances_path,
                  "ScanNet benchmark GT file (class*1000+k per vertex) of the GT mesh; overrides "

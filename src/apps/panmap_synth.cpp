@@ -161,8 +161,10 @@ int main(int argc, char** argv) {
                  "a building has at least this much floor, square metres")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 20000.0));
-  app.add_option("--scannet-labels", scannet_labels, "ScanNet label table (tsv)")
-      ->capture_default_str();
+  auto* labels_option = app.add_option("--scannet-labels", scannet_labels,
+                                       "ScanNet label table (tsv); default: the one in the "
+                                       "scene folder, its parent or its grandparent, else this")
+                            ->capture_default_str();
   app.add_option("--trajectory", trajectory_file, "TUM trajectory to follow instead of a survey");
   app.add_option("--frames", frames, "frames to render")
       ->capture_default_str()
@@ -276,6 +278,11 @@ int main(int argc, char** argv) {
       source_json = {
           {"type", "procedural_room"}, {"room_seed", room_seed}, {"room_style", room_style}};
     } else {
+      // Unless given: the scene's own (ScanNet's layout), else the shipped fixtures' copy.
+      if (labels_option->count() == 0) {
+        const std::string found = panmap::findScanNetLabelTable(scannet_dir);
+        if (!found.empty()) scannet_labels = found;
+      }
       const auto table = panmap::ScanNetLabelTable::load(scannet_labels);
       const panmap::ScanNetSceneFiles files = panmap::findScanNetSceneFiles(scannet_dir);
       const auto gt = panmap::loadScanNetGroundTruth(files.mesh_ply, files.aggregation_json,

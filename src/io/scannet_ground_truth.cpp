@@ -188,6 +188,21 @@ ScanNetGroundTruth loadScanNetGroundTruth(const std::string& mesh_ply,
   return gt;
 }
 
+std::string findScanNetLabelTable(const std::string& scene_dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path dir = fs::absolute(scene_dir, ec);
+  if (ec) return "";
+  if (!dir.has_filename()) dir = dir.parent_path();  // "scene0000_00/"
+  for (int up = 0; up < 3 && !dir.empty(); ++up) {
+    const fs::path table = dir / "scannetv2-labels.combined.tsv";
+    if (fs::is_regular_file(table, ec)) return table.string();
+    if (dir == dir.parent_path()) break;
+    dir = dir.parent_path();
+  }
+  return "";
+}
+
 ScanNetSceneFiles findScanNetSceneFiles(const std::string& scene_dir) {
   namespace fs = std::filesystem;
   std::error_code ec;

@@ -118,6 +118,26 @@ TEST(EvalCliInputs, ScanNetSceneFolderAndBenchmarkFileAgree) {
   EXPECT_DOUBLE_EQ(c["map50"].get<double>(), 1.0);
 }
 
+// In ScanNet's own layout (the table above scans/<scene>/) no --scannet-labels is needed.
+TEST(EvalCliInputs, TheLabelTableIsFoundInScanNetsLayout) {
+  PANMAP_REQUIRE_DATA("scannet-meta");
+  test::TempDir dir;
+  writePrediction(dir.path("pred.ply"));
+  namespace fs = std::filesystem;
+  fs::create_directories(dir.path("scans"));
+  fs::create_directory_symlink(tinyDir(), dir.path("scans/scene0000_00"));
+  fs::copy_file(test::dataDir(kTable), dir.path("scannetv2-labels.combined.tsv"));
+  const std::string common = eval() + " --pred " + dir.path("pred.ply") + " --min-region-size 1";
+  const auto found = runCommand(common + " --gt-scannet " + dir.path("scans/scene0000_00") +
+                                " --json " + dir.path("found.json"));
+  ASSERT_EQ(found.exit_code, 0) << found.output;
+  const auto given = runCommand(common + " --gt-scannet " + tinyDir() + " --scannet-labels " +
+                                test::dataDir(kTable) + " --json " + dir.path("given.json"));
+  ASSERT_EQ(given.exit_code, 0) << given.output;
+  EXPECT_EQ(readJson(dir.path("found.json"))["map50"], readJson(dir.path("given.json"))["map50"]);
+  EXPECT_EQ(readJson(dir.path("found.json"))["num_gt_vertices"].get<int>(), 11);
+}
+
 TEST(EvalCliInputs, BadCombinationsExitWithOneLine) {
   test::TempDir dir;
   writePrediction(dir.path("pred.ply"));
@@ -128,7 +148,9 @@ TEST(EvalCliInputs, BadCombinationsExitWithOneLine) {
   };
   expectFailure(runCommand(eval()), "nothing to evaluate");
   expectFailure(runCommand(eval() + pred), "--pred needs ground truth");
-  expectFailure(runCommand(eval() + pred + " --gt-scannet " + tinyDir()), "--scannet-labels");
+  expectFailure(runCommand(eval() + pred + " --gt-scannet " + tinyDir()),
+                "scannet_gt_tiny: no scannetv2-labels.combined.tsv in it, its parent or its "
+                "grandparent; give it with --scannet-labels");
   expectFailure(runCommand(eval() + " --gt " + dir.path("pred.ply")), "need --pred");
   expectFailure(runCommand(eval() + " --traj " + dir.path("t.txt")), "--gt-traj");
   const auto classes =

@@ -189,6 +189,23 @@ TEST(ScanNetGroundTruth, FindsTheScanNetFilesOfAFolder) {
             dir.path("scene0707_00/scene0707_00_vh_clean_2.0.010000.segs.json"));
 }
 
+// ScanNet's download puts the label table above scans/<scene>/: it is found there, in the
+// scene folder first, and nowhere else.
+TEST(ScanNetGroundTruth, FindsTheLabelTableAboveTheScene) {
+  test::TempDir dir;
+  fs::create_directories(dir.path("scans/scene0000_00"));
+  const std::string scene = dir.path("scans/scene0000_00");
+  EXPECT_EQ(findScanNetLabelTable(scene), "");
+  std::ofstream(dir.path("scannetv2-labels.combined.tsv")) << "id\n";
+  EXPECT_EQ(findScanNetLabelTable(scene), dir.path("scannetv2-labels.combined.tsv"));
+  EXPECT_EQ(findScanNetLabelTable(scene + "/"), dir.path("scannetv2-labels.combined.tsv"));
+  std::ofstream(scene + "/scannetv2-labels.combined.tsv") << "id\n";
+  EXPECT_EQ(findScanNetLabelTable(scene), scene + "/scannetv2-labels.combined.tsv");
+  // Three levels up is too far.
+  fs::create_directories(dir.path("a/b/c/d"));
+  EXPECT_EQ(findScanNetLabelTable(dir.path("a/b/c/d")), "");
+}
+
 TEST(ScanNetGroundTruth, MissingScanNetFilesAreNamed) {
   test::TempDir dir;
   expectError([&] { findScanNetSceneFiles(dir.path("absent")); }, {"absent", "not a folder"});

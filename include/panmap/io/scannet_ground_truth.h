@@ -68,6 +68,11 @@ struct ScanNetSceneFiles {
 /// folder or the missing file.
 ScanNetSceneFiles findScanNetSceneFiles(const std::string& scene_dir);
 
+/// ScanNet's label table for a scene when none is given: scannetv2-labels.combined.tsv in
+/// `scene_dir`, its parent or its grandparent (ScanNet's download script puts it above
+/// scans/<scene>/). "" when none of them has it.
+std::string findScanNetLabelTable(const std::string& scene_dir);
+
 /// Per-vertex NYU40 ids of ScanNet's *_vh_clean_2.labels.ply: its `label` property (ScanNet
 /// label ids) mapped through the table. Throws Error naming the file.
 std::vector<int32_t> readScanNetLabelsPly(const std::string& labels_ply,
