@@ -68,7 +68,7 @@ void MapRebuild::add(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
     for (const auto& time : times) {
       // By name, as a stage may be missing from a frame ("tracking" when refinement is off).
       // Not a structured binding: C++17 lambdas (clang) cannot capture one.
-      const std::string stage = time.first;
+      const char* stage = time.first;
       auto it = std::find_if(stage_ms_.begin(), stage_ms_.end(),
                              [&](const auto& entry) { return entry.first == stage; });
       if (it == stage_ms_.end())
