@@ -255,7 +255,9 @@ int main(int argc, char** argv) {
   app.add_option("--depth-calibration", depth_calibration,
                  "the depth sensor's calibration from panmap-calibrate-depth (overrides the "
                  "config's depth_calibration)");
-  app.add_option("--load", load_path, "resume from a map.panmap snapshot");
+  app.add_option("--load", load_path,
+                 "continue a saved map.panmap (with --log: frames up to its newest are "
+                 "skipped; mapping settings stay the map's own)");
   std::string resume_dir;
   app.add_option("--resume", resume_dir,
                  "continue after a crash from the newest good autosave of this output folder "
@@ -359,18 +361,27 @@ int main(int argc, char** argv) {
     }
     if (out_dir.empty()) out_dir = resume_dir;
     if (out_dir.empty()) throw panmap::Error("--out is required");
-    if (!config_path.empty()) {
-      file_config = panmap::loadConfig(config_path);
-      // Flags given on the command line win over the file.
-      if (app.count("--voxel-size") == 0)
-        config.map.voxel_size_m = file_config.mapper.map.voxel_size_m;
-      if (app.count("--threads") == 0) config.num_threads = file_config.mapper.num_threads;
-      const float voxel = config.map.voxel_size_m;
-      const int threads = config.num_threads;
-      config = file_config.mapper;
-      config.map.voxel_size_m = voxel;
-      config.num_threads = threads;
+    // A loaded or resumed map keeps mapping with the settings it was made with: the config
+    // file's keys and the flags below are checked against them instead of silently ignored.
+    std::unique_ptr<panmap::Mapper> mapper;
+    std::optional<panmap::ResumePoint> resumed;
+    if (!resume_dir.empty()) {
+      resumed = panmap::resumeFrom(autosaveDirOf(resume_dir));
+      mapper = std::move(resumed->mapper);
+      options.resume_after_utime = resumed->last_utime;
+      std::fprintf(stderr, "panmap-mapper: %s\n", panmap::describeResume(*resumed).c_str());
+    } else if (!load_path.empty()) {
+      mapper = panmap::Mapper::load(load_path);
     }
+    panmap::PanmapConfig base;
+    if (mapper) base.mapper = mapper->config();
+    const float flag_voxel = config.map.voxel_size_m;
+    const int flag_threads = config.num_threads;
+    file_config = config_path.empty() ? base : panmap::loadConfig(config_path, base);
+    config = file_config.mapper;
+    // Flags given on the command line win over the file.
+    if (app.count("--voxel-size") > 0) config.map.voxel_size_m = flag_voxel;
+    if (app.count("--threads") > 0) config.num_threads = flag_threads;
     if (!grid_shift.empty()) {
       options.grid_shift_m = Eigen::Vector3d(grid_shift[0], grid_shift[1], grid_shift[2]);
       if (!frame_store_dir.empty()) {
@@ -383,7 +394,7 @@ int main(int argc, char** argv) {
           panmap::DepthCalibration::load(depth_calibration));
       config.depth_calibration_file = depth_calibration;
     }
-    config.superpoints.semantic_consistency = !spatial_only;
+    if (spatial_only) config.superpoints.semantic_consistency = false;
     if (no_mask_edge_fill) config.mask_edge_fill.enabled = false;
     if (no_mask_only_surfaces) config.fusion.mask_only_surfaces = false;
     if (app.count("--pair-interior-px") > 0) config.graph.pair_interior_px = pair_interior_px;
@@ -393,16 +404,27 @@ int main(int argc, char** argv) {
     panmap::OptimiserConfig optimiser = file_config.optimiser;
     if (no_regularise) optimiser.regularise = false;
     if (no_refine) optimiser.refine = false;
-    std::unique_ptr<panmap::Mapper> mapper;
-    std::optional<panmap::ResumePoint> resumed;
-    if (!resume_dir.empty()) {
-      resumed = panmap::resumeFrom(autosaveDirOf(resume_dir));
-      mapper = std::move(resumed->mapper);
-      options.resume_after_utime = resumed->last_utime;
-      std::fprintf(stderr, "panmap-mapper: %s\n", panmap::describeResume(*resumed).c_str());
-    } else {
-      mapper = load_path.empty() ? std::make_unique<panmap::Mapper>(config)
-                                 : panmap::Mapper::load(load_path);
+    if (mapper && !export_only) {
+      const std::string difference = panmap::mapperSettingDifference(mapper->config(), config);
+      if (!difference.empty()) {
+        throw panmap::Error(
+            std::string(resumed ? "--resume" : "--load") + ": the map was made with " +
+            difference.substr(0, difference.find(" -> ")) + ", this run asks for " +
+            difference.substr(difference.find(" -> ") + 4) +
+            "; a map keeps mapping with its own settings (leave the flag or key out, or start "
+            "a new map)");
+      }
+    }
+    if (!mapper) mapper = std::make_unique<panmap::Mapper>(config);
+    // A map given with --load holds its frames: the same log given again must not map them
+    // twice, so frames up to its newest are skipped, as --resume does.
+    if (!resumed && !load_path.empty() && !mapper->trajectory().empty()) {
+      options.resume_after_utime = mapper->trajectory().back().utime;
+      std::fprintf(stderr,
+                   "panmap-mapper: loaded %s: %zu frames; frames of the log up to its newest "
+                   "(utime %lld) are skipped\n",
+                   load_path.c_str(), mapper->trajectory().size(),
+                   static_cast<long long>(options.resume_after_utime));
     }
     std::unique_ptr<panmap::FrameStore> frame_store;
     if (!frame_store_dir.empty() && !export_only) {

@@ -87,6 +87,16 @@ void checkConfigShape(const std::string& path, const std::string& text) {
                     std::to_string(i + 1));
       }
     }
+    // YAML indents with spaces, and OpenCV's reader takes no tab before a comment either: it
+    // failed naming one of its functions ("skipSpaces").
+    const size_t tab = line.substr(0, line.find('#')).find('\t');
+    if (tab != std::string::npos) {
+      const bool indent = line.find_first_not_of(" \t") > tab;
+      throw Error(
+          where +
+          (indent ? "a tab in the indentation" : "a tab at column " + std::to_string(tab + 1)) +
+          " (a config takes spaces only)");
+    }
     if (line.compare(0, 3, "...") == 0) {
       throw Error(where + "'...' ends the document; a config is one document without it");
     }
@@ -124,7 +134,9 @@ const char* weightingName(OptimiserConfig::Weighting weighting) {
 
 }  // namespace
 
-PanmapConfig loadConfig(const std::string& path) {
+PanmapConfig loadConfig(const std::string& path) { return loadConfig(path, PanmapConfig{}); }
+
+PanmapConfig loadConfig(const std::string& path, const PanmapConfig& base) {
   std::string text;
   {
     std::error_code ec;
@@ -153,7 +165,7 @@ PanmapConfig loadConfig(const std::string& path) {
   } catch (const cv::Exception& e) {
     throw Error(path + ": not a YAML config (" + std::string(e.err) + ")");
   }
-  PanmapConfig c;
+  PanmapConfig c = base;
   MapperConfig& m = c.mapper;
   const cv::FileNode root = fs.root();
   const std::set<std::string> sections = {"map",       "integrator",  "depth_segmentation",
@@ -592,6 +604,48 @@ std::string configToYaml(const PanmapConfig& c) {
          "panmap-calibrate-depth\n";
   }
   return y.str();
+}
+
+namespace {
+
+// A YAML line's key and value, comment and indentation left out.
+std::pair<std::string, std::string> keyAndValue(const std::string& line) {
+  const std::string text = line.substr(0, line.find('#'));
+  const size_t colon = text.find(':');
+  auto trim = [](std::string v) {
+    v.erase(0, v.find_first_not_of(' '));
+    v.erase(v.find_last_not_of(' ') + 1);
+    return v;
+  };
+  if (colon == std::string::npos) return {trim(text), ""};
+  return {trim(text.substr(0, colon)), trim(text.substr(colon + 1))};
+}
+
+}  // namespace
+
+std::string mapperSettingDifference(const MapperConfig& have, const MapperConfig& wanted) {
+  // Both printed with one optimiser, so that only the mapper's settings can differ; the
+  // printed values are what a user wrote and would recognise.
+  const PanmapConfig a{have, OptimiserConfig{}}, b{wanted, OptimiserConfig{}};
+  std::istringstream in_a(configToYaml(a)), in_b(configToYaml(b));
+  std::string line_a, line_b, section;
+  while (std::getline(in_a, line_a) && std::getline(in_b, line_b)) {
+    if (!line_a.empty() && line_a[0] != ' ' && line_a[0] != '#' && line_a[0] != '%') {
+      section = keyAndValue(line_a).first;
+    }
+    if (line_a == line_b) continue;
+    if (line_a.empty() || line_b.empty()) return section + ": settings differ";
+    // The depth calibration is a commented-out line when there is none.
+    const bool top_a = !line_a.empty() && line_a[0] != ' ';
+    const auto [key_a, value_a] = keyAndValue(line_a[0] == '#' ? line_a.substr(1) : line_a);
+    const auto [key_b, value_b] = keyAndValue(line_b[0] == '#' ? line_b.substr(1) : line_b);
+    const std::string name = top_a || line_b[0] == '#' ? key_a : section + "." + key_a;
+    auto shown = [](const std::string& line, const std::string& value) {
+      return !line.empty() && line[0] == '#' ? std::string("none") : value;
+    };
+    return name + ": " + shown(line_a, value_a) + " -> " + shown(line_b, value_b);
+  }
+  return "";
 }
 
 }  // namespace panmap

@@ -85,6 +85,40 @@ TEST(Cli, MapperWithoutTheOptimisationSaysSo) {
 
 // A log that gives no frame is an error, not an empty map: an empty file, bytes that are no LCM
 // log, and a log whose frames are on another channel than the one asked for.
+// `--load MAP --log LOG` continues the map: the frames it holds are not mapped twice, and
+// mapping flags that the map would ignore are refused, naming the setting.
+TEST(Cli, ALoadedMapSkipsItsFramesAndKeepsItsSettings) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  importSevenScenes(dir, 4);
+  if (HasFailure()) return;
+  const std::string common = binPath("panmap-mapper") + " -q --voxel-size 0.05 --no-snapshots " +
+                             "--log " + dir.path("s.lcmlog") + " ";
+  ASSERT_EQ(runCommand(common + "--max-frames 2 --out " + dir.path("a")).exit_code, 0);
+  const auto go_on =
+      runCommand(common + "--load " + dir.path("a/map.panmap") + " --out " + dir.path("b"));
+  ASSERT_EQ(go_on.exit_code, 0) << go_on.output;
+  EXPECT_NE(go_on.output.find("2 frames; frames of the log up to its newest"), std::string::npos)
+      << go_on.output;
+  std::ifstream in(dir.path("b/report.json"));
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["frames_integrated"].get<int64_t>(), 2);
+  EXPECT_EQ(report["rejected"]["frame: mapped before the resume point"].get<int64_t>(), 2);
+  std::ifstream trajectory(dir.path("b/trajectory.txt"));
+  int poses = 0;
+  for (std::string line; std::getline(trajectory, line);) poses += !line.empty() && line[0] != '#';
+  EXPECT_EQ(poses, 4);
+
+  const auto other =
+      runCommand(binPath("panmap-mapper") + " -q --voxel-size 0.02 --log " + dir.path("s.lcmlog") +
+                 " --load " + dir.path("a/map.panmap") + " --out " + dir.path("c"));
+  EXPECT_EQ(other.exit_code, 1);
+  EXPECT_EQ(test::countLines(other.output), 1) << other.output;
+  EXPECT_NE(other.output.find("map.voxel_size_m: 0.05, this run asks for 0.02"), std::string::npos)
+      << other.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path("c")));
+}
+
 TEST(Cli, MapperRefusesALogWithoutFramesInOneLine) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   test::TempDir dir;

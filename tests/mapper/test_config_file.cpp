@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "panmap/calibration/depth_calibration.h"
 #include "panmap/core/error.h"
 #include "panmap/mapper/config_file.h"
 #include "test_helpers.h"
@@ -190,6 +191,73 @@ TEST(ConfigFile, LinkScaleRoundTripsAndABadValueIsNamed) {
               std::string::npos)
         << e.what();
   }
+}
+
+// What `panmap-mapper --load MAP --config FILE` reads: the file restates or changes a loaded
+// map's settings, and the keys it leaves out are the map's, not the defaults.
+TEST(ConfigFile, ABaseFillsTheKeysTheFileLeavesOut) {
+  test::TempDir dir;
+  PanmapConfig base;
+  base.mapper.map.voxel_size_m = 0.05f;
+  base.mapper.num_threads = 1;
+  base.mapper.superpoints.semantic_consistency = false;
+  const PanmapConfig c = loadConfig(write(dir, "optimiser:\n   regularise: 0\n"), base);
+  EXPECT_FLOAT_EQ(c.mapper.map.voxel_size_m, 0.05f);
+  EXPECT_EQ(c.mapper.num_threads, 1);
+  EXPECT_FALSE(c.mapper.superpoints.semantic_consistency);
+  EXPECT_FALSE(c.optimiser.regularise);
+  EXPECT_EQ(mapperSettingDifference(base.mapper, c.mapper), "");
+  // Without a base the same file keeps the defaults.
+  EXPECT_FLOAT_EQ(loadConfig(dir.path("config.yaml")).mapper.map.voxel_size_m, 0.01f);
+}
+
+TEST(ConfigFile, MapperSettingDifferenceNamesTheFirstKey) {
+  const MapperConfig defaults;
+  EXPECT_EQ(mapperSettingDifference(defaults, defaults), "");
+  MapperConfig other = defaults;
+  other.fusion.geometry_only = true;
+  EXPECT_EQ(mapperSettingDifference(defaults, other), "fusion.geometry_only: 0 -> 1");
+  other = defaults;
+  other.map.voxel_size_m = 0.05f;
+  other.num_threads = 1;  // later in the file: the first difference is named
+  EXPECT_EQ(mapperSettingDifference(defaults, other), "map.voxel_size_m: 0.01 -> 0.05");
+  other = defaults;
+  other.num_threads = 1;
+  EXPECT_EQ(mapperSettingDifference(defaults, other), "threads: 2 -> 1");
+  other = defaults;
+  other.depth_calibration =
+      std::make_shared<const DepthCalibration>(4, 4, 1, 1, 2, 1.0, std::vector<float>{0.0f, 0.01f});
+  other.depth_calibration_file = "/cal.json";
+  EXPECT_EQ(mapperSettingDifference(defaults, other), "depth_calibration: none -> \"/cal.json\"");
+}
+
+// A map keeps every setting the config file shows: --load compares them and must not find a
+// difference the map file itself made.
+TEST(ConfigFile, AMapFileKeepsEveryPrintedMapperSetting) {
+  test::TempDir dir;
+  MapperConfig config;
+  config.num_threads = 1;
+  config.map.voxel_size_m = 0.04f;
+  config.fusion.geometry_only = true;
+  config.superpoints.semantic_consistency = false;
+  config.graph.pair_interior_px = 5;
+  config.tracking_mode = MapperConfig::TrackingMode::kOff;
+  config.mask_edge_fill.enabled = false;
+  config.integrator.vote_stride_px = 3;
+  Mapper(config).save(dir.path("m.panmap"));
+  EXPECT_EQ(mapperSettingDifference(config, Mapper::load(dir.path("m.panmap"))->config()), "");
+}
+
+TEST(ConfigFile, ATabOutsideACommentIsNamed) {
+  test::TempDir dir;
+  const std::string path = write(dir, "map:\n\tvoxel_size_m: 0.02\n");
+  test::expectError([&] { loadConfig(path); }, {path + ":2:", "tab in the indentation"});
+  const std::string after_value = write(dir, "map:\n   voxel_size_m: 0.02\t# cm\n");
+  test::expectError([&] { loadConfig(after_value); }, {after_value + ":2:", "tab at column 22"});
+  // In a comment a tab is text.
+  EXPECT_FLOAT_EQ(
+      loadConfig(write(dir, "map:\n   voxel_size_m: 0.02 # a\tcm\n")).mapper.map.voxel_size_m,
+      0.02f);
 }
 
 }  // namespace

@@ -19,6 +19,15 @@ struct PanmapConfig {
 /// values that fail a component's check() throw Error naming the file and the key.
 PanmapConfig loadConfig(const std::string& path);
 
+/// loadConfig(path) with the keys the file leaves out taken from `base` instead of the
+/// defaults (a loaded map's settings, which a config may only restate). Throws as loadConfig.
+PanmapConfig loadConfig(const std::string& path, const PanmapConfig& base);
+
+/// The first mapping setting that differs between `have` and `wanted`, as
+/// "section.key: have-value -> wanted-value" (YAML names, as --print-config shows them); empty
+/// when every one agrees. Optimiser settings are not compared.
+std::string mapperSettingDifference(const MapperConfig& have, const MapperConfig& wanted);
+
 /// The YAML text of a config, every key present with a comment (what --print-config shows).
 std::string configToYaml(const PanmapConfig& config);
 
