@@ -13,6 +13,7 @@
 
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
+#include "panmap/core/nearest_point.h"
 #include "panmap/eval/diagnostics.h"
 #include "panmap/eval/evaluation.h"
 #include "panmap/eval/ground_truth_input.h"
@@ -44,9 +45,55 @@ std::map<int32_t, double> readConfidences(const std::string& path) {
     if (!o.contains(key) || !o.contains("confidence")) {
       throw panmap::Error(path + ": an object lacks id or confidence");
     }
-    out[o[key].get<int32_t>()] = o["confidence"].get<double>();
+    const json& id = o[key];
+    if (!id.is_number_integer()) {
+      throw panmap::Error(path + ": an object's " + key + " is " + id.dump() +
+                          ", not an integer instance id");
+    }
+    if (!o["confidence"].is_number()) {
+      throw panmap::Error(path + ": object " + id.dump() + "'s confidence is " +
+                          o["confidence"].dump() + ", not a number");
+    }
+    out[id.get<int32_t>()] = o["confidence"].get<double>();
   }
   return out;
+}
+
+/// Share of the predicted vertices with a ground-truth vertex within `max_distance_m`: near 1
+/// for a map of the ground truth's scene, in its frame and units.
+double shareNearGroundTruth(const panmap::LabelledMesh& pred,
+                            const std::vector<Eigen::Vector3f>& gt_vertices,
+                            double max_distance_m) {
+  if (pred.vertices.empty() || gt_vertices.empty()) return 0.0;
+  const panmap::NearestPointIndex tree(&gt_vertices);
+  size_t near = 0;
+  for (const Eigen::Vector3f& p : pred.vertices) {
+    const int64_t g = tree.nearest(p);
+    if (g >= 0 && (gt_vertices[g].cast<double>() - p.cast<double>()).norm() <= max_distance_m) {
+      ++near;
+    }
+  }
+  return static_cast<double>(near) / pred.vertices.size();
+}
+
+/// Instances of the mesh scored by the evaluation (at least `min_vertices`) that `confidences`
+/// lacks: each would be scored at confidence 1. Smaller ones are left out of the evaluation
+/// (and the mapper leaves such fragments out of objects.json).
+size_t instancesWithoutConfidence(const panmap::LabelledMesh& pred,
+                                  const std::map<int32_t, double>& confidences,
+                                  int64_t min_vertices, size_t* instances) {
+  std::map<int32_t, int64_t> vertices;
+  for (const int32_t id : pred.instance) {
+    if (id != 0) ++vertices[id];
+  }
+  *instances = 0;
+  size_t missing = 0;
+  for (const auto& [id, count] : vertices) {
+    if (count < min_vertices) continue;
+    ++*instances;
+    missing += confidences.count(id) == 0;
+  }
+  return missing;
 }
 
 /// NaN as JSON null.
@@ -371,6 +418,13 @@ int main(int argc, char** argv) {
     if (mesh_eval) {
       if (!classes_text.empty()) config.classes = panmap::parseClassList(classes_text);
       panmap::LabelledMesh pred = panmap::readPly(pred_path);
+      // Without them every vertex would read as unlabelled and score 0 without a word.
+      if (pred.semantic.size() != pred.numVertices() ||
+          pred.instance.size() != pred.numVertices()) {
+        throw panmap::Error(pred_path +
+                            ": needs semantic and instance vertex properties (a panmap "
+                            "mesh_instance.ply)");
+      }
       if (align_pred) {
         const Eigen::Isometry3f T_gt_est = trajectory_error.T_gt_est.cast<float>();
         const float scale = static_cast<float>(trajectory_error.scale);
@@ -382,10 +436,39 @@ int main(int argc, char** argv) {
       if (!confidences_path.empty()) confidences = readConfidences(confidences_path);
       const panmap::TransferredLabels transferred =
           panmap::transferLabels(pred, gt.vertices, config.max_distance_m);
+      const double near_share = shareNearGroundTruth(pred, gt.vertices, config.max_distance_m);
+      if (transferred.num_transferred == 0 && pred.numVertices() > 0) {
+        char radius[32];
+        std::snprintf(radius, sizeof(radius), "%g", config.max_distance_m);
+        throw panmap::Error("no ground-truth vertex has a predicted vertex within " +
+                            std::string(radius) +
+                            " m: the meshes do not overlap (another scene, other units, or a "
+                            "map in another frame: --align-pred)");
+      }
+      if (near_share < 0.5 && pred.numVertices() > 0) {
+        std::fprintf(stderr,
+                     "panmap-eval: warning: only %.1f %% of the predicted vertices lie within "
+                     "%g m of the ground truth: the same scene, in the same frame and units?\n",
+                     100.0 * near_share, config.max_distance_m);
+      }
+      if (!confidences_path.empty()) {
+        size_t instances = 0;
+        const size_t missing =
+            instancesWithoutConfidence(pred, confidences, config.min_region_size, &instances);
+        if (missing > 0) {
+          std::fprintf(stderr,
+                       "panmap-eval: warning: %zu of the %zu scored instances of %s have no "
+                       "confidence in %s (scored at 1): the objects.json of another map?\n",
+                       missing, instances, pred_path.c_str(), confidences_path.c_str());
+        }
+      }
       const panmap::EvalResult result =
           panmap::evaluateTransferred(gt, transferred, confidences, config);
       std::printf("%s", panmap::formatEvalTable(result).c_str());
+      std::printf("predicted vertices within %g m of the ground truth: %.1f %%\n",
+                  config.max_distance_m, 100.0 * near_share);
       out = toJson(result);
+      out["pred_near_gt_share"] = near_share;
       const panmap::SceneDiagnostics diagnostics =
           panmap::diagnose(gt, transferred, confidences, 5, boundary_band_m);
       std::printf("%s", panmap::formatDiagnostics(diagnostics).c_str());

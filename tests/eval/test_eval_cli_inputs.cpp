@@ -164,6 +164,67 @@ TEST(EvalCliInputs, BadCombinationsExitWithOneLine) {
   EXPECT_EQ(test::countLines(missing.output), 1) << missing.output;
 }
 
+// Inputs that would score a meaningless 0 (or a wrong number) with exit 0: a mesh without
+// labels, meshes that do not overlap, another map's confidences.
+TEST(EvalCliInputs, WrongPredictionsAreNamedNotScored) {
+  test::TempDir dir;
+  writePrediction(dir.path("pred.ply"));
+  const std::string gt = " --gt " + dir.path("pred.ply");  // the prediction scores itself
+  LabelledMesh plain = readPly(dir.path("pred.ply"));
+  plain.semantic.clear();
+  plain.instance.clear();
+  plain.superpoint.clear();
+  writePly(dir.path("plain.ply"), plain);
+  const auto unlabelled = runCommand(eval() + " --pred " + dir.path("plain.ply") + gt);
+  EXPECT_EQ(unlabelled.exit_code, 1) << unlabelled.output;
+  EXPECT_EQ(test::countLines(unlabelled.output), 1) << unlabelled.output;
+  EXPECT_NE(unlabelled.output.find("plain.ply: needs semantic and instance vertex properties"),
+            std::string::npos)
+      << unlabelled.output;
+
+  // The same mesh 10 m away (another scene, or a map in another frame) overlaps nothing.
+  LabelledMesh far = readPly(dir.path("pred.ply"));
+  for (Eigen::Vector3f& p : far.vertices) p.x() += 10.0f;
+  writePly(dir.path("mm.ply"), far);
+  const auto apart = runCommand(eval() + " --pred " + dir.path("mm.ply") + gt);
+  EXPECT_EQ(apart.exit_code, 1) << apart.output;
+  EXPECT_NE(apart.output.find("no ground-truth vertex has a predicted vertex within 0.05 m"),
+            std::string::npos)
+      << apart.output;
+
+  // Half of it moved away: scored, with a warning and the share in the JSON.
+  LabelledMesh half = readPly(dir.path("pred.ply"));
+  for (size_t i = 0; i < half.numVertices(); i += 2) half.vertices[i].x() += 10.0f;
+  writePly(dir.path("half.ply"), half);
+  const auto partly =
+      runCommand(eval() + " --pred " + dir.path("half.ply") + gt + " --json " + dir.path("h.json"));
+  EXPECT_EQ(partly.exit_code, 0) << partly.output;
+  EXPECT_NE(partly.output.find("warning: only 45.5 % of the predicted vertices lie within"),
+            std::string::npos)
+      << partly.output;
+  EXPECT_NEAR(readJson(dir.path("h.json"))["pred_near_gt_share"].get<double>(), 5.0 / 11.0, 1e-12);
+
+  // Confidences of another map: none of the scored instances (at --min-region-size 1) is in it.
+  nlohmann::json other = {{"objects", {{{"id", 7}, {"confidence", 0.5}}}}};
+  std::ofstream(dir.path("other.json")) << other.dump();
+  const auto foreign = runCommand(eval() + " --pred " + dir.path("pred.ply") + gt +
+                                  " --min-region-size 1 --confidences " + dir.path("other.json"));
+  EXPECT_EQ(foreign.exit_code, 0) << foreign.output;
+  EXPECT_NE(foreign.output.find("warning: 3 of the 3 scored instances"), std::string::npos)
+      << foreign.output;
+  writeObjects(dir.path("objects.json"), 0.9, 0.1);
+  const auto own = runCommand(eval() + " --pred " + dir.path("pred.ply") + gt +
+                              " --min-region-size 1 --confidences " + dir.path("objects.json"));
+  EXPECT_EQ(own.output.find("warning"), std::string::npos) << own.output;
+  std::ofstream(dir.path("text_id.json")) << R"({"objects": [{"id": "10", "confidence": 0.5}]})";
+  const auto text_id = runCommand(eval() + " --pred " + dir.path("pred.ply") + gt +
+                                  " --confidences " + dir.path("text_id.json"));
+  EXPECT_EQ(text_id.exit_code, 1);
+  EXPECT_NE(text_id.output.find("an object's id is \"10\", not an integer instance id"),
+            std::string::npos)
+      << text_id.output;
+}
+
 TEST(EvalCliInputs, TrajectoriesAlone) {
   // Two laps of a box's corners, the second 0.5 m off: ATE RMSE 0.25 m after alignment
   // (tests/eval/test_trajectory_error.cpp explains why).
