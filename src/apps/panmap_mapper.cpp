@@ -12,6 +12,8 @@
 #include <fstream>
 #include <optional>
 
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -199,6 +201,31 @@ void printRefinement(const panmap::PoseRefinementStats& r) {
       100.0 * r.moved_m.max, r.turned_deg.median, r.turned_deg.max);
 }
 
+/// Throws Error unless `dir` is a folder this process can write into, or one it can create:
+/// checked before mapping, so that hours of it do not end in "cannot write". Creates nothing.
+void checkOutputFolder(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path path = fs::absolute(dir, ec);
+  if (fs::exists(path, ec)) {
+    if (!fs::is_directory(path, ec))
+      throw panmap::Error("--out " + dir + " is a file, not a folder");
+    if (::access(path.c_str(), W_OK | X_OK) != 0) {
+      throw panmap::Error("--out " + dir + ": folder not writable");
+    }
+    return;
+  }
+  fs::path parent = path.parent_path();
+  while (parent.has_relative_path() && !fs::exists(parent, ec)) parent = parent.parent_path();
+  if (!fs::is_directory(parent, ec)) {
+    throw panmap::Error("--out " + dir + ": " + parent.string() + " is a file, not a folder");
+  }
+  if (::access(parent.c_str(), W_OK | X_OK) != 0) {
+    throw panmap::Error("--out " + dir + ": cannot create it, " + parent.string() +
+                        " is not writable");
+  }
+}
+
 double msSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
@@ -361,6 +388,7 @@ int main(int argc, char** argv) {
     }
     if (out_dir.empty()) out_dir = resume_dir;
     if (out_dir.empty()) throw panmap::Error("--out is required");
+    checkOutputFolder(out_dir);
     // A loaded or resumed map keeps mapping with the settings it was made with: the config
     // file's keys and the flags below are checked against them instead of silently ignored.
     std::unique_ptr<panmap::Mapper> mapper;

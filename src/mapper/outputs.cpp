@@ -3,6 +3,8 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <set>
 
 #include "panmap/core/error.h"
@@ -26,10 +28,12 @@ OverviewColouring byLabel(const LabelledMesh& mesh, Rgb8 (*colour)(int32_t),
   return [](size_t) { return Rgb8{0, 0, 0}; };
 }
 
+constexpr const char* kSnapshotFiles[] = {"snapshot_semantic.png", "snapshot_instance.png",
+                                          "snapshot_superpoint.png", "snapshot_color.png"};
+
 // The four overview pictures, rasterised once (a building's mesh is 14 M faces).
 void writeSnapshots(const std::string& dir, const LabelledMesh& mesh, OutputSummary* summary) {
-  const std::vector<std::string> names = {"snapshot_semantic.png", "snapshot_instance.png",
-                                          "snapshot_superpoint.png", "snapshot_color.png"};
+  const std::vector<std::string> names(std::begin(kSnapshotFiles), std::end(kSnapshotFiles));
   const std::vector<ColorImage> pictures = renderOverviews(
       mesh, {byLabel(mesh, &semanticColor, mesh.semantic), byLabel(mesh, &idColor, mesh.instance),
              byLabel(mesh, &idColor, mesh.superpoint), vertexColours(mesh)});
@@ -53,6 +57,20 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
     summary.step_seconds.emplace_back(name, std::chrono::duration<double>(now - last).count());
     last = now;
   };
+  // The map first: it is what hours of mapping made, and every other output can be made again
+  // from it (--load MAP --export-only). A later output that cannot be written (a full disk, a
+  // folder in its place) is named at the end, after the others are written.
+  mapper->save(dir + "/map.panmap");
+  summary.files.push_back("map.panmap");
+  step("map.panmap");
+  std::vector<std::string> failed;
+  auto attempt = [&](const std::function<void()>& write) {
+    try {
+      write();
+    } catch (const std::exception& e) {
+      failed.push_back(e.what());
+    }
+  };
   {
     // The welded mesh lives only while the meshes and snapshots are written: the later steps
     // (the occupancy tree, the map file) would otherwise hold it on top of theirs (issue 23:
@@ -69,39 +87,56 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
     summary.instances_in_mesh = instances.size();
     step("mesh extraction");
 
-    writeLabelledMeshes(dir, mesh);
-    summary.files.insert(summary.files.end(),
-                         {kSemanticMeshFile, kInstanceMeshFile, kSuperpointMeshFile});
+    attempt([&] {
+      writeLabelledMeshes(dir, mesh);
+      summary.files.insert(summary.files.end(),
+                           {kSemanticMeshFile, kInstanceMeshFile, kSuperpointMeshFile});
+    });
     step("meshes");
     if (options.snapshots && !mesh.faces.empty()) {
-      writeSnapshots(dir, mesh, &summary);
+      attempt([&] { writeSnapshots(dir, mesh, &summary); });
       step("snapshots");
+    } else {
+      // Pictures of an earlier run in the same folder would pass for this map's.
+      for (const char* name : kSnapshotFiles) {
+        std::error_code ignored;
+        std::filesystem::remove(dir + "/" + name, ignored);
+      }
     }
   }
-  const std::vector<MappedObject> objects = computeObjects(*mapper, labels, optimiser.objects);
-  writeObjectsJson(dir + "/objects.json", objects, options.utime);
-  summary.objects = objects.size();
-  summary.files.push_back("objects.json");
+  attempt([&] {
+    const std::vector<MappedObject> objects = computeObjects(*mapper, labels, optimiser.objects);
+    writeObjectsJson(dir + "/objects.json", objects, options.utime);
+    summary.objects = objects.size();
+    summary.files.push_back("objects.json");
+  });
   step("objects.json");
   if (mapper->occupancy()) {
-    mapper->occupancy()->writeBt(dir + "/occupancy.bt");
-    summary.files.push_back("occupancy.bt");
+    attempt([&] {
+      mapper->occupancy()->writeBt(dir + "/occupancy.bt");
+      summary.files.push_back("occupancy.bt");
+    });
     step("occupancy.bt");
   }
-  writeTumTrajectory(dir + "/trajectory.txt", mapper->trajectory());
-  summary.files.push_back("trajectory.txt");
+  attempt([&] {
+    writeTumTrajectory(dir + "/trajectory.txt", mapper->trajectory());
+    summary.files.push_back("trajectory.txt");
+  });
   step("trajectory.txt");
-  mapper->save(dir + "/map.panmap");
-  summary.files.push_back("map.panmap");
-  step("map.panmap");
   // The exact parameters the outputs were made with (a loaded map brings its own).
-  {
+  attempt([&] {
     std::ofstream out(dir + "/config.yaml");
     out << configToYaml(PanmapConfig{mapper->config(), optimiser});
     if (!out) throw Error("cannot write " + dir + "/config.yaml");
     summary.files.push_back("config.yaml");
-  }
+  });
   step("config.yaml");
+  if (!failed.empty()) {
+    throw Error(failed.front() +
+                (failed.size() > 1 ? " (and " + std::to_string(failed.size() - 1) + " more)"
+                                   : std::string()) +
+                "; " + dir + "/map.panmap and the other outputs were written");
+  }
   return summary;
 }
 

@@ -52,6 +52,20 @@ TEST(Cli, MapperRefusesAGridShiftWithAFrameStoreInOneLine) {
   EXPECT_FALSE(std::filesystem::exists(dir.path("store")));
 }
 
+// The output folder is checked before any mapping: a long run must not end in "cannot write".
+TEST(Cli, MapperChecksTheOutputFolderFirst) {
+  test::TempDir dir;
+  std::ofstream(dir.path("file")) << "x";
+  for (const std::string out : {dir.path("file"), dir.path("file/map")}) {
+    const auto r = runCommand(binPath("panmap-mapper") + " --log " + dir.path("absent.lcmlog") +
+                              " --out " + out);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(test::countLines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find(dir.path("file") + " is a file, not a folder"), std::string::npos)
+        << r.output;
+  }
+}
+
 TEST(Cli, MapperRefusesNoOptimiseLiveInOneLine) {
   test::TempDir dir;
   const auto r = runCommand(binPath("panmap-mapper") + " --no-optimise --out " + dir.path("out"));

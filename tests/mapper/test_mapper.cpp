@@ -2,6 +2,8 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <set>
@@ -179,6 +181,27 @@ TEST_F(BoxScene, AFinalExportWritesTheSameFilesAndLeavesTheMeshIntact) {
   EXPECT_EQ(before.semantic, after.semantic);
   EXPECT_EQ(before.instance, after.instance);
   EXPECT_EQ(before.superpoint, after.superpoint);
+}
+
+// An output that cannot be written (here a folder in the way of objects.json) costs that
+// output alone: the map is written first, the rest after it, and the error names the file.
+// Pictures of an earlier run are not left beside a map that made none.
+TEST_F(BoxScene, AnOutputThatCannotBeWrittenCostsOnlyThatOutput) {
+  auto mapper = run(config(), 3);
+  const GraphLabels labels = optimise(mapper->graph(), OptimiserConfig{});
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.path("out/objects.json"));
+  std::ofstream(dir.path("out/snapshot_color.png")) << "an old picture";
+  OutputOptions options;
+  options.snapshots = false;
+  test::expectError(
+      [&] { writeOutputs(dir.path("out"), mapper.get(), &labels, {}, options); },
+      {dir.path("out/objects.json"), "map.panmap and the other outputs were written"});
+  for (const char* name : {"map.panmap", "mesh_instance.ply", "trajectory.txt", "config.yaml"}) {
+    EXPECT_TRUE(std::filesystem::is_regular_file(dir.path("out/") + name)) << name;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.path("out/snapshot_color.png")));
+  EXPECT_EQ(Mapper::load(dir.path("out/map.panmap"))->framesIntegrated(), 3);
 }
 
 TEST_F(BoxScene, LiveMeshUpdatesAddUpToTheExportedMesh) {

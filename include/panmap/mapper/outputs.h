@@ -28,15 +28,18 @@ struct OutputSummary {
   size_t instances_in_mesh = 0;    ///< distinct instance ids > 0 on mesh vertices
   size_t objects = 0;              ///< entries of objects.json
   std::vector<std::string> files;  ///< file names written, in order
-  /// Wall time of each step ("mesh extraction", "meshes", "snapshots", "objects.json",
-  /// "occupancy.bt", "trajectory.txt", "map.panmap", "config.yaml"), seconds, in order.
+  /// Wall time of each step ("map.panmap", "mesh extraction", "meshes", "snapshots",
+  /// "objects.json", "occupancy.bt", "trajectory.txt", "config.yaml"), seconds, in order.
   std::vector<std::pair<std::string, double>> step_seconds;
 };
 
 /// Writes a map's outputs (DESIGN 4) into `dir` (created when missing): mesh_semantic.ply,
 /// mesh_instance.ply, mesh_superpoint.ply, objects.json, occupancy.bt (when enabled),
 /// trajectory.txt (TUM, the poses as integrated), map.panmap, config.yaml (the exact parameters)
-/// and the snapshot PNGs. Throws Error naming the file that could not be written.
+/// and the snapshot PNGs (removed when none are made: no faces, or options.snapshots off).
+/// map.panmap is written first; when it cannot be, Error names it and nothing else is written.
+/// A later output that cannot be written is named in the Error thrown after the others are
+/// written.
 /// @param labels optimised labels, or null for the frame-count labels
 /// @param optimiser the optimiser settings recorded in config.yaml
 OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLabels* labels,
