@@ -1,6 +1,7 @@
 #include "panmap/lcm/mapping_session.h"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -28,7 +29,14 @@ StageTiming summariseTimes(std::vector<double> times_ms) {
 
 std::string reasonOf(const std::string& what) {
   const auto colon = what.find(':');
-  return colon == std::string::npos ? what : what.substr(0, colon);
+  if (colon == std::string::npos) return what;
+  // "rgbd frame 12: principal point ... lies outside ...": the head names one message, and
+  // counted by it every frame was a reason of its own and what was wrong was lost.
+  if (colon > 0 && std::isdigit(static_cast<unsigned char>(what[colon - 1]))) {
+    const size_t rest = what.find_first_not_of(' ', colon + 1);
+    if (rest != std::string::npos) return what.substr(rest);
+  }
+  return what.substr(0, colon);
 }
 
 MappingSession::MappingSession(const SessionOptions& options, Mapper* mapper)

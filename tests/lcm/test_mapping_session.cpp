@@ -434,5 +434,17 @@ TEST_F(MappingSessionTest, ABackgroundRepairTakesTheFramesMappedMeanwhile) {
   }
 }
 
+// A rejection is counted by what was wrong, not by the message that was: a log whose every
+// frame has the same bad intrinsics gives one reason that names the fault.
+TEST(MappingSession, RejectionsAreCountedByTheirFault) {
+  EXPECT_EQ(reasonOf("rgbd frame 12: principal point (3200, 2400) lies outside the 640x480 "
+                     "depth image"),
+            "principal point (3200, 2400) lies outside the 640x480 depth image");
+  EXPECT_EQ(reasonOf("rgbd frame 13: intrinsics: fx must be > 0"), "intrinsics: fx must be > 0");
+  EXPECT_EQ(reasonOf("pose: utime out of range"), "pose");
+  EXPECT_EQ(reasonOf("no pose"), "no pose");
+  EXPECT_EQ(reasonOf("pose 5:"), "pose 5");
+}
+
 }  // namespace
 }  // namespace panmap

@@ -160,7 +160,9 @@ class MappingSession {
 /// Median / p95 / last of a list of times.
 StageTiming summariseTimes(std::vector<double> times_ms);
 
-/// The first words of an error message, used as its counted reason ("pose", "depth is ...").
+/// An error message's counted reason: its text up to the first ':' ("pose", "extent"), or,
+/// when that names one message by its number ("rgbd frame 12: principal point ..."), the text
+/// after it, so that every frame with the same fault counts under one reason that says it.
 std::string reasonOf(const std::string& what);
 
 }  // namespace panmap
