@@ -34,7 +34,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--traj", trajectories, "TUM trajectory to score (repeat for several)")
       ->required();
-  app.add_option("--gaps", config.frame_gaps, "frame gaps of the pairs")->capture_default_str();
+  app.add_option("--gaps", config.frame_gaps, "frame gaps of the pairs (1,3,10 or 1 3 10)")
+      ->capture_default_str()
+      ->delimiter(',');
   app.add_option("--stride", config.pixel_stride, "pixel stride")->capture_default_str();
   app.add_option("--min-gradient", config.min_gradient, "grey levels per pixel")
       ->capture_default_str();

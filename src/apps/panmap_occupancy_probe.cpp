@@ -146,6 +146,12 @@ int main(int argc, char** argv) {
     if (!compare.empty()) {
       const panmap::OccupancyAgreement a =
           panmap::compareOccupancy(*tree, *panmap::readBtFile(compare));
+      // "100 % of 0 cells" would read as agreement.
+      if (a.known_in_both == 0) {
+        throw panmap::Error("no cell is known in both trees (" + std::to_string(a.only_in_a) +
+                            " only here, " + std::to_string(a.only_in_b) + " only in " + compare +
+                            "): maps of other places, or in other frames?");
+      }
       char line[256];
       std::snprintf(line, sizeof(line),
                     "agree on %.2f %% of %llu cells known in both; known only here %llu, only "

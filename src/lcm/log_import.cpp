@@ -86,6 +86,7 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
   try {
     LogWriter writer(partial);
     int64_t last_utime = INT64_MIN;
+    std::string first_color_stem;
     for (size_t i = 0; i < total; ++i) {
       // Everything that reads a file comes first, so a bad frame is skipped whole.
       DatasetFrame frame;
@@ -117,6 +118,7 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
         if (progress) progress(i + 1, total);
         continue;
       }
+      if (first_color_stem.empty()) first_color_stem = frame.color_stem;
       if (frame.rgbd.utime <= last_utime) {
         throw Error("frame " + std::to_string(frame.rgbd.frame_id) +
                     ": timestamps are not increasing");
@@ -148,6 +150,13 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
         ++stats.frames_without_mask;
       }
       if (progress) progress(i + 1, total);
+    }
+    // Masks named otherwise than their images (a stem with or without ".color", other
+    // numbering) would give a map without a single class and no word of why.
+    if (masks && stats.frames_written > 0 && stats.panoptic_written == 0) {
+      throw Error("no mask in " + options.mask_dir + " matches a frame: a mask is found by its " +
+                  "colour image's name (the first frame's is '" + first_color_stem +
+                  "', its mask '" + first_color_stem + ".png')");
     }
     if (stats.frames_written == 0 && stats.skipped_invalid_pose > 0) {
       throw Error("no frame has a valid pose: all " + std::to_string(stats.skipped_invalid_pose) +

@@ -1,6 +1,7 @@
 #include "panmap/occupancy/octree_io.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -46,6 +47,9 @@ std::unique_ptr<octomap::OcTree> canonicalCopy(const octomap::OcTree& tree) {
 }
 
 std::string readWholeFile(const std::string& path) {
+  std::error_code ec;
+  // A folder opens as a stream and then fails inside libstdc++ ("basic_filebuf::underflow").
+  if (std::filesystem::is_directory(path, ec)) throw Error(path + " is a folder, not a .bt file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot open");
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -295,6 +295,27 @@ TEST(Import, PanopticMasksBecomeMessages) {
   EXPECT_TRUE(inspectLog(dir.path("m.lcmlog"), true).allDecoded());
 }
 
+// Masks that match no frame by name are an error, not a map without classes: the message
+// names the file name the first frame's mask would have. No log is left behind.
+TEST(Import, MasksMatchingNoFrameAreNamed) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  fs::create_directory(dir.path("masks"));
+  writeFileBytes(dir.path("masks/frame-000000.png"), encodeLabelPng(LabelImage(640, 480, 1)));
+  std::ofstream(dir.path("masks/frame-000000.json"))
+      << R"({"segments_info": [{"id": 1, "category_id": 1}]})";
+  ImportOptions options;
+  options.max_frames = 2;
+  options.mask_dir = dir.path("masks");
+  options.label_table = test::fixtureDir("coco_tiny/labels.tsv");
+  test::expectError(
+      [&] { importDataset(test::dataDir("7scenes-200"), dir.path("m.lcmlog"), options); },
+      {"no mask in " + dir.path("masks") + " matches a frame",
+       "its mask 'frame-000000.color.png'"});
+  EXPECT_FALSE(fs::exists(dir.path("m.lcmlog")));
+  EXPECT_FALSE(fs::exists(dir.path("m.lcmlog.partial")));
+}
+
 TEST(Import, CocoNetworkMasksTakeTheShippedTablesClasses) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   test::TempDir dir;

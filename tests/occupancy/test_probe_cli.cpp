@@ -143,6 +143,12 @@ TEST_F(ProbeCli, FailsWithOneLineOnBadInput) {
   std::ofstream(garbage) << "# Octomap OcTree binary file\nid OcTree\nsize 9\nres 0.05\ndata\nxyz";
   expectFailure("--file " + garbage + " --point 0 0 0", "malformed or truncated");
   expectFailure("--file " + garbage, "nothing to ask");
+  expectFailure("--file " + dir_.path("") + " --point 0 0 0", "is a folder, not a .bt file");
+  // Trees that share no known cell do not "agree on 100 % of 0 cells".
+  const std::string bt = dir_.path("occupancy.bt"), empty = dir_.path("empty.bt");
+  map_->writeBt(bt);
+  OccupancyMap().writeBt(empty);
+  expectFailure("--file " + bt + " --compare " + empty, "no cell is known in both trees");
 
   const std::string log = dir_.path("bad.lcmlog");
   const std::string url = "--lcm-url 'file://" + log + "?speed=0' --point 0 0 0";
