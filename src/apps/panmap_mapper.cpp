@@ -433,14 +433,13 @@ int main(int argc, char** argv) {
     if (no_regularise) optimiser.regularise = false;
     if (no_refine) optimiser.refine = false;
     if (mapper && !export_only) {
-      const std::string difference = panmap::mapperSettingDifference(mapper->config(), config);
-      if (!difference.empty()) {
-        throw panmap::Error(
-            std::string(resumed ? "--resume" : "--load") + ": the map was made with " +
-            difference.substr(0, difference.find(" -> ")) + ", this run asks for " +
-            difference.substr(difference.find(" -> ") + 4) +
-            "; a map keeps mapping with its own settings (leave the flag or key out, or start "
-            "a new map)");
+      const panmap::SettingDifference d = panmap::mapperSettingDifference(mapper->config(), config);
+      if (!d.key.empty()) {
+        throw panmap::Error(std::string(resumed ? "--resume" : "--load") +
+                            ": the map was made with " + d.key + ": " + d.have +
+                            ", this run asks for " + d.wanted +
+                            "; a map keeps mapping with its own settings (leave the flag or key "
+                            "out, or start a new map)");
       }
     }
     if (!mapper) mapper = std::make_unique<panmap::Mapper>(config);

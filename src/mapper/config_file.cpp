@@ -623,7 +623,7 @@ std::pair<std::string, std::string> keyAndValue(const std::string& line) {
 
 }  // namespace
 
-std::string mapperSettingDifference(const MapperConfig& have, const MapperConfig& wanted) {
+SettingDifference mapperSettingDifference(const MapperConfig& have, const MapperConfig& wanted) {
   // Both printed with one optimiser, so that only the mapper's settings can differ; the
   // printed values are what a user wrote and would recognise.
   const PanmapConfig a{have, OptimiserConfig{}}, b{wanted, OptimiserConfig{}};
@@ -634,18 +634,16 @@ std::string mapperSettingDifference(const MapperConfig& have, const MapperConfig
       section = keyAndValue(line_a).first;
     }
     if (line_a == line_b) continue;
-    if (line_a.empty() || line_b.empty()) return section + ": settings differ";
+    if (line_a.empty() || line_b.empty()) return {section, "?", "?"};
     // The depth calibration is a commented-out line when there is none.
-    const bool top_a = !line_a.empty() && line_a[0] != ' ';
-    const auto [key_a, value_a] = keyAndValue(line_a[0] == '#' ? line_a.substr(1) : line_a);
-    const auto [key_b, value_b] = keyAndValue(line_b[0] == '#' ? line_b.substr(1) : line_b);
-    const std::string name = top_a || line_b[0] == '#' ? key_a : section + "." + key_a;
-    auto shown = [](const std::string& line, const std::string& value) {
-      return !line.empty() && line[0] == '#' ? std::string("none") : value;
-    };
-    return name + ": " + shown(line_a, value_a) + " -> " + shown(line_b, value_b);
+    const bool none_a = line_a[0] == '#', none_b = line_b[0] == '#';
+    const auto [key, value_a] = keyAndValue(none_a ? line_a.substr(1) : line_a);
+    const std::string value_b = keyAndValue(none_b ? line_b.substr(1) : line_b).second;
+    const bool top_level = line_a[0] != ' ';
+    return {top_level ? key : section + "." + key, none_a ? "none" : value_a,
+            none_b ? "none" : value_b};
   }
-  return "";
+  return {};
 }
 
 }  // namespace panmap

@@ -206,29 +206,33 @@ TEST(ConfigFile, ABaseFillsTheKeysTheFileLeavesOut) {
   EXPECT_EQ(c.mapper.num_threads, 1);
   EXPECT_FALSE(c.mapper.superpoints.semantic_consistency);
   EXPECT_FALSE(c.optimiser.regularise);
-  EXPECT_EQ(mapperSettingDifference(base.mapper, c.mapper), "");
+  EXPECT_EQ(mapperSettingDifference(base.mapper, c.mapper).key, "");
   // Without a base the same file keeps the defaults.
   EXPECT_FLOAT_EQ(loadConfig(dir.path("config.yaml")).mapper.map.voxel_size_m, 0.01f);
 }
 
+// The difference as the mapper's error shows it.
+std::string shown(const SettingDifference& d) { return d.key + ": " + d.have + " -> " + d.wanted; }
+
 TEST(ConfigFile, MapperSettingDifferenceNamesTheFirstKey) {
   const MapperConfig defaults;
-  EXPECT_EQ(mapperSettingDifference(defaults, defaults), "");
+  EXPECT_EQ(mapperSettingDifference(defaults, defaults).key, "");
   MapperConfig other = defaults;
   other.fusion.geometry_only = true;
-  EXPECT_EQ(mapperSettingDifference(defaults, other), "fusion.geometry_only: 0 -> 1");
+  EXPECT_EQ(shown(mapperSettingDifference(defaults, other)), "fusion.geometry_only: 0 -> 1");
   other = defaults;
   other.map.voxel_size_m = 0.05f;
   other.num_threads = 1;  // later in the file: the first difference is named
-  EXPECT_EQ(mapperSettingDifference(defaults, other), "map.voxel_size_m: 0.01 -> 0.05");
+  EXPECT_EQ(shown(mapperSettingDifference(defaults, other)), "map.voxel_size_m: 0.01 -> 0.05");
   other = defaults;
   other.num_threads = 1;
-  EXPECT_EQ(mapperSettingDifference(defaults, other), "threads: 2 -> 1");
+  EXPECT_EQ(shown(mapperSettingDifference(defaults, other)), "threads: 2 -> 1");
   other = defaults;
   other.depth_calibration =
       std::make_shared<const DepthCalibration>(4, 4, 1, 1, 2, 1.0, std::vector<float>{0.0f, 0.01f});
   other.depth_calibration_file = "/cal.json";
-  EXPECT_EQ(mapperSettingDifference(defaults, other), "depth_calibration: none -> \"/cal.json\"");
+  EXPECT_EQ(shown(mapperSettingDifference(defaults, other)),
+            "depth_calibration: none -> \"/cal.json\"");
 }
 
 // A map keeps every setting the config file shows: --load compares them and must not find a
@@ -245,7 +249,7 @@ TEST(ConfigFile, AMapFileKeepsEveryPrintedMapperSetting) {
   config.mask_edge_fill.enabled = false;
   config.integrator.vote_stride_px = 3;
   Mapper(config).save(dir.path("m.panmap"));
-  EXPECT_EQ(mapperSettingDifference(config, Mapper::load(dir.path("m.panmap"))->config()), "");
+  EXPECT_EQ(mapperSettingDifference(config, Mapper::load(dir.path("m.panmap"))->config()).key, "");
 }
 
 TEST(ConfigFile, ATabOutsideACommentIsNamed) {

@@ -23,10 +23,16 @@ PanmapConfig loadConfig(const std::string& path);
 /// defaults (a loaded map's settings, which a config may only restate). Throws as loadConfig.
 PanmapConfig loadConfig(const std::string& path, const PanmapConfig& base);
 
-/// The first mapping setting that differs between `have` and `wanted`, as
-/// "section.key: have-value -> wanted-value" (YAML names, as --print-config shows them); empty
-/// when every one agrees. Optimiser settings are not compared.
-std::string mapperSettingDifference(const MapperConfig& have, const MapperConfig& wanted);
+/// One setting that differs between two configs, by its YAML name and printed values.
+struct SettingDifference {
+  std::string key;     ///< "section.key" as --print-config shows it; empty: none differs
+  std::string have;    ///< the value in the first config ("none": no depth calibration)
+  std::string wanted;  ///< the value in the second
+};
+
+/// The first mapping setting that differs between `have` and `wanted`; key empty when every
+/// one agrees. Optimiser settings are not compared.
+SettingDifference mapperSettingDifference(const MapperConfig& have, const MapperConfig& wanted);
 
 /// The YAML text of a config, every key present with a comment (what --print-config shows).
 std::string configToYaml(const PanmapConfig& config);
