@@ -159,8 +159,10 @@ std::vector<PhotometricResult> photometricConsistency(
     }
   }
   if (pairs == 0) {
-    throw Error("photometric check: no frame pair that every trajectory poses with overlap (" +
-                std::to_string(frames.size()) + " frames)");
+    // Sparse sampling alone gets here too (--stride 64 on 640x480 frames): say what is counted.
+    throw Error("photometric check: no frame pair that every trajectory poses with " +
+                std::to_string(config.min_samples) + " pixels seen in both (" +
+                std::to_string(frames.size()) + " frames; a smaller pixel stride samples more)");
   }
   for (size_t t = 0; t < k; ++t) {
     results[t].pairs = pairs;

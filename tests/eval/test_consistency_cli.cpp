@@ -60,6 +60,27 @@ TEST(ConsistencyCli, AJitteredTrajectoryScoresWorseOnTheSamePixels) {
       << run.output;
 }
 
+// --gaps as the README writes it (1,3) and as CLI11 lists it (1 3) give the same pairs.
+TEST(ConsistencyCli, GapsTakeCommasOrSpaces) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  writeTrajectories(dir.path("recorded.txt"), dir.path("jittered.txt"));
+  const std::string common = consistency() + " --data " + test::dataDir("7scenes-200") +
+                             " --traj " + dir.path("recorded.txt");
+  const auto commas = runCommand(common + " --stride 8 --gaps 1,3 --json " + dir.path("c.json"));
+  ASSERT_EQ(commas.exit_code, 0) << commas.output;
+  const auto spaces = runCommand(common + " --stride 8 --gaps 1 3 --json " + dir.path("s.json"));
+  ASSERT_EQ(spaces.exit_code, 0) << spaces.output;
+  std::ifstream c(dir.path("c.json")), s(dir.path("s.json"));
+  const nlohmann::json with_commas = nlohmann::json::parse(c);
+  EXPECT_EQ(with_commas, nlohmann::json::parse(s));
+  EXPECT_EQ(with_commas[0]["pairs"].get<int>(), 199 + 197);  // gaps 1 and 3 of 200 frames
+  // Samples too sparse for any pair: the message says what was missing.
+  const auto sparse = runCommand(common + " --gaps 1 --stride 64");
+  EXPECT_EQ(sparse.exit_code, 1);
+  EXPECT_NE(sparse.output.find("200 pixels seen in both"), std::string::npos) << sparse.output;
+}
+
 TEST(ConsistencyCli, BadInputsFailWithOneLineNamingTheProblem) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   test::TempDir dir;
