@@ -221,7 +221,7 @@ int main(int argc, char** argv) {
       }
     }
     if (s.unmatched_frames) {
-      std::printf("dropped %zu depth images without a colour image in time\n", s.unmatched_frames);
+      std::printf("dropped %zu %s\n", s.unmatched_frames, s.unmatched_what.c_str());
     }
     if (!options.mask_dir.empty()) {
       std::printf(

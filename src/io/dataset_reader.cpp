@@ -244,6 +244,33 @@ void checkImageSize(const std::string& path, const char* kind, int width, int he
   throw Error(msg.str());
 }
 
+void checkPrincipalPoint(const PinholeCamera& camera, const std::string& from) {
+  const double w = camera.width, h = camera.height;
+  if (camera.cx > 0.25 * w && camera.cx < 0.75 * w && camera.cy > 0.25 * h &&
+      camera.cy < 0.75 * h) {
+    return;
+  }
+  std::ostringstream msg;
+  msg << from << ": principal point (" << camera.cx << ", " << camera.cy
+      << ") lies outside the middle half of the " << camera.width << "x" << camera.height
+      << " depth image";
+  // Images resized after calibration keep a principal point at the old size's centre.
+  const double kx = 2.0 * camera.cx / w, ky = 2.0 * camera.cy / h;
+  if (kx > 0.2 && kx < 10.0 && std::abs(kx / ky - 1.0) < 0.05) {
+    PinholeCamera original = camera;
+    original.width = static_cast<int>(std::lround(w * kx));
+    original.height = static_cast<int>(std::lround(h * ky));
+    const PinholeCamera fitted = original.resized(camera.width, camera.height);
+    msg.precision(6);
+    msg << "; the intrinsics look like those of a " << original.width << "x" << original.height
+        << " image: for these images pass --intrinsics " << fitted.fx << "," << fitted.fy << ","
+        << fitted.cx << "," << fitted.cy;
+  } else {
+    msg << "; give the depth camera's intrinsics (--intrinsics fx,fy,cx,cy)";
+  }
+  throw Error(msg.str());
+}
+
 void readDepthPng(const std::string& path, int width, int height, DatasetFrame* frame) {
   frame->depth_png = readFileBytes(path);
   frame->rgbd.depth = decodeDepthPng(frame->depth_png.data(), frame->depth_png.size(), path);

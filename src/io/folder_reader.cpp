@@ -19,6 +19,7 @@
 #include "panmap/io/opencv_image.h"
 #include "panmap/io/pose_list.h"
 #include "panmap/io/text_files.h"
+#include "panmap/io/timestamps.h"
 
 namespace panmap {
 namespace internal {
@@ -37,6 +38,17 @@ constexpr const char* kPoseFolders[] = {"pose", "poses"};
 // indoor RGB-D sensor but typical of TUM's 1/5000 m.
 constexpr double kMaxMedianDepthMm = 6500.0;
 constexpr double kMaxP99DepthMm = 15000.0;
+// A median beyond this in mm is possible (a hall) but is also TUM's 1/5000 m at 0.8-1.3 m.
+constexpr double kFarMedianDepthMm = 4000.0;
+// Depth images, spread over the sequence, whose values decide the depth unit.
+constexpr size_t kDepthScaleImages = 9;
+
+// The q-quantile of values (reordered).
+double quantile(std::vector<uint16_t>* values, double q) {
+  const size_t k = std::min(values->size() - 1, static_cast<size_t>(q * values->size()));
+  std::nth_element(values->begin(), values->begin() + static_cast<long>(k), values->end());
+  return static_cast<double>((*values)[k]);
+}
 
 struct NamedFile {
   std::string name;
@@ -105,6 +117,15 @@ bool areTimestamps(const std::vector<NamedFile>& files) {
   });
 }
 
+// Timestamp names as seconds (names in ms, us or ns are scaled); the unit's name.
+const char* namesInSeconds(std::vector<NamedFile>* files) {
+  std::vector<double> numbers;
+  for (const NamedFile& f : *files) numbers.push_back(f.number);
+  const TimestampUnit unit = timestampUnitOf(numbers);
+  for (NamedFile& f : *files) f.number *= unit.seconds_per_unit;
+  return unit.name;
+}
+
 // The key two files of one frame share: the number when both folders number their files,
 // else the stem.
 std::string keyOf(const NamedFile& f, bool numbers) {
@@ -151,10 +172,12 @@ class FolderReader : public DatasetReader {
     if (!missing.empty()) throw Error(dir + ": not an RGB-D folder (" + missing + ")");
     color_dir_ = firstExisting(dir, kColorFolders, std::size(kColorFolders), true);
     depth_dir_ = dir + "/depth";
-    const std::vector<NamedFile> colors = listFiles(color_dir_, {".png", ".jpg", ".jpeg"});
-    const std::vector<NamedFile> depths = listFiles(depth_dir_, {".png"});
+    std::vector<NamedFile> colors = listFiles(color_dir_, {".png", ".jpg", ".jpeg"});
+    std::vector<NamedFile> depths = listFiles(depth_dir_, {".png"});
     if (depths.empty()) throw Error(depth_dir_ + ": no PNG depth images");
     if (colors.empty()) throw Error(color_dir_ + ": no PNG or JPEG colour images");
+    if (areTimestamps(depths)) time_unit_ = namesInSeconds(&depths);
+    if (areTimestamps(colors)) namesInSeconds(&colors);
     pairImages(colors, depths);
     timestamps_ = areTimestamps(depths);
     readCamera();
@@ -193,7 +216,7 @@ class FolderReader : public DatasetReader {
                 cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0, 0, 0));
       frame.rgbd.color = colorFromMat(registered);
     }
-    frame.rgbd.utime = timestamps_ ? static_cast<int64_t>(std::llround(f.depth.number * 1e6))
+    frame.rgbd.utime = timestamps_ ? utimeOfSeconds(f.depth.number, depth_path)
                                    : frameUtime(frameNumber(index), options_.frame_rate_hz);
     frame.rgbd.frame_id = frameNumber(index);
     frame.rgbd.camera_name = "folder";
@@ -231,7 +254,9 @@ class FolderReader : public DatasetReader {
       const bool positional = colors.size() == depths.size();
       if (!named.empty() && (pairing == FramePairing::kName || 2 * named.size() >= depths.size())) {
         frames_ = std::move(named);
-        how = numbers ? "by frame number" : "by file name";
+        how = !numbers                ? "by file name"
+              : areTimestamps(depths) ? "by the timestamp in the name"
+                                      : "by frame number";
       } else if (pairing == FramePairing::kAuto && areTimestamps(colors) && areTimestamps(depths)) {
         pairing = FramePairing::kTime;
       } else if (positional) {
@@ -260,10 +285,18 @@ class FolderReader : public DatasetReader {
                   " in depth/ (names differ, counts differ, names are not timestamps)");
     }
     unmatched_ = depths.size() - frames_.size();
+    // Paired by name, a colour image left over is a frame whose depth image is missing.
+    const size_t colors_left = how.rfind("by f", 0) == 0 || how.rfind("by the", 0) == 0
+                                   ? colors.size() - std::min(colors.size(), frames_.size())
+                                   : 0;
     std::ostringstream note;
     note << "images: " << frames_.size() << " frames from " << color_name << " and depth/, paired "
          << how;
     if (unmatched_) note << "; " << unmatched_ << " depth images without a colour image";
+    if (colors_left) note << "; " << colors_left << " colour images without a depth image";
+    if (time_unit_ != std::string("seconds")) {
+      note << "; the names are timestamps in " << time_unit_;
+    }
     notes_.push_back(note.str());
   }
 
@@ -381,7 +414,7 @@ class FolderReader : public DatasetReader {
         for (size_t i = 0; i < list.poses.size(); ++i) {
           if (!list.poses[i]) continue;
           StampedPose p;
-          p.utime = static_cast<int64_t>(std::llround(list.times_s[i] * 1e6));
+          p.utime = utimeOfSeconds(list.times_s[i], poses_from_);
           p.T_W_C = *list.poses[i];
           timed_.push_back(p);
         }
@@ -448,32 +481,51 @@ class FolderReader : public DatasetReader {
       notes_.push_back("depth scale: " + formatDepthScale(depth_scale_m_) + " (given)");
       return;
     }
+    // Pixels of images spread over the sequence: one image may face a near wall.
     std::vector<uint16_t> values;
-    for (int v = 0; v < first_depth_.height(); ++v) {
-      const uint16_t* row = first_depth_.row(v);
-      for (int u = 0; u < first_depth_.width(); ++u) {
-        if (row[u] > 0) values.push_back(row[u]);
+    double largest_p99 = 0.0;
+    const size_t images = std::min(kDepthScaleImages, frames_.size());
+    for (size_t k = 0; k < images; ++k) {
+      const size_t index = images > 1 ? k * (frames_.size() - 1) / (images - 1) : 0;
+      DepthImage depth = first_depth_;
+      if (index > 0) {
+        try {
+          depth = readDepthFile(depth_dir_ + "/" + frames_[index].depth.name);
+        } catch (const Error&) {
+          continue;  // named when the frame is read (or skipped with --skip-bad)
+        }
       }
+      std::vector<uint16_t> image_values;
+      for (int v = 0; v < depth.height(); v += 2) {
+        const uint16_t* row = depth.row(v);
+        for (int u = 0; u < depth.width(); u += 2) {
+          if (row[u] > 0) image_values.push_back(row[u]);
+        }
+      }
+      if (image_values.empty()) continue;
+      largest_p99 = std::max(largest_p99, quantile(&image_values, 0.99));
+      values.insert(values.end(), image_values.begin(), image_values.end());
     }
     if (values.empty()) {
       depth_scale_m_ = 0.001;
-      notes_.push_back("depth scale: " + formatDepthScale(depth_scale_m_) +
-                       " (assumed: the first depth image is empty; --depth-scale overrides)");
+      notes_.push_back("depth scale: " + formatDepthScale(depth_scale_m_) + " (assumed: the " +
+                       std::to_string(images) +
+                       " depth images looked at are empty; --depth-scale overrides)");
       return;
     }
-    auto quantile = [&values](double q) {
-      const size_t k = std::min(values.size() - 1, static_cast<size_t>(q * values.size()));
-      std::nth_element(values.begin(), values.begin() + static_cast<long>(k), values.end());
-      return static_cast<double>(values[k]);
-    };
-    const double median = quantile(0.5);
-    const double p99 = quantile(0.99);
-    depth_scale_m_ = (median <= kMaxMedianDepthMm && p99 <= kMaxP99DepthMm) ? 0.001 : 1.0 / 5000.0;
+    const double median = quantile(&values, 0.5);
+    const bool mm = median <= kMaxMedianDepthMm && largest_p99 <= kMaxP99DepthMm;
+    depth_scale_m_ = mm ? 0.001 : 1.0 / 5000.0;
     std::ostringstream note;
     note.precision(3);
-    note << "depth scale: " << formatDepthScale(depth_scale_m_)
-         << ", detected from the first image (median " << median * depth_scale_m_ << " m, 99th "
-         << "percentile " << p99 * depth_scale_m_ << " m; --depth-scale overrides)";
+    note << "depth scale: " << formatDepthScale(depth_scale_m_) << ", detected from " << images
+         << (images == 1 ? " image" : " images") << " (median " << median * depth_scale_m_
+         << " m, largest 99th percentile " << largest_p99 * depth_scale_m_
+         << " m; --depth-scale overrides)";
+    if (mm && median > kFarMedianDepthMm) {
+      note << "; WARNING: a median this far is unusual indoors: if the images are in TUM's "
+           << "1/5000 m, pass --depth-scale 0.0002";
+    }
     notes_.push_back(note.str());
   }
 
@@ -484,6 +536,7 @@ class FolderReader : public DatasetReader {
   std::vector<Frame> frames_;
   size_t unmatched_ = 0;
   bool timestamps_ = false;
+  const char* time_unit_ = "seconds";  ///< of the depth images' timestamp names
   bool integer_numbers_ = false;
   PinholeCamera camera_;
   int color_width_ = 0;

@@ -5,6 +5,7 @@
 #include "panmap/core/error.h"
 #include "panmap/core/pose.h"
 #include "panmap/io/text_files.h"
+#include "panmap/io/timestamps.h"
 
 namespace panmap {
 namespace {
@@ -98,6 +99,9 @@ PoseList readPoseList(const std::string& path, double tolerance) {
                 " numbers per line; expected TUM (t tx ty tz qx qy qz qw), 12 or 16 (a 3x4 or "
                 "4x4 matrix per line) or 4 (a 4x4 matrix over four lines)");
   }
+  const TimestampUnit unit = timestampUnitOf(list.times_s);
+  for (double& t : list.times_s) t *= unit.seconds_per_unit;
+  list.time_unit = unit.name;
   return list;
 }
 

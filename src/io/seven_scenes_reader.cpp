@@ -1,6 +1,7 @@
 // 7-Scenes / tsdf-fusion layout: frame-XXXXXX.{color.jpg,depth.png,pose.txt} and
 // camera-intrinsics.txt (3x3 K) in one folder. Colour and depth are registered already.
 #include <cmath>
+#include <set>
 
 #include "panmap/core/error.h"
 #include "panmap/io/image_codec.h"
@@ -19,11 +20,12 @@ class SevenScenesReader : public DatasetReader {
     if (frames_.empty()) {
       throw Error(dir + ": no frame-XXXXXX.depth.png files (not a 7-Scenes/tsdf-fusion folder)");
     }
+    countColorWithoutDepth();
+    const std::string path = dir + "/camera-intrinsics.txt";
     if (options.intrinsics) {
       const Eigen::Vector4d& k = *options.intrinsics;
       camera_ = PinholeCamera{k(0), k(1), k(2), k(3), 0, 0};
     } else {
-      const std::string path = dir + "/camera-intrinsics.txt";
       if (!isRegularFile(path)) {
         throw Error(path + ": intrinsics file missing (or pass --intrinsics fx,fy,cx,cy)");
       }
@@ -36,11 +38,17 @@ class SevenScenesReader : public DatasetReader {
     camera_.width = depth.width();
     camera_.height = depth.height();
     std::string why;
-    if (!camera_.isValid(&why)) throw Error(dir + "/camera-intrinsics.txt: " + why);
+    if (!camera_.isValid(&why)) throw Error(path + ": " + why);
+    // Given on the command line, a cropped sensor may really have it off-centre.
+    if (!options.intrinsics) checkPrincipalPoint(camera_, path);
   }
 
   std::string layoutName() const override { return "7scenes"; }
   size_t size() const override { return frames_.size(); }
+  size_t unmatchedFrames() const override { return color_without_depth_.size(); }
+  std::string unmatchedWhat() const override {
+    return "colour images without a depth image (first: " + color_without_depth_.front() + ")";
+  }
 
   DatasetFrame read(size_t index) const override {
     DatasetFrame frame;
@@ -71,10 +79,20 @@ class SevenScenesReader : public DatasetReader {
   }
   std::string depthPath(size_t index) const { return dir_ + "/" + frames_.at(index).second; }
 
+  // A frame whose depth image is missing is left out; it is counted so the user hears of it.
+  void countColorWithoutDepth() {
+    std::set<long long> depth_numbers;
+    for (const auto& f : frames_) depth_numbers.insert(f.first);
+    for (const auto& c : listNumberedFiles(dir_, R"(frame-(\d+)\.color\.(?:jpg|png))")) {
+      if (!depth_numbers.count(c.first)) color_without_depth_.push_back(c.second);
+    }
+  }
+
   std::string dir_;
   DatasetOptions options_;
   PinholeCamera camera_;
   std::vector<std::pair<long long, std::string>> frames_;
+  std::vector<std::string> color_without_depth_;
 };
 
 }  // namespace

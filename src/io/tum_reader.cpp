@@ -11,6 +11,7 @@
 #include "panmap/io/image_codec.h"
 #include "panmap/io/internal/readers.h"
 #include "panmap/io/text_files.h"
+#include "panmap/io/timestamps.h"
 #include "panmap/io/tum_trajectory.h"
 
 namespace panmap {
@@ -38,6 +39,10 @@ std::vector<Stamped> readFileList(const std::string& path) {
     }
     out.push_back(s);
   }
+  std::vector<double> times;
+  for (const Stamped& s : out) times.push_back(s.t);
+  const double unit_s = timestampUnitOf(times).seconds_per_unit;
+  for (Stamped& s : out) s.t *= unit_s;
   std::sort(out.begin(), out.end(), [](const Stamped& a, const Stamped& b) { return a.t < b.t; });
   return out;
 }
@@ -77,18 +82,22 @@ class TumReader : public DatasetReader {
     }
     ground_truth_ = readGroundTruth(poses_path_);
 
+    std::string from = dir + "/camera-intrinsics.txt";
     if (options.intrinsics) {
       const Eigen::Vector4d& k = *options.intrinsics;
       camera_ = PinholeCamera{k(0), k(1), k(2), k(3), 0, 0};
-    } else if (isRegularFile(dir + "/camera-intrinsics.txt")) {
+    } else if (isRegularFile(from)) {
       const Eigen::MatrixXd K = readMatrixFile(dir + "/camera-intrinsics.txt", 3, 3);
       camera_ = PinholeCamera{K(0, 0), K(1, 1), K(0, 2), K(1, 2), 0, 0};
     } else if (dir.find("freiburg1") != std::string::npos) {
       camera_ = PinholeCamera{517.3, 516.5, 318.6, 255.3, 0, 0};  // TUM's published fr1 values
+      from = "TUM's freiburg1 intrinsics";
     } else if (dir.find("freiburg2") != std::string::npos) {
       camera_ = PinholeCamera{520.9, 521.0, 325.1, 249.7, 0, 0};
+      from = "TUM's freiburg2 intrinsics";
     } else if (dir.find("freiburg3") != std::string::npos) {
       camera_ = PinholeCamera{535.4, 539.2, 320.1, 247.6, 0, 0};
+      from = "TUM's freiburg3 intrinsics";
     } else {
       throw Error(dir +
                   "/camera-intrinsics.txt: intrinsics file missing and the folder name "
@@ -99,6 +108,7 @@ class TumReader : public DatasetReader {
     camera_.height = first.height();
     std::string why;
     if (!camera_.isValid(&why)) throw Error(dir + ": intrinsics: " + why);
+    if (!options.intrinsics) checkPrincipalPoint(camera_, from);
   }
 
   std::string layoutName() const override { return "tum"; }
@@ -112,7 +122,7 @@ class TumReader : public DatasetReader {
     readDepthPng(depth_path, camera_.width, camera_.height, &frame);
     readRegisteredColor(dir_ + "/" + p.color.file, camera_.width, camera_.height, &frame);
 
-    frame.rgbd.utime = static_cast<int64_t>(std::llround(p.depth.t * 1e6));
+    frame.rgbd.utime = utimeOfSeconds(p.depth.t, dir_ + "/depth.txt");
     frame.rgbd.frame_id = static_cast<int64_t>(index);
     frame.rgbd.camera_name = "tum";
     frame.rgbd.camera = camera_;

@@ -7,13 +7,20 @@
 
 #include "panmap/core/error.h"
 #include "panmap/io/text_files.h"
+#include "panmap/io/timestamps.h"
 
 namespace panmap {
 
 std::vector<StampedPose> readTumTrajectory(const std::string& path) {
   if (!isRegularFile(path)) throw Error("cannot read trajectory " + path);
   std::vector<StampedPose> out;
-  for (const NumberLine& line : readNumberLines(path)) {
+  const std::vector<NumberLine> lines = readNumberLines(path);
+  std::vector<double> times;
+  for (const NumberLine& line : lines) {
+    if (!line.values.empty()) times.push_back(line.values[0]);
+  }
+  const TimestampUnit unit = timestampUnitOf(times);
+  for (const NumberLine& line : lines) {
     const std::string where = path + ":" + std::to_string(line.line);
     const std::vector<double>& v = line.values;
     if (v.size() < 8) throw Error(where + ": expected 't tx ty tz qx qy qz qw'");
@@ -25,7 +32,7 @@ std::vector<StampedPose> readTumTrajectory(const std::string& path) {
       throw Error(where + ": quaternion is not unit length");
     }
     StampedPose pose;
-    pose.utime = static_cast<int64_t>(std::llround(v[0] * 1e6));
+    pose.utime = utimeOfSeconds(v[0] * unit.seconds_per_unit, where);
     pose.T_W_C.linear() = q.normalized().toRotationMatrix();
     pose.T_W_C.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
     out.push_back(pose);

@@ -77,6 +77,7 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
   stats.layout = reader->layoutName();
   stats.frames_found = reader->size();
   stats.unmatched_frames = reader->unmatchedFrames();
+  if (stats.unmatched_frames) stats.unmatched_what = reader->unmatchedWhat();
   stats.notes = reader->notes();
   const size_t total =
       options.max_frames ? std::min(options.max_frames, reader->size()) : reader->size();

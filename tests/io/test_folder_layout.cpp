@@ -269,6 +269,63 @@ TEST(IntrinsicsFile, ReadsTheThreeFormsAndRefusesOthers) {
   EXPECT_THROW(readIntrinsicsFile(path), Error);
 }
 
+// Exporters name frames by Unix time in ms or ns as often as in seconds; read as seconds, a
+// name in ms put frames 33 s apart in the year 43000 and one in ns overflowed the utime.
+TEST(FolderLayout, ReadsTimestampNamesInMillisecondsAndNanoseconds) {
+  for (const double unit : {1e-3, 1e-9}) {
+    test::TempDir dir;
+    fs::create_directory(dir.path("rgb"));
+    fs::create_directory(dir.path("depth"));
+    for (int i = 0; i < 3; ++i) {
+      const long long ms = 1305031102175LL + 33 * i;
+      const std::string name =
+          (unit == 1e-3 ? std::to_string(ms) : std::to_string(ms) + "000000") + ".png";
+      writeFrame(dir.path("rgb/") + name, dir.path("depth/") + name, i, 1500);
+    }
+    writeText(dir.path("intrinsics.txt"), "5 6 4 3\n");
+    // Poses with a time column in nanoseconds, 1 m apart along x, 100 ms apart in time.
+    writeText(dir.path("groundtruth.txt"),
+              "1305031102100000000 0 0 0 0 0 0 1\n1305031102200000000 1 0 0 0 0 0 1\n"
+              "1305031102300000000 2 0 0 0 0 0 1\n");
+    DatasetOptions options;
+    options.tum_max_dt_s = 0.06;
+    const auto reader = openDataset(dir.path(), options);
+    ASSERT_EQ(reader->size(), 3u);
+    const DatasetFrame f = reader->read(1);
+    EXPECT_EQ(f.rgbd.utime, 1305031102208000);
+    ASSERT_TRUE(f.T_W_C.has_value()) << f.pose_problem;
+    EXPECT_NEAR(f.T_W_C->translation().x(), 1.08, 1e-5);  // 108 ms after the pose at x = 0
+    EXPECT_NE(reader->notes()[0].find(unit == 1e-3 ? "timestamps in milliseconds"
+                                                   : "timestamps in nanoseconds"),
+              std::string::npos)
+        << reader->notes()[0];
+  }
+}
+
+// The unit decided on the first image alone read a TUM sequence (1/5000 m) that starts facing
+// a wall 1.2 m away as millimetres; the images after it say otherwise.
+TEST(FolderLayout, DetectsTheDepthUnitFromImagesAcrossTheSequence) {
+  test::TempDir dir;
+  makeIssueFolder(dir, 6, 6000);  // 6 m in mm or 1.2 m in TUM units: either would do
+  for (int i = 1; i < 6; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06d.png", i);
+    writeFrame(dir.path("rgb/") + name, dir.path("depth/") + name, i, 17500);  // 3.5 m in TUM
+  }
+  const auto reader = openDataset(dir.path(), DatasetOptions{});
+  EXPECT_DOUBLE_EQ(reader->read(0).rgbd.depth_scale_m, 1.0 / 5000.0);
+  EXPECT_NE(reader->notes()[3].find("detected from 6 images"), std::string::npos)
+      << reader->notes()[3];
+
+  // Every image at 5 m in mm: taken as mm (a hall), with a warning naming the other reading.
+  test::TempDir far;
+  makeIssueFolder(far, 2, 5000);
+  const auto far_reader = openDataset(far.path(), DatasetOptions{});
+  EXPECT_DOUBLE_EQ(far_reader->read(0).rgbd.depth_scale_m, 0.001);
+  EXPECT_NE(far_reader->notes()[3].find("WARNING"), std::string::npos);
+  EXPECT_NE(far_reader->notes()[3].find("--depth-scale 0.0002"), std::string::npos);
+}
+
 TEST(PoseList, DetectsFormatsAndKeepsBadPosesAsProblems) {
   test::TempDir dir;
   const std::string path = dir.path("poses.txt");
@@ -297,6 +354,11 @@ TEST(PoseList, DetectsFormatsAndKeepsBadPosesAsProblems) {
               std::string::npos)
         << e.what();
   }
+  writeText(path, "1305031102100000 1 2 3 0 0 0 1\n1305031102200000 1 2 3 0 0 0 1\n");
+  list = readPoseList(path, 1e-3);
+  EXPECT_DOUBLE_EQ(list.times_s[1], 1305031102.2);  // microseconds read as such
+  EXPECT_EQ(list.time_unit, "microseconds");
+
   writeText(path, "1 2 3 4 5\n");
   EXPECT_THROW(readPoseList(path, 1e-3), Error);
   writeText(path, "");

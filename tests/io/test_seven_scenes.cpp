@@ -104,6 +104,37 @@ TEST_F(SevenScenesBadInput, DepthOfTheWrongSize) {
   EXPECT_NE(error.find("320x240"), std::string::npos) << error;
 }
 
+// Images resized to 320x240 with the 640x480 intrinsics left beside them: the principal point
+// sits in the image's corner and every point would be shifted by half an image.
+TEST_F(SevenScenesBadInput, ResizedImagesWithTheOriginalIntrinsicsAreNamed) {
+  test::TempDir small;
+  writeFileBytes(small.path("frame-000000.depth.png"), encodeDepthPng(DepthImage(320, 240, 1000)));
+  fs::copy_file(dir_.path("camera-intrinsics.txt"), small.path("camera-intrinsics.txt"));
+  try {
+    openDataset(small.path(), DatasetOptions{});
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    const std::string error = e.what();
+    EXPECT_NE(error.find("camera-intrinsics.txt: principal point (320, 240)"), std::string::npos)
+        << error;
+    EXPECT_NE(error.find("those of a 640x480 image"), std::string::npos) << error;
+    EXPECT_NE(error.find("--intrinsics 292.5,292.5,159.75,119.75"), std::string::npos) << error;
+  }
+  DatasetOptions options;
+  options.intrinsics = Eigen::Vector4d(292.5, 292.5, 159.75, 119.75);
+  EXPECT_EQ(openDataset(small.path(), options)->size(), 1u);
+}
+
+// A frame whose depth image is missing was left out of the import without a word.
+TEST_F(SevenScenesBadInput, AColourImageWithoutDepthIsCounted) {
+  fs::remove(dir_.path("frame-000003.depth.png"));
+  const auto reader = openDataset(dir_.path(), DatasetOptions{});
+  EXPECT_EQ(reader->size(), 1u);
+  EXPECT_EQ(reader->unmatchedFrames(), 1u);
+  EXPECT_EQ(reader->unmatchedWhat(),
+            "colour images without a depth image (first: frame-000003.color.jpg)");
+}
+
 TEST_F(SevenScenesBadInput, TruncatedJpeg) {
   auto bytes = readFileBytes(test::dataDir("7scenes-200/frame-000003.color.jpg"));
   bytes.resize(bytes.size() * 2 / 3);

@@ -318,6 +318,11 @@ TEST(Survey, TumReaderNamesTheBadLine) {
   EXPECT_EQ(message("0.5 1 2 3 0 0 0 1\n"), "no error");
   EXPECT_EQ(readTumTrajectory(path)[0].utime, 500000);
   EXPECT_THROW(readTumTrajectory(dir.path("missing.txt")), Error);
+  // A time column in nanoseconds (EuRoC, ROS) overflowed the utime; it is read as such.
+  EXPECT_EQ(message("1403636579763555584 1 2 3 0 0 0 1\n"), "no error");
+  EXPECT_EQ(readTumTrajectory(path)[0].utime, 1403636579763556);
+  EXPECT_EQ(message("1e30 1 2 3 0 0 0 1\n"),
+            path + ":1: timestamp 1e+21 s is not a time a clock gives");
 }
 
 }  // namespace

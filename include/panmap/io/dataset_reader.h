@@ -89,6 +89,10 @@ class DatasetReader {
   virtual bool invalidPosesExpected() const { return false; }
   /// Frames the reader dropped while indexing (e.g. TUM depth without a matching colour).
   virtual size_t unmatchedFrames() const { return 0; }
+  /// What the unmatchedFrames() were, for "dropped N <what>".
+  virtual std::string unmatchedWhat() const {
+    return "depth images without a colour image in time";
+  }
   /// What auto-detection chose, one line each (files found, depth scale, pairing), for users.
   virtual std::vector<std::string> notes() const { return {}; }
 };

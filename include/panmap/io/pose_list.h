@@ -15,6 +15,8 @@ struct PoseList {
   enum class Format { kTum, kMatrixPerLine, kStacked };
   Format format = Format::kTum;
   std::vector<double> times_s;  ///< kTum only: each pose's timestamp, seconds
+  /// kTum only: the unit the file's time column was in (see timestampUnitOf).
+  std::string time_unit = "seconds";
   /// The poses in file order; empty where the entry is not a rigid transform (see problems).
   std::vector<std::optional<Eigen::Isometry3d>> poses;
   std::vector<std::string> problems;  ///< per pose: "" or "file:line: why"

@@ -57,6 +57,7 @@ struct ImportStats {
   size_t unknown_category_segments = 0;
   size_t masks_resized = 0;     ///< with resize_masks: masks scaled to their colour image
   size_t unmatched_frames = 0;  ///< e.g. TUM depth without colour in time
+  std::string unmatched_what;   ///< what those were (DatasetReader::unmatchedWhat)
   size_t bytes_written = 0;
   std::string first_skip_reason;
   std::vector<std::string> skipped_bad;     ///< with skip_bad: each skipped frame's error

@@ -61,6 +61,11 @@ std::string fileStem(const std::string& path);
 void checkImageSize(const std::string& path, const char* kind, int width, int height,
                     int expected_width, int expected_height);
 
+/// Throws Error (naming `from`, the intrinsics' source) when the camera's principal point lies
+/// outside the middle half of its image, as it does when images were resized after
+/// calibration; the message gives the intrinsics scaled to the images when that fits.
+void checkPrincipalPoint(const PinholeCamera& camera, const std::string& from);
+
 /// Reads the depth PNG at path into frame->depth_png (its bytes) and frame->rgbd.depth; throws
 /// Error naming the file when it cannot be read or decoded or is not width x height.
 void readDepthPng(const std::string& path, int width, int height, DatasetFrame* frame);
