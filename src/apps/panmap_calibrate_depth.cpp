@@ -14,6 +14,7 @@
 #include "panmap/core/error.h"
 #include "panmap/core/memory_policy.h"
 #include "panmap/core/progress.h"
+#include "panmap/io/output_path.h"
 #include "panmap/io/tum_trajectory.h"
 #include "panmap/lcm/offline_mapping.h"
 #include "panmap/mapper/config_file.h"
@@ -98,6 +99,7 @@ int main(int argc, char** argv) {
   app.add_option("--voxel-size", voxel_m, "voxel edge of the mapping rounds, metres")
       ->capture_default_str();
   app.add_option("--first", first, "first frame (0-based, in log order) to learn from")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--last", last, "last frame to learn from (-1: the log's last)")
       ->capture_default_str();
@@ -121,10 +123,12 @@ int main(int argc, char** argv) {
   try {
     cal.check();
     // Fail before the work, not after it.
-    const std::filesystem::path out_dir = std::filesystem::path(out_path).parent_path();
-    if (!out_dir.empty() && !std::filesystem::is_directory(out_dir)) {
-      throw panmap::Error("output folder " + out_dir.string() + " does not exist");
+    if (last < -1 || (last >= 0 && last < first)) {
+      throw panmap::Error("--last " + std::to_string(last) + ": not -1 (the log's last) and not " +
+                          "at or after --first " + std::to_string(first));
     }
+    panmap::checkOutputFile(out_path, "--out");
+    if (!trajectory_out.empty()) panmap::checkOutputFile(trajectory_out, "--trajectory-out");
     panmap::MapperConfig config;
     if (!config_path.empty()) config = panmap::loadConfig(config_path).mapper;
     config.map.voxel_size_m = voxel_m;

@@ -23,6 +23,7 @@
 #include "panmap/core/process_memory.h"
 #include "panmap/core/progress.h"
 #include "panmap/graph/optimiser.h"
+#include "panmap/io/output_path.h"
 #include "panmap/lcm/live_mapper.h"
 #include "panmap/lcm/object_conversions.h"
 #include "panmap/lcm/offline_mapping.h"
@@ -201,31 +202,6 @@ void printRefinement(const panmap::PoseRefinementStats& r) {
       100.0 * r.moved_m.max, r.turned_deg.median, r.turned_deg.max);
 }
 
-/// Throws Error unless `dir` is a folder this process can write into, or one it can create:
-/// checked before mapping, so that hours of it do not end in "cannot write". Creates nothing.
-void checkOutputFolder(const std::string& dir) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::path path = fs::absolute(dir, ec);
-  if (fs::exists(path, ec)) {
-    if (!fs::is_directory(path, ec))
-      throw panmap::Error("--out " + dir + " is a file, not a folder");
-    if (::access(path.c_str(), W_OK | X_OK) != 0) {
-      throw panmap::Error("--out " + dir + ": folder not writable");
-    }
-    return;
-  }
-  fs::path parent = path.parent_path();
-  while (parent.has_relative_path() && !fs::exists(parent, ec)) parent = parent.parent_path();
-  if (!fs::is_directory(parent, ec)) {
-    throw panmap::Error("--out " + dir + ": " + parent.string() + " is a file, not a folder");
-  }
-  if (::access(parent.c_str(), W_OK | X_OK) != 0) {
-    throw panmap::Error("--out " + dir + ": cannot create it, " + parent.string() +
-                        " is not writable");
-  }
-}
-
 double msSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
@@ -388,7 +364,7 @@ int main(int argc, char** argv) {
     }
     if (out_dir.empty()) out_dir = resume_dir;
     if (out_dir.empty()) throw panmap::Error("--out is required");
-    checkOutputFolder(out_dir);
+    panmap::checkOutputFolder(out_dir, "--out");
     // A loaded or resumed map keeps mapping with the settings it was made with: the config
     // file's keys and the flags below are checked against them instead of silently ignored.
     std::unique_ptr<panmap::Mapper> mapper;
@@ -566,8 +542,10 @@ int main(int argc, char** argv) {
                        {"regularise", optimiser.regularise},
                        {"class_consensus", optimiser.class_consensus},
                        {"refine", optimiser.refine}};
+      json["outputs_failed"] = outputs.failed;
       writeJson(out_dir + "/report.json", json);
       finishAutosave();
+      panmap::requireAllWritten(outputs, out_dir);
       std::printf(
           "mapped %lld frames in %.1f s (median %.1f ms/frame): %zu super-points, %zu "
           "instances after optimisation, %zu mesh vertices; outputs in %s\n",
@@ -599,7 +577,8 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "panmap-mapper: map saved to %s\n", path.c_str());
       } else {
         const std::string dir = argument.empty() ? out_dir : argument;
-        panmap::writeOutputs(dir, m, labels, optimiser, output_options);
+        panmap::requireAllWritten(panmap::writeOutputs(dir, m, labels, optimiser, output_options),
+                                  dir);
         std::fprintf(stderr, "panmap-mapper: outputs written to %s\n", dir.c_str());
       }
     });
@@ -668,8 +647,10 @@ int main(int argc, char** argv) {
                      {"solve_ms", labels ? labels->solve_ms : 0.0},
                      {"fragments_folded", labels ? labels->fragments_folded : 0},
                      {"fragments_dropped", labels ? labels->fragments_dropped : 0}};
+    json["outputs_failed"] = outputs.failed;
     writeJson(out_dir + "/report.json", json);
     finishAutosave();
+    panmap::requireAllWritten(outputs, out_dir);
     std::printf(
         "mapped %lld of %lld frames received (%lld dropped behind) in %.1f s: %zu "
         "super-points, %zu instances%s, %zu mesh vertices; outputs in %s\n",

@@ -63,12 +63,11 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
   mapper->save(dir + "/map.panmap");
   summary.files.push_back("map.panmap");
   step("map.panmap");
-  std::vector<std::string> failed;
   auto attempt = [&](const std::function<void()>& write) {
     try {
       write();
     } catch (const std::exception& e) {
-      failed.push_back(e.what());
+      summary.failed.push_back(e.what());
     }
   };
   {
@@ -131,13 +130,16 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
     summary.files.push_back("config.yaml");
   });
   step("config.yaml");
-  if (!failed.empty()) {
-    throw Error(failed.front() +
-                (failed.size() > 1 ? " (and " + std::to_string(failed.size() - 1) + " more)"
-                                   : std::string()) +
-                "; " + dir + "/map.panmap and the other outputs were written");
-  }
   return summary;
+}
+
+void requireAllWritten(const OutputSummary& summary, const std::string& dir) {
+  const std::vector<std::string>& failed = summary.failed;
+  if (failed.empty()) return;
+  throw Error(failed.front() +
+              (failed.size() > 1 ? " (and " + std::to_string(failed.size() - 1) + " more)"
+                                 : std::string()) +
+              "; " + dir + "/map.panmap and the other outputs were written");
 }
 
 }  // namespace panmap

@@ -182,7 +182,28 @@ TEST(CalibrateDepthCli, LearnsFromALogAndRefusesBadInput) {
       test::runCommand(test::binPath("panmap-calibrate-depth") + " --log " +
                        dir.path("r/sequence.lcmlog") + " --out " + dir.path("none/sensor.json"));
   EXPECT_EQ(no_folder.exit_code, 1);
-  EXPECT_NE(no_folder.output.find("output folder"), std::string::npos) << no_folder.output;
+  EXPECT_NE(no_folder.output.find("--out " + dir.path("none/sensor.json") + ": folder " +
+                                  dir.path("none") + " does not exist"),
+            std::string::npos)
+      << no_folder.output;
+  // Checked before the rounds, not after them (the trajectory was found unwritable at the end).
+  const auto no_trajectory_folder = test::runCommand(
+      test::binPath("panmap-calibrate-depth") + " --log " + dir.path("r/sequence.lcmlog") +
+      " --out " + out + " --trajectory-out " + dir.path("r") + " -q");
+  EXPECT_EQ(no_trajectory_folder.exit_code, 1);
+  EXPECT_EQ(test::countLines(no_trajectory_folder.output), 1) << no_trajectory_folder.output;
+  EXPECT_NE(no_trajectory_folder.output.find("--trajectory-out " + dir.path("r") +
+                                             " is a folder, not a file"),
+            std::string::npos)
+      << no_trajectory_folder.output;
+  for (const std::string range : {"--first -5", "--first 4 --last 2", "--last -3"}) {
+    const auto bad =
+        test::runCommand(test::binPath("panmap-calibrate-depth") + " --log " +
+                         dir.path("r/sequence.lcmlog") + " --out " + out + " " + range + " -q");
+    EXPECT_NE(bad.exit_code, 0) << range;
+    EXPECT_EQ(bad.output.find("round 1"), std::string::npos) << range << ": " << bad.output;
+    EXPECT_LE(test::countLines(bad.output), 2) << range << ": " << bad.output;
+  }
   const auto no_frames =
       test::runCommand(test::binPath("panmap-calibrate-depth") + " --log " +
                        dir.path("r/sequence.lcmlog") + " --out " + out + " --first 1000 -q");

@@ -97,8 +97,28 @@ TEST(Cli, MapperWithoutTheOptimisationSaysSo) {
   EXPECT_TRUE(optimised("b"));
 }
 
-// A log that gives no frame is an error, not an empty map: an empty file, bytes that are no LCM
-// log, and a log whose frames are on another channel than the one asked for.
+// An output that cannot be written (a folder where objects.json goes) fails the run in one
+// line, and report.json, which says what was mapped and written, is still there and names it.
+TEST(Cli, MapperReportsAnOutputThatCouldNotBeWritten) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  importSevenScenes(dir, 2);
+  if (HasFailure()) return;
+  std::filesystem::create_directories(dir.path("a/objects.json"));
+  const auto mapped =
+      runCommand(binPath("panmap-mapper") + " -q --voxel-size 0.05 --no-snapshots --log " +
+                 dir.path("s.lcmlog") + " --out " + dir.path("a"));
+  EXPECT_EQ(mapped.exit_code, 1);
+  EXPECT_EQ(test::countLines(mapped.output), 1) << mapped.output;
+  EXPECT_NE(mapped.output.find("objects.json"), std::string::npos) << mapped.output;
+  std::ifstream in(dir.path("a/report.json"));
+  ASSERT_TRUE(in.good());
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["frames_integrated"].get<int64_t>(), 2);
+  ASSERT_EQ(report["outputs_failed"].size(), 1u);
+  EXPECT_NE(report["outputs_failed"][0].get<std::string>().find("objects.json"), std::string::npos);
+}
+
 // `--load MAP --log LOG` continues the map: the frames it holds are not mapped twice, and
 // mapping flags that the map would ignore are refused, naming the setting.
 TEST(Cli, ALoadedMapSkipsItsFramesAndKeepsItsSettings) {
@@ -133,6 +153,8 @@ TEST(Cli, ALoadedMapSkipsItsFramesAndKeepsItsSettings) {
   EXPECT_FALSE(std::filesystem::exists(dir.path("c")));
 }
 
+// A log that gives no frame is an error, not an empty map: an empty file, bytes that are no LCM
+// log, and a log whose frames are on another channel than the one asked for.
 TEST(Cli, MapperRefusesALogWithoutFramesInOneLine) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   test::TempDir dir;

@@ -194,8 +194,12 @@ TEST_F(BoxScene, AnOutputThatCannotBeWrittenCostsOnlyThatOutput) {
   std::ofstream(dir.path("out/snapshot_color.png")) << "an old picture";
   OutputOptions options;
   options.snapshots = false;
+  const OutputSummary summary = writeOutputs(dir.path("out"), mapper.get(), &labels, {}, options);
+  ASSERT_EQ(summary.failed.size(), 1u);
+  EXPECT_EQ(std::count(summary.files.begin(), summary.files.end(), "objects.json"), 0);
+  EXPECT_EQ(std::count(summary.files.begin(), summary.files.end(), "config.yaml"), 1);
   test::expectError(
-      [&] { writeOutputs(dir.path("out"), mapper.get(), &labels, {}, options); },
+      [&] { requireAllWritten(summary, dir.path("out")); },
       {dir.path("out/objects.json"), "map.panmap and the other outputs were written"});
   for (const char* name : {"map.panmap", "mesh_instance.ply", "trajectory.txt", "config.yaml"}) {
     EXPECT_TRUE(std::filesystem::is_regular_file(dir.path("out/") + name)) << name;

@@ -31,6 +31,8 @@ struct OutputSummary {
   /// Wall time of each step ("map.panmap", "mesh extraction", "meshes", "snapshots",
   /// "objects.json", "occupancy.bt", "trajectory.txt", "config.yaml"), seconds, in order.
   std::vector<std::pair<std::string, double>> step_seconds;
+  /// Outputs that could not be written, one reason each (file and cause); the others were.
+  std::vector<std::string> failed;
 };
 
 /// Writes a map's outputs (DESIGN 4) into `dir` (created when missing): mesh_semantic.ply,
@@ -38,11 +40,15 @@ struct OutputSummary {
 /// trajectory.txt (TUM, the poses as integrated), map.panmap, config.yaml (the exact parameters)
 /// and the snapshot PNGs (removed when none are made: no faces, or options.snapshots off).
 /// map.panmap is written first; when it cannot be, Error names it and nothing else is written.
-/// A later output that cannot be written is named in the Error thrown after the others are
-/// written.
+/// A later output that cannot be written is recorded in OutputSummary::failed and the others
+/// are written (requireAllWritten() turns that into an Error), so a caller can still report.
 /// @param labels optimised labels, or null for the frame-count labels
 /// @param optimiser the optimiser settings recorded in config.yaml
 OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLabels* labels,
                            const OptimiserConfig& optimiser, const OutputOptions& options = {});
+
+/// Throws Error naming the first output of `summary` that could not be written (and how many
+/// more), saying that map.panmap in `dir` and the others were; returns when all were written.
+void requireAllWritten(const OutputSummary& summary, const std::string& dir);
 
 }  // namespace panmap
