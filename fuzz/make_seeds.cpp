@@ -385,6 +385,10 @@ void lcmSeeds() {
   status.stage_last_ms = {3.0f};
   status.depth_check = "pending";
   status.depth_pattern_mm = -1.0f;
+  status.num_commands = 1;
+  status.command_utimes = {4};
+  status.command_states = {"failed"};
+  status.command_results = {"cannot write /x/map.panmap"};
   seed("lcm_messages", "status", selected(3, status));
   panmap::MappedObject o;
   o.id = 2;

@@ -1,7 +1,7 @@
 // panmap-command: sends one PANMAP_COMMAND to a running panmap-mapper (finish, save, export,
 // optimise), e.g. at the end of an lcm-logplayer replay, and waits for the mapper's status that
-// shows it is listening; `status` prints the mapper's next PANMAP_STATUS as one JSON line (for
-// scripts and monitoring).
+// reports the command's result (finish: the outputs written); `status` prints the mapper's
+// next PANMAP_STATUS as one JSON line (for scripts and monitoring).
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -45,6 +45,12 @@ nlohmann::json statusJson(const panmap::status_t& s) {
     stages[s.stage_names[i]] = {{"median_ms", s.stage_median_ms[i]},
                                 {"last_ms", s.stage_last_ms[i]}};
   }
+  nlohmann::json commands = nlohmann::json::array();
+  for (int i = 0; i < s.num_commands; ++i) {
+    commands.push_back({{"utime", s.command_utimes[i]},
+                        {"state", s.command_states[i]},
+                        {"result", s.command_results[i]}});
+  }
   return {{"utime", s.utime},
           {"state", s.state},
           {"frames_received", s.frames_received},
@@ -67,27 +73,46 @@ nlohmann::json statusJson(const panmap::status_t& s) {
           {"poses_corrected", s.poses_corrected},
           {"poses_kept_as_given", s.poses_kept_as_given},
           {"depth_check", s.depth_check},
-          {"depth_pattern_mm", s.depth_pattern_mm}};
+          {"depth_pattern_mm", s.depth_pattern_mm},
+          {"commands", commands}};
 }
 
+// What a status says about one command.
+struct CommandProgress {
+  std::string state;   ///< "running", "done" or "failed"
+  std::string result;  ///< what it did, or why it failed
+  std::string mapper_state;
+  int64_t frames_integrated = 0;
+};
+
 struct StatusCatcher {
-  std::optional<panmap::status_t> received;
+  std::optional<panmap::status_t> received;  ///< the newest status
+  int64_t command_utime = -1;                ///< the command whose state is followed
+  std::optional<CommandProgress> about;      ///< the newest status's word on that command
   int malformed = 0;
   void onMessage(const lcm::ReceiveBuffer* buffer, const std::string&) {
     panmap::status_t msg;
-    if (panmap::decodeExactly(buffer->data, buffer->data_size, &msg)) {
-      received = msg;
-    } else {
+    if (!panmap::decodeExactly(buffer->data, buffer->data_size, &msg)) {
       ++malformed;
+      return;
+    }
+    received = msg;
+    for (int i = 0; i < msg.num_commands; ++i) {
+      if (msg.command_utimes[i] == command_utime) {
+        about = CommandProgress{msg.command_states[i], msg.command_results[i], msg.state,
+                                msg.frames_integrated};
+      }
     }
   }
+  bool finished() const { return about && (about->state == "done" || about->state == "failed"); }
 };
 
-// Handles messages until `catcher` holds a status or `timeout_s` has passed.
-void waitForStatus(lcm::LCM* lcm, const StatusCatcher& catcher, double timeout_s) {
+// Handles messages until `until()` holds or `timeout_s` has passed.
+template <typename Until>
+void waitForStatus(lcm::LCM* lcm, double timeout_s, Until until) {
   const auto deadline = std::chrono::steady_clock::now() +
                         std::chrono::milliseconds(static_cast<int64_t>(timeout_s * 1000));
-  while (!catcher.received && std::chrono::steady_clock::now() < deadline) {
+  while (!until() && std::chrono::steady_clock::now() < deadline) {
     lcm->handleTimeout(100);
   }
 }
@@ -96,7 +121,7 @@ void waitForStatus(lcm::LCM* lcm, const StatusCatcher& catcher, double timeout_s
 int printStatus(lcm::LCM* lcm, const std::string& channel, double timeout_s) {
   StatusCatcher catcher;
   lcm->subscribe(channel, &StatusCatcher::onMessage, &catcher);
-  waitForStatus(lcm, catcher, timeout_s);
+  waitForStatus(lcm, timeout_s, [&] { return catcher.received.has_value(); });
   if (!catcher.received) {
     std::fprintf(stderr, "panmap-command: error: no status on %s within %.1f s%s\n",
                  channel.c_str(), timeout_s, catcher.malformed ? " (only malformed messages)" : "");
@@ -112,17 +137,24 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Sends a command to panmap-mapper on PANMAP_COMMAND: finish (optimise, write the "
       "outputs, exit), save [PATH] (map snapshot), export [DIR] (outputs now), optimise; or "
-      "status: print the mapper's next PANMAP_STATUS as one JSON line. A command is confirmed by "
-      "the mapper's next status: exit 1 when none comes (no mapper listening)."};
+      "status: print the mapper's next PANMAP_STATUS as one JSON line. A command returns when "
+      "the mapper's status reports its result (finish: when the outputs are written): exit 1 "
+      "when it failed, or when no mapper status comes (none listening)."};
   std::string url, channel = panmap::kChannelCommand, command, argument;
   bool self_test = false;
   app.add_option("command", command, "finish | save | export | optimise | status");
   double timeout_s = 5.0;
   std::string status_channel = panmap::kChannelStatus;
   app.add_option("--timeout-s", timeout_s,
-                 "how long to wait for the mapper's status (every command but with --no-wait)")
+                 "how long to wait for the mapper's status that shows it took the command")
       ->capture_default_str();
-  bool no_wait = false;
+  double result_timeout_s = 3600.0;
+  app.add_option("--result-timeout-s", result_timeout_s,
+                 "how long to wait after that for the command's result (finish optimises and "
+                 "writes every output)")
+      ->capture_default_str();
+  bool no_wait = false, quiet = false;
+  app.add_flag("-q,--quiet", quiet, "no line while waiting for the result");
   app.add_flag("--no-wait", no_wait,
                "send the command and exit 0 without waiting for a status that shows a mapper "
                "listening");
@@ -174,6 +206,7 @@ int main(int argc, char** argv) {
   msg.argument = argument;
   // Subscribed before sending: a finishing mapper publishes its status at once, then exits.
   StatusCatcher catcher;
+  catcher.command_utime = msg.utime;
   if (!no_wait) lcm.subscribe(status_channel, &StatusCatcher::onMessage, &catcher);
   if (lcm.publish(channel, &msg) != 0) {
     std::fprintf(stderr, "panmap-command: error: publishing on %s failed\n", channel.c_str());
@@ -181,17 +214,43 @@ int main(int argc, char** argv) {
   }
   if (no_wait) return 0;
   // LCM publishes whether or not anyone listens: only a mapper's status shows that one does.
-  waitForStatus(&lcm, catcher, timeout_s);
-  if (!catcher.received) {
-    std::fprintf(stderr,
-                 "panmap-command: error: sent %s on %s, but no panmap-mapper status came on %s "
-                 "within %.1f s: is a mapper running on this LCM URL? (--self-test checks "
-                 "multicast, --no-wait only sends)\n",
-                 command.c_str(), channel.c_str(), status_channel.c_str(), timeout_s);
+  waitForStatus(&lcm, timeout_s, [&] { return catcher.about.has_value(); });
+  if (!catcher.about) {
+    if (catcher.received) {
+      std::fprintf(stderr,
+                   "panmap-command: error: sent %s on %s; panmap-mapper is %s but its status "
+                   "within %.1f s does not show the command taken (lost on the way, or another "
+                   "--channel)\n",
+                   command.c_str(), channel.c_str(), catcher.received->state.c_str(), timeout_s);
+    } else {
+      std::fprintf(stderr,
+                   "panmap-command: error: sent %s on %s, but no panmap-mapper status came on %s "
+                   "within %.1f s: is a mapper running on this LCM URL? (--self-test checks "
+                   "multicast, --no-wait only sends)\n",
+                   command.c_str(), channel.c_str(), status_channel.c_str(), timeout_s);
+    }
     return 1;
   }
-  std::printf("panmap-command: sent %s; panmap-mapper is %s, %lld frames integrated\n",
-              command.c_str(), catcher.received->state.c_str(),
-              static_cast<long long>(catcher.received->frames_integrated));
+  if (!catcher.finished() && !quiet) {
+    std::fprintf(stderr, "panmap-command: %s: %s\n", command.c_str(),
+                 catcher.about->result.c_str());
+  }
+  waitForStatus(&lcm, result_timeout_s, [&] { return catcher.finished(); });
+  if (!catcher.finished()) {
+    std::fprintf(stderr,
+                 "panmap-command: error: %s taken by panmap-mapper, but no result within %.0f s "
+                 "(last state: %s)\n",
+                 command.c_str(), result_timeout_s, catcher.about->state.c_str());
+    return 1;
+  }
+  const CommandProgress& done = *catcher.about;
+  if (done.state == "failed") {
+    std::fprintf(stderr, "panmap-command: error: %s failed: %s\n", command.c_str(),
+                 done.result.c_str());
+    return 1;
+  }
+  std::printf("panmap-command: %s: %s; panmap-mapper is %s, %lld frames integrated\n",
+              command.c_str(), done.result.c_str(), done.mapper_state.c_str(),
+              static_cast<long long>(done.frames_integrated));
   return 0;
 }

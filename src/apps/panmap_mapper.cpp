@@ -571,16 +571,19 @@ int main(int argc, char** argv) {
                             });
     node.setCommandHandler([&](int8_t command, const std::string& argument, panmap::Mapper* m,
                                const panmap::GraphLabels* labels) {
+      std::string done;
       if (command == panmap::command_t::COMMAND_SAVE) {
         const std::string path = argument.empty() ? out_dir + "/map.panmap" : argument;
         m->save(path);
-        std::fprintf(stderr, "panmap-mapper: map saved to %s\n", path.c_str());
+        done = "map saved to " + path;
       } else {
         const std::string dir = argument.empty() ? out_dir : argument;
         panmap::requireAllWritten(panmap::writeOutputs(dir, m, labels, optimiser, output_options),
                                   dir);
-        std::fprintf(stderr, "panmap-mapper: outputs written to %s\n", dir.c_str());
+        done = "outputs written to " + dir;
       }
+      std::fprintf(stderr, "panmap-mapper: %s\n", done.c_str());
+      return done;
     });
     node.setPeriodicPublisher(
         [&live, &optimiser](panmap::Mapper* m, int64_t utime, const panmap::GraphLabels* labels) {
@@ -628,29 +631,37 @@ int main(int argc, char** argv) {
     panmap::OutputOptions final_options = output_options;  // the export command keeps its own
     final_options.utime = stats.last_frame_utime;
     final_options.final_export = true;
-    const panmap::OutputSummary outputs = panmap::writeOutputs(
-        out_dir, mapper.get(), labels ? &*labels : nullptr, optimiser, final_options);
-    nlohmann::json json = sessionJson(stats);
-    json["mode"] = "live";
-    json["lcm_url"] = lcm_url;
-    json["autosave"] = autosaveJson(autosaver.get(), autosave_s);
-    json["resumed"] = resumeJson(resumed);
-    json["graph_requests_sent"] = node.graphRequestsSent();
-    json["idle_scan_refreshes"] = node.idleScanRefreshes();
-    json["frames_received"] = node.framesReceived();
-    json["frames_dropped_behind"] = node.framesDropped();
-    json["wall_s"] = wall_s;
-    json.update(mapJson(*mapper, outputs));
-    json["graph"] = {{"optimised", labels.has_value()},
-                     {"edges_pruned", mapper->edgesPruned()},
-                     {"optimise_ms", optimise_ms},
-                     {"solve_ms", labels ? labels->solve_ms : 0.0},
-                     {"fragments_folded", labels ? labels->fragments_folded : 0},
-                     {"fragments_dropped", labels ? labels->fragments_dropped : 0}};
-    json["outputs_failed"] = outputs.failed;
-    writeJson(out_dir + "/report.json", json);
-    finishAutosave();
-    panmap::requireAllWritten(outputs, out_dir);
+    panmap::OutputSummary outputs;
+    // `panmap-command finish` waits for this status: a failure must reach it too.
+    try {
+      outputs = panmap::writeOutputs(out_dir, mapper.get(), labels ? &*labels : nullptr, optimiser,
+                                     final_options);
+      nlohmann::json json = sessionJson(stats);
+      json["mode"] = "live";
+      json["lcm_url"] = lcm_url;
+      json["autosave"] = autosaveJson(autosaver.get(), autosave_s);
+      json["resumed"] = resumeJson(resumed);
+      json["graph_requests_sent"] = node.graphRequestsSent();
+      json["idle_scan_refreshes"] = node.idleScanRefreshes();
+      json["frames_received"] = node.framesReceived();
+      json["frames_dropped_behind"] = node.framesDropped();
+      json["wall_s"] = wall_s;
+      json.update(mapJson(*mapper, outputs));
+      json["graph"] = {{"optimised", labels.has_value()},
+                       {"edges_pruned", mapper->edgesPruned()},
+                       {"optimise_ms", optimise_ms},
+                       {"solve_ms", labels ? labels->solve_ms : 0.0},
+                       {"fragments_folded", labels ? labels->fragments_folded : 0},
+                       {"fragments_dropped", labels ? labels->fragments_dropped : 0}};
+      json["outputs_failed"] = outputs.failed;
+      writeJson(out_dir + "/report.json", json);
+      finishAutosave();
+      panmap::requireAllWritten(outputs, out_dir);
+    } catch (const std::exception& e) {
+      node.publishFinished(false, e.what());
+      throw;
+    }
+    node.publishFinished(true, "outputs written to " + out_dir);
     std::printf(
         "mapped %lld of %lld frames received (%lld dropped behind) in %.1f s: %zu "
         "super-points, %zu instances%s, %zu mesh vertices; outputs in %s\n",

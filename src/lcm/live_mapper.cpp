@@ -127,24 +127,37 @@ void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& 
       std::fprintf(stderr, "panmap-mapper: malformed message on %s ignored\n", channel.c_str());
       return;
     }
+    const int64_t utime = msg.utime;
     switch (msg.command) {
       case command_t::COMMAND_FINISH:
         finish_requested_ = true;
+        finish_command_utime_ = utime;
+        setCommandState(utime, "running", "finishing: mapping what is queued, then the outputs");
         return;
       case command_t::COMMAND_OPTIMISE:
         requestOptimisation();
+        setCommandState(utime, "done", "graph sent to the optimiser");
         return;
       case command_t::COMMAND_SAVE:
       case command_t::COMMAND_EXPORT: {
-        if (!command_handler_) return;
+        if (!command_handler_) {
+          setCommandState(utime, "failed", "this mapper does not save or export on command");
+          return;
+        }
         const int8_t command = msg.command;
         const std::string argument = msg.argument;
-        postWithLabels([this, command, argument](Mapper* mapper, const GraphLabels* labels) {
+        setCommandState(utime, "running", "queued behind the frames already received");
+        postWithLabels([this, command, argument, utime](Mapper* mapper, const GraphLabels* labels) {
           try {
-            command_handler_(command, argument, mapper, labels);
+            setCommandState(utime, "done", command_handler_(command, argument, mapper, labels));
           } catch (const std::exception& e) {
             std::fprintf(stderr, "panmap-mapper: command failed: %s\n", e.what());
+            setCommandState(utime, "failed", e.what());
           }
+          // At once, not at the next period: panmap-command is waiting for it.
+          const status_t now = status(session_.stats().repair_running ? "repairing" : "mapping");
+          std::lock_guard<std::mutex> lock(outbox_mutex_);
+          outbox_.push_back(encodeMessage(options_.channel_status, now));
         });
         return;
       }
@@ -155,6 +168,27 @@ void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& 
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-mapper: command ignored: %s\n", e.what());
   }
+}
+
+void LiveMapper::setCommandState(int64_t utime, const std::string& state,
+                                 const std::string& result) {
+  std::lock_guard<std::mutex> lock(command_mutex_);
+  for (CommandState& c : commands_) {
+    if (c.utime == utime) {
+      c.state = state;
+      c.result = result;
+      return;
+    }
+  }
+  commands_.push_back({utime, state, result});
+  if (commands_.size() > kCommandsReported) commands_.pop_front();
+}
+
+void LiveMapper::publishFinished(bool ok, const std::string& result) {
+  if (finish_command_utime_ != 0) {
+    setCommandState(finish_command_utime_, ok ? "done" : "failed", result);
+  }
+  publishStatus("done");
 }
 
 void LiveMapper::requestOptimisation() {
@@ -311,6 +345,15 @@ status_t LiveMapper::status(const std::string& state) const {
   msg.depth_check = DepthPatternMonitor::name(check.verdict());
   const double pattern_m = check.patternRmsM();
   msg.depth_pattern_mm = std::isfinite(pattern_m) ? static_cast<float>(1000.0 * pattern_m) : -1.0f;
+  {
+    std::lock_guard<std::mutex> lock(command_mutex_);
+    for (const CommandState& c : commands_) {
+      msg.command_utimes.push_back(c.utime);
+      msg.command_states.push_back(c.state);
+      msg.command_results.push_back(c.result);
+    }
+    msg.num_commands = static_cast<int32_t>(commands_.size());
+  }
   return msg;
 }
 

@@ -107,12 +107,30 @@ TEST_F(LiveCli, LogplayerToMapperAndOptimiserOverUdp) {
   EXPECT_TRUE(probe.output.find("\nblocked at") != std::string::npos ||
               probe.output.find("\nunknown at") != std::string::npos)
       << probe.output;
-  // As a user ends a replay: the command is confirmed by the mapper's status.
-  const test::CommandResult finish =
-      test::runCommand(test::binPath("panmap-command") + " --lcm-url '" + kUrl + "' finish");
+  // A command returns with its result: a save that cannot be written fails, naming why,
+  // and an export returns once its files exist.
+  const std::string command = test::binPath("panmap-command") + " -q --lcm-url '" + kUrl + "' ";
+  const test::CommandResult bad_save =
+      test::runCommand(command + "save " + dir_->path("none/map.panmap"));
+  EXPECT_EQ(bad_save.exit_code, 1) << bad_save.output;
+  EXPECT_EQ(test::countLines(bad_save.output), 1) << bad_save.output;
+  EXPECT_NE(bad_save.output.find("panmap-command: error: save failed: "), std::string::npos)
+      << bad_save.output;
+  EXPECT_NE(bad_save.output.find("none/map.panmap"), std::string::npos) << bad_save.output;
+  const test::CommandResult exported = test::runCommand(command + "export " + dir_->path("midway"));
+  EXPECT_EQ(exported.exit_code, 0) << exported.output;
+  EXPECT_NE(exported.output.find("export: outputs written to " + dir_->path("midway")),
+            std::string::npos)
+      << exported.output;
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir_->path("midway/mesh_instance.ply")));
+  // As a user ends a replay: finish returns when the outputs are written.
+  const test::CommandResult finish = test::runCommand(command + "finish");
   EXPECT_EQ(finish.exit_code, 0) << finish.output;
-  EXPECT_NE(finish.output.find("panmap-command: sent finish; panmap-mapper is "), std::string::npos)
+  EXPECT_NE(finish.output.find("panmap-command: finish: outputs written to " + out +
+                               "; panmap-mapper is done"),
+            std::string::npos)
       << finish.output;
+  EXPECT_TRUE(std::filesystem::is_regular_file(out + "/report.json"));
   ASSERT_TRUE(mapper.wait(120)) << test::fileBytes(dir_->path("mapper.log"));
   ASSERT_EQ(mapper.exitCode(), 0) << test::fileBytes(dir_->path("mapper.log"));
   optimiser.signal(SIGTERM);

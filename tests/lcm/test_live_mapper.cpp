@@ -33,9 +33,10 @@ void publishAll(lcm::LCM* lcm, const std::vector<test::Encoded>& messages) {
   }
 }
 
-void publishCommand(lcm::LCM* lcm, int8_t command, const std::string& argument = "") {
+void publishCommand(lcm::LCM* lcm, int8_t command, const std::string& argument = "",
+                    int64_t utime = 0) {
   command_t msg;
-  msg.utime = 0;
+  msg.utime = utime;
   msg.command = command;
   msg.argument = argument;
   lcm->publish("PANMAP_COMMAND", &msg);
@@ -225,8 +226,11 @@ TEST(LiveMapper, LabelsFromBeforeARemapStillNameTheSuperpointsThatKeptTheirIds) 
   std::vector<size_t> named_live;  // per export: named super-points live in the map it writes
   live.setCommandHandler(
       [&](int8_t command, const std::string&, Mapper* m, const GraphLabels* given) {
-        ASSERT_EQ(command, +command_t::COMMAND_EXPORT);
-        ASSERT_NE(given, nullptr);
+        EXPECT_EQ(command, +command_t::COMMAND_EXPORT);
+        if (given == nullptr) {
+          ADD_FAILURE() << "an export without labels";
+          return std::string();
+        }
         exported.push_back(*given);
         named_live.push_back(0);
         for (const auto& entry : given->instance) {
@@ -236,6 +240,7 @@ TEST(LiveMapper, LabelsFromBeforeARemapStillNameTheSuperpointsThatKeptTheirIds) 
         const GraphLabels fitted = fitLabelsToMap(labels, largest, m->superpoints());
         EXPECT_EQ(given->instance, fitted.instance);
         EXPECT_EQ(given->instance_confidence, fitted.instance_confidence);
+        return std::string("exported");
       });
   publishAll(&lcm, stream.messages());
   publishCommand(&lcm, command_t::COMMAND_OPTIMISE);  // request 1
@@ -383,20 +388,47 @@ TEST(LiveMapper, SaveCommandRunsOnTheWorkerAndMappingGoesOn) {
   std::vector<std::string> saved;
   live.setCommandHandler(
       [&](int8_t command, const std::string& argument, Mapper* m, const GraphLabels*) {
-        ASSERT_EQ(command, +command_t::COMMAND_SAVE);
+        EXPECT_EQ(command, +command_t::COMMAND_SAVE);
         m->save(argument);
         saved.push_back(argument);
+        return "saved " + argument;
       });
+  StatusInbox inbox;
+  lcm.subscribe("PANMAP_STATUS", &StatusInbox::onStatus, &inbox);
   // Half the stream, a save, the rest: the snapshot holds exactly the first half.
   const size_t half = messages.size() / 2 / 3 * 3;
   publishAll(&lcm, {messages.begin(), messages.begin() + half});
-  publishCommand(&lcm, command_t::COMMAND_SAVE, dir.path("half.panmap"));
+  publishCommand(&lcm, command_t::COMMAND_SAVE, dir.path("half.panmap"), 11);
+  // A save that cannot be written: mapping goes on, and the status says why (utime 12).
+  publishCommand(&lcm, command_t::COMMAND_SAVE, dir.path("none/x.panmap"), 12);
   publishAll(&lcm, {messages.begin() + half, messages.end()});
   publishCommand(&lcm, 42);  // unknown: counted, ignored
   publishCommand(&lcm, command_t::COMMAND_FINISH);
   std::atomic<bool> stop{false};
   live.run(stop);
   live.drain();
+  while (lcm.handleTimeout(0) > 0) {
+  }
+  // Each command's result reaches the status channel as soon as it is known.
+  std::map<int64_t, std::pair<std::string, std::string>> results;
+  for (const status_t& st : inbox.received) {
+    for (int i = 0; i < st.num_commands; ++i) {
+      if (st.command_states[i] != "running") {
+        results[st.command_utimes[i]] = {st.command_states[i], st.command_results[i]};
+      }
+    }
+  }
+  ASSERT_EQ(results.count(11), 1u);
+  EXPECT_EQ(results[11].first, "done");
+  EXPECT_EQ(results[11].second, "saved " + dir.path("half.panmap"));
+  ASSERT_EQ(results.count(12), 1u);
+  EXPECT_EQ(results[12].first, "failed");
+  EXPECT_NE(results[12].second.find("x.panmap"), std::string::npos) << results[12].second;
+  // The finish command (utime 0) after them, still running, keeps its own entry.
+  const status_t finished = live.status("finishing");
+  EXPECT_EQ(finished.command_utimes, (std::vector<int64_t>{11, 12, 0}));
+  EXPECT_EQ(finished.command_states, (std::vector<std::string>{"done", "failed", "running"}));
+
   ASSERT_EQ(saved.size(), 1u);
   const std::unique_ptr<Mapper> snapshot = Mapper::load(dir.path("half.panmap"));
   // The synchroniser may hold the newest frame back until its mask and pose are in.
@@ -437,6 +469,7 @@ TEST(LiveMapper, AnswersToAnotherMappersRequestsAreIgnored) {
   std::vector<bool> exported_with_labels;
   live.setCommandHandler([&](int8_t, const std::string&, Mapper*, const GraphLabels* labels) {
     exported_with_labels.push_back(labels != nullptr);
+    return std::string("exported");
   });
   GraphLabels labels;
   labels.semantic[1] = 5;

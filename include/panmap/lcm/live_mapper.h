@@ -88,9 +88,10 @@ class LiveMapper {
   using Publisher = std::function<std::vector<OutgoingMessage>(Mapper* mapper, int64_t utime,
                                                                const GraphLabels* labels)>;
   /// Runs a command's file work on the worker thread: COMMAND_SAVE / COMMAND_EXPORT with the
-  /// command's argument. Labels are the latest optimised ones, or null.
-  using CommandHandler = std::function<void(int8_t command, const std::string& argument,
-                                            Mapper* mapper, const GraphLabels* labels)>;
+  /// command's argument. Labels are the latest optimised ones, or null. Returns what it did
+  /// ("map saved to PATH"), which the status reports; throws Error when it failed.
+  using CommandHandler = std::function<std::string(int8_t command, const std::string& argument,
+                                                   Mapper* mapper, const GraphLabels* labels)>;
 
   /// Subscribes on `lcm` (not owned; must outlive this) and starts the worker.
   /// @param mapper the map (not owned); only the worker touches it until stop()
@@ -129,6 +130,10 @@ class LiveMapper {
   int64_t idleScanRefreshes() const { return idle_scan_refreshes_; }
   /// A status message of the current state. Call from the worker, or after drain().
   status_t status(const std::string& state) const;
+  /// Reports how the finish command ended (ok: what was written; else why it failed) in a
+  /// "done" status, so that `panmap-command finish` returns when the outputs exist. Call after
+  /// the outputs were written, whether a command or a signal ended the run.
+  void publishFinished(bool ok, const std::string& result);
 
  private:
   struct Item {
@@ -151,6 +156,8 @@ class LiveMapper {
   void publishOutbox();
   void publishStatus(const std::string& state);
   void countRejected(const std::string& reason);
+  /// Records the state of the command sent at `utime` for the status messages (any thread).
+  void setCommandState(int64_t utime, const std::string& state, const std::string& result);
 
   lcm::LCM* lcm_;
   LiveOptions options_;
@@ -187,7 +194,18 @@ class LiveMapper {
   // Commands and labels refused (written by the LCM thread, read by status()).
   mutable std::mutex rejected_mutex_;
   std::map<std::string, int64_t> rejected_commands_;
-  bool finish_requested_ = false;  // LCM thread only
+  bool finish_requested_ = false;     // LCM thread only
+  int64_t finish_command_utime_ = 0;  // LCM thread only: the finish command's utime
+  // The newest commands' progress, oldest first (written by the LCM thread and the worker,
+  // read by status()): a save still running when the next command comes keeps its own entry.
+  struct CommandState {
+    int64_t utime = 0;
+    std::string state;
+    std::string result;
+  };
+  static constexpr size_t kCommandsReported = 8;
+  mutable std::mutex command_mutex_;
+  std::deque<CommandState> commands_;
 
   // Optimiser round trip (LCM thread only).
   int64_t request_base_ = 0;  // request ids above this are ours
