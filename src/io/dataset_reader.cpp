@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include "panmap/core/error.h"
@@ -224,6 +225,17 @@ std::vector<std::pair<long long, std::string>> listNumberedFiles(const std::stri
   }
   if (ec) throw Error("cannot list " + dir + ": " + ec.message());
   std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::string> unpairedFiles(const std::vector<std::pair<long long, std::string>>& frames,
+                                       const std::string& dir, const std::string& pattern) {
+  std::set<long long> numbers;
+  for (const auto& f : frames) numbers.insert(f.first);
+  std::vector<std::string> out;
+  for (const auto& f : listNumberedFiles(dir, pattern)) {
+    if (!numbers.count(f.first)) out.push_back(f.second);
+  }
   return out;
 }
 

@@ -60,6 +60,8 @@ class ScanNetReader : public DatasetReader {
       : dir_(dir), options_(options) {
     frames_ = listNumberedFiles(dir + "/depth", R"((\d+)\.png)");
     if (frames_.empty()) throw Error(dir + "/depth: no N.png depth images (not a ScanNet export)");
+    // A frame whose depth image is missing is left out; it is counted so the user hears of it.
+    color_without_depth_ = unpairedFiles(frames_, dir + "/color", R"((\d+)\.(?:jpg|png))");
     depth_camera_ = readIntrinsics4x4(dir + "/intrinsic/intrinsic_depth.txt");
     color_camera_ = readIntrinsics4x4(dir + "/intrinsic/intrinsic_color.txt");
     if (options.intrinsics) {
@@ -111,6 +113,11 @@ class ScanNetReader : public DatasetReader {
 
   std::string layoutName() const override { return "scannet"; }
   size_t size() const override { return frames_.size(); }
+  size_t unmatchedFrames() const override { return color_without_depth_.size(); }
+  std::string unmatchedWhat() const override {
+    return "colour images without a depth image (first: color/" + color_without_depth_.front() +
+           ")";
+  }
   bool invalidPosesExpected() const override { return true; }
 
   DatasetFrame read(size_t index) const override {
@@ -188,6 +195,7 @@ class ScanNetReader : public DatasetReader {
   PinholeCamera color_camera_;
   Eigen::Isometry3d T_C_D_ = Eigen::Isometry3d::Identity();
   std::vector<std::pair<long long, std::string>> frames_;
+  std::vector<std::string> color_without_depth_;
 };
 
 }  // namespace

@@ -1,7 +1,6 @@
 // 7-Scenes / tsdf-fusion layout: frame-XXXXXX.{color.jpg,depth.png,pose.txt} and
 // camera-intrinsics.txt (3x3 K) in one folder. Colour and depth are registered already.
 #include <cmath>
-#include <set>
 
 #include "panmap/core/error.h"
 #include "panmap/io/image_codec.h"
@@ -81,11 +80,7 @@ class SevenScenesReader : public DatasetReader {
 
   // A frame whose depth image is missing is left out; it is counted so the user hears of it.
   void countColorWithoutDepth() {
-    std::set<long long> depth_numbers;
-    for (const auto& f : frames_) depth_numbers.insert(f.first);
-    for (const auto& c : listNumberedFiles(dir_, R"(frame-(\d+)\.color\.(?:jpg|png))")) {
-      if (!depth_numbers.count(c.first)) color_without_depth_.push_back(c.second);
-    }
+    color_without_depth_ = unpairedFiles(frames_, dir_, R"(frame-(\d+)\.color\.(?:jpg|png))");
   }
 
   std::string dir_;

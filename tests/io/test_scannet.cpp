@@ -87,6 +87,25 @@ TEST(ScanNetExport, InfPoseIsReportedNotRead) {
   EXPECT_TRUE(reader->read(2).T_W_C.has_value());
 }
 
+// A frame whose depth image is missing was left out of the import without a word.
+TEST(ScanNetExport, AColourImageWithoutDepthIsCounted) {
+  PANMAP_REQUIRE_DATA("scannet-export-3");
+  test::TempDir dir;
+  const std::string src = test::dataDir("scannet-export-3");
+  for (const char* sub : {"color", "pose", "intrinsic"}) {
+    fs::create_directory_symlink(src + "/" + sub, dir.path(sub));
+  }
+  fs::create_symlink(src + "/scene0707_00.txt", dir.path("scene0707_00.txt"));
+  fs::create_directory(dir.path("depth"));
+  for (const char* name : {"0.png", "2.png"}) {
+    fs::create_symlink(src + "/depth/" + name, dir.path("depth/") + name);
+  }
+  const auto reader = openDataset(dir.path(), DatasetOptions{});
+  EXPECT_EQ(reader->size(), 2u);
+  EXPECT_EQ(reader->unmatchedFrames(), 1u);
+  EXPECT_EQ(reader->unmatchedWhat(), "colour images without a depth image (first: color/1.jpg)");
+}
+
 TEST(ScanNetExport, MissingDepthIntrinsics) {
   PANMAP_REQUIRE_DATA("scannet-export-3");
   test::TempDir dir;

@@ -51,6 +51,11 @@ std::optional<Eigen::Isometry3d> readPoseFile(const std::string& path, double to
 std::vector<std::pair<long long, std::string>> listNumberedFiles(const std::string& dir,
                                                                  const std::string& pattern);
 
+/// Files in `dir` matching `pattern` (first capture group a frame number) whose number no
+/// entry of `frames` has: e.g. colour images whose depth image is missing.
+std::vector<std::string> unpairedFiles(const std::vector<std::pair<long long, std::string>>& frames,
+                                       const std::string& dir, const std::string& pattern);
+
 /// utime of frame `number` of a sequence recorded at rate_hz starting at utime 0.
 int64_t frameUtime(long long number, double rate_hz);
 
