@@ -158,7 +158,8 @@ nlohmann::json autosaveJson(const panmap::Autosaver* autosaver, double period_s)
           {"failed", s.failed},
           {"last_bytes", s.last_bytes},
           {"last_serialize_ms", s.last_serialize_ms},
-          {"last_write_ms", s.last_write_ms}};
+          {"last_write_ms", s.last_write_ms},
+          {"ahead_of_store", s.ahead_of_store}};
 }
 
 nlohmann::json resumeJson(const std::optional<panmap::ResumePoint>& point) {
@@ -443,6 +444,22 @@ int main(int argc, char** argv) {
                             std::to_string(frame_store->size()) +
                             " frames; give an empty folder, or --load / --resume their map");
       }
+      // A map that holds frames its store lacks (a snapshot of a version that did not wait
+      // for the store, or a store emptied by hand) cannot have those frames repaired.
+      if (!load_path.empty() || !resume_dir.empty()) {
+        size_t missing = 0;
+        int64_t first_missing = 0;
+        for (const panmap::StampedPose& p : mapper->trajectory()) {
+          if (!frame_store->has(p.utime) && missing++ == 0) first_missing = p.utime;
+        }
+        if (missing > 0) {
+          std::fprintf(stderr,
+                       "panmap-mapper: warning: frame store %s lacks %zu of the map's %zu "
+                       "frames (first: utime %lld): a correction that moves them is refused\n",
+                       frame_store_dir.c_str(), missing, mapper->trajectory().size(),
+                       static_cast<long long>(first_missing));
+        }
+      }
       options.frame_store = frame_store.get();
       options.repair.reassociate = !repair_reintegrate_only;
       options.repair.occupancy_first = !repair_occupancy_last;
@@ -456,6 +473,11 @@ int main(int argc, char** argv) {
       panmap::Autosaver::Config autosave_config;
       autosave_config.dir = out_dir + "/autosave";
       autosave_config.period_s = autosave_s;
+      if (frame_store) {
+        autosave_config.frame_stored = [store = frame_store.get()](int64_t utime) {
+          return store->has(utime);
+        };
+      }
       autosaver = std::make_unique<panmap::Autosaver>(autosave_config);
     }
     // After the outputs are safely written the snapshots have served their purpose.

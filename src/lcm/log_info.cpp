@@ -42,7 +42,10 @@ LogInfo inspectLog(const std::string& path, bool deep,
   info.path = path;
   std::map<std::string, ChannelInfo> channels;
   LogByteAccount bytes;
-  while (const lcm::LogEvent* event = log.readNextEvent()) {
+  // A header claiming more bytes than are left is the damaged end (and would crash liblcm).
+  while (nextEventFits(log.getFilePtr(), file_size)) {
+    const lcm::LogEvent* event = log.readNextEvent();
+    if (!event) break;
     ++info.events;
     bytes.addEvent(LogByteAccount::eventBytes(event->channel.size(), event->datalen),
                    std::ftell(log.getFilePtr()));

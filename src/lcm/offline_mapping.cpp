@@ -29,6 +29,8 @@ OfflineReport mapLog(const std::string& log_path, const SessionOptions& options,
   LogByteAccount bytes;
   std::map<std::string, int64_t> channel_events;
   while (!session.done()) {
+    // A header claiming more bytes than are left is the damaged end (and would crash liblcm).
+    if (!nextEventFits(log.getFilePtr(), static_cast<size_t>(st.st_size))) break;
     const lcm::LogEvent* e = log.readNextEvent();
     if (!e) break;
     ++events;

@@ -740,6 +740,11 @@ size_t FrameStore::size() const {
   return entries_.size();
 }
 
+bool FrameStore::has(int64_t utime) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return entries_.count(utime) > 0;
+}
+
 size_t FrameStore::sizeWithPanoptic() const {
   std::lock_guard<std::mutex> lock(mutex_);
   size_t n = 0;

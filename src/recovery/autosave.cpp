@@ -43,6 +43,9 @@ void Autosaver::Config::check() const {
   if (dir.empty()) throw Error("autosave: no folder");
   if (!(period_s >= 0.0 && std::isfinite(period_s))) throw Error("autosave: period_s must be >= 0");
   if (keep < 1) throw Error("autosave: keep must be at least 1");
+  if (!(store_wait_s >= 0.0 && std::isfinite(store_wait_s))) {
+    throw Error("autosave: store_wait_s must be >= 0");
+  }
 }
 
 std::string autosavePath(const std::string& dir, int64_t number) {
@@ -94,6 +97,7 @@ void Autosaver::afterFrame(const Mapper& mapper, int64_t frame_id, int64_t utime
   // the journal is for (saying which frames were lost).
   std::fprintf(journal_, "%" PRId64 " %" PRId64 "\n", frame_id, utime);
   std::fflush(journal_);
+  last_frame_utime_ = utime;
   if (config_.period_s <= 0.0) return;
   if (last_snapshot_utime_ == INT64_MIN) {
     last_snapshot_utime_ = utime;
@@ -114,6 +118,21 @@ void Autosaver::snapshotNow(const Mapper& mapper) {
       cv_.wait(lock, [&] { return !pending_ && !writing_; });
       ++stats_.waited_busy;
       stats_.waited_ms += msSince(start);
+    }
+  }
+  if (config_.frame_stored && last_frame_utime_ != INT64_MIN) {
+    // Rarely more than a few frames behind (13 ms each); a failing store is not waited for
+    // long, and its failures are counted where they happen.
+    const auto deadline =
+        std::chrono::steady_clock::now() +
+        std::chrono::milliseconds(static_cast<int64_t>(config_.store_wait_s * 1e3));
+    while (!config_.frame_stored(last_frame_utime_) &&
+           std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    if (!config_.frame_stored(last_frame_utime_)) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++stats_.ahead_of_store;
     }
   }
   const auto start = std::chrono::steady_clock::now();

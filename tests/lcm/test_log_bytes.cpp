@@ -1,8 +1,13 @@
 // Accounting for every byte of an LCM log, and the one-line reasons an offline run gives.
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "panmap/lcm/log_bytes.h"
+#include "panmap/lcm/log_info.h"
+#include "panmap/lcm/log_writer.h"
 #include "panmap/lcm/offline_mapping.h"
+#include "test_helpers.h"
 
 namespace panmap {
 namespace {
@@ -27,6 +32,43 @@ TEST(LogByteAccount, CountsGarbageBetweenEventsAndIgnoresImpossiblePositions) {
   bytes.addEvent(500, 300);  // ends before it could have started
   EXPECT_EQ(bytes.readableBytes(), 168u);
   EXPECT_EQ(bytes.skippedBytes(), 18u);
+}
+
+// liblcm allocates an event's claimed payload plus one byte before reading it: a header that
+// claims 2^31 - 1 bytes overflowed that and crashed panmap-loginfo and panmap-mapper --log. Such
+// a header is the log's damaged end, read up to and reported like a cut.
+TEST(LogByteAccount, AHeaderClaimingMoreThanTheFileIsTheDamagedEnd) {
+  test::TempDir dir;
+  const std::string path = dir.path("claims.lcmlog");
+  const uint8_t payload[5] = {1, 2, 3, 4, 5};
+  {
+    LogWriter writer(path);
+    writer.writeRaw("A", 1, payload, sizeof(payload));
+    writer.writeRaw("A", 2, payload, sizeof(payload));
+  }
+  const size_t whole = LogByteAccount::eventBytes(1, 5) * 2;
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::app);
+    // Sync word, event number and timestamp (zeros), a 1-byte channel, 2^31 - 1 payload bytes.
+    uint8_t header[28] = {0xED, 0xA1, 0xDA, 0x01};
+    header[23] = 1;
+    header[24] = 0x7F;
+    header[25] = header[26] = header[27] = 0xFF;
+    out.write(reinterpret_cast<const char*>(header), sizeof(header));
+    out << "A" << std::string(10, 'x');
+  }
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  ASSERT_NE(file, nullptr);
+  EXPECT_TRUE(nextEventFits(file, whole + 39));
+  std::fseek(file, static_cast<long>(whole), SEEK_SET);
+  EXPECT_FALSE(nextEventFits(file, whole + 39));
+  EXPECT_EQ(std::ftell(file), static_cast<long>(whole));  // the position is restored
+  std::fclose(file);
+
+  const LogInfo info = inspectLog(path, false);
+  EXPECT_EQ(info.events, 2u);
+  EXPECT_EQ(info.readable_bytes, whole);
+  EXPECT_TRUE(info.truncated);
 }
 
 TEST(OfflineReport, NamesTheLogsDamage) {

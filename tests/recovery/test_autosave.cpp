@@ -1,6 +1,7 @@
 // Crash recovery: periodic snapshots in stream time, atomic files, the frame journal, and
 // resuming from the newest snapshot that loads (past a corrupt one) exactly as if never
 // interrupted.
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 
@@ -67,6 +68,44 @@ TEST(Autosaver, SnapshotsEveryPeriodOfStreamTimeAndKeepsTheNewestTwo) {
   EXPECT_EQ(listAutosaves(dir.path())[0], autosavePath(dir.path(), 4));
   again.clear();
   EXPECT_TRUE(listAutosaves(dir.path()).empty());
+}
+
+// The loop-closure store is written behind the map on a thread of its own: a snapshot taken
+// ahead of it, resumed after a crash, held frames the store never got, and a later correction
+// of them was refused. A snapshot now waits for the store to hold its newest frame.
+TEST(Autosaver, ASnapshotWaitsForTheFrameStoreToHoldItsNewestFrame) {
+  const test::SyntheticStream& s = test::syntheticStream();
+  Mapper mapper(test::streamMapperConfig());
+  integrate(&mapper, s, 0);
+  test::TempDir dir;
+  Autosaver::Config config;
+  config.dir = dir.path();
+  std::atomic<int> asked{0};
+  std::atomic<int64_t> asked_utime{0};
+  config.frame_stored = [&](int64_t utime) {
+    asked_utime = utime;
+    return ++asked > 3;  // the writer catches up after a few polls
+  };
+  {
+    Autosaver autosaver(config);
+    autosaver.afterFrame(mapper, s.frames[0].frame_id, s.frames[0].utime);
+    autosaver.snapshotNow(mapper);
+    autosaver.wait();
+    EXPECT_GE(asked.load(), 4);
+    EXPECT_EQ(asked_utime.load(), s.frames[0].utime);
+    EXPECT_EQ(autosaver.stats().ahead_of_store, 0);
+    EXPECT_EQ(autosaver.stats().written, 1);
+  }
+  // A store that never catches up (its writes fail) delays the snapshot by store_wait_s at
+  // most; the snapshot is taken and counted.
+  config.frame_stored = [](int64_t) { return false; };
+  config.store_wait_s = 0.01;
+  Autosaver autosaver(config);
+  autosaver.afterFrame(mapper, s.frames[0].frame_id, s.frames[0].utime);
+  autosaver.snapshotNow(mapper);
+  autosaver.wait();
+  EXPECT_EQ(autosaver.stats().ahead_of_store, 1);
+  EXPECT_EQ(autosaver.stats().written, 1);
 }
 
 TEST(Resume, SkipsACorruptSnapshotListsLostFramesAndContinuesExactly) {

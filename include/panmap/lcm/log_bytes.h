@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 
 namespace panmap {
 
@@ -30,5 +31,12 @@ class LogByteAccount {
   size_t readable_bytes_ = 0;
   size_t skipped_bytes_ = 0;
 };
+
+/// True unless the event LCM's reader would read next from `file` (from its position, after
+/// the garbage it skips) claims more payload or channel bytes than the file holds from there.
+/// liblcm allocates the claimed payload plus one byte before reading it: a claim of 2^31 - 1
+/// bytes overflows that and crashes it (fread into NULL), so readers ask this first and treat
+/// a false as the log's damaged end. The file position is restored.
+bool nextEventFits(std::FILE* file, size_t file_bytes);
 
 }  // namespace panmap

@@ -155,6 +155,8 @@ class FrameStore {
 
   /// Number of frames stored.
   size_t size() const;
+  /// True when the frame of `utime` is stored.
+  bool has(int64_t utime) const;
   /// Number of them stored with their panoptic segmentation.
   size_t sizeWithPanoptic() const;
   /// The stored frames' utimes, increasing.

@@ -3,6 +3,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -27,6 +28,13 @@ class Autosaver {
     std::string dir;         ///< snapshots: dir/autosave-NNNNNN.panmap; journal: dir/frames.journal
     double period_s = 60.0;  ///< stream time (frame utimes) between snapshots; 0: never
     int keep = 2;            ///< newest snapshots kept, older ones removed
+    /// With a loop-closure frame store: true when the frame of a utime is in it. A snapshot
+    /// waits until the store holds its newest frame (the store's writer runs behind on a
+    /// thread of its own): a map resumed from a snapshot ahead of its store could not be
+    /// repaired. Empty: no store.
+    std::function<bool(int64_t utime)> frame_stored;
+    /// How long a snapshot waits for the store before it is taken anyway (counted).
+    double store_wait_s = 30.0;
     /// Throws Error naming the bad field.
     void check() const;
   };
@@ -42,6 +50,8 @@ class Autosaver {
     size_t last_bytes = 0;
     double last_serialize_ms = 0.0;  ///< streaming the map to the file, on the mapping thread
     double last_write_ms = 0.0;      ///< fsync and rename, on the background thread
+    /// Snapshots taken while the frame store still lacked their newest frame (store_wait_s).
+    int64_t ahead_of_store = 0;
   };
 
   /// Creates the folder; continues the numbering of snapshots already there (a resumed run).
@@ -73,6 +83,7 @@ class Autosaver {
   std::FILE* journal_ = nullptr;
   int64_t next_number_ = 1;
   int64_t last_snapshot_utime_ = INT64_MIN;
+  int64_t last_frame_utime_ = INT64_MIN;  ///< the newest frame journaled
 
   mutable std::mutex mutex_;
   std::condition_variable cv_;
