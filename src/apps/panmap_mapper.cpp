@@ -468,6 +468,9 @@ int main(int argc, char** argv) {
     // Offline runs can be replayed from their log, so they autosave only when asked to.
     const bool offline = !log_path.empty() || export_only;
     if (offline && app.count("--autosave-s") == 0) autosave_s = 0.0;
+    // From here on the run writes into OUT (autosaves, then the outputs): one process at a time.
+    std::optional<panmap::OutputFolderLock> out_lock;
+    out_lock.emplace(out_dir);
     std::unique_ptr<panmap::Autosaver> autosaver;
     if (autosave_s > 0.0 && !export_only) {
       panmap::Autosaver::Config autosave_config;

@@ -39,6 +39,14 @@ std::string reasonOf(const std::string& what) {
   return what.substr(0, colon);
 }
 
+std::string storeFailure(const std::string& what) {
+  // "cannot write DIR/frames/300000.depth.zst.partial: No space left on device": the file
+  // names one frame, and counted by it every failed frame was a reason of its own.
+  const auto colon = what.rfind(": ");
+  const std::string cause = colon == std::string::npos ? what : what.substr(colon + 2);
+  return "frame store: write failed (" + cause + "); the frame is mapped, a repair cannot move it";
+}
+
 MappingSession::MappingSession(const SessionOptions& options, Mapper* mapper)
     : options_(options), mapper_(mapper), sync_(options.sync) {
   if (!mapper_) throw Error("MappingSession: no mapper");
@@ -54,8 +62,7 @@ void MappingSession::countStoreErrors() {
   if (!writer_) return;
   // The map holds the frame either way; a frame the store lacks makes a later repair fail by
   // name, so the failure is counted as soon as it is known.
-  for (const std::string& e : writer_->takeErrors())
-    ++stats_.rejected["frame store: " + reasonOf(e)];
+  for (const std::string& e : writer_->takeErrors()) ++stats_.rejected[storeFailure(e)];
 }
 
 void MappingSession::countDropped(const std::string& reason, int64_t n) {

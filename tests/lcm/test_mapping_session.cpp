@@ -444,6 +444,13 @@ TEST(MappingSession, RejectionsAreCountedByTheirFault) {
   EXPECT_EQ(reasonOf("pose: utime out of range"), "pose");
   EXPECT_EQ(reasonOf("no pose"), "no pose");
   EXPECT_EQ(reasonOf("pose 5:"), "pose 5");
+  // A full disk under the frame store gave each frame a reason of its own (31 in one run).
+  EXPECT_EQ(storeFailure("cannot write s/frames/300000.depth.zst.partial: No space left on device"),
+            "frame store: write failed (No space left on device); the frame is mapped, a repair "
+            "cannot move it");
+  EXPECT_EQ(
+      storeFailure("cannot write s/frames/333333.depth.zst.partial: No space left on device"),
+      storeFailure("cannot write s/frames/300000.depth.zst.partial: No space left on device"));
 }
 
 }  // namespace

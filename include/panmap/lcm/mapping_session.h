@@ -165,4 +165,8 @@ StageTiming summariseTimes(std::vector<double> times_ms);
 /// after it, so that every frame with the same fault counts under one reason that says it.
 std::string reasonOf(const std::string& what);
 
+/// The counted reason of a frame store write that failed: the cause (the text after the last
+/// ": ", e.g. "No space left on device") without the file, which names one frame.
+std::string storeFailure(const std::string& what);
+
 }  // namespace panmap
