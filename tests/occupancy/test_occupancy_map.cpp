@@ -132,6 +132,13 @@ TEST_F(WallInFront, SegmentsAreFreeBlockedOrUnknown) {
   EXPECT_EQ(up.verdict, Occupancy::kUnknown);
   EXPECT_NEAR(up.where_W.z(), 0.275, 0.051);
   EXPECT_EQ(up.cells_checked, static_cast<size_t>(std::lround(up.where_W.z() / 0.05 + 0.5)));
+  // A far end beyond the tree's range (+-1638 m at 5 cm): the first non-free cell from A is
+  // still the wall, not the far end (which was reported as "unknown at 2000 0 0").
+  expectBoth(eye_, {2000.0, 0.01, 0.03}, Occupancy::kOccupied, {2.025, 0.025, 0.025});
+  // Leaving the view below, long before the range's edge: where a segment in range says.
+  const SegmentCheck below = map_.checkSegment({1.0, 0.01, 0.03}, {1.0, 0.01, -1.0});
+  ASSERT_EQ(below.verdict, Occupancy::kUnknown);
+  expectBoth({1.0, 0.01, 0.03}, {1.0, 0.01, -5000.0}, Occupancy::kUnknown, below.where_W);
   // A segment inside one cell looks at that cell only.
   EXPECT_EQ(map_.checkSegment({1.0, 0.01, 0.03}, {1.01, 0.02, 0.04}).cells_checked, 1u);
   test::expectError([&] { map_.checkSegment({NAN, 0, 0}, eye_); }, {"finite"});

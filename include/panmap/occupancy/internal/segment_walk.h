@@ -1,5 +1,7 @@
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <string>
 
@@ -33,9 +35,26 @@ SegmentCheck walkSegment(const octomap::OcTree& geometry, const Eigen::Vector3d&
     out.where_W = a_W;
     return out;
   }
+  // B beyond the tree's range (+-2^15 cells): the segment is walked up to the range's edge,
+  // and found free that far it meets unknown there, not at B (a planner was told a ray was
+  // clear for two kilometres when its far end lay out of range).
+  Eigen::Vector3d end_W = b_W;
+  bool clipped = false;
   if (!geometry.coordToKeyChecked(toOctomapPoint(b_W), key_b)) {
-    out.where_W = b_W;
-    return out;
+    const double limit = (32768.0 - 1.0) * geometry.getResolution();
+    double t = 1.0;
+    const Eigen::Vector3d d = b_W - a_W;
+    for (int i = 0; i < 3; ++i) {
+      if (std::abs(b_W[i]) > limit && d[i] != 0.0) {
+        t = std::min(t, ((d[i] > 0 ? limit : -limit) - a_W[i]) / d[i]);
+      }
+    }
+    end_W = a_W + std::max(0.0, t) * d;
+    clipped = true;
+    if (!geometry.coordToKeyChecked(toOctomapPoint(end_W), key_b)) {
+      out.where_W = end_W;
+      return out;
+    }
   }
   long steps = 0;
   for (int i = 0; i < 3; ++i) steps += std::labs(static_cast<long>(key_a[i]) - key_b[i]);
@@ -45,8 +64,8 @@ SegmentCheck walkSegment(const octomap::OcTree& geometry, const Eigen::Vector3d&
   }
   // A ray buffer is 600 kB: allocate it once per thread, not per query.
   thread_local octomap::KeyRay ray;
-  geometry.computeRayKeys(toOctomapPoint(a_W), toOctomapPoint(b_W), ray);  // A's cell .. B's
-  auto visit = [&](const octomap::OcTreeKey& key) {                        // (exclusive)
+  geometry.computeRayKeys(toOctomapPoint(a_W), toOctomapPoint(end_W), ray);  // A's cell .. B's
+  auto visit = [&](const octomap::OcTreeKey& key) {                          // (exclusive)
     ++out.cells_checked;
     const Occupancy s = state(key);
     if (s == Occupancy::kFree) return true;
@@ -59,6 +78,10 @@ SegmentCheck walkSegment(const octomap::OcTree& geometry, const Eigen::Vector3d&
     if (!visit(key)) return out;
   }
   if (!visit(key_b)) return out;
+  if (clipped) {
+    out.where_W = end_W;  // free up to the range's edge, unknown beyond it
+    return out;
+  }
   out.verdict = Occupancy::kFree;
   return out;
 }
