@@ -83,7 +83,11 @@ LiveMapper::~LiveMapper() {
 void LiveMapper::post(Item item) {
   {
     std::lock_guard<std::mutex> lock(queue_mutex_);
-    if (draining_ || stop_worker_) return;
+    if (draining_ || stop_worker_) {
+      // Received while the outputs are made: counted, so every frame received is accounted for.
+      if (item.channel == options_.session.channel_rgbd) ++after_finish_frames_;
+      return;
+    }
     if (item.channel == options_.session.channel_rgbd) {
       if (queued_frames_ >= options_.max_queued_frames) {
         // Newest data is worth more to a robot than a backlog: push the oldest frame out.
@@ -112,6 +116,16 @@ void LiveMapper::onInput(const lcm::ReceiveBuffer* buffer, const std::string& ch
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-mapper: message on %s lost: %s\n", channel.c_str(), e.what());
   }
+}
+
+SessionStats LiveMapper::withOwnRejections(SessionStats stats) const {
+  {
+    std::lock_guard<std::mutex> lock(rejected_mutex_);
+    for (const auto& [reason, n] : rejected_commands_) stats.rejected[reason] += n;
+  }
+  const int64_t late = after_finish_frames_;
+  if (late > 0) stats.rejected[kAfterFinish] += late;
+  return stats;
 }
 
 void LiveMapper::countRejected(const std::string& reason) {
@@ -310,11 +324,7 @@ status_t LiveMapper::status(const std::string& state) const {
   msg.frames_received = received_frames_;
   msg.frames_integrated = s.frames_integrated;
   msg.frames_dropped = dropped_frames_ + s.sync.dropped_queue_full;
-  std::map<std::string, int64_t> reasons = s.rejected;
-  {
-    std::lock_guard<std::mutex> lock(rejected_mutex_);
-    for (const auto& [reason, n] : rejected_commands_) reasons[reason] += n;
-  }
+  const std::map<std::string, int64_t> reasons = withOwnRejections(s).rejected;
   msg.frames_rejected = 0;
   for (const auto& [reason, n] : reasons) {
     msg.reject_reasons.push_back(reason);

@@ -438,6 +438,34 @@ TEST(LiveMapper, SaveCommandRunsOnTheWorkerAndMappingGoesOn) {
   EXPECT_EQ(live.status("done").frames_rejected, 1);
 }
 
+// Frames that came after the finish command were counted as received and then neither mapped,
+// dropped nor refused (48 of 85 in a replay finished part way).
+TEST(LiveMapper, FramesAfterFinishAreCountedNotLost) {
+  const test::SyntheticStream& stream = test::syntheticStream();
+  const std::vector<test::Encoded> messages = stream.messages();
+  lcm::LCM lcm("memq://");
+  Mapper mapper(test::streamMapperConfig());
+  LiveMapper live(&lcm, testOptions(), &mapper);
+  const size_t half = messages.size() / 2 / 3 * 3;
+  publishAll(&lcm, {messages.begin(), messages.begin() + half});
+  publishCommand(&lcm, command_t::COMMAND_FINISH);
+  publishAll(&lcm, {messages.begin() + half, messages.end()});
+  std::atomic<bool> stop{false};
+  EXPECT_TRUE(live.run(stop));
+  live.drain();
+  while (lcm.handleTimeout(0) > 0) {  // what comes while the outputs are made
+  }
+  const SessionStats stats = live.stats();
+  int64_t rejected = 0;
+  for (const auto& [reason, n] : stats.rejected) rejected += n;
+  EXPECT_EQ(live.framesReceived(), static_cast<int64_t>(stream.frames.size()));
+  EXPECT_EQ(stats.rejected.at(LiveMapper::kAfterFinish),
+            static_cast<int64_t>(stream.frames.size() - half / 3));
+  // Every frame received is mapped, dropped or refused with a reason.
+  EXPECT_EQ(stats.frames_integrated + live.framesDropped() + rejected, live.framesReceived());
+  EXPECT_EQ(live.status("done").frames_rejected, rejected);
+}
+
 TEST(LiveMapper, RefusesBadOptionsNamingThem) {
   LiveOptions options = testOptions();
   options.idle_scan_every_frames = -1;

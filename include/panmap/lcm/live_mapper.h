@@ -116,8 +116,11 @@ class LiveMapper {
   /// Call after drain(). Returns nothing when no answer came within optimiser_timeout_s.
   std::optional<GraphLabels> requestLabels(const std::atomic<bool>& stop);
 
-  /// Counters and timings of the session. Call after drain() (the worker owns them before).
-  SessionStats stats() const { return session_.stats(); }
+  /// Counters and timings of the session, with what this process refused itself (malformed
+  /// commands, frames that came after finish). Call after drain() (the worker owns them before).
+  SessionStats stats() const { return withOwnRejections(session_.stats()); }
+  /// The reason RGB-D frames received after a finish command or signal are counted under.
+  static constexpr const char* kAfterFinish = "frame: arrived after finish (not mapped)";
   /// RGB-D messages pushed out of the full queue so far.
   int64_t framesDropped() const { return dropped_frames_; }
   /// RGB-D messages received on the input channel so far.
@@ -156,6 +159,8 @@ class LiveMapper {
   void publishOutbox();
   void publishStatus(const std::string& state);
   void countRejected(const std::string& reason);
+  /// `stats` with this process's own rejections added (any thread).
+  SessionStats withOwnRejections(SessionStats stats) const;
   /// Records the state of the command sent at `utime` for the status messages (any thread).
   void setCommandState(int64_t utime, const std::string& state, const std::string& result);
 
@@ -191,6 +196,7 @@ class LiveMapper {
 
   std::atomic<int64_t> received_frames_{0};
   std::atomic<int64_t> dropped_frames_{0};
+  std::atomic<int64_t> after_finish_frames_{0};  // RGB-D frames that came while draining
   // Commands and labels refused (written by the LCM thread, read by status()).
   mutable std::mutex rejected_mutex_;
   std::map<std::string, int64_t> rejected_commands_;
