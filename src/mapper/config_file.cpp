@@ -5,6 +5,8 @@
 #include <iterator>
 #include <set>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -25,10 +27,23 @@ class Section {
     seen_.insert(key);
     const cv::FileNode n = node_[key];
     if (n.empty()) return;
-    if (!n.isInt() && !n.isReal()) fail(name_ + "." + key + " must be a number");
     if constexpr (std::is_same<T, bool>::value) {
-      *value = static_cast<int>(n) != 0;
-    } else if constexpr (std::is_integral<T>::value) {
+      // A switch: 0.5 became 0 and -1 became 1 when any number was taken.
+      std::string word = n.isString() ? static_cast<std::string>(n) : "";
+      word = word.substr(0, word.find('#'));
+      word.erase(word.find_last_not_of(" \t") + 1);
+      if (word == "true" || word == "false") {
+        *value = word == "true";
+        return;
+      }
+      if (!n.isInt() || (static_cast<int>(n) != 0 && static_cast<int>(n) != 1)) {
+        fail(name_ + "." + key + " is a switch: 0 or 1 (or false / true)");
+      }
+      *value = static_cast<int>(n) == 1;
+      return;
+    }
+    if (!n.isInt() && !n.isReal()) fail(name_ + "." + key + " must be a number");
+    if constexpr (std::is_integral<T>::value) {
       if (!n.isInt()) fail(name_ + "." + key + " must be an integer");
       *value = static_cast<T>(static_cast<int>(n));
     } else {
@@ -71,11 +86,34 @@ class Section {
 // entry is a section name at column 0, with no "..." line. Control characters are refused as
 // well: OpenCV measures lines with strlen, and a NUL byte on the header line led to the same
 // loop. Checked before OpenCV parses the file.
+// OpenCV's reader keeps the first of two equal keys in a mapping and drops the second without
+// a word: a section appended to a printed config to override it did nothing. `open` holds the
+// keys of the mappings enclosing this line, by indentation.
+void checkDuplicateKey(const std::string& line, const std::string& where,
+                       std::vector<std::pair<size_t, std::set<std::string>>>* open) {
+  const size_t indent = line.find_first_not_of(' ');
+  if (indent == std::string::npos || line[indent] == '#' || line[indent] == '-' || line[0] == '%' ||
+      line.compare(0, 3, "---") == 0) {
+    return;
+  }
+  const size_t colon = line.find(':', indent);
+  if (colon == std::string::npos) return;
+  std::string key = line.substr(indent, colon - indent);
+  key.erase(key.find_last_not_of(' ') + 1);
+  if (key.empty() || key.find_first_of(" \"'{}[],") != std::string::npos) return;
+  while (!open->empty() && open->back().first > indent) open->pop_back();
+  if (open->empty() || open->back().first < indent) open->push_back({indent, {}});
+  if (!open->back().second.insert(key).second) {
+    throw Error(where + "'" + key + "' appears twice in its mapping (the first would be used)");
+  }
+}
+
 void checkConfigShape(const std::string& path, const std::string& text) {
   std::istringstream in(text);
   std::string line;
   int line_no = 0;
   bool root_seen = false;
+  std::vector<std::pair<size_t, std::set<std::string>>> keys_by_indent;
   while (std::getline(in, line)) {
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -100,6 +138,7 @@ void checkConfigShape(const std::string& path, const std::string& text) {
     if (line.compare(0, 3, "...") == 0) {
       throw Error(where + "'...' ends the document; a config is one document without it");
     }
+    checkDuplicateKey(line, where, &keys_by_indent);
     if (root_seen) continue;
     const size_t first = line.find_first_not_of(' ');
     if (first == std::string::npos || line[first] == '#' || line[0] == '%') continue;

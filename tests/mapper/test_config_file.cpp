@@ -252,6 +252,35 @@ TEST(ConfigFile, AMapFileKeepsEveryPrintedMapperSetting) {
   EXPECT_EQ(mapperSettingDifference(config, Mapper::load(dir.path("m.panmap"))->config()).key, "");
 }
 
+// OpenCV keeps the first of two equal keys: a section appended to a printed config to
+// override it was silently ignored (the run mapped at 1 cm, not the 5 cm appended).
+TEST(ConfigFile, AKeyTwiceInOneMappingIsNamed) {
+  test::TempDir dir;
+  const std::string appended =
+      write(dir, configToYaml(PanmapConfig{}) + "map:\n   voxel_size_m: 0.05\n");
+  test::expectError([&] { loadConfig(appended); }, {"'map' appears twice"});
+  const std::string key = write(dir, "map:\n   voxel_size_m: 0.02\n   voxel_size_m: 0.05\n");
+  test::expectError([&] { loadConfig(key); }, {key + ":3:", "'voxel_size_m' appears twice"});
+  // The same key in two sections is two keys.
+  EXPECT_NO_THROW(loadConfig(write(dir,
+                                   "tracking:\n   mode: \"off\"\noccupancy:\n   enabled: 1\n"
+                                   "fusion:\n   geometry_only: 0\n")));
+}
+
+// A switch took any number: 0.5 became off, -1 on.
+TEST(ConfigFile, ASwitchIsZeroOrOne) {
+  test::TempDir dir;
+  for (const char* bad : {"0.5", "-1", "2"}) {
+    const std::string path = write(dir, std::string("fusion:\n   geometry_only: ") + bad + "\n");
+    test::expectError([&] { loadConfig(path); }, {"fusion.geometry_only is a switch: 0 or 1"});
+  }
+  EXPECT_TRUE(loadConfig(write(dir, "fusion:\n   geometry_only: 1\n")).mapper.fusion.geometry_only);
+  EXPECT_TRUE(
+      loadConfig(write(dir, "fusion:\n   geometry_only: true\n")).mapper.fusion.geometry_only);
+  EXPECT_FALSE(loadConfig(write(dir, "fusion:\n   geometry_only: false # off\n"))
+                   .mapper.fusion.geometry_only);
+}
+
 TEST(ConfigFile, ATabOutsideACommentIsNamed) {
   test::TempDir dir;
   const std::string path = write(dir, "map:\n\tvoxel_size_m: 0.02\n");
