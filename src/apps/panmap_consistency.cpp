@@ -89,6 +89,7 @@ int main(int argc, char** argv) {
     if (!json_path.empty()) {
       std::ofstream file(json_path);
       file << out.dump(2) << "\n";
+      file.close();
       if (!file) throw panmap::Error(json_path + ": cannot write");
     }
   } catch (const std::exception& e) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <optional>
 
@@ -183,7 +184,21 @@ std::string autosaveDirOf(const std::string& dir) {
 void writeJson(const std::string& path, const nlohmann::json& json) {
   std::ofstream out(path);
   out << json.dump(2) << "\n";
+  out.close();  // the last bytes reach the disk here: a full disk shows now, not never
   if (!out) throw panmap::Error("cannot write " + path);
+}
+
+// report.json last: a failure to write it is one more failed output, named with the others.
+void writeReport(const std::string& out_dir, const nlohmann::json& json,
+                 panmap::OutputSummary* outputs) {
+  const std::string path = out_dir + "/report.json";
+  try {
+    writeJson(path, json);
+  } catch (const std::exception& e) {
+    outputs->failed.push_back(e.what());
+    std::error_code ignored;
+    std::filesystem::remove(path, ignored);
+  }
 }
 
 void printRejected(const std::map<std::string, int64_t>& rejected) {
@@ -541,7 +556,7 @@ int main(int argc, char** argv) {
       const double optimise_ms = msSince(optimise_start);
       output_options.utime = report.last_frame_utime;
       output_options.final_export = true;  // nothing meshes this map after it
-      const panmap::OutputSummary outputs = panmap::writeOutputs(
+      panmap::OutputSummary outputs = panmap::writeOutputs(
           out_dir, mapper.get(), no_optimise ? nullptr : &labels, optimiser, output_options);
       // After the outputs, which create OUT: OUT/graph.json is the natural place for it.
       if (!graph_json.empty()) panmap::writeGraphJson(graph_json, graph, labels);
@@ -568,7 +583,7 @@ int main(int argc, char** argv) {
                        {"class_consensus", optimiser.class_consensus},
                        {"refine", optimiser.refine}};
       json["outputs_failed"] = outputs.failed;
-      writeJson(out_dir + "/report.json", json);
+      writeReport(out_dir, json, &outputs);
       finishAutosave();
       panmap::requireAllWritten(outputs, out_dir);
       std::printf(
@@ -679,7 +694,7 @@ int main(int argc, char** argv) {
                        {"fragments_folded", labels ? labels->fragments_folded : 0},
                        {"fragments_dropped", labels ? labels->fragments_dropped : 0}};
       json["outputs_failed"] = outputs.failed;
-      writeJson(out_dir + "/report.json", json);
+      writeReport(out_dir, json, &outputs);
       finishAutosave();
       panmap::requireAllWritten(outputs, out_dir);
     } catch (const std::exception& e) {

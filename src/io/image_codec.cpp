@@ -43,6 +43,7 @@ void writeFileBytes(const std::string& path, const std::vector<uint8_t>& bytes) 
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(bytes.data()),
             static_cast<std::streamsize>(bytes.size()));
+  out.close();  // the last bytes reach the disk here: a full disk shows now, not never
   if (!out) throw Error("cannot write " + path);
 }
 

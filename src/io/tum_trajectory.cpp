@@ -53,6 +53,7 @@ void writeTumTrajectory(const std::string& path, const std::vector<StampedPose>&
                   p.utime * 1e-6, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
     out << buffer;
   }
+  out.close();  // the last bytes reach the disk here: a full disk shows now, not never
   if (!out) throw Error("cannot write trajectory " + path);
 }
 

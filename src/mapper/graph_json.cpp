@@ -49,6 +49,7 @@ void writeGraphJson(const std::string& path, const SuperpointGraph& graph,
       {"voxel_size_m", graph.voxel_size_m}, {"vertices", vertices}, {"edges", edges}};
   std::ofstream out(path);
   out << root.dump() << "\n";
+  out.close();  // the last bytes reach the disk here: a full disk shows now, not never
   if (!out) throw Error(path + ": cannot write");
 }
 

@@ -280,6 +280,7 @@ void writeObjectsJson(const std::string& path, const std::vector<MappedObject>& 
   const json root = {{"utime", utime}, {"objects", list}};
   std::ofstream out(path);
   out << root.dump(2) << "\n";
+  out.close();  // the last bytes reach the disk here: a full disk shows now, not never
   if (!out) throw Error(path + ": cannot write");
 }
 

@@ -63,11 +63,18 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
   mapper->save(dir + "/map.panmap");
   summary.files.push_back("map.panmap");
   step("map.panmap");
-  auto attempt = [&](const std::function<void()>& write) {
+  // A failed output's files are removed: a PLY cut off by a full disk still claims all its
+  // vertices in its header, and an empty occupancy.bt reads as "not an OctoMap file".
+  auto attempt = [&](std::initializer_list<const char*> names, const std::function<void()>& write) {
     try {
       write();
     } catch (const std::exception& e) {
       summary.failed.push_back(e.what());
+      for (const char* name : names) {
+        const std::string path = dir + "/" + name;
+        std::error_code ignored;
+        if (std::filesystem::is_regular_file(path, ignored)) std::filesystem::remove(path, ignored);
+      }
     }
   };
   {
@@ -86,14 +93,15 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
     summary.instances_in_mesh = instances.size();
     step("mesh extraction");
 
-    attempt([&] {
+    attempt({kSemanticMeshFile, kInstanceMeshFile, kSuperpointMeshFile}, [&] {
       writeLabelledMeshes(dir, mesh);
       summary.files.insert(summary.files.end(),
                            {kSemanticMeshFile, kInstanceMeshFile, kSuperpointMeshFile});
     });
     step("meshes");
     if (options.snapshots && !mesh.faces.empty()) {
-      attempt([&] { writeSnapshots(dir, mesh, &summary); });
+      attempt({kSnapshotFiles[0], kSnapshotFiles[1], kSnapshotFiles[2], kSnapshotFiles[3]},
+              [&] { writeSnapshots(dir, mesh, &summary); });
       step("snapshots");
     } else {
       // Pictures of an earlier run in the same folder would pass for this map's.
@@ -103,7 +111,7 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
       }
     }
   }
-  attempt([&] {
+  attempt({"objects.json"}, [&] {
     const std::vector<MappedObject> objects = computeObjects(*mapper, labels, optimiser.objects);
     writeObjectsJson(dir + "/objects.json", objects, options.utime);
     summary.objects = objects.size();
@@ -111,21 +119,22 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
   });
   step("objects.json");
   if (mapper->occupancy()) {
-    attempt([&] {
+    attempt({"occupancy.bt"}, [&] {
       mapper->occupancy()->writeBt(dir + "/occupancy.bt");
       summary.files.push_back("occupancy.bt");
     });
     step("occupancy.bt");
   }
-  attempt([&] {
+  attempt({"trajectory.txt"}, [&] {
     writeTumTrajectory(dir + "/trajectory.txt", mapper->trajectory());
     summary.files.push_back("trajectory.txt");
   });
   step("trajectory.txt");
   // The exact parameters the outputs were made with (a loaded map brings its own).
-  attempt([&] {
+  attempt({"config.yaml"}, [&] {
     std::ofstream out(dir + "/config.yaml");
     out << configToYaml(PanmapConfig{mapper->config(), optimiser});
+    out.close();
     if (!out) throw Error("cannot write " + dir + "/config.yaml");
     summary.files.push_back("config.yaml");
   });
