@@ -188,6 +188,18 @@ void writeJson(const std::string& path, const nlohmann::json& json) {
   if (!out) throw panmap::Error("cannot write " + path);
 }
 
+// Frames mapped into no surface at all: wrong depth units, intrinsics or pose units look
+// exactly like this, and an exit 0 with an empty map would hide them.
+void warnIfNoSurface(const panmap::Mapper& mapper, size_t mesh_vertices) {
+  if (mesh_vertices > 0 || mapper.framesIntegrated() == 0) return;
+  const panmap::IntegratorConfig& c = mapper.config().integrator;
+  std::fprintf(stderr,
+               "panmap-mapper: warning: %lld frames mapped but no surface came of them: no depth "
+               "within %.2f-%.2f m, or frames that do not overlap (check the depth scale, the "
+               "intrinsics and the poses' units)\n",
+               static_cast<long long>(mapper.framesIntegrated()), c.min_depth_m, c.max_depth_m);
+}
+
 // report.json last: a failure to write it is one more failed output, named with the others.
 void writeReport(const std::string& out_dir, const nlohmann::json& json,
                  panmap::OutputSummary* outputs) {
@@ -596,6 +608,7 @@ int main(int argc, char** argv) {
       printRejected(report.rejected);
       printRefinement(report.refinement);
       printDepthCheck(*mapper);
+      warnIfNoSurface(*mapper, outputs.mesh_vertices);
       return 0;
     }
 
@@ -712,6 +725,7 @@ int main(int argc, char** argv) {
     printRejected(stats.rejected);
     printRefinement(stats.refinement);
     printDepthCheck(*mapper);
+    warnIfNoSurface(*mapper, outputs.mesh_vertices);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-mapper: error: %s\n", e.what());

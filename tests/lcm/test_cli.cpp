@@ -153,6 +153,30 @@ TEST(Cli, ALoadedMapSkipsItsFramesAndKeepsItsSettings) {
   EXPECT_FALSE(std::filesystem::exists(dir.path("c")));
 }
 
+// Depth in the wrong units (here read as metres per unit: every point kilometres away) mapped
+// into an empty map with exit 0 and no word; it says so now.
+TEST(Cli, MapperWarnsWhenFramesGiveNoSurface) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  const auto imp =
+      runCommand(binPath("panmap-import") + " --quiet --max-frames 2 --depth-scale 1 " +
+                 test::dataDir("7scenes-200") + " " + dir.path("s.lcmlog"));
+  ASSERT_EQ(imp.exit_code, 0) << imp.output;
+  const auto mapped =
+      runCommand(binPath("panmap-mapper") + " -q --voxel-size 0.05 " + "--no-snapshots --log " +
+                 dir.path("s.lcmlog") + " --out " + dir.path("a"));
+  EXPECT_EQ(mapped.exit_code, 0) << mapped.output;
+  EXPECT_NE(mapped.output.find("warning: 2 frames mapped but no surface came of them"),
+            std::string::npos)
+      << mapped.output;
+  importSevenScenes(dir, 2);  // the right units: no warning
+  const auto good =
+      runCommand(binPath("panmap-mapper") + " -q --voxel-size 0.05 " + "--no-snapshots --log " +
+                 dir.path("s.lcmlog") + " --out " + dir.path("b"));
+  EXPECT_EQ(good.exit_code, 0) << good.output;
+  EXPECT_EQ(good.output.find("no surface"), std::string::npos) << good.output;
+}
+
 // A log that gives no frame is an error, not an empty map: an empty file, bytes that are no LCM
 // log, and a log whose frames are on another channel than the one asked for.
 TEST(Cli, MapperRefusesALogWithoutFramesInOneLine) {
