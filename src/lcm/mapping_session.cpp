@@ -78,6 +78,24 @@ void MappingSession::sanitise(PanopticFrame* panoptic) {
       segment.category = 0;
     }
   }
+  // Pixels whose id no segment lists vote for nothing: a converter that numbers the pixels
+  // and the segment list differently gave a map without classes and no word of why.
+  std::vector<int32_t> listed;
+  listed.reserve(panoptic->segments.size());
+  for (const PanopticSegment& segment : panoptic->segments) listed.push_back(segment.id);
+  std::sort(listed.begin(), listed.end());
+  const LabelImage& ids = panoptic->segment_ids;
+  const int32_t* id = ids.data();
+  const size_t n = static_cast<size_t>(ids.width()) * static_cast<size_t>(ids.height());
+  int32_t last_checked = 0;  // masks are piecewise constant: one lookup per run of an id
+  for (size_t i = 0; i < n; ++i) {
+    if (id[i] == 0 || id[i] == last_checked) continue;
+    if (!std::binary_search(listed.begin(), listed.end(), id[i])) {
+      ++stats_.rejected["panoptic: pixel ids that no segment lists (read as no segment)"];
+      return;
+    }
+    last_checked = id[i];
+  }
 }
 
 bool MappingSession::handle(const std::string& channel, const void* data, size_t size,

@@ -211,6 +211,25 @@ TEST_F(MappingSessionTest, UnknownCategoriesBecomeUnlabelled) {
   EXPECT_EQ(test::mapBytes(mapper), test::mapBytes(reference));
 }
 
+// A converter that lists its segments under other ids than the pixels carry gave a map without
+// classes and no word: such masks are counted (and mapped as they are: the pixels vote for no
+// segment). The clean stream counts none.
+TEST_F(MappingSessionTest, MaskPixelsOfUnlistedSegmentsAreCounted) {
+  test::SyntheticStream shifted = stream_;
+  for (PanopticFrame& mask : shifted.masks) {
+    for (PanopticSegment& segment : mask.segments) segment.id += 100000;
+  }
+  Mapper mapper(test::streamMapperConfig());
+  MappingSession session(SessionOptions{}, &mapper);
+  feed(&session, shifted.messages());
+  EXPECT_EQ(
+      session.stats().rejected.at("panoptic: pixel ids that no segment lists (read as no segment)"),
+      static_cast<int64_t>(stream_.masks.size()));
+  EXPECT_EQ(
+      clean_stats_.rejected.count("panoptic: pixel ids that no segment lists (read as no segment)"),
+      0u);
+}
+
 TEST_F(MappingSessionTest, FramesWithoutPoseAndAStoppedPoseStream) {
   std::vector<test::Encoded> messages = stream_.messages();
   // After the clean stream the poses stop while frames keep coming: each is refused once
