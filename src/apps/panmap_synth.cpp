@@ -336,6 +336,19 @@ int main(int argc, char** argv) {
       trajectory = panmap::planSurveyThrough(mesh, survey, building_stops, seed);
     } else if (!trajectory_file.empty()) {
       trajectory = panmap::readTumTrajectory(trajectory_file);
+      // Frames at a repeated or earlier time are refused by the mapper one by one.
+      for (size_t k = 1; k < trajectory.size(); ++k) {
+        if (trajectory[k].utime <= trajectory[k - 1].utime) {
+          throw panmap::Error(trajectory_file + ": pose " + std::to_string(k + 1) +
+                              "'s timestamp is not after the one before (times must increase)");
+        }
+      }
+      for (const char* flag : {"--laps", "--rate-hz"}) {
+        if (app.count(flag)) {
+          std::cerr << "panmap-synth: " << flag << " is ignored with --trajectory (its poses and "
+                    << "timestamps are the frames)\n";
+        }
+      }
       if (static_cast<int>(trajectory.size()) > frames)
         trajectory.resize(static_cast<size_t>(frames));
     } else {
@@ -353,6 +366,13 @@ int main(int argc, char** argv) {
     }
 
     fs::create_directories(out_dir + "/gt");
+    {
+      // Previews of an earlier run into the same folder would pass for this one's.
+      std::error_code ignored;
+      for (const auto& entry : fs::directory_iterator(out_dir + "/preview", ignored)) {
+        if (entry.path().extension() == ".png") fs::remove(entry.path(), ignored);
+      }
+    }
     panmap::SequenceSynthesizer synth(mesh, trajectory, config);
     panmap::LogWriter log(out_dir + "/sequence.lcmlog");
     const panmap::ImageEncoding encoding;

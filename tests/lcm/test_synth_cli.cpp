@@ -120,6 +120,34 @@ TEST(SynthCli, BadArgumentsFailClearly) {
   EXPECT_EQ(join.exit_code, 1);
   EXPECT_EQ(test::countLines(join.output), 1) << join.output;
   EXPECT_NE(join.output.find("--join-parts needs --scannet"), std::string::npos) << join.output;
+  // A trajectory whose times repeat was synthesised, and the mapper then refused its frames.
+  std::ofstream(dir.path("repeat.txt")) << "0.0 0 0 1 0 0 0 1\n0.1 0 0 1 0 0 0 1\n"
+                                           "0.1 0.1 0 1 0 0 0 1\n";
+  const auto repeat = runCommand(binPath("panmap-synth") + " --room 1 --trajectory " +
+                                 dir.path("repeat.txt") + " --out " + dir.path("x"));
+  EXPECT_EQ(repeat.exit_code, 1);
+  EXPECT_NE(repeat.output.find("repeat.txt: pose 3's timestamp is not after the one before"),
+            std::string::npos)
+      << repeat.output;
+}
+
+// Previews of an earlier run into the same folder were left beside the new run's.
+TEST(SynthCli, PreviewsOfAnEarlierRunAreRemoved) {
+  test::TempDir dir;
+  const std::string synth = binPath("panmap-synth") + " --quiet --preview-every 1 --out " +
+                            dir.path("x") + " --room 2 --frames ";
+  ASSERT_EQ(runCommand(synth + "4").exit_code, 0);
+  auto previews = [&] {
+    size_t n = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir.path("x/preview"))) {
+      n += e.path().extension() == ".png";
+    }
+    return n;
+  };
+  const size_t per_frame = previews() / 4;
+  ASSERT_GT(per_frame, 0u);
+  ASSERT_EQ(runCommand(synth + "2").exit_code, 0);
+  EXPECT_EQ(previews(), 2 * per_frame);
 }
 
 }  // namespace
