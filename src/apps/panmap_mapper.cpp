@@ -513,7 +513,13 @@ int main(int argc, char** argv) {
     // After the outputs are safely written the snapshots have served their purpose.
     auto finishAutosave = [&]() {
       if (autosaver) {
-        autosaver->clear();
+        // The outputs are written by now: snapshots left behind cost disk, not the map.
+        try {
+          autosaver->clear();
+        } catch (const std::exception& e) {
+          std::fprintf(stderr, "panmap-mapper: warning: autosave snapshots not removed: %s\n",
+                       e.what());
+        }
       } else if (resumed) {
         for (const std::string& path : panmap::listResumeCandidates(autosaveDirOf(resume_dir))) {
           std::remove(path.c_str());
@@ -685,10 +691,28 @@ int main(int argc, char** argv) {
     final_options.utime = stats.last_frame_utime;
     final_options.final_export = true;
     panmap::OutputSummary outputs;
+    // map.panmap that cannot be written (a full disk, the folder gone) must not cost the map
+    // that lives only in this process: it is kept, and save / export commands to another place
+    // are served, until a finish command tries again or a signal gives it up.
+    for (;;) {
+      try {
+        outputs = panmap::writeOutputs(out_dir, mapper.get(), labels ? &*labels : nullptr,
+                                       optimiser, final_options);
+        break;
+      } catch (const std::exception& e) {
+        const std::string why = std::string(e.what()) +
+                                "; the map is kept: send save PATH or export DIR to another "
+                                "place, or finish again once " +
+                                out_dir + " can be written (Ctrl-C gives it up)";
+        std::fprintf(stderr, "panmap-mapper: error: %s\n", why.c_str());
+        node.publishFinished(false, why);
+        g_stop = false;
+        if (!node.serveCommandsAfterFailedFinish(g_stop)) throw;
+        std::fprintf(stderr, "panmap-mapper: finish command; writing the outputs again\n");
+      }
+    }
     // `panmap-command finish` waits for this status: a failure must reach it too.
     try {
-      outputs = panmap::writeOutputs(out_dir, mapper.get(), labels ? &*labels : nullptr, optimiser,
-                                     final_options);
       nlohmann::json json = sessionJson(stats);
       json["mode"] = "live";
       json["lcm_url"] = lcm_url;

@@ -158,6 +158,18 @@ void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& 
           setCommandState(utime, "failed", "this mapper does not save or export on command");
           return;
         }
+        if (serving_after_finish_) {
+          // The worker is gone and the map is this thread's: the command runs here, now.
+          try {
+            setCommandState(utime, "done",
+                            command_handler_(msg.command, msg.argument, mapper_,
+                                             labels_ ? &*labels_ : nullptr));
+          } catch (const std::exception& e) {
+            setCommandState(utime, "failed", e.what());
+          }
+          publishStatus("finish failed");
+          return;
+        }
         const int8_t command = msg.command;
         const std::string argument = msg.argument;
         setCommandState(utime, "running", "queued behind the frames already received");
@@ -198,11 +210,28 @@ void LiveMapper::setCommandState(int64_t utime, const std::string& state,
   if (commands_.size() > kCommandsReported) commands_.pop_front();
 }
 
+bool LiveMapper::serveCommandsAfterFailedFinish(const std::atomic<bool>& stop) {
+  if (worker_.joinable()) throw Error("serveCommandsAfterFailedFinish: drain() first");
+  serving_after_finish_ = true;
+  finish_requested_ = false;
+  auto next_status = std::chrono::steady_clock::now();
+  while (!stop && !finish_requested_) {
+    lcm_->handleTimeout(100);
+    if (std::chrono::steady_clock::now() >= next_status) {
+      publishStatus("finish failed");
+      next_status += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+          std::chrono::duration<double>(options_.status_period_s));
+    }
+  }
+  serving_after_finish_ = false;
+  return finish_requested_;
+}
+
 void LiveMapper::publishFinished(bool ok, const std::string& result) {
   if (finish_command_utime_ != 0) {
     setCommandState(finish_command_utime_, ok ? "done" : "failed", result);
   }
-  publishStatus("done");
+  publishStatus(ok ? "done" : "finish failed");
 }
 
 void LiveMapper::requestOptimisation() {

@@ -95,8 +95,10 @@ Autosaver::~Autosaver() {
 void Autosaver::afterFrame(const Mapper& mapper, int64_t frame_id, int64_t utime) {
   // One write per frame: survives kill -9 (the kernel holds it), not a power cut, which is all
   // the journal is for (saying which frames were lost).
-  std::fprintf(journal_, "%" PRId64 " %" PRId64 "\n", frame_id, utime);
-  std::fflush(journal_);
+  if (journal_) {
+    std::fprintf(journal_, "%" PRId64 " %" PRId64 "\n", frame_id, utime);
+    std::fflush(journal_);
+  }
   last_frame_utime_ = utime;
   if (config_.period_s <= 0.0) return;
   if (last_snapshot_utime_ == INT64_MIN) {
@@ -163,7 +165,9 @@ void Autosaver::wait() {
 void Autosaver::clear() {
   wait();
   for (const std::string& path : listResumeCandidates(config_.dir)) std::remove(path.c_str());
-  std::fclose(journal_);
+  if (journal_) std::fclose(journal_);
+  std::error_code ignored;  // the folder may have gone with the output folder it was in
+  std::filesystem::create_directories(config_.dir, ignored);
   journal_ = std::fopen((config_.dir + "/frames.journal").c_str(), "w");  // emptied
   if (!journal_) throw Error("cannot reopen " + config_.dir + "/frames.journal");
 }

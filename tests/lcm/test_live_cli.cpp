@@ -202,5 +202,43 @@ TEST_F(LiveCli, DeadOptimiserCostsTheLabelsNotTheMap) {
   EXPECT_GT(readPly(out + "/mesh_instance.ply").numVertices(), 1000u);
 }
 
+// The output folder gone when the live mapper finishes (a full disk does the same): the map
+// lived only in the process and was lost with it. It is kept now: save and export to another
+// place are served, and finish tries again.
+TEST_F(LiveCli, AFinishThatCannotWriteKeepsTheMap) {
+  const std::string url = "udpm://239.255.76.67:7686?ttl=0&recv_buf_size=16777216";
+  if (!test::multicastWorks(url)) GTEST_SKIP() << test::kNoMulticast;
+  const std::string out = dir_->path("kept");
+  test::ChildProcess mapper(
+      {test::binPath("panmap-mapper"), "--lcm-url", url, "--out", out, "--voxel-size", "0.04",
+       "--queue-frames", "64", "--optimizer-timeout-s", "0.5"},
+      dir_->path("kept.log"));
+  lcm::LCM lcm(url);
+  test::StatusWatch watch;
+  lcm.subscribe("PANMAP_STATUS", &test::StatusWatch::onStatus, &watch);
+  for (int i = 0; i < 100 && watch.received == 0; ++i) lcm.handleTimeout(100);
+  ASSERT_GT(watch.received, 0);
+  test::ChildProcess player({"lcm-logplayer", "-l", url, log()});
+  ASSERT_TRUE(player.wait(60));
+  std::filesystem::remove_all(out);
+  std::ofstream(out) << "a file where the folder was";
+  const std::string command = test::binPath("panmap-command") + " -q --lcm-url '" + url + "' ";
+  const test::CommandResult failed = test::runCommand(command + "finish");
+  EXPECT_EQ(failed.exit_code, 1) << failed.output;
+  EXPECT_NE(failed.output.find("finish failed: "), std::string::npos) << failed.output;
+  EXPECT_NE(failed.output.find("the map is kept"), std::string::npos) << failed.output;
+  const test::CommandResult saved =
+      test::runCommand(command + "save " + dir_->path("rescued.panmap"));
+  EXPECT_EQ(saved.exit_code, 0) << saved.output;
+  std::filesystem::remove(out);
+  const test::CommandResult again = test::runCommand(command + "finish");
+  EXPECT_EQ(again.exit_code, 0) << again.output;
+  ASSERT_TRUE(mapper.wait(60)) << test::fileBytes(dir_->path("kept.log"));
+  EXPECT_EQ(mapper.exitCode(), 0) << test::fileBytes(dir_->path("kept.log"));
+  const std::unique_ptr<Mapper> rescued = Mapper::load(dir_->path("rescued.panmap"));
+  EXPECT_GT(rescued->framesIntegrated(), 0);
+  EXPECT_EQ(Mapper::load(out + "/map.panmap")->framesIntegrated(), rescued->framesIntegrated());
+}
+
 }  // namespace
 }  // namespace panmap

@@ -133,6 +133,11 @@ class LiveMapper {
   int64_t idleScanRefreshes() const { return idle_scan_refreshes_; }
   /// A status message of the current state. Call from the worker, or after drain().
   status_t status(const std::string& state) const;
+  /// After drain(), when the final outputs could not be written: keeps the map and serves
+  /// PANMAP_COMMAND on this thread (save and export at once, with the final labels; their
+  /// results on the status channel, state "finish failed") until a finish command asks to try
+  /// again (returns true) or `stop` is set (returns false: the caller gives the map up).
+  bool serveCommandsAfterFailedFinish(const std::atomic<bool>& stop);
   /// Reports how the finish command ended (ok: what was written; else why it failed) in a
   /// "done" status, so that `panmap-command finish` returns when the outputs exist. Call after
   /// the outputs were written, whether a command or a signal ended the run.
@@ -200,8 +205,9 @@ class LiveMapper {
   // Commands and labels refused (written by the LCM thread, read by status()).
   mutable std::mutex rejected_mutex_;
   std::map<std::string, int64_t> rejected_commands_;
-  bool finish_requested_ = false;     // LCM thread only
-  int64_t finish_command_utime_ = 0;  // LCM thread only: the finish command's utime
+  bool finish_requested_ = false;      // LCM thread only
+  bool serving_after_finish_ = false;  // LCM thread only: serveCommandsAfterFailedFinish()
+  int64_t finish_command_utime_ = 0;   // LCM thread only: the finish command's utime
   // The newest commands' progress, oldest first (written by the LCM thread and the worker,
   // read by status()): a save still running when the next command comes keeps its own entry.
   struct CommandState {
