@@ -74,6 +74,7 @@ nlohmann::json statusJson(const panmap::status_t& s) {
           {"poses_kept_as_given", s.poses_kept_as_given},
           {"depth_check", s.depth_check},
           {"depth_pattern_mm", s.depth_pattern_mm},
+          {"warnings", s.warnings},
           {"commands", commands}};
 }
 

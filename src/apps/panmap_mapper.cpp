@@ -628,6 +628,18 @@ int main(int argc, char** argv) {
                                 autosaver->afterFrame(*mapper, f.frame.frame_id, f.frame.utime);
                               }
                             });
+    node.setWarningSource([&autosaver]() {
+      std::vector<std::string> warnings;
+      if (autosaver) {
+        const panmap::Autosaver::Stats a = autosaver->stats();
+        if (a.last_failed) {
+          warnings.push_back("autosave: the last snapshot failed (" + std::to_string(a.failed) +
+                             " so far): " + a.last_error + "; a crash now loses more than " +
+                             "one period");
+        }
+      }
+      return warnings;
+    });
     node.setCommandHandler([&](int8_t command, const std::string& argument, panmap::Mapper* m,
                                const panmap::GraphLabels* labels) {
       std::string done;

@@ -384,6 +384,8 @@ status_t LiveMapper::status(const std::string& state) const {
   msg.depth_check = DepthPatternMonitor::name(check.verdict());
   const double pattern_m = check.patternRmsM();
   msg.depth_pattern_mm = std::isfinite(pattern_m) ? static_cast<float>(1000.0 * pattern_m) : -1.0f;
+  if (warning_source_) msg.warnings = warning_source_();
+  msg.num_warnings = static_cast<int32_t>(msg.warnings.size());
   {
     std::lock_guard<std::mutex> lock(command_mutex_);
     for (const CommandState& c : commands_) {

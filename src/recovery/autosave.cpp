@@ -138,13 +138,16 @@ void Autosaver::snapshotNow(const Mapper& mapper) {
     }
   }
   const auto start = std::chrono::steady_clock::now();
-  auto file = std::make_unique<AtomicFileWriter>(autosavePath(config_.dir, next_number_++));
+  std::unique_ptr<AtomicFileWriter> file;
   try {
+    // Created in here: a folder gone or a full disk fails the snapshot, not the frame.
+    file = std::make_unique<AtomicFileWriter>(autosavePath(config_.dir, next_number_++));
     mapper.serialize(file.get());
   } catch (const std::exception& e) {
     std::lock_guard<std::mutex> lock(mutex_);
     ++stats_.failed;
     stats_.last_error = e.what();
+    stats_.last_failed = true;
     std::fprintf(stderr, "panmap: autosave failed: %s\n", e.what());
     return;  // the partial file goes with `file`
   }
@@ -207,6 +210,7 @@ void Autosaver::writerLoop() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       writing_ = false;
+      stats_.last_failed = !error.empty();
       if (error.empty()) {
         ++stats_.written;
         stats_.last_path = path;

@@ -466,6 +466,18 @@ TEST(LiveMapper, FramesAfterFinishAreCountedNotLost) {
   EXPECT_EQ(live.status("done").frames_rejected, rejected);
 }
 
+TEST(LiveMapper, TheStatusCarriesTheWarningsOfItsSource) {
+  lcm::LCM lcm("memq://");
+  Mapper mapper(test::streamMapperConfig());
+  LiveMapper live(&lcm, testOptions(), &mapper);
+  EXPECT_EQ(live.status("mapping").num_warnings, 0);
+  live.setWarningSource(
+      [] { return std::vector<std::string>{"autosave: the last snapshot failed"}; });
+  const status_t status = live.status("mapping");
+  EXPECT_EQ(status.num_warnings, 1);
+  EXPECT_EQ(status.warnings, std::vector<std::string>{"autosave: the last snapshot failed"});
+}
+
 TEST(LiveMapper, RefusesBadOptionsNamingThem) {
   LiveOptions options = testOptions();
   options.idle_scan_every_frames = -1;

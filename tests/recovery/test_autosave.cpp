@@ -108,6 +108,29 @@ TEST(Autosaver, ASnapshotWaitsForTheFrameStoreToHoldItsNewestFrame) {
   EXPECT_EQ(autosaver.stats().written, 1);
 }
 
+// Failing snapshots went to stderr only; the live status warns while the newest one failed.
+TEST(Autosaver, TheLastSnapshotsFailureIsKnownUntilOneSucceeds) {
+  const test::SyntheticStream& s = test::syntheticStream();
+  Mapper mapper(test::streamMapperConfig());
+  integrate(&mapper, s, 0);
+  test::TempDir dir;
+  Autosaver::Config config;
+  config.dir = dir.path("auto");
+  Autosaver autosaver(config);
+  fs::rename(dir.path("auto"), dir.path("moved"));
+  std::ofstream(dir.path("auto")) << "a file where the folder was";
+  autosaver.snapshotNow(mapper);
+  autosaver.wait();
+  EXPECT_TRUE(autosaver.stats().last_failed);
+  EXPECT_EQ(autosaver.stats().failed, 1);
+  fs::remove(dir.path("auto"));
+  fs::rename(dir.path("moved"), dir.path("auto"));
+  autosaver.snapshotNow(mapper);
+  autosaver.wait();
+  EXPECT_FALSE(autosaver.stats().last_failed);
+  EXPECT_EQ(autosaver.stats().written, 1);
+}
+
 TEST(Resume, SkipsACorruptSnapshotListsLostFramesAndContinuesExactly) {
   test::TempDir dir;
   mapWithAutosave(dir.path());

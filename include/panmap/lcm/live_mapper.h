@@ -103,6 +103,11 @@ class LiveMapper {
 
   /// Sets what is published every publish_period_s.
   void setPeriodicPublisher(Publisher publisher) { publisher_ = std::move(publisher); }
+  /// Sets what the status's warnings are (called with each status, on the worker thread):
+  /// problems mapping survives that an operator must hear of, e.g. autosaves that fail.
+  void setWarningSource(std::function<std::vector<std::string>()> source) {
+    warning_source_ = std::move(source);
+  }
   /// Sets what save and export commands do.
   void setCommandHandler(CommandHandler handler) { command_handler_ = std::move(handler); }
 
@@ -177,6 +182,7 @@ class LiveMapper {
   std::vector<lcm::Subscription*> subscriptions_;
   Publisher publisher_;
   CommandHandler command_handler_;
+  std::function<std::vector<std::string>()> warning_source_;
 
   // Input queue (LCM thread -> worker).
   mutable std::mutex queue_mutex_;

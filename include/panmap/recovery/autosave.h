@@ -41,10 +41,11 @@ class Autosaver {
 
   /// What the autosaver has done.
   struct Stats {
-    int64_t written = 0;      ///< snapshots on disk
-    int64_t waited_busy = 0;  ///< due while the previous one was still being written
-    double waited_ms = 0.0;   ///< mapping time spent waiting for those writes
-    int64_t failed = 0;       ///< writes that failed (disk full, ...), with last_error
+    int64_t written = 0;       ///< snapshots on disk
+    int64_t waited_busy = 0;   ///< due while the previous one was still being written
+    double waited_ms = 0.0;    ///< mapping time spent waiting for those writes
+    int64_t failed = 0;        ///< writes that failed (disk full, ...), with last_error
+    bool last_failed = false;  ///< the newest snapshot failed: crash recovery is behind
     std::string last_path;
     std::string last_error;
     size_t last_bytes = 0;
