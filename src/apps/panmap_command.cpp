@@ -128,7 +128,9 @@ int printStatus(lcm::LCM* lcm, const std::string& channel, double timeout_s) {
                  channel.c_str(), timeout_s, catcher.malformed ? " (only malformed messages)" : "");
     return 1;
   }
-  std::printf("%s\n", statusJson(*catcher.received).dump().c_str());
+  std::printf("%s\n", statusJson(*catcher.received)
+                          .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
+                          .c_str());
   return 0;
 }
 

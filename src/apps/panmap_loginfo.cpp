@@ -28,8 +28,13 @@ int main(int argc, char** argv) {
     std::printf("%s\n",
                 json ? panmap::logInfoToJson(info).c_str() : panmap::logInfoToTable(info).c_str());
     if (!info.allDecoded()) {
-      std::fprintf(stderr, "panmap-loginfo: %s has messages that do not decode\n",
-                   log_path.c_str());
+      // Say which: a cut log decodes every message it has (this said "do not decode" then).
+      bool failures = false;
+      for (const panmap::ChannelInfo& c : info.channels) failures = failures || c.failures > 0;
+      std::fprintf(stderr, "panmap-loginfo: %s %s\n", log_path.c_str(),
+                   failures         ? "has messages that do not decode"
+                   : info.truncated ? "is cut or corrupt after its last whole event"
+                                    : "has bytes between events that are not events");
       return 1;
     }
   } catch (const std::exception& e) {

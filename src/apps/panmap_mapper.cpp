@@ -183,7 +183,8 @@ std::string autosaveDirOf(const std::string& dir) {
 
 void writeJson(const std::string& path, const nlohmann::json& json) {
   std::ofstream out(path);
-  out << json.dump(2) << "\n";
+  // Rejection reasons may quote a channel name, which need not be UTF-8.
+  out << json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   out.close();  // the last bytes reach the disk here: a full disk shows now, not never
   if (!out) throw panmap::Error("cannot write " + path);
 }

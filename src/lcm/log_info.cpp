@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <iomanip>
 #include <map>
@@ -99,20 +100,35 @@ std::string logInfoToJson(const LogInfo& info) {
                         {"first_error", c.first_error}});
   }
   root["channels"] = channels;
-  return root.dump(2);
+  // Channel names are bytes: one that is not UTF-8 made dump() throw and --json print nothing.
+  return root.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::string logInfoToTable(const LogInfo& info) {
+  // Columns as wide as their longest entry (PANMAP_POSE_CORRECTION ran into the type), with
+  // control bytes of a channel name shown as '?' (a newline in one broke the table).
+  auto printable = [](std::string text) {
+    for (char& ch : text) {
+      if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7F) ch = '?';
+    }
+    return text;
+  };
+  int channel_width = 16, type_width = 20;
+  for (const ChannelInfo& c : info.channels) {
+    channel_width = std::max(channel_width, static_cast<int>(c.channel.size()) + 2);
+    type_width = std::max(type_width, static_cast<int>(c.type.size()) + 2);
+  }
   std::ostringstream out;
-  out << std::left << std::setw(16) << "channel" << std::setw(20) << "type" << std::right
-      << std::setw(8) << "count" << std::setw(10) << "rate_hz" << std::setw(12) << "mean_bytes"
-      << std::setw(18) << "first_utime" << std::setw(18) << "last_utime"
+  out << std::left << std::setw(channel_width) << "channel" << std::setw(type_width) << "type"
+      << std::right << std::setw(8) << "count" << std::setw(10) << "rate_hz" << std::setw(12)
+      << "mean_bytes" << std::setw(18) << "first_utime" << std::setw(18) << "last_utime"
       << "  decoded\n";
   for (const ChannelInfo& c : info.channels) {
-    out << std::left << std::setw(16) << c.channel << std::setw(20)
-        << (c.type.empty() ? "?" : c.type) << std::right << std::setw(8) << c.count << std::setw(10)
-        << std::fixed << std::setprecision(2) << c.rateHz() << std::setw(12) << std::setprecision(0)
-        << c.meanBytes() << std::setw(18) << c.first_utime << std::setw(18) << c.last_utime << "  "
+    out << std::left << std::setw(channel_width) << printable(c.channel) << std::setw(type_width)
+        << (c.type.empty() ? "?" : c.type) << std::right << std::setw(8) << c.count << " "
+        << std::setw(9) << std::fixed << std::setprecision(2) << c.rateHz() << " " << std::setw(11)
+        << std::setprecision(0) << c.meanBytes() << std::setw(18) << c.first_utime << std::setw(18)
+        << c.last_utime << "  "
         << (c.failures ? std::to_string(c.count - c.failures) + "/" + std::to_string(c.count)
                        : std::string("all"))
         << "\n";

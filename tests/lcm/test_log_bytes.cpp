@@ -71,6 +71,31 @@ TEST(LogByteAccount, AHeaderClaimingMoreThanTheFileIsTheDamagedEnd) {
   EXPECT_TRUE(info.truncated);
 }
 
+// A channel name is bytes: one that is not UTF-8 made --json print nothing, a long one ran
+// into the next column, and a newline in one broke the table.
+TEST(LogInfo, AnyChannelNamePrints) {
+  test::TempDir dir;
+  const std::string path = dir.path("names.lcmlog");
+  const uint8_t payload[3] = {1, 2, 3};
+  {
+    LogWriter writer(path);
+    writer.writeRaw(
+        "CAMERA\xff"
+        "POSE",
+        1, payload, sizeof(payload));
+    writer.writeRaw("A_CHANNEL_NAME_LONGER_THAN_SIXTEEN", 2, payload, sizeof(payload));
+    writer.writeRaw("TWO\nLINES", 3, payload, sizeof(payload));
+  }
+  const LogInfo info = inspectLog(path, false);
+  ASSERT_EQ(info.channels.size(), 3u);
+  const std::string json = logInfoToJson(info);
+  EXPECT_NE(json.find("\"events\": 3"), std::string::npos) << json;
+  const std::string table = logInfoToTable(info);
+  EXPECT_NE(table.find("A_CHANNEL_NAME_LONGER_THAN_SIXTEEN  ?"), std::string::npos) << table;
+  EXPECT_NE(table.find("TWO?LINES"), std::string::npos) << table;
+  EXPECT_EQ(test::countLines(table), 1 + 3 + 3 + 1) << table;  // header, rows, failures, total
+}
+
 TEST(OfflineReport, NamesTheLogsDamage) {
   OfflineReport report;
   report.log_bytes = 1000;
