@@ -10,6 +10,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli_checks.h"
+
 #include "panmap/calibration/depth_calibrator.h"
 #include "panmap/core/error.h"
 #include "panmap/core/memory_policy.h"
@@ -94,17 +96,17 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"off", "auto", "on"}))
       ->capture_default_str();
   app.add_option("--rounds", rounds, "map-then-calibrate rounds (1 when poses are not refined)")
-      ->check(CLI::PositiveNumber)
+      ->check(panmap::cli::positive())
       ->capture_default_str();
   app.add_option("--voxel-size", voxel_m, "voxel edge of the mapping rounds, metres")
       ->capture_default_str();
   app.add_option("--first", first, "first frame (0-based, in log order) to learn from")
-      ->check(CLI::NonNegativeNumber)
+      ->check(panmap::cli::nonNegative())
       ->capture_default_str();
   app.add_option("--last", last, "last frame to learn from (-1: the log's last)")
       ->capture_default_str();
   app.add_option("--every", every, "learn from every Nth frame (memory: 0.6 MB per 640x480 frame)")
-      ->check(CLI::PositiveNumber)
+      ->check(panmap::cli::positive())
       ->capture_default_str();
   app.add_option("--cells", cal.cells_x,
                  "image cells across (down: as many as the image's "

@@ -9,7 +9,9 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+
 #include <nlohmann/json.hpp>
+#include "cli_checks.h"
 
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
@@ -352,7 +354,7 @@ int main(int argc, char** argv) {
   app.add_option("--min-region-size", config.min_region_size,
                  "ignore GT and predicted instances with fewer vertices (ScanNet: 100)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(panmap::cli::nonNegative());
   app.add_option("--json", json_path, "write the results as JSON to this file");
   app.add_option("--max-distance", config.max_distance_m, "label transfer radius, metres")
       ->capture_default_str();
@@ -361,7 +363,7 @@ int main(int argc, char** argv) {
                  "diagnostics: GT vertices this close to another class are left out of the "
                  "count of super-points that span two classes (1.5 voxels of the map), metres")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(panmap::cli::nonNegative());
   app.add_flag("--paper-compatible", config.paper_compatible,
                "score matched predictions at confidence 1 (the released scripts' quirk)");
   auto* traj_option = app.add_option("--traj", traj_path,

@@ -8,6 +8,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli_checks.h"
+
 #include "panmap/core/error.h"
 #include "panmap/core/memory_policy.h"
 #include "panmap/core/progress.h"
@@ -89,7 +91,7 @@ int main(int argc, char** argv) {
   app.add_option("--depth-scale", depth_scale,
                  "metres per depth unit (e.g. 0.001 for mm); default: the layout's convention, "
                  "for the folder layout detected from the values (mm or 1/5000 m)")
-      ->check(CLI::PositiveNumber);
+      ->check(panmap::cli::positive());
   app.add_option("--pairing", pairing,
                  "folder layout, colour to depth: auto, name (frame number or file name, else "
                  "sorted position) or time (file names are timestamps)")
@@ -111,13 +113,15 @@ int main(int argc, char** argv) {
   app.add_option("--pose-source", pose_source, "recorded pose source: gt, slam, odometry, unknown")
       ->check(CLI::IsMember({"gt", "slam", "odometry", "unknown"}))
       ->capture_default_str();
-  app.add_option("--max-frames", options.max_frames, "import at most N frames (0 = all)");
+  app.add_option("--max-frames", options.max_frames, "import at most N frames (0 = all)")
+      ->check(panmap::cli::nonNegative());
   auto* drift_option = app.add_option(
       "--drift", drift,
       "inject SLAM-like drift into the recorded poses: light (1 %/m, 0.5 deg/m), heavy (3x), "
       "slam, slam-hard or gt (docs/SIMULATION.md); poses are flagged slam unless "
       "--pose-source says otherwise, the recorded ones are written as the reference");
   app.add_option("--seed", drift_seed, "seed of the injected drift")
+      ->check(panmap::cli::nonNegative())
       ->needs(drift_option)
       ->capture_default_str();
   size_t correction_every = 0;
@@ -126,7 +130,7 @@ int main(int argc, char** argv) {
                  "would publish on PANMAP_POSE_CORRECTION: the recorded poses of every Nth frame "
                  "(keyframes) and of the last one (docs/LOOP_CLOSURE.md)")
       ->needs(drift_option)
-      ->check(CLI::PositiveNumber);
+      ->check(panmap::cli::positive());
   app.add_option("--reference", reference_path,
                  "with --drift: TUM file for the recorded poses (default: LOG minus .lcmlog + "
                  ".reference.txt); the drifted ones go to .input.txt beside it")

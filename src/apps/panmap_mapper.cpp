@@ -16,7 +16,9 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+
 #include <nlohmann/json.hpp>
+#include "cli_checks.h"
 
 #include "panmap/command_t.hpp"
 #include "panmap/core/error.h"
@@ -261,7 +263,8 @@ int main(int argc, char** argv) {
   app.add_option("--voxel-size", config.map.voxel_size_m, "voxel edge, metres")
       ->capture_default_str();
   app.add_option("--threads", config.num_threads, "integration threads")->capture_default_str();
-  app.add_option("--max-frames", options.max_frames, "stop after N integrated frames (0 = all)");
+  app.add_option("--max-frames", options.max_frames, "stop after N integrated frames (0 = all)")
+      ->check(panmap::cli::nonNegative());
   app.add_flag("--geometry-only", geometry_only, "ignore panoptic masks (ablation)");
   app.add_flag("--no-mask-edge-fill", no_mask_edge_fill,
                "pixels of a mask outside every surface cast no vote (fusion.fill_mask_edges 0; "
@@ -299,6 +302,7 @@ int main(int argc, char** argv) {
   app.add_option("--autosave-s", autosave_s,
                  "snapshot the map every S seconds of stream time into OUT/autosave (atomic, "
                  "two kept; 0: never). Default 60 live, off offline unless given")
+      ->check(panmap::cli::atLeast(0.0, false, "a period in seconds >= 0 (0: never)"))
       ->capture_default_str();
   app.add_flag("--no-optimise", no_optimise,
                "offline and --export-only: write frame-count outputs without the final "

@@ -11,7 +11,9 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+
 #include <lcm/lcm-cpp.hpp>
+#include "cli_checks.h"
 
 #include "panmap/core/error.h"
 #include "panmap/lcm/channels.h"
@@ -123,7 +125,7 @@ int main(int argc, char** argv) {
   auto* timeout_opt =
       app.add_option("--timeout-s", timeout_s, "give up when no message arrives in this time")
           ->capture_default_str()
-          ->check(CLI::PositiveNumber);
+          ->check(panmap::cli::positive());
   file_opt->excludes(url_opt)->excludes(channel_opt)->excludes(timeout_opt);
   app.add_option("--point", point, "state at this point (world, metres)")
       ->expected(3)

@@ -10,7 +10,9 @@
 #include <iostream>
 
 #include <CLI/CLI.hpp>
+
 #include <nlohmann/json.hpp>
+#include "cli_checks.h"
 
 #include "panmap/building/building.h"
 #include "panmap/core/error.h"
@@ -127,7 +129,7 @@ int main(int argc, char** argv) {
   std::string unannotated_masks = "painted";
   bool join_parts = false, semantic_masks = false;
   auto* source = app.add_option_group("source", "ground-truth mesh (one of)");
-  // CLI::NonNegativeNumber would print the double range up to 1.8e308 in its message.
+  // panmap::cli::nonNegative() would print the double range up to 1.8e308 in its message.
   const CLI::Validator seed_check(
       [](const std::string& text) {
         return !text.empty() && text[0] != '-' ? std::string()
@@ -186,6 +188,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::IsMember({"gt", "slam", "slam-hard", "light", "heavy"}));
   app.add_option("--seed", seed, "seed of trajectory, noise, masks and drift")
+      ->check(panmap::cli::nonNegative())
       ->capture_default_str();
   app.add_flag("--no-depth-noise", no_depth_noise, "exact depth (quantised to 1 mm)");
   app.add_option("--image-scale", image_scale,
@@ -211,14 +214,14 @@ int main(int argc, char** argv) {
                  "PANMAP_POSE_CORRECTION once the survey is back at its start (--laps 2): the "
                  "ground-truth poses of every Nth frame (keyframes) and of the last one "
                  "(docs/LOOP_CLOSURE.md)")
-      ->check(CLI::PositiveNumber);
+      ->check(panmap::cli::positive());
   app.add_option("--correction-residual-cm", residual_cm,
                  "the correction's residual error: each keyframe pose off by this much per axis "
                  "(standard deviation, drawn with --seed)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(panmap::cli::nonNegative());
   app.add_option("--correction-residual-deg", residual_deg,
                  "and turned by this much per axis (standard deviation)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(panmap::cli::nonNegative());
   app.add_option("--unannotate", unannotate_config.fraction,
                  "leave this share of the ground truth's vertices without a class (whole objects "
                  "and clutter patches, drawn with --seed; vertices already without one count)")
@@ -240,9 +243,9 @@ int main(int argc, char** argv) {
                "chair's seat and its star base) into one, where a derived annotation split one "
                "object into connected components (docs/SIMULATION.md)");
   app.add_option("--out", out_dir, "output folder")->required();
-  app.add_option(
-      "--preview-every", preview_every,
-      "write colour, depth and mask PNGs of every Nth frame into OUT/preview (0 = none)");
+  app.add_option("--preview-every", preview_every,
+                 "write colour, depth and mask PNGs of every Nth frame into OUT/preview (0 = none)")
+      ->check(panmap::cli::nonNegative());
   app.add_flag("-q,--quiet", quiet, "no progress line");
   CLI11_PARSE(app, argc, argv);
 

@@ -120,6 +120,17 @@ TEST(SynthCli, BadArgumentsFailClearly) {
   EXPECT_EQ(join.exit_code, 1);
   EXPECT_EQ(test::countLines(join.output), 1) << join.output;
   EXPECT_NE(join.output.find("--join-parts needs --scannet"), std::string::npos) << join.output;
+  // -1 wrapped to 2^64 - 1 as a seed; ranges printed DBL_MAX in 300 digits.
+  const auto seed =
+      runCommand(binPath("panmap-synth") + " --room 1 --seed -1 --out " + dir.path("x"));
+  EXPECT_NE(seed.exit_code, 0);
+  EXPECT_NE(seed.output.find("--seed: a number >= 0, not -1"), std::string::npos) << seed.output;
+  const auto autosave =
+      runCommand(binPath("panmap-mapper") + " --autosave-s nan --out " + dir.path("x"));
+  EXPECT_NE(autosave.exit_code, 0);
+  EXPECT_NE(autosave.output.find("--autosave-s: a period in seconds >= 0 (0: never), not nan"),
+            std::string::npos)
+      << autosave.output;
   // A trajectory whose times repeat was synthesised, and the mapper then refused its frames.
   std::ofstream(dir.path("repeat.txt")) << "0.0 0 0 1 0 0 0 1\n0.1 0 0 1 0 0 0 1\n"
                                            "0.1 0.1 0 1 0 0 0 1\n";
