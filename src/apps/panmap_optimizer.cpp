@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "panmap/core/error.h"
 #include "panmap/core/memory_policy.h"
 #include "panmap/lcm/optimizer_node.h"
 #include "panmap/mapper/config_file.h"
@@ -35,6 +36,14 @@ int main(int argc, char** argv) {
     if (!config_path.empty()) config.optimiser = panmap::loadConfig(config_path).optimiser;
     if (no_regularise) config.optimiser.regularise = false;
     if (no_refine) config.optimiser.refine = false;
+    // An empty channel, or answers on the channel it listens to, waited forever in silence.
+    if (config.channel_graph.empty() || config.channel_labels.empty()) {
+      throw panmap::Error("--channel-graph and --channel-labels must name channels");
+    }
+    if (config.channel_graph == config.channel_labels) {
+      throw panmap::Error("--channel-graph and --channel-labels are both " + config.channel_graph +
+                          ": the answers would come back as graphs");
+    }
     lcm::LCM lcm(url);
     if (!lcm.good()) {
       std::fprintf(stderr, "panmap-optimizer: error: cannot open LCM URL '%s'\n", url.c_str());

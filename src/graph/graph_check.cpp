@@ -54,6 +54,12 @@ void checkGraph(const SuperpointGraph& graph) {
       throw Error(field() + ".void_share: " + std::to_string(v.void_share) +
                   " (must be in [0, 1])");
     }
+    // Sizes weight the energy and centroids place objects: an optimiser fed a graph from the
+    // bus answered one of -5 voxels and NaN centroids as if they were real.
+    if (v.num_voxels < 0) {
+      throw Error(field() + ".num_voxels: " + std::to_string(v.num_voxels) + " (must be >= 0)");
+    }
+    if (!v.centroid.allFinite()) throw Error(field() + ".centroid: not finite");
     checkValues(v.scores, field, ".scores");
   }
   const VertexIndex index(graph);

@@ -675,6 +675,10 @@ TEST(OptimiserConfig, RejectsBadGraphs) {
             "SuperpointGraph.vertices[1].void_share");
   expectBad([](SuperpointGraph& g) { g.vertices[1].void_share = 1.25; },
             "SuperpointGraph.vertices[1].void_share");
+  expectBad([](SuperpointGraph& g) { g.vertices[1].num_voxels = -5; },
+            "SuperpointGraph.vertices[1].num_voxels");
+  expectBad([](SuperpointGraph& g) { g.vertices[2].centroid.y() = NAN; },
+            "SuperpointGraph.vertices[2].centroid");
   expectBad([](SuperpointGraph& g) { g.vertices[2].scores[5] = -1.0; },
             "SuperpointGraph.vertices[2].scores[5]");
   expectBad([](SuperpointGraph& g) { g.edges[0].b = 5; }, "SuperpointGraph.edges[0].b");

@@ -53,6 +53,16 @@ TEST(Cli, MapperRefusesAGridShiftWithAFrameStoreInOneLine) {
 }
 
 // The output folder is checked before any mapping: a long run must not end in "cannot write".
+// The optimiser listened on its own answer channel (or none) and waited forever in silence.
+TEST(Cli, OptimizerRefusesChannelsThatCannotWork) {
+  for (const std::string args : {"--channel-graph G --channel-labels G", "--channel-graph ''"}) {
+    const auto r = runCommand(binPath("panmap-optimizer") + " " + args);
+    EXPECT_EQ(r.exit_code, 1) << args;
+    EXPECT_EQ(test::countLines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find("--channel-graph and --channel-labels"), std::string::npos) << r.output;
+  }
+}
+
 TEST(Cli, MapperChecksTheOutputFolderFirst) {
   test::TempDir dir;
   std::ofstream(dir.path("file")) << "x";
