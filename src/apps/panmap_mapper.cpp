@@ -590,6 +590,10 @@ int main(int argc, char** argv) {
       json["resumed"] = resumeJson(resumed);
       json["events"] = report.events;
       json["log_damage"] = panmap::describeLogDamage(report);
+      // The outputs are in the moved frame: a report that did not say so passed them off as
+      // the log's (config.yaml cannot carry it: it is not a map setting).
+      json["grid_shift_m"] = {options.grid_shift_m.x(), options.grid_shift_m.y(),
+                              options.grid_shift_m.z()};
       json["wall_s"] = report.wall_s;
       json.update(mapJson(*mapper, outputs));
       json["graph"] = {{"vertices", graph.vertices.size()},
