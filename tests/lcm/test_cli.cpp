@@ -180,11 +180,14 @@ TEST(Cli, MapperWarnsWhenFramesGiveNoSurface) {
             std::string::npos)
       << mapped.output;
   importSevenScenes(dir, 2);  // the right units: no warning
-  const auto good =
-      runCommand(binPath("panmap-mapper") + " -q --voxel-size 0.05 " + "--no-snapshots --log " +
-                 dir.path("s.lcmlog") + " --out " + dir.path("b"));
+  const auto good = runCommand(binPath("panmap-mapper") + " -q --voxel-size 0.05 " +
+                               "--no-snapshots --grid-shift 0.01,0,0 --log " +
+                               dir.path("s.lcmlog") + " --out " + dir.path("b"));
   EXPECT_EQ(good.exit_code, 0) << good.output;
   EXPECT_EQ(good.output.find("no surface"), std::string::npos) << good.output;
+  // The outputs of a shifted grid are in the moved frame, and the report says so.
+  std::ifstream in(dir.path("b/report.json"));
+  EXPECT_EQ(nlohmann::json::parse(in)["grid_shift_m"], nlohmann::json::array({0.01, 0.0, 0.0}));
 }
 
 // A log that gives no frame is an error, not an empty map: an empty file, bytes that are no LCM
