@@ -565,6 +565,15 @@ int main(int argc, char** argv) {
           throw panmap::Error("no frame mapped from " + log_path + ": " +
                               panmap::describeNothingMapped(report, options));
         }
+        // Another log's frames would be mapped onto this map without a word: the map's own log
+        // holds a frame at the map's newest utime.
+        if (options.resume_after_utime != INT64_MIN && !report.resume_point_seen) {
+          std::fprintf(stderr,
+                       "panmap-mapper: warning: %s has no frame at the %s map's newest utime "
+                       "(%lld): is it the log the map was made from?\n",
+                       log_path.c_str(), resumed ? "resumed" : "loaded",
+                       static_cast<long long>(options.resume_after_utime));
+        }
         const std::string damage = panmap::describeLogDamage(report);
         if (!damage.empty()) {
           std::fprintf(stderr,

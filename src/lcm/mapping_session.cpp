@@ -130,6 +130,8 @@ bool MappingSession::handle(const std::string& channel, const void* data, size_t
       RgbdFrame frame = fromMessage(msg);
       ++stats_.frames_received;
       if (frame.utime <= options_.resume_after_utime) {
+        stats_.resume_point_seen =
+            stats_.resume_point_seen || frame.utime == options_.resume_after_utime;
         ++stats_.rejected["frame: mapped before the resume point"];
         return true;
       }

@@ -152,6 +152,22 @@ TEST(Cli, ALoadedMapSkipsItsFramesAndKeepsItsSettings) {
   int poses = 0;
   for (std::string line; std::getline(trajectory, line);) poses += !line.empty() && line[0] != '#';
   EXPECT_EQ(poses, 4);
+  EXPECT_EQ(go_on.output.find("is it the log the map was made from"), std::string::npos)
+      << go_on.output;
+  // Another log (the same frames at another rate: other utimes) would be mapped onto the map
+  // without a word; it is warned of.
+  const auto other_log =
+      runCommand(binPath("panmap-import") + " --quiet --max-frames 4 --rate 10 " +
+                 test::dataDir("7scenes-200") + " " + dir.path("t.lcmlog"));
+  ASSERT_EQ(other_log.exit_code, 0) << other_log.output;
+  const auto onto = runCommand(binPath("panmap-mapper") + " -q --voxel-size 0.05 --no-snapshots " +
+                               "--log " + dir.path("t.lcmlog") + " --load " +
+                               dir.path("a/map.panmap") + " --out " + dir.path("d"));
+  EXPECT_EQ(onto.exit_code, 0) << onto.output;
+  EXPECT_NE(onto.output.find("has no frame at the loaded map's newest utime (100000): is it the "
+                             "log the map was made from?"),
+            std::string::npos)
+      << onto.output;
 
   const auto other =
       runCommand(binPath("panmap-mapper") + " -q --voxel-size 0.02 --log " + dir.path("s.lcmlog") +

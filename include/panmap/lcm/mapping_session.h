@@ -65,10 +65,12 @@ struct PoseRefinementStats {
 
 /// What a session has done so far.
 struct SessionStats {
-  int64_t messages = 0;                     ///< messages on the three input channels
-  int64_t frames_received = 0;              ///< RGB-D messages that decoded
-  int64_t frames_integrated = 0;            ///< frames fused into the map
-  int64_t last_frame_utime = 0;             ///< utime of the newest integrated frame
+  int64_t messages = 0;           ///< messages on the three input channels
+  int64_t frames_received = 0;    ///< RGB-D messages that decoded
+  int64_t frames_integrated = 0;  ///< frames fused into the map
+  int64_t last_frame_utime = 0;   ///< utime of the newest integrated frame
+  /// With resume_after_utime: a frame at exactly that utime came (the log is the map's own).
+  bool resume_point_seen = false;
   std::map<std::string, int64_t> rejected;  ///< reason -> frames (or messages) refused
   SyncStats sync;
   std::map<std::string, StageTiming> timings;  ///< by stage name
