@@ -281,6 +281,10 @@ int main(int argc, char** argv) {
       source_json = {
           {"type", "procedural_room"}, {"room_seed", room_seed}, {"room_style", room_style}};
     } else {
+      // The scene first: a missing folder was reported as a missing label table.
+      if (!fs::is_directory(scannet_dir)) {
+        throw panmap::Error("--scannet " + scannet_dir + ": no such folder");
+      }
       // Unless given: the scene's own (ScanNet's layout), else the shipped fixtures' copy.
       if (labels_option->count() == 0) {
         const std::string found = panmap::findScanNetLabelTable(scannet_dir);

@@ -120,6 +120,12 @@ TEST(SynthCli, BadArgumentsFailClearly) {
   EXPECT_EQ(join.exit_code, 1);
   EXPECT_EQ(test::countLines(join.output), 1) << join.output;
   EXPECT_NE(join.output.find("--join-parts needs --scannet"), std::string::npos) << join.output;
+  const auto scene = runCommand(binPath("panmap-synth") + " --scannet " + dir.path("none") +
+                                " --out " + dir.path("x"));
+  EXPECT_EQ(scene.exit_code, 1);
+  EXPECT_NE(scene.output.find("--scannet " + dir.path("none") + ": no such folder"),
+            std::string::npos)
+      << scene.output;
   // -1 wrapped to 2^64 - 1 as a seed; ranges printed DBL_MAX in 300 digits.
   const auto seed =
       runCommand(binPath("panmap-synth") + " --room 1 --seed -1 --out " + dir.path("x"));
