@@ -406,7 +406,6 @@ int main(int argc, char** argv) {
       resumed = panmap::resumeFrom(autosaveDirOf(resume_dir));
       mapper = std::move(resumed->mapper);
       options.resume_after_utime = resumed->last_utime;
-      std::fprintf(stderr, "panmap-mapper: %s\n", panmap::describeResume(*resumed).c_str());
     } else if (!load_path.empty()) {
       mapper = panmap::Mapper::load(load_path);
     }
@@ -452,6 +451,10 @@ int main(int argc, char** argv) {
       }
     }
     if (!mapper) mapper = std::make_unique<panmap::Mapper>(config);
+    // Said once the settings agree: "resumed" followed by a refusal read as both.
+    if (resumed) {
+      std::fprintf(stderr, "panmap-mapper: %s\n", panmap::describeResume(*resumed).c_str());
+    }
     // A map given with --load holds its frames: the same log given again must not map them
     // twice, so frames up to its newest are skipped, as --resume does.
     if (!resumed && !load_path.empty() && !mapper->trajectory().empty()) {
