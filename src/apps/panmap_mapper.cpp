@@ -710,10 +710,18 @@ int main(int argc, char** argv) {
     node.drain();
     const double wall_s = msSince(start) / 1000.0;
     g_stop = false;  // a second Ctrl-C cuts the wait for labels short
+    std::fprintf(stderr,
+                 "panmap-mapper: waiting up to %.0f s for panmap-optimizer's labels (Ctrl-C "
+                 "again skips them)\n",
+                 live.optimiser_timeout_s);
     const auto optimise_start = std::chrono::steady_clock::now();
     const std::optional<panmap::GraphLabels> labels = node.requestLabels(g_stop);
     const double optimise_ms = msSince(optimise_start);
-    if (!labels) {
+    if (!labels && g_stop) {
+      std::fprintf(stderr,
+                   "panmap-mapper: labels skipped by a second signal: writing unoptimised "
+                   "outputs (frame-count labels)\n");
+    } else if (!labels) {
       std::fprintf(stderr,
                    "panmap-mapper: no labels from panmap-optimizer within %.0f s: writing "
                    "unoptimised outputs (frame-count labels)\n",
