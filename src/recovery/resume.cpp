@@ -12,15 +12,19 @@ namespace {
 
 // (frame id, utime) of the frames journaled after `utime`, by utime: frames mapped again by a
 // resumed run (a replayed log) appear once.
-std::vector<std::pair<int64_t, int64_t>> journalAfter(const std::string& path, int64_t utime) {
+std::vector<std::pair<int64_t, int64_t>> journalAfter(const std::string& path, int64_t utime,
+                                                      bool* readable) {
   std::map<int64_t, int64_t> by_utime;
   std::ifstream in(path);
+  // A journal that is gone or holds no frame line cannot say nothing was lost.
+  *readable = false;
   std::string line;
   while (std::getline(in, line)) {
     if (line.empty() || line[0] == '#') continue;  // '#': a run marker
     std::istringstream fields(line);
     int64_t id = 0, t = 0;
     if (!(fields >> id >> t)) continue;  // a line cut by the crash
+    *readable = true;
     if (t > utime) by_utime.emplace(t, id);
   }
   std::vector<std::pair<int64_t, int64_t>> out;
@@ -54,7 +58,7 @@ ResumePoint resumeFrom(const std::string& dir) {
     point.last_utime = trajectory.back().utime;
     point.last_frame_id = trajectory.back().frame_id;
   }
-  point.lost = journalAfter(dir + "/frames.journal", point.last_utime);
+  point.lost = journalAfter(dir + "/frames.journal", point.last_utime, &point.journal_read);
   return point;
 }
 
@@ -64,7 +68,9 @@ std::string describeResume(const ResumePoint& point) {
   if (point.last_frame_id >= 0) {
     out << " (last frame " << point.last_frame_id << ", utime " << point.last_utime << ")";
   }
-  if (point.lost.empty()) {
+  if (!point.journal_read) {
+    out << "; the frame journal is missing or unreadable: frames lost since it are not known";
+  } else if (point.lost.empty()) {
     out << "; no frame integrated after it was lost";
   } else {
     out << "; lost " << point.lost.size() << " frames integrated after it (frames "

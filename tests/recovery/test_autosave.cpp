@@ -152,6 +152,13 @@ TEST(Resume, SkipsACorruptSnapshotListsLostFramesAndContinuesExactly) {
   EXPECT_EQ(point.lost.back().second, s.frames[11].utime);
   EXPECT_NE(describeResume(point).find("lost 5 frames"), std::string::npos)
       << describeResume(point);
+  // Without its journal a resume cannot know what was lost, and says so (it said nothing was).
+  fs::rename(dir.path("frames.journal"), dir.path("journal.kept"));
+  EXPECT_NE(describeResume(resumeFrom(dir.path()))
+                .find("the frame journal is missing or unreadable: frames lost since it are not "
+                      "known"),
+            std::string::npos);
+  fs::rename(dir.path("journal.kept"), dir.path("frames.journal"));
 
   // Mapping on from the snapshot equals never stopping.
   for (size_t k = 7; k < s.frames.size(); ++k) integrate(point.mapper.get(), s, k);

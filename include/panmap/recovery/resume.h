@@ -20,6 +20,7 @@ struct ResumePoint {
   int64_t last_frame_id = -1;
   /// Frames the journal shows integrated after the snapshot: (frame id, utime), lost.
   std::vector<std::pair<int64_t, int64_t>> lost;
+  bool journal_read = false;  ///< the journal held frame lines (else `lost` says nothing)
 };
 
 /// Loads the newest snapshot of an autosave folder that reads cleanly, a complete .partial one
