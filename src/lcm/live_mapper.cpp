@@ -146,6 +146,7 @@ void LiveMapper::onCommand(const lcm::ReceiveBuffer* buffer, const std::string& 
       case command_t::COMMAND_FINISH:
         finish_requested_ = true;
         finish_command_utime_ = utime;
+        finish_by_command_ = true;
         setCommandState(utime, "running", "finishing: mapping what is queued, then the outputs");
         return;
       case command_t::COMMAND_OPTIMISE:
@@ -228,7 +229,7 @@ bool LiveMapper::serveCommandsAfterFailedFinish(const std::atomic<bool>& stop) {
 }
 
 void LiveMapper::publishFinished(bool ok, const std::string& result) {
-  if (finish_command_utime_ != 0) {
+  if (finish_by_command_) {
     setCommandState(finish_command_utime_, ok ? "done" : "failed", result);
   }
   publishStatus(ok ? "done" : "finish failed");

@@ -213,6 +213,7 @@ class LiveMapper {
   std::map<std::string, int64_t> rejected_commands_;
   bool finish_requested_ = false;      // LCM thread only
   bool serving_after_finish_ = false;  // LCM thread only: serveCommandsAfterFailedFinish()
+  bool finish_by_command_ = false;     // LCM thread only: a finish command (not a signal) came
   int64_t finish_command_utime_ = 0;   // LCM thread only: the finish command's utime
   // The newest commands' progress, oldest first (written by the LCM thread and the worker,
   // read by status()): a save still running when the next command comes keeps its own entry.
