@@ -46,6 +46,16 @@ class LiveCli : public ::testing::Test {
     dir_ = nullptr;
   }
   static std::string log() { return dir_->path("seq/sequence.lcmlog"); }
+  // Waits for a mapper's first status on `url`, then replays the log into it.
+  static void replayOnceListening(const std::string& url) {
+    lcm::LCM lcm(url);
+    test::StatusWatch watch;
+    lcm.subscribe("PANMAP_STATUS", &test::StatusWatch::onStatus, &watch);
+    for (int i = 0; i < 100 && watch.received == 0; ++i) lcm.handleTimeout(100);
+    ASSERT_GT(watch.received, 0) << "no mapper status on " << url;
+    test::ChildProcess player({"lcm-logplayer", "-l", url, log()});
+    ASSERT_TRUE(player.wait(60)) << "lcm-logplayer did not finish";
+  }
   static test::TempDir* dir_;
 };
 test::TempDir* LiveCli::dir_ = nullptr;
@@ -180,13 +190,8 @@ TEST_F(LiveCli, DeadOptimiserCostsTheLabelsNotTheMap) {
       {test::binPath("panmap-mapper"), "--lcm-url", url, "--out", out, "--voxel-size", "0.04",
        "--queue-frames", "64", "--optimizer-timeout-s", "1"},
       dir_->path("dead.log"));
-  lcm::LCM lcm(url);
-  test::StatusWatch watch;
-  lcm.subscribe("PANMAP_STATUS", &test::StatusWatch::onStatus, &watch);
-  for (int i = 0; i < 100 && watch.received == 0; ++i) lcm.handleTimeout(100);
-  ASSERT_GT(watch.received, 0);
-  test::ChildProcess player({"lcm-logplayer", "-l", url, log()});
-  ASSERT_TRUE(player.wait(60));
+  replayOnceListening(url);
+  if (HasFatalFailure()) return;
   optimiser.signal(SIGKILL);  // the optimiser dies mid-run
   ASSERT_TRUE(optimiser.wait(10));
   mapper.signal(SIGINT);  // Ctrl-C finishes like the command
@@ -213,13 +218,8 @@ TEST_F(LiveCli, AFinishThatCannotWriteKeepsTheMap) {
       {test::binPath("panmap-mapper"), "--lcm-url", url, "--out", out, "--voxel-size", "0.04",
        "--queue-frames", "64", "--optimizer-timeout-s", "0.5"},
       dir_->path("kept.log"));
-  lcm::LCM lcm(url);
-  test::StatusWatch watch;
-  lcm.subscribe("PANMAP_STATUS", &test::StatusWatch::onStatus, &watch);
-  for (int i = 0; i < 100 && watch.received == 0; ++i) lcm.handleTimeout(100);
-  ASSERT_GT(watch.received, 0);
-  test::ChildProcess player({"lcm-logplayer", "-l", url, log()});
-  ASSERT_TRUE(player.wait(60));
+  replayOnceListening(url);
+  if (HasFatalFailure()) return;
   std::filesystem::remove_all(out);
   std::ofstream(out) << "a file where the folder was";
   const std::string command = test::binPath("panmap-command") + " -q --lcm-url '" + url + "' ";
