@@ -334,6 +334,12 @@ int main(int argc, char** argv) {
                "live repairs that map the frames again re-integrate them and swap that map in "
                "(geometry, labels, objects and occupancy repaired in about a third of the time; "
                "after the occupancy tree unless --repair-occupancy-last), then map them again");
+  double correction_tolerance_ms = 1.0;
+  app.add_option("--correction-tolerance-ms", correction_tolerance_ms,
+                 "a corrected pose matches the mapped frame nearest in time within this (0: the "
+                 "utime exactly); utimes further from every mapped frame are refused and named")
+      ->capture_default_str()
+      ->check(panmap::cli::nonNegative());
   std::vector<double> grid_shift;
   app.add_option("--grid-shift", grid_shift,
                  "X,Y,Z metres: move every pose by this before mapping, so the voxel grid falls "
@@ -499,6 +505,9 @@ int main(int argc, char** argv) {
       options.repair.reassociate = !repair_reintegrate_only;
       options.repair.occupancy_first = !repair_occupancy_last;
       options.repair.reintegrate_first = repair_reintegrate_first;
+      // Beyond 10^9 ms (11 days) every utime matches anyway; the cap keeps llround defined.
+      options.repair.match_tolerance_us =
+          std::llround(std::min(correction_tolerance_ms, 1e9) * 1000.0);
     }
     // Offline runs can be replayed from their log, so they autosave only when asked to.
     const bool offline = !log_path.empty() || export_only;

@@ -68,9 +68,7 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
   CorrectedTrajectory corrected =
       applyCorrection(mapper_->trajectory(), correction, config_.match_tolerance_us);
   if (corrected.matched == 0) {
-    throw Error(name + ": none of its " + std::to_string(correction.poses.size()) +
-                " utimes is a mapped frame (first " +
-                std::to_string(correction.poses.front().utime) + ")");
+    throw Error(name + ": " + unmatchedCorrectionReason(mapper_->trajectory(), correction, config_.match_tolerance_us));
   }
   if (running()) {
     cancel();

@@ -53,9 +53,7 @@ MapRepairResult repairMap(Mapper* mapper, FrameStore* store, const PoseCorrectio
   result.max_translation_m = corrected.max_translation_m;
   result.max_rotation_rad = corrected.max_rotation_rad;
   if (corrected.matched == 0) {
-    throw Error(name + ": none of its " + std::to_string(correction.poses.size()) +
-                " utimes is a mapped frame (first " +
-                std::to_string(correction.poses.front().utime) + ")");
+    throw Error(name + ": " + unmatchedCorrectionReason(mapper->trajectory(), correction, config.match_tolerance_us));
   }
   // Association under the old poses may have joined surfaces to the wrong super-points;
   // with the segmentations stored, the frames are associated again. A store that holds some

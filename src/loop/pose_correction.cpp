@@ -133,4 +133,21 @@ CorrectedTrajectory applyCorrection(const std::vector<StampedPose>& trajectory,
   return out;
 }
 
+std::string unmatchedCorrectionReason(const std::vector<StampedPose>& trajectory,
+                                      const PoseCorrection& correction, int64_t tolerance_us) {
+  std::string out = "none of its " + std::to_string(correction.poses.size()) +
+                    " utimes is a mapped frame";
+  if (correction.poses.empty()) return out;
+  const int64_t first = correction.poses.front().utime;
+  out += " (first " + std::to_string(first);
+  if (trajectory.empty()) return out + ", no frame mapped yet)";
+  int64_t gap = INT64_MAX;
+  for (const StampedPose& p : correction.poses) {
+    const int k = nearestFrame(trajectory, p.utime, INT64_MAX);
+    if (k >= 0) gap = std::min<int64_t>(gap, std::abs(trajectory[k].utime - p.utime));
+  }
+  return out + ", " + std::to_string(gap) + " us from the nearest mapped frame, tolerance " +
+         std::to_string(std::max<int64_t>(tolerance_us, 0)) + " us)";
+}
+
 }  // namespace panmap

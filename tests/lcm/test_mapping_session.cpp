@@ -355,7 +355,7 @@ TEST_F(MappingSessionTest, ACorrectionRepairsTheMapFromTheFrameStore) {
   // The same correction again is stale; a newer one naming no mapped frame is refused.
   PoseCorrection stranger = correction;
   stranger.correction_id = 4;
-  stranger.poses[0].utime += 1;
+  stranger.poses[0].utime += 50000;  // 50 ms from every frame (frames are further apart)
   const std::vector<test::Encoded> more = {
       encodeMessage(kChannelPoseCorrection, toMessage(correction)),
       encodeMessage(kChannelPoseCorrection, toMessage(stranger)),

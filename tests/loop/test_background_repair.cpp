@@ -242,7 +242,7 @@ TEST_F(BackgroundRepairTest, BadCorrectionsAndLostFramesChangeNothing) {
   });
   repair.start(keyframeCorrection(*mapper, 1, move(0.02, {0.02, 0.0, 0.0}), 5));
   PoseCorrection stranger = keyframeCorrection(*mapper, 1, move(0.02, {0.02, 0.0, 0.0}), 6);
-  stranger.poses[0].utime += 1;
+  stranger.poses[0].utime += 50000;  // 50 ms from every frame (frames are further apart)
   try {
     repair.start(stranger);
     FAIL() << "a correction of no mapped frame was started";

@@ -137,6 +137,31 @@ TEST_F(MapRepair, WithTheMasksStoredTheFramesAreMappedAgain) {
   EXPECT_NE(describe(plain).find("re-integrated"), std::string::npos);
 }
 
+TEST_F(MapRepair, UtimesAFewMicrosecondsOffMatchWithinTheDefaultTolerance) {
+  // A back-end that keeps stamps as double seconds gives them back a few microseconds off.
+  test::TempDir dir;
+  FrameStore store(storeConfig(dir.path("store")));
+  auto mapper = mapWithStore(4, &store);
+  PoseCorrection c = keyframeCorrection(*mapper, 1, correction());
+  c.poses[0].utime += 7;
+  const std::vector<uint8_t> before = mapper->serialize();
+  MapRepairConfig exact;
+  exact.match_tolerance_us = 0;
+  try {
+    repairMap(mapper.get(), &store, c, exact);
+    FAIL() << "a utime 7 us off matched with tolerance 0";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("7 us from the nearest mapped frame, tolerance 0 us"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(mapper->serialize(), before);
+  const MapRepairResult result = repairMap(mapper.get(), &store, c);
+  EXPECT_EQ(result.matched, 1);
+  EXPECT_TRUE(result.unknown_utimes.empty());
+  EXPECT_TRUE(result.reintegration.completed);
+}
+
 TEST_F(MapRepair, UnknownUtimesAreCountedNamedAndNeverGuessed) {
   test::TempDir dir;
   FrameStore store(storeConfig(dir.path("store")));

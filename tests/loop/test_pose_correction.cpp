@@ -182,5 +182,21 @@ TEST(KeyframeCorrection, EveryNthFrameAndTheLastOneWithTheirReferencePoses) {
   EXPECT_THROW(keyframeCorrection(reference, 0), Error);
 }
 
+TEST(PoseCorrection, AnUnmatchedCorrectionSaysHowFarOffItsUtimesAre) {
+  const std::vector<StampedPose> trajectory = walk();
+  PoseCorrection c;
+  StampedPose a = corrected(trajectory[1], pose(0.1, 0.0, 0.0));
+  a.utime = 1150000;  // 50 ms from frames 1 and 2
+  StampedPose b = corrected(trajectory[3], pose(0.1, 0.0, 0.0));
+  b.utime += 1200;  // 1.2 ms after frame 3: the nearest of the two
+  c.poses = {a, b};
+  EXPECT_EQ(applyCorrection(trajectory, c, 1000).matched, 0);
+  EXPECT_EQ(unmatchedCorrectionReason(trajectory, c, 1000),
+            "none of its 2 utimes is a mapped frame (first 1150000, 1200 us from the nearest "
+            "mapped frame, tolerance 1000 us)");
+  EXPECT_EQ(unmatchedCorrectionReason({}, c, 1000),
+            "none of its 2 utimes is a mapped frame (first 1150000, no frame mapped yet)");
+}
+
 }  // namespace
 }  // namespace panmap

@@ -13,8 +13,9 @@ namespace panmap {
 /// How a correction is turned into a repair.
 struct MapRepairConfig {
   /// A corrected utime matches the mapped frame nearest in time within this, microseconds
-  /// (0: exactly; a back-end that republishes the utimes it was given needs no more).
-  int64_t match_tolerance_us = 0;
+  /// (0: exactly). A back-end that keeps stamps as seconds in a double, or in another clock's
+  /// ticks, gives them back a few microseconds off; 1 ms is far below any camera's frame period.
+  int64_t match_tolerance_us = 1000;
   /// When the store holds panoptic segmentations, map the frames again (Mapper::remap:
   /// super-points, graph and objects made anew; a frame stored without one is mapped without,
   /// as it was) instead of re-integrating them with the super-points association gave them

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "panmap/core/pose.h"
@@ -55,5 +56,12 @@ struct CorrectedTrajectory {
 /// @param tolerance_us a corrected utime matches the frame nearest in time within this.
 CorrectedTrajectory applyCorrection(const std::vector<StampedPose>& trajectory,
                                     const PoseCorrection& correction, int64_t tolerance_us = 0);
+
+/// Why a correction none of whose utimes matched was refused, for a one-line error: "none of
+/// its N utimes is a mapped frame (first U, D us from the nearest mapped frame, tolerance T
+/// us)", or "(first U, no frame mapped yet)". Says how far off the utimes are, so that a
+/// back-end whose timestamps went through a float can be told from one naming other frames.
+std::string unmatchedCorrectionReason(const std::vector<StampedPose>& trajectory,
+                                      const PoseCorrection& correction, int64_t tolerance_us);
 
 }  // namespace panmap
