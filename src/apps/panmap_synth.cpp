@@ -117,8 +117,9 @@ int main(int argc, char** argv) {
       "OUT/gt/instances.txt, OUT/gt/trajectory_gt.txt, OUT/gt/trajectory_input.txt, "
       "OUT/info.json"};
   int64_t room_seed = -1;
-  std::string scannet_dir,
-      scannet_labels = "../shared/data/scannet-meta/scannetv2-labels.combined.tsv";
+  // The shipped data's copy, for runs from the repository's root (its scenes keep it apart).
+  const std::string shipped_labels = "../shared/data/scannet-meta/scannetv2-labels.combined.tsv";
+  std::string scannet_dir, scannet_labels;
   std::string trajectory_file, masks = "m2f", poses = "slam", out_dir;
   int frames = 300;
   uint64_t seed = 1;
@@ -165,8 +166,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 20000.0));
   auto* labels_option = app.add_option("--scannet-labels", scannet_labels,
                                        "ScanNet label table (tsv); default: the one in the "
-                                       "scene folder, its parent or its grandparent, else this")
-                            ->capture_default_str();
+                                       "scene folder, its parent or its grandparent, else " +
+                                           shipped_labels);
   app.add_option("--trajectory", trajectory_file, "TUM trajectory to follow instead of a survey");
   app.add_option("--frames", frames, "frames to render")
       ->capture_default_str()
@@ -287,8 +288,15 @@ int main(int argc, char** argv) {
       }
       // Unless given: the scene's own (ScanNet's layout), else the shipped fixtures' copy.
       if (labels_option->count() == 0) {
-        const std::string found = panmap::findScanNetLabelTable(scannet_dir);
-        if (!found.empty()) scannet_labels = found;
+        scannet_labels = panmap::findScanNetLabelTable(scannet_dir);
+        if (scannet_labels.empty() && fs::is_regular_file(shipped_labels)) {
+          scannet_labels = shipped_labels;
+        }
+        if (scannet_labels.empty()) {
+          throw panmap::Error("--scannet " + scannet_dir +
+                              ": no scannetv2-labels.combined.tsv in it, its parent or its "
+                              "grandparent; give it with --scannet-labels");
+        }
       }
       const auto table = panmap::ScanNetLabelTable::load(scannet_labels);
       const panmap::ScanNetSceneFiles files = panmap::findScanNetSceneFiles(scannet_dir);

@@ -126,6 +126,20 @@ TEST(SynthCli, BadArgumentsFailClearly) {
   EXPECT_NE(scene.output.find("--scannet " + dir.path("none") + ": no such folder"),
             std::string::npos)
       << scene.output;
+  // A scene folder with no label table near it, run from a folder with no shipped copy: named
+  // (it was "cannot open ../shared/data/scannet-meta/...", a path the user never gave).
+  const std::string lone = dir.path("scans/scene0001_00");
+  std::filesystem::create_directories(lone);
+  const auto no_table = runCommand("cd " + dir.path("scans") + " && " +
+                                   binPath("panmap-synth") + " --scannet " + lone + " --out " +
+                                   dir.path("x"));
+  EXPECT_EQ(no_table.exit_code, 1);
+  EXPECT_EQ(test::countLines(no_table.output), 1) << no_table.output;
+  EXPECT_NE(no_table.output.find("--scannet " + lone +
+                                 ": no scannetv2-labels.combined.tsv in it, its parent or its "
+                                 "grandparent; give it with --scannet-labels"),
+            std::string::npos)
+      << no_table.output;
   // -1 wrapped to 2^64 - 1 as a seed; ranges printed DBL_MAX in 300 digits.
   const auto seed =
       runCommand(binPath("panmap-synth") + " --room 1 --seed -1 --out " + dir.path("x"));
