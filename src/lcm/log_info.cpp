@@ -18,8 +18,10 @@
 namespace panmap {
 
 double ChannelInfo::rateHz() const {
-  if (count < 2 || last_utime <= first_utime) return 0.0;
-  return static_cast<double>(count - 1) * 1e6 / static_cast<double>(last_utime - first_utime);
+  const size_t decoded = count - failures;
+  const size_t n = decoded > 0 ? decoded : count;
+  if (n < 2 || last_utime <= first_utime) return 0.0;
+  return static_cast<double>(n - 1) * 1e6 / static_cast<double>(last_utime - first_utime);
 }
 
 bool LogInfo::allDecoded() const {
@@ -53,14 +55,20 @@ LogInfo inspectLog(const std::string& path, bool deep,
     ChannelInfo& c = channels[event->channel];
     c.channel = event->channel;
     const MessageCheck check = checkMessage(event->data, static_cast<size_t>(event->datalen), deep);
-    const int64_t utime = check.ok ? check.utime : event->timestamp;
     if (c.count == 0) {
       c.type = check.type;
-      c.first_utime = utime;
     } else if (c.type != check.type) {
       c.type.clear();  // mixed types on one channel
     }
-    c.last_utime = utime;
+    // Times from the messages that decoded; until one has, from the logger's clock.
+    const size_t decoded = c.count - c.failures;
+    if (check.ok) {
+      if (decoded == 0) c.first_utime = check.utime;
+      c.last_utime = check.utime;
+    } else if (decoded == 0) {
+      if (c.count == 0) c.first_utime = event->timestamp;
+      c.last_utime = event->timestamp;
+    }
     ++c.count;
     c.bytes += static_cast<size_t>(event->datalen);
     if (!check.ok) {

@@ -3,6 +3,7 @@
 
 #include <fstream>
 
+#include "panmap/lcm/conversions.h"
 #include "panmap/lcm/log_bytes.h"
 #include "panmap/lcm/log_info.h"
 #include "panmap/lcm/log_writer.h"
@@ -94,6 +95,38 @@ TEST(LogInfo, AnyChannelNamePrints) {
   EXPECT_NE(table.find("A_CHANNEL_NAME_LONGER_THAN_SIXTEEN  ?"), std::string::npos) << table;
   EXPECT_NE(table.find("TWO?LINES"), std::string::npos) << table;
   EXPECT_EQ(test::countLines(table), 1 + 3 + 3 + 1) << table;  // header, rows, failures, total
+}
+
+TEST(LogInfo, TheRateCountsOnlyMessagesThatDecode) {
+  // Poses 100 ms apart by their utimes; garbage on the same channel, stamped by the logger's
+  // clock (seconds since 1970), counted every pose twice and stretched the span to decades.
+  test::TempDir dir;
+  const std::string path = dir.path("rate.lcmlog");
+  const uint8_t garbage[3] = {1, 2, 3};
+  {
+    LogWriter writer(path);
+    for (int k = 0; k < 5; ++k) {
+      StampedPose pose;
+      pose.utime = 1000000 + 100000 * k;
+      writer.write("CAMERA_POSE", 1700000000000000 + k, toMessage(pose));
+      writer.writeRaw("CAMERA_POSE", 1700000000000000 + k, garbage, sizeof(garbage));
+    }
+    writer.writeRaw("ONLY_GARBAGE", 2000000, garbage, sizeof(garbage));
+    writer.writeRaw("ONLY_GARBAGE", 2500000, garbage, sizeof(garbage));
+  }
+  const LogInfo info = inspectLog(path, false);
+  ASSERT_EQ(info.channels.size(), 2u);
+  const ChannelInfo& poses = info.channels[0];
+  EXPECT_EQ(poses.count, 10u);
+  EXPECT_EQ(poses.failures, 5u);
+  EXPECT_EQ(poses.first_utime, 1000000);
+  EXPECT_EQ(poses.last_utime, 1400000);
+  EXPECT_NEAR(poses.rateHz(), 10.0, 1e-9);
+  // A channel where nothing decodes still gets a rate, by the logger's clock.
+  const ChannelInfo& garbage_only = info.channels[1];
+  EXPECT_EQ(garbage_only.first_utime, 2000000);
+  EXPECT_EQ(garbage_only.last_utime, 2500000);
+  EXPECT_NEAR(garbage_only.rateHz(), 2.0, 1e-9);
 }
 
 TEST(OfflineReport, NamesTheLogsDamage) {

@@ -15,11 +15,15 @@ struct ChannelInfo {
   size_t count = 0;         ///< events
   size_t bytes = 0;         ///< payload bytes
   size_t failures = 0;      ///< events that did not decode as a panmap type
-  int64_t first_utime = 0;  ///< utime of the first message (event timestamp if undecodable)
+  /// utime of the first and last message that decoded; when none did, the log's event
+  /// timestamps (another clock: when the logger received them).
+  int64_t first_utime = 0;
   int64_t last_utime = 0;
   std::string first_error;  ///< the first failure's reason
 
-  /// Messages per second between the first and last utime (0 for fewer than two).
+  /// Messages per second between the first and last utime (0 for fewer than two): the
+  /// decoded messages only when two or more decoded, so that garbage on a channel, stamped
+  /// by the logger's clock, neither counts nor stretches the span.
   double rateHz() const;
   /// Mean payload size, bytes.
   double meanBytes() const { return count ? static_cast<double>(bytes) / count : 0.0; }
