@@ -256,6 +256,58 @@ void checkImageSize(const std::string& path, const char* kind, int width, int he
   throw Error(msg.str());
 }
 
+namespace {
+
+// The q-quantile of values (reordered).
+double quantile(std::vector<uint16_t>* values, double q) {
+  const size_t k = std::min(values->size() - 1, static_cast<size_t>(q * values->size()));
+  std::nth_element(values->begin(), values->begin() + static_cast<long>(k), values->end());
+  return static_cast<double>((*values)[k]);
+}
+
+}  // namespace
+
+DepthValueSample sampleDepthValues(const std::vector<std::string>& paths, size_t max_images) {
+  DepthValueSample sample;
+  std::vector<uint16_t> values;
+  // Images spread over the sequence: one image may face a near wall.
+  const size_t images = std::min(max_images, paths.size());
+  for (size_t k = 0; k < images; ++k) {
+    const size_t index = images > 1 ? k * (paths.size() - 1) / (images - 1) : 0;
+    DepthImage depth;
+    try {
+      depth = readDepthFile(paths[index]);
+    } catch (const Error&) {
+      continue;
+    }
+    std::vector<uint16_t> image_values;
+    for (int v = 0; v < depth.height(); v += 2) {
+      const uint16_t* row = depth.row(v);
+      for (int u = 0; u < depth.width(); u += 2) {
+        if (row[u] > 0) image_values.push_back(row[u]);
+      }
+    }
+    if (image_values.empty()) continue;
+    ++sample.images;
+    sample.largest_p99 = std::max(sample.largest_p99, quantile(&image_values, 0.99));
+    values.insert(values.end(), image_values.begin(), image_values.end());
+  }
+  if (!values.empty()) sample.median = quantile(&values, 0.5);
+  return sample;
+}
+
+std::string formatDepthScale(double scale) {
+  std::ostringstream out;
+  if (std::abs(scale - 0.001) < 1e-12) {
+    out << "0.001 m per unit (mm)";
+  } else if (std::abs(scale - 1.0 / 5000.0) < 1e-12) {
+    out << "1/5000 m per unit (TUM)";
+  } else {
+    out << scale << " m per unit";
+  }
+  return out.str();
+}
+
 void checkPrincipalPoint(const PinholeCamera& camera, const std::string& from) {
   const double w = camera.width, h = camera.height;
   if (camera.cx > 0.25 * w && camera.cx < 0.75 * w && camera.cy > 0.25 * h &&

@@ -43,13 +43,6 @@ constexpr double kFarMedianDepthMm = 4000.0;
 // Depth images, spread over the sequence, whose values decide the depth unit.
 constexpr size_t kDepthScaleImages = 9;
 
-// The q-quantile of values (reordered).
-double quantile(std::vector<uint16_t>* values, double q) {
-  const size_t k = std::min(values->size() - 1, static_cast<size_t>(q * values->size()));
-  std::nth_element(values->begin(), values->begin() + static_cast<long>(k), values->end());
-  return static_cast<double>((*values)[k]);
-}
-
 struct NamedFile {
   std::string name;
   std::string stem;
@@ -150,18 +143,6 @@ std::string joined(const char* const (&names)[N]) {
   std::string out;
   for (size_t i = 0; i < N; ++i) out += std::string(i ? ", " : "") + names[i];
   return out;
-}
-
-std::string formatDepthScale(double scale) {
-  std::ostringstream out;
-  if (std::abs(scale - 0.001) < 1e-12) {
-    out << "0.001 m per unit (mm)";
-  } else if (std::abs(scale - 1.0 / 5000.0) < 1e-12) {
-    out << "1/5000 m per unit (TUM)";
-  } else {
-    out << scale << " m per unit";
-  }
-  return out.str();
 }
 
 class FolderReader : public DatasetReader {
@@ -481,39 +462,18 @@ class FolderReader : public DatasetReader {
       notes_.push_back("depth scale: " + formatDepthScale(depth_scale_m_) + " (given)");
       return;
     }
-    // Pixels of images spread over the sequence: one image may face a near wall.
-    std::vector<uint16_t> values;
-    double largest_p99 = 0.0;
-    const size_t images = std::min(kDepthScaleImages, frames_.size());
-    for (size_t k = 0; k < images; ++k) {
-      const size_t index = images > 1 ? k * (frames_.size() - 1) / (images - 1) : 0;
-      DepthImage depth = first_depth_;
-      if (index > 0) {
-        try {
-          depth = readDepthFile(depth_dir_ + "/" + frames_[index].depth.name);
-        } catch (const Error&) {
-          continue;  // named when the frame is read (or skipped with --skip-bad)
-        }
-      }
-      std::vector<uint16_t> image_values;
-      for (int v = 0; v < depth.height(); v += 2) {
-        const uint16_t* row = depth.row(v);
-        for (int u = 0; u < depth.width(); u += 2) {
-          if (row[u] > 0) image_values.push_back(row[u]);
-        }
-      }
-      if (image_values.empty()) continue;
-      largest_p99 = std::max(largest_p99, quantile(&image_values, 0.99));
-      values.insert(values.end(), image_values.begin(), image_values.end());
-    }
-    if (values.empty()) {
+    std::vector<std::string> paths;
+    for (const Frame& f : frames_) paths.push_back(depth_dir_ + "/" + f.depth.name);
+    const DepthValueSample sample = sampleDepthValues(paths, kDepthScaleImages);
+    const size_t images = sample.images;
+    if (images == 0) {
       depth_scale_m_ = 0.001;
       notes_.push_back("depth scale: " + formatDepthScale(depth_scale_m_) + " (assumed: the " +
-                       std::to_string(images) +
+                       std::to_string(std::min(kDepthScaleImages, paths.size())) +
                        " depth images looked at are empty; --depth-scale overrides)");
       return;
     }
-    const double median = quantile(&values, 0.5);
+    const double median = sample.median, largest_p99 = sample.largest_p99;
     const bool mm = median <= kMaxMedianDepthMm && largest_p99 <= kMaxP99DepthMm;
     depth_scale_m_ = mm ? 0.001 : 1.0 / 5000.0;
     std::ostringstream note;

@@ -3,6 +3,7 @@
 // paired with the colour image nearest in time (within tum_max_dt_s) and the ground-truth
 // pose interpolated between its neighbours (or the nearest one within tum_max_dt_s).
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -47,6 +48,33 @@ std::vector<Stamped> readFileList(const std::string& path) {
   return out;
 }
 
+// Median depth below this at TUM's unit is not a Kinect's: the images are likely millimetres.
+constexpr double kNearestPlausibleMedianM = 0.5;
+
+// The last component of a folder path ("a/b/" -> "b").
+std::string folderName(const std::string& dir) {
+  std::string d = dir;
+  while (d.size() > 1 && d.back() == '/') d.pop_back();
+  const size_t slash = d.rfind('/');
+  return slash == std::string::npos ? d : d.substr(slash + 1);
+}
+
+// 1, 2 or 3 when the folder's own name names TUM's camera as its sequences do
+// ("rgbd_dataset_freiburg1_desk"): "freiburg" and one digit, not followed by another digit.
+// Only the folder's own name counts: a parent folder names a collection, not a camera.
+int freiburgCamera(const std::string& dir) {
+  const std::string name = folderName(dir);
+  for (size_t at = name.find("freiburg"); at != std::string::npos;
+       at = name.find("freiburg", at + 1)) {
+    const size_t d = at + 8;
+    if (d < name.size() && name[d] >= '1' && name[d] <= '3' &&
+        (d + 1 == name.size() || !std::isdigit(static_cast<unsigned char>(name[d + 1])))) {
+      return name[d] - '0';
+    }
+  }
+  return 0;
+}
+
 // Ground truth, sorted by time; a TUM folder without it yields frames without poses.
 std::vector<StampedPose> readGroundTruth(const std::string& path) {
   if (!isRegularFile(path)) return {};
@@ -89,18 +117,18 @@ class TumReader : public DatasetReader {
     } else if (isRegularFile(from)) {
       const Eigen::MatrixXd K = readMatrixFile(dir + "/camera-intrinsics.txt", 3, 3);
       camera_ = PinholeCamera{K(0, 0), K(1, 1), K(0, 2), K(1, 2), 0, 0};
-    } else if (dir.find("freiburg1") != std::string::npos) {
-      camera_ = PinholeCamera{517.3, 516.5, 318.6, 255.3, 0, 0};  // TUM's published fr1 values
-      from = "TUM's freiburg1 intrinsics";
-    } else if (dir.find("freiburg2") != std::string::npos) {
-      camera_ = PinholeCamera{520.9, 521.0, 325.1, 249.7, 0, 0};
-      from = "TUM's freiburg2 intrinsics";
-    } else if (dir.find("freiburg3") != std::string::npos) {
-      camera_ = PinholeCamera{535.4, 539.2, 320.1, 247.6, 0, 0};
-      from = "TUM's freiburg3 intrinsics";
+    } else if (const int camera = freiburgCamera(dir); camera > 0) {
+      // TUM's published values of its three Kinects.
+      static const PinholeCamera kFreiburg[3] = {{517.3, 516.5, 318.6, 255.3, 0, 0},
+                                                 {520.9, 521.0, 325.1, 249.7, 0, 0},
+                                                 {535.4, 539.2, 320.1, 247.6, 0, 0}};
+      camera_ = kFreiburg[camera - 1];
+      from = "TUM's freiburg" + std::to_string(camera) + " intrinsics";
+      notes_.push_back("intrinsics: " + from + " (the folder is named " + folderName(dir) +
+                       "; --intrinsics overrides)");
     } else {
       throw Error(dir +
-                  "/camera-intrinsics.txt: intrinsics file missing and the folder name "
+                  "/camera-intrinsics.txt: intrinsics file missing and the folder's name "
                   "names no freiburg camera (pass --intrinsics fx,fy,cx,cy)");
     }
     const DepthImage first = readDepthFile(dir + "/" + pairs_.front().depth.file);
@@ -109,9 +137,11 @@ class TumReader : public DatasetReader {
     std::string why;
     if (!camera_.isValid(&why)) throw Error(dir + ": intrinsics: " + why);
     if (!options.intrinsics) checkPrincipalPoint(camera_, from);
+    checkDepthScale(dir);
   }
 
   std::string layoutName() const override { return "tum"; }
+  std::vector<std::string> notes() const override { return notes_; }
   size_t size() const override { return pairs_.size(); }
   size_t unmatchedFrames() const override { return unmatched_; }
 
@@ -126,13 +156,43 @@ class TumReader : public DatasetReader {
     frame.rgbd.frame_id = static_cast<int64_t>(index);
     frame.rgbd.camera_name = "tum";
     frame.rgbd.camera = camera_;
-    frame.rgbd.depth_scale_m = options_.depth_scale_m.value_or(1.0 / 5000.0);
+    frame.rgbd.depth_scale_m = depth_scale_m_;
     frame.T_W_C = poseAtTime(ground_truth_, p.depth.t, options_.tum_max_dt_s, poses_path_,
                              &frame.pose_problem);
     return frame;
   }
 
  private:
+  // TUM's depth unit is 1/5000 m; depth in millimetres laid out as TUM would map everything a
+  // fifth of its size. A Kinect measures nothing nearer than about 0.5 m, so a median nearer
+  // than that at 1/5000 m is named (not changed: --depth-scale decides).
+  void checkDepthScale(const std::string& dir) {
+    depth_scale_m_ = options_.depth_scale_m.value_or(1.0 / 5000.0);
+    if (options_.depth_scale_m) {
+      notes_.push_back("depth scale: " + formatDepthScale(depth_scale_m_) + " (given)");
+      return;
+    }
+    std::vector<std::string> paths;
+    for (const Pair& p : pairs_) paths.push_back(dir + "/" + p.depth.file);
+    const DepthValueSample sample = sampleDepthValues(paths);
+    std::ostringstream note;
+    note.precision(3);
+    note << "depth scale: " << formatDepthScale(depth_scale_m_) << ", TUM's";
+    if (sample.images == 0) {
+      note << " (the depth images looked at are empty)";
+    } else {
+      const double median_m = sample.median * depth_scale_m_;
+      note << " (median " << median_m << " m over " << sample.images
+           << (sample.images == 1 ? " image" : " images") << "; --depth-scale overrides)";
+      if (median_m < kNearestPlausibleMedianM) {
+        note << "; WARNING: a median this near is closer than a Kinect measures: if the images "
+             << "are in millimetres (median " << sample.median * 0.001
+             << " m), pass --depth-scale 0.001";
+      }
+    }
+    notes_.push_back(note.str());
+  }
+
   struct Pair {
     Stamped depth;
     Stamped color;
@@ -145,6 +205,8 @@ class TumReader : public DatasetReader {
   std::vector<StampedPose> ground_truth_;
   std::string poses_path_;
   size_t unmatched_ = 0;
+  double depth_scale_m_ = 1.0 / 5000.0;
+  std::vector<std::string> notes_;
 };
 
 }  // namespace

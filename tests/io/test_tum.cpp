@@ -1,7 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include "panmap/core/error.h"
 #include "panmap/io/dataset_reader.h"
+#include "panmap/io/image_codec.h"
 #include "test_helpers.h"
 
 namespace panmap {
@@ -54,6 +58,80 @@ TEST(Tum, IntrinsicsOverride) {
   EXPECT_DOUBLE_EQ(f.rgbd.camera.fy, 21.0);
   options.intrinsics = Eigen::Vector4d(-1, 21, 4, 3);
   EXPECT_THROW(openDataset(test::fixtureDir("tum_tiny"), options), Error);
+}
+
+// A two-frame 640x480 TUM folder at `dir` (no intrinsics file), every depth pixel `depth`.
+void writeTumFolder(const std::string& dir, uint16_t depth) {
+  namespace fs = std::filesystem;
+  fs::create_directories(dir + "/rgb");
+  fs::create_directories(dir + "/depth");
+  std::ofstream rgb(dir + "/rgb.txt"), depth_list(dir + "/depth.txt");
+  for (const char* t : {"1.000000", "1.033000"}) {
+    writeFileBytes(dir + "/rgb/" + t + ".png", encodePng(ColorImage(640, 480, Rgb8{90, 90, 90})));
+    writeFileBytes(dir + "/depth/" + t + ".png", encodeDepthPng(DepthImage(640, 480, depth)));
+    rgb << t << " rgb/" << t << ".png\n";
+    depth_list << t << " depth/" << t << ".png\n";
+  }
+}
+
+std::string joined(const std::vector<std::string>& notes) {
+  std::string out;
+  for (const std::string& n : notes) out += n + "\n";
+  return out;
+}
+
+TEST(Tum, OnlyTheSequenceFoldersOwnNameNamesItsCamera) {
+  test::TempDir dir;
+  // A sequence named as TUM names them, below a parent that names another camera.
+  const std::string fr3 = dir.path("freiburg1_copies/rgbd_dataset_freiburg3_office");
+  writeTumFolder(fr3, 7500);
+  const auto reader = openDataset(fr3, DatasetOptions{});
+  EXPECT_DOUBLE_EQ(reader->read(0).rgbd.camera.fx, 535.4);
+  EXPECT_NE(joined(reader->notes()).find("intrinsics: TUM's freiburg3 intrinsics (the folder is "
+                                         "named rgbd_dataset_freiburg3_office"),
+            std::string::npos)
+      << joined(reader->notes());
+  // A user's own recording below a folder whose name merely contains "freiburg2...".
+  const std::string own = dir.path("freiburg2024_recordings/my_kinect");
+  writeTumFolder(own, 7500);
+  try {
+    openDataset(own, DatasetOptions{});
+    FAIL() << "a parent folder's name chose the intrinsics";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("names no freiburg camera"), std::string::npos)
+        << e.what();
+  }
+  const std::string year = dir.path("rgbd_dataset_freiburg2024");
+  writeTumFolder(year, 7500);
+  EXPECT_THROW(openDataset(year, DatasetOptions{}), Error);
+}
+
+TEST(Tum, DepthInMillimetresIsNamed) {
+  test::TempDir dir;
+  // 1.5 m everywhere: 7500 in TUM's 1/5000 m is a Kinect's range, 1500 is not.
+  const std::string tum = dir.path("rgbd_dataset_freiburg1_a");
+  writeTumFolder(tum, 7500);
+  const std::string tum_notes = joined(openDataset(tum, DatasetOptions{})->notes());
+  EXPECT_NE(tum_notes.find("depth scale: 1/5000 m per unit (TUM), TUM's (median 1.5 m over 2 "
+                           "images"),
+            std::string::npos)
+      << tum_notes;
+  EXPECT_EQ(tum_notes.find("WARNING"), std::string::npos) << tum_notes;
+  const std::string mm = dir.path("rgbd_dataset_freiburg1_b");
+  writeTumFolder(mm, 1500);
+  const auto reader = openDataset(mm, DatasetOptions{});
+  const std::string mm_notes = joined(reader->notes());
+  EXPECT_NE(mm_notes.find("WARNING: a median this near is closer than a Kinect measures: if the "
+                          "images are in millimetres (median 1.5 m), pass --depth-scale 0.001"),
+            std::string::npos)
+      << mm_notes;
+  EXPECT_DOUBLE_EQ(reader->read(0).rgbd.depth_scale_m, 1.0 / 5000.0);  // named, not changed
+  DatasetOptions given;
+  given.depth_scale_m = 0.001;
+  const auto fixed = openDataset(mm, given);
+  EXPECT_DOUBLE_EQ(fixed->read(0).rgbd.depth_scale_m, 0.001);
+  EXPECT_NE(joined(fixed->notes()).find("depth scale: 0.001 m per unit (mm) (given)"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -71,6 +71,21 @@ void checkImageSize(const std::string& path, const char* kind, int width, int he
 /// calibration; the message gives the intrinsics scaled to the images when that fits.
 void checkPrincipalPoint(const PinholeCamera& camera, const std::string& from);
 
+/// Raw depth values of a few images spread over a sequence, as units (not metres): what a
+/// reader judges a depth unit by.
+struct DepthValueSample {
+  size_t images = 0;         ///< images that held a valid pixel
+  double median = 0.0;       ///< median of their valid pixels (every second row and column)
+  double largest_p99 = 0.0;  ///< largest of the images' 99th percentiles
+};
+
+/// Samples up to `max_images` of the depth images at `paths`, spread evenly over them
+/// (unreadable images are skipped: they are named when their frame is read).
+DepthValueSample sampleDepthValues(const std::vector<std::string>& paths, size_t max_images = 9);
+
+/// "0.001 m per unit (mm)", "1/5000 m per unit (TUM)" or "S m per unit".
+std::string formatDepthScale(double scale);
+
 /// Reads the depth PNG at path into frame->depth_png (its bytes) and frame->rgbd.depth; throws
 /// Error naming the file when it cannot be read or decoded or is not width x height.
 void readDepthPng(const std::string& path, int width, int height, DatasetFrame* frame);
