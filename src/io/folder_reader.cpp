@@ -9,6 +9,7 @@
 #include <iterator>
 #include <map>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include <opencv2/imgproc.hpp>
@@ -169,6 +170,11 @@ class FolderReader : public DatasetReader {
   std::string layoutName() const override { return "folder"; }
   size_t size() const override { return frames_.size(); }
   size_t unmatchedFrames() const override { return unmatched_; }
+  std::string unmatchedWhat() const override {
+    return std::string("depth images without a colour image ") +
+           (paired_in_time_ ? "in time" : "of the same name") + " (first: " + first_unmatched_ +
+           ")";
+  }
   std::vector<std::string> notes() const override { return notes_; }
 
   DatasetFrame read(size_t index) const override {
@@ -266,6 +272,17 @@ class FolderReader : public DatasetReader {
                   " in depth/ (names differ, counts differ, names are not timestamps)");
     }
     unmatched_ = depths.size() - frames_.size();
+    paired_in_time_ = pairing == FramePairing::kTime;
+    if (unmatched_ > 0) {
+      std::set<std::string> paired;
+      for (const Frame& f : frames_) paired.insert(f.depth.name);
+      for (const NamedFile& d : depths) {
+        if (!paired.count(d.name)) {
+          first_unmatched_ = "depth/" + d.name;
+          break;
+        }
+      }
+    }
     // Paired by name, a colour image left over is a frame whose depth image is missing.
     const size_t colors_left = how.rfind("by f", 0) == 0 || how.rfind("by the", 0) == 0
                                    ? colors.size() - std::min(colors.size(), frames_.size())
@@ -275,6 +292,7 @@ class FolderReader : public DatasetReader {
          << how;
     if (unmatched_) note << "; " << unmatched_ << " depth images without a colour image";
     if (colors_left) note << "; " << colors_left << " colour images without a depth image";
+    if (integer_numbers_ && (unmatched_ || colors_left)) note << numberShiftWarning(colors, depths);
     if (time_unit_ != std::string("seconds")) {
       note << "; the names are timestamps in " << time_unit_;
     }
@@ -413,7 +431,8 @@ class FolderReader : public DatasetReader {
         throw Error(poses_from_ + ": " + std::to_string(list.poses.size()) + " TUM poses for " +
                     std::to_string(frames_.size()) +
                     " frames whose names are not timestamps, and the timestamp column does not "
-                    "number the frames: cannot pair them");
+                    "number the frames: cannot pair them" +
+                    framesLeftOut());
       }
     } else if (list.poses.size() == frames_.size()) {
       how = "by order (one pose per frame)";
@@ -421,11 +440,42 @@ class FolderReader : public DatasetReader {
     } else {
       throw Error(poses_from_ + ": " + std::to_string(list.poses.size()) + " poses (" +
                   poseListFormatName(list.format) + ") for " + std::to_string(frames_.size()) +
-                  " frames: a pose per frame needed");
+                  " frames: a pose per frame needed" + framesLeftOut());
     }
     list_ = list;
     notes_.push_back("poses: " + poses_from_ + " (" + poseListFormatName(list.format) +
                      "), matched " + how);
+  }
+
+  // For a pose count that does not match the frames: the frames pairing left out.
+  std::string framesLeftOut() const {
+    if (unmatched_ == 0) return "";
+    return " (" + std::to_string(unmatched_) + " depth images were left out for want of a " +
+           "colour image, first " + first_unmatched_ + ")";
+  }
+
+  // Integer-numbered colour and depth images whose numbers are the same run shifted (colour
+  // 1..60, depth 0..59): paired by number, every colour image lands one frame off.
+  static std::string numberShiftWarning(const std::vector<NamedFile>& colors,
+                                        const std::vector<NamedFile>& depths) {
+    if (colors.size() != depths.size() || colors.empty()) return "";
+    std::vector<double> c, d;
+    for (const NamedFile& f : colors) c.push_back(f.number);
+    for (const NamedFile& f : depths) d.push_back(f.number);
+    std::sort(c.begin(), c.end());
+    std::sort(d.begin(), d.end());
+    const double shift = c.front() - d.front();
+    if (shift == 0.0) return "";
+    for (size_t i = 0; i < c.size(); ++i) {
+      if (c[i] - d[i] != shift) return "";
+    }
+    std::ostringstream out;
+    out << "; WARNING: the colour images are numbered " << static_cast<long long>(c.front())
+        << "-" << static_cast<long long>(c.back()) << " and the depth images "
+        << static_cast<long long>(d.front()) << "-" << static_cast<long long>(d.back())
+        << ": if they are the same frames counted from another start, renumber one folder "
+        << "(paired by number, each frame's colour comes from another frame)";
+    return out.str();
   }
 
   std::vector<NamedFile> depthFiles() const {
@@ -495,6 +545,8 @@ class FolderReader : public DatasetReader {
   std::string depth_dir_;
   std::vector<Frame> frames_;
   size_t unmatched_ = 0;
+  bool paired_in_time_ = false;
+  std::string first_unmatched_;  ///< the first depth image left without colour
   bool timestamps_ = false;
   const char* time_unit_ = "seconds";  ///< of the depth images' timestamp names
   bool integer_numbers_ = false;

@@ -146,6 +146,44 @@ TEST(FolderLayout, PairsByPositionAndReadsPoseFolders) {
   EXPECT_NE(g.pose_problem.find("no pose file for depth image 1.png"), std::string::npos);
 }
 
+TEST(FolderLayout, ColourNumberedFromAnotherStartIsNamed) {
+  // Colour 1..4, depth 0..3: paired by number, each colour image would come from the next
+  // frame. The import says so, and a pose count that no longer fits names the left-out frame.
+  test::TempDir dir;
+  fs::create_directory(dir.path("rgb"));
+  fs::create_directory(dir.path("depth"));
+  for (int i = 0; i < 4; ++i) {
+    writeFrame(dir.path("rgb/" + std::to_string(i + 1) + ".png"),
+               dir.path("depth/" + std::to_string(i) + ".png"), i, 1000);
+  }
+  writeText(dir.path("K.txt"), "5 0 4\n0 6 3\n0 0 1\n");
+  const auto reader = openDataset(dir.path(), DatasetOptions{});
+  EXPECT_EQ(reader->size(), 3u);
+  EXPECT_EQ(reader->unmatchedFrames(), 1u);
+  EXPECT_EQ(reader->unmatchedWhat(),
+            "depth images without a colour image of the same name (first: depth/0.png)");
+  EXPECT_NE(reader->notes()[0].find("WARNING: the colour images are numbered 1-4 and the depth "
+                                    "images 0-3: if they are the same frames counted from "
+                                    "another start, renumber one folder"),
+            std::string::npos)
+      << reader->notes()[0];
+  writeText(dir.path("traj.txt"),
+            "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n1 0 0 2 0 1 0 0 0 0 1 0\n"
+            "1 0 0 3 0 1 0 0 0 0 1 0\n");
+  DatasetOptions options;
+  options.poses_path = dir.path("traj.txt");
+  try {
+    openDataset(dir.path(), options);
+    FAIL() << "4 poses were taken for 3 frames";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("for 3 frames: a pose per frame needed (1 depth images "
+                                         "were left out for want of a colour image, first "
+                                         "depth/0.png)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(FolderLayout, MatrixPerLinePosesGivenOnTheCommandLine) {
   test::TempDir dir;
   makeIssueFolder(dir, 2);
