@@ -32,7 +32,8 @@ std::vector<Stamped> readFileList(const std::string& path) {
   int line_no = 0;
   while (std::getline(in, line)) {
     ++line_no;
-    if (line.empty() || line[0] == '#') continue;
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;  // as pose files are read
     std::istringstream fields(line);
     Stamped s;
     if (!(fields >> s.t >> s.file)) {
@@ -115,8 +116,8 @@ class TumReader : public DatasetReader {
       const Eigen::Vector4d& k = *options.intrinsics;
       camera_ = PinholeCamera{k(0), k(1), k(2), k(3), 0, 0};
     } else if (isRegularFile(from)) {
-      const Eigen::MatrixXd K = readMatrixFile(dir + "/camera-intrinsics.txt", 3, 3);
-      camera_ = PinholeCamera{K(0, 0), K(1, 1), K(0, 2), K(1, 2), 0, 0};
+      const Eigen::Vector4d k = readIntrinsicsFile(from);  // as the folder layout reads them
+      camera_ = PinholeCamera{k(0), k(1), k(2), k(3), 0, 0};
     } else if (const int camera = freiburgCamera(dir); camera > 0) {
       // TUM's published values of its three Kinects.
       static const PinholeCamera kFreiburg[3] = {{517.3, 516.5, 318.6, 255.3, 0, 0},

@@ -134,5 +134,23 @@ TEST(Tum, DepthInMillimetresIsNamed) {
             std::string::npos);
 }
 
+TEST(Tum, ListsAndIntrinsicsAreReadAsTheOtherLayoutsReadThem) {
+  test::TempDir dir;
+  const std::string seq = dir.path("my_kinect");
+  writeTumFolder(seq, 7500);
+  // An indented comment and a blank line of spaces, as pose files may have them.
+  std::ofstream(seq + "/rgb.txt")
+      << "  # colour\n   \n1.000000 rgb/1.000000.png\n1.033000 rgb/1.033000.png\n";
+  // "fx fy cx cy", as the folder layout accepts.
+  std::ofstream(seq + "/camera-intrinsics.txt") << "525 526 319.5 239.5\n";
+  const auto reader = openDataset(seq, DatasetOptions{});
+  EXPECT_EQ(reader->size(), 2u);
+  const PinholeCamera camera = reader->read(0).rgbd.camera;
+  EXPECT_DOUBLE_EQ(camera.fx, 525.0);
+  EXPECT_DOUBLE_EQ(camera.fy, 526.0);
+  EXPECT_DOUBLE_EQ(camera.cx, 319.5);
+  EXPECT_DOUBLE_EQ(camera.cy, 239.5);
+}
+
 }  // namespace
 }  // namespace panmap
