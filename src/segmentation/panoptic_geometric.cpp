@@ -266,6 +266,7 @@ void PanopticGeometricSegmenter::segment(const RgbdFrame& frame, const PanopticF
     out->surfaces = LabelImage(width, height);
   }
   impl.fuser.fuse(panoptic, impl.fusion_config, out, &impl.pool, &frame.depth);
+  out->panoptic = panoptic != nullptr;
 }
 
 bool PanopticGeometricSegmenter::keptLast() const { return impl_->kept_last; }

@@ -318,8 +318,13 @@ void SuperpointTracker::associate(const FrameSegmentation& segmentation, const R
                               static_cast<double>(overlap[s].at(lost[s])) / seen});
       }
     }
-    // Semantic frame count (background surfaces count for class 0).
-    states_[out.surface_labels[s]].class_counts[surfaces[s].category] += 1.0;
+    // Semantic frame count (background surfaces count for class 0). A frame mapped without a
+    // segmentation is no evidence either way: counted as class 0, a network that masks one
+    // frame in six made every surface "unlabelled in 83 % of its frames", and the optimiser
+    // left the map without classes (optimiser.max_void_share).
+    if (segmentation.panoptic) {
+      states_[out.surface_labels[s]].class_counts[surfaces[s].category] += 1.0;
+    }
   }
 
   // The super-points significantly overlapping each surface: L_N(s_i).

@@ -131,6 +131,29 @@ TEST_F(WallScene, SurfacesKeepTheirSuperpointAcrossFrames) {
   EXPECT_EQ(tracker.numInstances(), 1);
 }
 
+TEST_F(WallScene, FramesWithoutASegmentationAreNoClassEvidence) {
+  // A network that segments one frame in six: the five frames between see the same surfaces
+  // with class 0 everywhere. Counted as "no mask here", they made the wall 83 % void.
+  TsdfMap map(TsdfMap::Config{0.05f});
+  SuperpointTracker tracker(SuperpointConfig{});
+  FrameSegmentation geometry_only = columns(384, 0, 0);
+  geometry_only.panoptic = false;
+  for (int round = 0; round < 3; ++round) {
+    step(&tracker, &map, columns(384, 1, 4));
+    for (int k = 0; k < 5; ++k) {
+      const FrameAssociation a = step(&tracker, &map, geometry_only);
+      EXPECT_EQ(a.new_labels, 0);  // still associated with the super-points they hold
+    }
+  }
+  EXPECT_EQ(tracker.state(1)->class_counts, (std::map<int32_t, double>{{1, 3.0}}));
+  EXPECT_EQ(tracker.state(2)->class_counts, (std::map<int32_t, double>{{4, 3.0}}));
+  EXPECT_EQ(tracker.state(1)->voidShare(), 0.0);
+  EXPECT_EQ(tracker.state(2)->semanticClass(), 4);
+  // A segmentation that holds no mask of a known class is evidence: class 0 counts.
+  step(&tracker, &map, columns(384, 0, 0));
+  EXPECT_EQ(tracker.state(2)->class_counts, (std::map<int32_t, double>{{0, 1.0}, {4, 3.0}}));
+}
+
 // The paper's Fig. 4: a surface spanning a wall and a bed (noisy geometric segmentation)
 // co-observes both super-points. Spatial-only merging (Voxblox++) joins them once M exceeds
 // theta_merge; the semantic consistency check keeps them apart. Clean frames in between keep

@@ -67,6 +67,11 @@ struct FrameSegmentation {
   LabelImage geometric;  ///< geometric segment id per pixel, 0 = edge / invalid / small
   LabelImage surfaces;   ///< surface id per pixel, 0 = none
   std::vector<Surface> surface_list;  ///< indexed by id - 1
+  /// Made with the frame's panoptic segmentation (the segmenter sets it). Without one (a
+  /// network slower than the camera, or no network) every surface has class 0 but the frame
+  /// says nothing about classes: its surfaces are not counted as unlabelled
+  /// (SuperpointState::class_counts).
+  bool panoptic = true;
 };
 
 /// A frame's geometric segments (FrameSegmentation::geometric) kept from an earlier
