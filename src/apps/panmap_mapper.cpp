@@ -57,7 +57,10 @@ nlohmann::json sessionJson(const panmap::SessionStats& s) {
           {"frames_integrated", s.frames_integrated},
           {"rejected", s.rejected},
           {"geometry_only_frames", s.sync.geometry_only},
+          {"geometry_only_queue_full", s.sync.geometry_only_queue_full},
           {"unmatched_panoptic", s.sync.unmatched_panoptic},
+          {"late_panoptic", s.sync.late_panoptic},
+          {"panoptic_time_offset", s.sync.panoptic_time_offset},
           {"timings", timings},
           {"pose_refinement",
            {{"frames", s.refinement.frames},
@@ -421,6 +424,7 @@ int main(int argc, char** argv) {
     const int flag_threads = config.num_threads;
     file_config = config_path.empty() ? base : panmap::loadConfig(config_path, base);
     config = file_config.mapper;
+    options.sync = file_config.sync;
     // Flags given on the command line win over the file.
     if (app.count("--voxel-size") > 0) config.map.voxel_size_m = flag_voxel;
     if (app.count("--threads") > 0) config.num_threads = flag_threads;
@@ -545,6 +549,7 @@ int main(int argc, char** argv) {
     };
     panmap::OutputOptions output_options;
     output_options.snapshots = !no_snapshots;
+    output_options.sync = options.sync;
 
     if (export_only && load_path.empty()) throw panmap::Error("--export-only needs --load");
     if (export_only && !log_path.empty()) throw panmap::Error("--export-only takes no --log");
@@ -574,6 +579,9 @@ int main(int argc, char** argv) {
         progress.finish();
         // Empty outputs and exit 0 would pass a wrong file or channel name off as a map.
         if (report.frames_integrated == 0 && mapper->framesIntegrated() == 0) {
+          for (const std::string& w : panmap::syncWarnings(report, options.sync)) {
+            std::fprintf(stderr, "panmap-mapper: warning: %s\n", w.c_str());
+          }
           throw panmap::Error("no frame mapped from " + log_path + ": " +
                               panmap::describeNothingMapped(report, options));
         }
@@ -642,6 +650,9 @@ int main(int argc, char** argv) {
           mapper->superpoints().states().size(), outputs.instances_in_mesh, outputs.mesh_vertices,
           out_dir.c_str());
       printRejected(report.rejected);
+      for (const std::string& w : panmap::syncWarnings(report, options.sync)) {
+        std::fprintf(stderr, "panmap-mapper: warning: %s\n", w.c_str());
+      }
       printRefinement(report.refinement);
       printDepthCheck(*mapper);
       warnIfNoSurface(*mapper, outputs.mesh_vertices);
@@ -797,6 +808,9 @@ int main(int argc, char** argv) {
         wall_s, mapper->superpoints().states().size(), outputs.instances_in_mesh,
         labels ? " after optimisation" : " (unoptimised)", outputs.mesh_vertices, out_dir.c_str());
     printRejected(stats.rejected);
+    for (const std::string& w : panmap::syncWarnings(stats, options.sync)) {
+      std::fprintf(stderr, "panmap-mapper: warning: %s\n", w.c_str());
+    }
     printRefinement(stats.refinement);
     printDepthCheck(*mapper);
     warnIfNoSurface(*mapper, outputs.mesh_vertices);

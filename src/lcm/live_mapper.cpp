@@ -353,7 +353,7 @@ status_t LiveMapper::status(const std::string& state) const {
   msg.state = state;
   msg.frames_received = received_frames_;
   msg.frames_integrated = s.frames_integrated;
-  msg.frames_dropped = dropped_frames_ + s.sync.dropped_queue_full;
+  msg.frames_dropped = dropped_frames_;  // the synchroniser's drops are counted as rejected
   const std::map<std::string, int64_t> reasons = withOwnRejections(s).rejected;
   msg.frames_rejected = 0;
   for (const auto& [reason, n] : reasons) {
@@ -386,6 +386,7 @@ status_t LiveMapper::status(const std::string& state) const {
   const double pattern_m = check.patternRmsM();
   msg.depth_pattern_mm = std::isfinite(pattern_m) ? static_cast<float>(1000.0 * pattern_m) : -1.0f;
   if (warning_source_) msg.warnings = warning_source_();
+  for (std::string& w : syncWarnings(s, options_.session.sync)) msg.warnings.push_back(w);
   msg.num_warnings = static_cast<int32_t>(msg.warnings.size());
   {
     std::lock_guard<std::mutex> lock(command_mutex_);

@@ -351,16 +351,25 @@ void MappingSession::integrate(std::vector<SyncedFrame> ready) {
 SessionStats MappingSession::stats() const {
   SessionStats out = stats_;
   out.sync = sync_.stats();
-  if (out.sync.rejected_no_pose) out.rejected["frame: no pose"] += out.sync.rejected_no_pose;
+  // Frames between two poses too far apart to interpolate have a reason of their own: the
+  // setting that would map them is named by syncWarnings().
+  if (out.sync.rejected_no_pose > out.sync.rejected_pose_gap) {
+    out.rejected["frame: no pose"] += out.sync.rejected_no_pose - out.sync.rejected_pose_gap;
+  }
+  if (out.sync.rejected_pose_gap) {
+    out.rejected["frame: poses around it too far apart to interpolate"] +=
+        out.sync.rejected_pose_gap;
+  }
   if (out.sync.dropped_queue_full) {
-    out.rejected["frame: synchroniser queue full"] += out.sync.dropped_queue_full;
+    out.rejected["frame: no pose while the synchroniser queue was full"] +=
+        out.sync.dropped_queue_full;
   }
   const std::pair<const char*, int64_t> counted[] = {
       {"frame: repeated timestamp", out.sync.repeated_frames},
       {"frame: out of order", out.sync.out_of_order_frames},
       {"pose: repeated timestamp", out.sync.repeated_poses},
       {"panoptic: repeated timestamp", out.sync.repeated_panoptic},
-      {"panoptic: frame already mapped", out.sync.late_panoptic}};
+      {"panoptic: arrived after its frame was mapped", out.sync.late_panoptic}};
   for (const auto& [reason, n] : counted) {
     if (n) out.rejected[reason] += n;
   }
@@ -372,6 +381,61 @@ SessionStats MappingSession::stats() const {
     out.repair_running = true;
     out.repair_frames_done = background_->framesDone();
     out.repair_frames_total = background_->framesTotal();
+  }
+  return out;
+}
+
+std::vector<std::string> syncWarnings(const SessionStats& stats, const SyncConfig& config) {
+  std::vector<std::string> out;
+  const SyncStats& s = stats.sync;
+  char line[320];
+  // Frames without a mask are only news when masks come at all: a geometry-only run has none.
+  const int64_t with_mask = s.frames_out - s.geometry_only;
+  if (with_mask > 0 && s.geometry_only > 0) {
+    std::snprintf(line, sizeof(line),
+                  "panoptic: %lld of %lld frames mapped without a mask (a network slower than the "
+                  "camera skips frames; masks late by more than sync.wait_s %.2f or stamped "
+                  "more than sync.mask_tolerance_ms %.1f off their frame are not matched)",
+                  static_cast<long long>(s.geometry_only), static_cast<long long>(s.frames_out),
+                  config.wait_us * 1e-6, config.mask_tolerance_us * 1e-3);
+    out.push_back(line);
+  }
+  if (s.unmatched_panoptic > 0) {
+    std::string gap;
+    if (s.last_unmatched_gap_us >= 0) {
+      char text[96];
+      std::snprintf(text, sizeof(text), " (the last one %.1f ms from the nearest frame)",
+                    s.last_unmatched_gap_us * 1e-3);
+      gap = text;
+    }
+    std::snprintf(line, sizeof(line),
+                  "panoptic: %lld masks matched no frame%s: a mask's utime must be its frame's, "
+                  "within sync.mask_tolerance_ms %.1f",
+                  static_cast<long long>(s.unmatched_panoptic), gap.c_str(),
+                  config.mask_tolerance_us * 1e-3);
+    out.push_back(line);
+  }
+  if (s.late_panoptic > 0) {
+    std::snprintf(line, sizeof(line),
+                  "panoptic: %lld masks arrived after their frame was mapped (frames wait "
+                  "sync.wait_s %.2f for their mask)",
+                  static_cast<long long>(s.late_panoptic), config.wait_us * 1e-6);
+    out.push_back(line);
+  }
+  if (s.rejected_pose_gap > 0) {
+    std::snprintf(line, sizeof(line),
+                  "pose: %lld frames refused between poses %.0f ms apart (the last), more than "
+                  "sync.max_pose_gap_ms %.0f: a SLAM that sends keyframes only needs it larger",
+                  static_cast<long long>(s.rejected_pose_gap), s.last_pose_gap_us * 1e-3,
+                  config.max_pose_gap_us * 1e-3);
+    out.push_back(line);
+  }
+  if (s.geometry_only_queue_full > 0) {
+    std::snprintf(line, sizeof(line),
+                  "frame: %lld frames went on without waiting for their mask: the synchroniser "
+                  "holds sync.max_queue %zu frames",
+                  static_cast<long long>(s.geometry_only_queue_full), config.max_queue);
+    out.push_back(line);
   }
   return out;
 }

@@ -25,7 +25,6 @@ OfflineReport mapLog(const std::string& log_path, const SessionOptions& options,
   MappingSession session(options, mapper);
   if (hook) session.setFrameHook(hook);
   int64_t events = 0;
-  int64_t newest = INT64_MIN;
   LogByteAccount bytes;
   std::map<std::string, int64_t> channel_events;
   while (!session.done()) {
@@ -37,8 +36,9 @@ OfflineReport mapLog(const std::string& log_path, const SessionOptions& options,
     bytes.addEvent(LogByteAccount::eventBytes(e->channel.size(), e->datalen),
                    std::ftell(log.getFilePtr()));
     ++channel_events[e->channel];
-    newest = std::max(newest, e->timestamp);
-    session.handle(e->channel, e->data, static_cast<size_t>(e->datalen), newest);
+    // Waits run on the messages' own utimes, as live: the logger's clock (event timestamps)
+    // may be another, and any channel's events advanced it.
+    session.handle(e->channel, e->data, static_cast<size_t>(e->datalen));
     if (progress && events % 8 == 0) {
       progress(static_cast<size_t>(std::ftell(log.getFilePtr())), static_cast<size_t>(st.st_size));
     }

@@ -210,7 +210,8 @@ PanmapConfig loadConfig(const std::string& path, const PanmapConfig& base) {
   const std::set<std::string> sections = {"map",       "integrator",  "depth_segmentation",
                                           "fusion",    "superpoints", "graph",
                                           "occupancy", "tracking",    "optimiser",
-                                          "objects",   "threads",     "depth_calibration"};
+                                          "objects",   "threads",     "depth_calibration",
+                                          "sync"};
   for (auto it = root.begin(); it != root.end(); ++it) {
     if (!sections.count((*it).name())) throw Error(path + ": unknown section " + (*it).name());
   }
@@ -348,6 +349,32 @@ PanmapConfig loadConfig(const std::string& path, const PanmapConfig& base) {
     s.read("drift_correlation_m", &d.correlation_m);
     s.read("measurement_sigma_m", &d.measurement_sigma_m);
     s.read("measurement_sigma_deg", &d.measurement_sigma_deg);
+    s.finish();
+  }
+  {
+    SyncConfig& y = c.sync;
+    Section s(root["sync"], "sync", path);
+    // Times in the units a user thinks in; kept in microseconds. Out of range is refused here,
+    // before the conversion: a negative or huge value is a typo, not a setting.
+    auto readTime = [&](const char* key, double unit_us, double max, int64_t* us) {
+      double value = static_cast<double>(*us) / unit_us;
+      s.read(key, &value);
+      if (!(value >= 0.0 && value <= max)) {
+        std::ostringstream why;
+        why << "sync." << key << " must be in [0, " << max << "]";
+        s.fail(why.str());
+      }
+      *us = static_cast<int64_t>(std::llround(value * unit_us));
+    };
+    readTime("pose_tolerance_ms", 1e3, 1e6, &y.pose_tolerance_us);
+    readTime("max_pose_gap_ms", 1e3, 1e6, &y.max_pose_gap_us);
+    readTime("mask_tolerance_ms", 1e3, 1e6, &y.mask_tolerance_us);
+    readTime("wait_s", 1e6, 3600.0, &y.wait_us);
+    s.read("masks_in_order", &y.masks_in_order);
+    int max_queue = static_cast<int>(y.max_queue);
+    s.read("max_queue", &max_queue);
+    if (max_queue < 1 || max_queue > 100000) s.fail("sync.max_queue must be in [1, 100000]");
+    y.max_queue = static_cast<size_t>(max_queue);
     s.finish();
   }
   {
@@ -634,6 +661,21 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   confidence_area: " << ob.area << "\n"
     << "   confidence_support: " << ob.support << "\n"
     << "   confidence_share: " << ob.share << "\n";
+  const SyncConfig& sy = c.sync;
+  y << "sync:   # how frames, poses and masks arriving apart are matched (live and offline)\n"
+    << "   pose_tolerance_ms: " << sy.pose_tolerance_us * 1e-3
+    << "   # a pose this near a frame's utime is taken as it is\n"
+    << "   max_pose_gap_ms: " << sy.max_pose_gap_us * 1e-3
+    << "   # poses this far apart or nearer are interpolated at the frame's utime\n"
+    << "   mask_tolerance_ms: " << sy.mask_tolerance_us * 1e-3
+    << "   # a mask goes with the frame nearest its utime within this\n"
+    << "   wait_s: " << sy.wait_us * 1e-6
+    << "   # how long a frame waits for its mask (then mapped without) and its pose (then "
+       "refused), by the newest utime received\n"
+    << "   masks_in_order: " << sy.masks_in_order
+    << "   # the network sends masks in frame order: a later frame's mask ends the wait (0/1)\n"
+    << "   max_queue: " << sy.max_queue
+    << "   # frames waiting at most; the oldest then goes on without its mask\n";
   y << "threads: " << m.num_threads << "\n";
   if (m.hasDepthCalibration()) {
     y << "depth_calibration: \"" << m.depth_calibration_file
@@ -665,7 +707,8 @@ std::pair<std::string, std::string> keyAndValue(const std::string& line) {
 SettingDifference mapperSettingDifference(const MapperConfig& have, const MapperConfig& wanted) {
   // Both printed with one optimiser, so that only the mapper's settings can differ; the
   // printed values are what a user wrote and would recognise.
-  const PanmapConfig a{have, OptimiserConfig{}}, b{wanted, OptimiserConfig{}};
+  const PanmapConfig a{have, OptimiserConfig{}, SyncConfig{}};
+  const PanmapConfig b{wanted, OptimiserConfig{}, SyncConfig{}};
   std::istringstream in_a(configToYaml(a)), in_b(configToYaml(b));
   std::string line_a, line_b, section;
   while (std::getline(in_a, line_a) && std::getline(in_b, line_b)) {

@@ -133,7 +133,7 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
   // The exact parameters the outputs were made with (a loaded map brings its own).
   attempt({"config.yaml"}, [&] {
     std::ofstream out(dir + "/config.yaml");
-    out << configToYaml(PanmapConfig{mapper->config(), optimiser});
+    out << configToYaml(PanmapConfig{mapper->config(), optimiser, options.sync});
     out.close();
     if (!out) throw Error("cannot write " + dir + "/config.yaml");
     summary.files.push_back("config.yaml");

@@ -66,6 +66,40 @@ TEST_F(MappingSessionTest, CleanStreamMapsEveryFrame) {
   EXPECT_EQ(clean_stats_.refinement.moved_m.max, 0.0);
 }
 
+TEST_F(MappingSessionTest, ANetworkSlowerThanTheCameraDelaysNoFrameAndIsNamed) {
+  // Masks for every third frame: the frames between go on as soon as the next mask shows the
+  // network skipped them (they waited 0.5 s of stream time each, and the queue filled).
+  std::vector<test::Encoded> messages;
+  const size_t n = stream_.frames.size();
+  for (size_t k = 0; k < n; ++k) {
+    messages.push_back(test::encodeMessage("CAMERA_POSE", toMessage(stream_.poses[k])));
+    if (k % 3 == 0) {
+      messages.push_back(
+          test::encodeMessage("PANOPTIC", toMessage(stream_.masks[k], ImageEncoding{})));
+    }
+    messages.push_back(
+        test::encodeMessage("CAMERA_RGBD", toMessage(stream_.frames[k], ImageEncoding{})));
+  }
+  Mapper mapper(test::streamMapperConfig());
+  MappingSession session(SessionOptions{}, &mapper);
+  for (const test::Encoded& m : messages) session.handle(m.channel, m.bytes.data(), m.bytes.size());
+  // Before the end of the stream: all but the frames after the last mask are mapped.
+  EXPECT_EQ(session.stats().frames_integrated, static_cast<int64_t>(n - (n - 1) % 3));
+  session.flush();
+  const SessionStats stats = session.stats();
+  EXPECT_EQ(stats.frames_integrated, static_cast<int64_t>(n));
+  EXPECT_TRUE(stats.rejected.empty());
+  const int64_t without = static_cast<int64_t>(n - (n + 2) / 3);
+  EXPECT_EQ(stats.sync.geometry_only, without);
+  const std::vector<std::string> warnings = syncWarnings(stats, SyncConfig{});
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("panoptic: " + std::to_string(without) + " of " + std::to_string(n) +
+                             " frames mapped without a mask"),
+            std::string::npos)
+      << warnings[0];
+  EXPECT_TRUE(syncWarnings(clean_stats_, SyncConfig{}).empty());
+}
+
 TEST_F(MappingSessionTest, RefinementReportsHowFarItMovedTheGivenPoses) {
   // The same frames with their poses flagged as SLAM, one of them 3 cm off along x: tracking
   // refines every frame after the warm-up and pulls that one back by about its error.

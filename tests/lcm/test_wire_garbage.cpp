@@ -204,7 +204,7 @@ TEST_F(WireGarbage, OutOfOrderTimestamps) {
   messages.insert(messages.begin() + 3 * 8, messages_[3 * 2 + 2]);
   const SessionStats stats = expectCleanMap(messages);
   EXPECT_EQ(stats.rejected.at("frame: out of order"), 5);
-  EXPECT_EQ(stats.rejected.at("panoptic: frame already mapped"), 4);
+  EXPECT_EQ(stats.rejected.at("panoptic: arrived after its frame was mapped"), 4);
 }
 
 TEST_F(WireGarbage, FramesWhosePoseNeverComes) {
@@ -220,7 +220,10 @@ TEST_F(WireGarbage, FramesWhosePoseNeverComes) {
     messages.push_back(test::encodeMessage("CAMERA_RGBD", toMessage(orphan, ImageEncoding{})));
   }
   const SessionStats stats = expectCleanMap(messages);
-  EXPECT_EQ(stats.rejected.at("frame: no pose"), static_cast<int64_t>(n));
+  // Between two frames' poses (333 ms apart, beyond sync.max_pose_gap_ms) but the last.
+  EXPECT_EQ(stats.rejected.at("frame: poses around it too far apart to interpolate"),
+            static_cast<int64_t>(n - 1));
+  EXPECT_EQ(stats.rejected.at("frame: no pose"), 1);
 }
 
 }  // namespace

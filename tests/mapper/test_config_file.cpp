@@ -1,4 +1,5 @@
 #include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 
@@ -26,6 +27,14 @@ TEST(ConfigFile, PrintedDefaultsReadBackUnchanged) {
   EXPECT_EQ(back.mapper.superpoints.merge_threshold, 3);
   EXPECT_DOUBLE_EQ(back.optimiser.thresholds(5).theta_L, 0.4);
   EXPECT_DOUBLE_EQ(back.optimiser.thresholds(7).theta_L, 0.3);  // the tuned default
+}
+
+TEST(ConfigFile, TheShippedDefaultIsWhatPrintConfigPrints) {
+  // configs/default.yaml is what a user copies: it must hold every key with its default.
+  std::ifstream in(test::fixtureDir("../../configs/default.yaml"));
+  ASSERT_TRUE(in.good());
+  const std::string shipped((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(shipped, configToYaml(PanmapConfig{}));
 }
 
 TEST(ConfigFile, PartialFilesKeepDefaults) {
@@ -78,6 +87,28 @@ TEST(ConfigFile, TrackingAndOccupancySections) {
   test::expectError(
       [&] { loadConfig(write(dir, "%YAML:1.0\n---\noccupancy:\n   resolution_m: -1\n")); },
       {"resolution"});
+}
+
+TEST(ConfigFile, SyncSectionInTheUnitsAUserThinksIn) {
+  test::TempDir dir;
+  const PanmapConfig c = loadConfig(write(dir,
+                                          "%YAML:1.0\n---\nsync:\n   mask_tolerance_ms: 8\n"
+                                          "   wait_s: 1.5\n   masks_in_order: 0\n"
+                                          "   max_queue: 60\n   max_pose_gap_ms: 600\n"));
+  EXPECT_EQ(c.sync.mask_tolerance_us, 8000);
+  EXPECT_EQ(c.sync.wait_us, 1500000);
+  EXPECT_FALSE(c.sync.masks_in_order);
+  EXPECT_EQ(c.sync.max_queue, 60u);
+  EXPECT_EQ(c.sync.max_pose_gap_us, 600000);
+  EXPECT_EQ(c.sync.pose_tolerance_us, SyncConfig{}.pose_tolerance_us);
+  const PanmapConfig back = loadConfig(write(dir, configToYaml(c)));
+  EXPECT_EQ(configToYaml(back), configToYaml(c));
+  test::expectError([&] { loadConfig(write(dir, "%YAML:1.0\n---\nsync:\n   wait_s: -1\n")); },
+                    {"sync.wait_s must be in [0, 3600]"});
+  test::expectError([&] { loadConfig(write(dir, "%YAML:1.0\n---\nsync:\n   max_queue: 0\n")); },
+                    {"sync.max_queue"});
+  test::expectError([&] { loadConfig(write(dir, "%YAML:1.0\n---\nsync:\n   wait: 1\n")); },
+                    {"unknown key sync.wait"});
 }
 
 TEST(ConfigFile, DriftFilterCorrectionSwitchesTheAlignerDefaults) {

@@ -171,4 +171,10 @@ std::string reasonOf(const std::string& what);
 /// ": ", e.g. "No space left on device") without the file, which names one frame.
 std::string storeFailure(const std::string& what);
 
+/// One line per way the frames and masks of a session failed to meet (frames mapped without
+/// a mask while masks do come, masks that matched no frame or came late, frames sent on by a
+/// full queue), naming the sync setting that governs it; empty when none did. For the
+/// status channel's warnings and the end of an offline run.
+std::vector<std::string> syncWarnings(const SessionStats& stats, const SyncConfig& config);
+
 }  // namespace panmap

@@ -3,18 +3,22 @@
 #include <string>
 
 #include "panmap/graph/optimiser.h"
+#include "panmap/mapper/frame_sync.h"
 #include "panmap/mapper/mapper.h"
 
 namespace panmap {
 
-/// Every tunable of a mapping run: the per-frame pipeline and the final optimisation.
+/// Every tunable of a mapping run: the per-frame pipeline, the final optimisation, and how
+/// the processes match frames, poses and masks as they stream in (not part of a map: a loaded
+/// map takes whatever the config says).
 struct PanmapConfig {
   MapperConfig mapper;
   OptimiserConfig optimiser;
+  SyncConfig sync;
 };
 
 /// Reads a YAML config (OpenCV FileStorage dialect, `%YAML:1.0` header): sections map,
-/// integrator, depth_segmentation, fusion, superpoints, graph, optimiser, each optional, each
+/// integrator, depth_segmentation, fusion, superpoints, graph, optimiser, sync, each optional, each
 /// key optional (missing keys keep their defaults). Unknown sections or keys, wrong types and
 /// values that fail a component's check() throw Error naming the file and the key.
 PanmapConfig loadConfig(const std::string& path);

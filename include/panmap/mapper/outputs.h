@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "panmap/graph/optimiser.h"
+#include "panmap/mapper/frame_sync.h"
 #include "panmap/mapper/mapper.h"
 
 namespace panmap {
@@ -18,6 +19,8 @@ struct OutputOptions {
   /// the mesh is made from scratch block by block (Mapper::extractFinalMesh), so neither
   /// they nor a copy of the mesh in pieces are held beside the welded mesh.
   bool final_export = false;
+  /// The session's frame matching, written into config.yaml with the map's settings.
+  SyncConfig sync;
 };
 
 /// What writeOutputs wrote.
