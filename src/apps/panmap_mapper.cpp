@@ -135,6 +135,7 @@ nlohmann::json mapJson(const panmap::Mapper& mapper, const panmap::OutputSummary
           {"instances_frame_counting", mapper.superpoints().numInstances()},
           {"instances_in_mesh", outputs.instances_in_mesh},
           {"objects", outputs.objects},
+          {"objects_off_mesh", outputs.objects_off_mesh},
           {"vote_evictions", mapper.voteEvictions()},
           {"tracking", trackingJson(mapper)},
           {"depth_check", depthCheckJson(mapper)},

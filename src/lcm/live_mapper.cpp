@@ -23,6 +23,13 @@ int64_t wallUtime() {
       .count();
 }
 
+// The time of the map state a message describes: its newest frame's utime, in the sensor's
+// clock as objects.json has it (the wall clock told a planner nothing about which frame the
+// map holds). 0 before the first frame.
+int64_t mapUtime(const Mapper& mapper) {
+  return mapper.trajectory().empty() ? 0 : mapper.trajectory().back().utime;
+}
+
 }  // namespace
 
 void LiveOptions::check() const {
@@ -243,7 +250,7 @@ void LiveMapper::requestOptimisation() {
               graph_instances_[request] = largestInitialInstance(taken);
               // Only the latest few requests can still be answered.
               while (graph_instances_.size() > 16) graph_instances_.erase(graph_instances_.begin());
-              const superpoint_graph_t graph = toMessage(taken, wallUtime(), request);
+              const superpoint_graph_t graph = toMessage(taken, mapUtime(*mapper), request);
               std::lock_guard<std::mutex> lock(outbox_mutex_);
               outbox_.push_back(encodeMessage(graph_channel, graph));
             }});
@@ -436,7 +443,7 @@ bool LiveMapper::run(const std::atomic<bool>& stop) {
     if (options_.publish_period_s > 0.0 && publisher_ && now >= next_publish) {
       next_publish = now + period(options_.publish_period_s);
       postWithLabels([this](Mapper* mapper, const GraphLabels* labels) {
-        std::vector<OutgoingMessage> out = publisher_(mapper, wallUtime(), labels);
+        std::vector<OutgoingMessage> out = publisher_(mapper, mapUtime(*mapper), labels);
         std::lock_guard<std::mutex> lock(outbox_mutex_);
         for (OutgoingMessage& m : out) outbox_.push_back(std::move(m));
       });
@@ -460,7 +467,7 @@ std::optional<GraphLabels> LiveMapper::requestLabels(const std::atomic<bool>& st
   if (worker_.joinable()) throw Error("requestLabels: drain() first");
   const int64_t request = ++request_id_;
   labels_.reset();
-  const superpoint_graph_t graph = toMessage(mapper_->graph(), wallUtime(), request);
+  const superpoint_graph_t graph = toMessage(mapper_->graph(), mapUtime(*mapper_), request);
   using Clock = std::chrono::steady_clock;
   const auto seconds = [](double s) {
     return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));

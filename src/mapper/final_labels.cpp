@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "panmap/core/classes.h"
+
 namespace panmap {
 
 SuperpointLabels finalLabels(int32_t superpoint, const SuperpointTracker& tracker,
@@ -17,6 +19,10 @@ SuperpointLabels finalLabels(int32_t superpoint, const SuperpointTracker& tracke
     const auto i = labels->instance.find(superpoint);
     if (i != labels->instance.end()) out.instance = i->second;
   }
+  // An instance is an object of a thing class, as the optimiser makes them: a super-point
+  // whose frame counts say unlabelled or wall joined a frame-count instance through one
+  // thing mask, and live objects of class 0 or "wall" came of it.
+  if (out.semantic <= 0 || isStuffClass(out.semantic)) out.instance = 0;
   return out;
 }
 

@@ -1,6 +1,7 @@
 #include "panmap/mapper/objects.h"
 
 #include <algorithm>
+#include <set>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -335,6 +336,16 @@ std::vector<MappedObject> readObjectsJson(const std::string& path, int64_t* utim
     objects.push_back(std::move(o));
   }
   return objects;
+}
+
+size_t keepObjectsOnMesh(const std::vector<int32_t>& mesh_instance,
+                         std::vector<MappedObject>* objects) {
+  const std::set<int32_t> on_mesh(mesh_instance.begin(), mesh_instance.end());
+  const size_t before = objects->size();
+  objects->erase(std::remove_if(objects->begin(), objects->end(),
+                                [&](const MappedObject& o) { return !on_mesh.count(o.id); }),
+                 objects->end());
+  return before - objects->size();
 }
 
 }  // namespace panmap

@@ -77,6 +77,7 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
       }
     }
   };
+  std::vector<int32_t> mesh_instances;  // of mesh_instance.ply: objects.json lists these only
   {
     // The welded mesh lives only while the meshes and snapshots are written: the later steps
     // (the occupancy tree, the map file) would otherwise hold it on top of theirs (issue 23:
@@ -90,6 +91,7 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
     for (int32_t id : mesh.instance) {
       if (id > 0) instances.insert(id);
     }
+    mesh_instances.assign(instances.begin(), instances.end());
     summary.instances_in_mesh = instances.size();
     step("mesh extraction");
 
@@ -112,7 +114,8 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
     }
   }
   attempt({"objects.json"}, [&] {
-    const std::vector<MappedObject> objects = computeObjects(*mapper, labels, optimiser.objects);
+    std::vector<MappedObject> objects = computeObjects(*mapper, labels, optimiser.objects);
+    summary.objects_off_mesh = keepObjectsOnMesh(mesh_instances, &objects);
     writeObjectsJson(dir + "/objects.json", objects, options.utime);
     summary.objects = objects.size();
     summary.files.push_back("objects.json");

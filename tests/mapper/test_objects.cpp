@@ -125,6 +125,60 @@ TEST(Objects, HandBuiltFrameCountObjects) {
   EXPECT_EQ(cabinet.q_W_B.y(), 0.0);
 }
 
+TEST(Objects, NoInstanceWithoutAThingClass) {
+  // Frame counting joined an unlabelled and a wall super-point to chair instance 7 (one thing
+  // mask over them): live objects of class 0 and "wall" came of such joins.
+  SuperpointTracker tracker{SuperpointConfig{}};
+  SuperpointTracker::Snapshot s;
+  s.parents = {0, 1, 2, 3};
+  s.states[1].class_counts = {{5, 4.0}};
+  s.states[1].instance_counts = {{7, 3}};
+  s.states[2].class_counts = {{0, 5.0}, {5, 1.0}};
+  s.states[2].instance_counts = {{7, 1}};
+  s.states[3].class_counts = {{1, 6.0}};
+  s.states[3].instance_counts = {{7, 2}};
+  s.next_instance = 8;
+  tracker.restore(s);
+  EXPECT_EQ(finalLabels(1, tracker, nullptr).instance, 7);
+  EXPECT_EQ(finalLabels(2, tracker, nullptr).semantic, 0);
+  EXPECT_EQ(finalLabels(2, tracker, nullptr).instance, 0);
+  EXPECT_EQ(finalLabels(3, tracker, nullptr).semantic, 1);
+  EXPECT_EQ(finalLabels(3, tracker, nullptr).instance, 0);
+  TsdfMap map(TsdfMap::Config{kVoxel});
+  for (int x = 0; x < 4; ++x) {
+    setVoxel(&map, {x, 0, 0}, 0.0f, 1.0f, {{1, 2}});
+    setVoxel(&map, {x, 1, 0}, 0.0f, 1.0f, {{2, 2}});
+    setVoxel(&map, {x, 2, 0}, 0.0f, 1.0f, {{3, 2}});
+  }
+  std::vector<MappedObject> objects = computeObjects(map, tracker, nullptr);
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_EQ(objects[0].id, 7);
+  EXPECT_EQ(objects[0].class_id, 5);
+  EXPECT_EQ(objects[0].num_voxels, 4);  // the chair's own voxels only
+  // The optimiser's labels decide for the super-points they name.
+  GraphLabels labels;
+  labels.semantic[2] = 5;
+  labels.instance[2] = 7;
+  EXPECT_EQ(finalLabels(2, tracker, &labels).instance, 7);
+  objects = computeObjects(map, tracker, &labels);
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_EQ(objects[0].num_voxels, 8);
+}
+
+TEST(Objects, OnlyObjectsTheMeshCarriesAreKept) {
+  std::vector<MappedObject> objects(3);
+  objects[0].id = 4;
+  objects[1].id = 9;  // no vertex carries it
+  objects[2].id = 12;
+  EXPECT_EQ(keepObjectsOnMesh({4, 12}, &objects), 1u);
+  ASSERT_EQ(objects.size(), 2u);
+  EXPECT_EQ(objects[0].id, 4);
+  EXPECT_EQ(objects[1].id, 12);
+  EXPECT_EQ(keepObjectsOnMesh({0, 4, 4, 12}, &objects), 0u);
+  EXPECT_EQ(keepObjectsOnMesh({}, &objects), 2u);
+  EXPECT_TRUE(objects.empty());
+}
+
 // A square footprint turned by 45 degrees (a diamond of voxels |i - 3| + |j - 3| <= 3): PCA of
 // its centres is isotropic and names no axis; the minimum-area rectangle is the diamond itself,
 // half the area of the axis-aligned box. A square takes the positive yaw of its two axes.

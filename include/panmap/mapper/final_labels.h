@@ -14,7 +14,8 @@ struct SuperpointLabels {
 };
 
 /// A super-point's reported labels: the optimiser's when `labels` names it, else its
-/// frame-count labels. Meshes and objects both use this, so their ids agree.
+/// frame-count labels; no instance without a thing class (0 and the stuff classes carry none).
+/// Meshes and objects both use this, so their ids agree.
 SuperpointLabels finalLabels(int32_t superpoint, const SuperpointTracker& tracker,
                              const GraphLabels* labels);
 

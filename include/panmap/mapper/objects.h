@@ -91,6 +91,12 @@ std::vector<MappedObject> computeObjects(const TsdfMap& map, const SuperpointTra
 std::vector<MappedObject> computeObjects(const Mapper& mapper, const GraphLabels* labels = nullptr,
                                          const OptimiserConfig::Objects& model = {});
 
+/// Leaves out the objects whose id no entry of `mesh_instance` (mesh_instance.ply's per-vertex
+/// instance) carries: a thin piece whose surface the mesh labels by its neighbour's voxels
+/// would be an object a planner cannot find in the mesh. Returns how many were left out.
+size_t keepObjectsOnMesh(const std::vector<int32_t>& mesh_instance,
+                         std::vector<MappedObject>* objects);
+
 /// Writes objects.json: {"utime", "objects": [{"id", "class", "class_name", "confidence",
 /// "num_voxels", "centroid", "aabb_min", "aabb_max", "obb_center", "obb_orientation_wxyz",
 /// "obb_extent", "superpoints"}]} (panmap-eval --confidences reads id and confidence).

@@ -30,6 +30,9 @@ struct OutputSummary {
   double mesh_area_m2 = 0.0;       ///< LabelledMesh::surfaceArea()
   size_t instances_in_mesh = 0;    ///< distinct instance ids > 0 on mesh vertices
   size_t objects = 0;              ///< entries of objects.json
+  /// Instances left out of objects.json because no vertex of mesh_instance.ply carries them
+  /// (a thin piece whose surface the mesh labels by its neighbour's voxels).
+  size_t objects_off_mesh = 0;
   std::vector<std::string> files;  ///< file names written, in order
   /// Wall time of each step ("map.panmap", "mesh extraction", "meshes", "snapshots",
   /// "objects.json", "occupancy.bt", "trajectory.txt", "config.yaml"), seconds, in order.
