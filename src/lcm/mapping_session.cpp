@@ -55,7 +55,12 @@ MappingSession::MappingSession(const SessionOptions& options, Mapper* mapper)
     // Corrections come in the SLAM's frame, the stored poses would be in the moved one.
     throw Error("grid shift: a diagnostic of offline maps, not combined with a frame store");
   }
-  if (options_.frame_store) writer_ = std::make_unique<FrameStoreWriter>(options_.frame_store);
+  if (options_.frame_store) {
+    writer_ = std::make_unique<FrameStoreWriter>(options_.frame_store);
+    // A loaded or resumed map with its store: corrections up to the last one in the map are
+    // stale, as they were for the session that applied it.
+    applied_before_ = options_.frame_store->lastCorrectionId();
+  }
 }
 
 void MappingSession::countStoreErrors() {
@@ -115,9 +120,10 @@ bool MappingSession::handle(const std::string& channel, const void* data, size_t
       }
       const PoseCorrection correction = fromMessage(msg);
       ++stats_.corrections_received;
-      // Frames that are ready by now go in first: the correction names frames up to its
-      // time, and the repair moves every frame the map holds.
-      newest_utime_ = std::max(newest_utime_, correction.utime);
+      // Frames that are ready by now go in first: the repair moves every frame the map holds.
+      // The correction's own utime is when the back-end published it, perhaps by another
+      // clock (its wall clock against the sensor's): it does not move the stream's time, or
+      // every frame after it was refused as waiting too long.
       integrate(sync_.popReady(now_utime >= 0 ? now_utime : newest_utime_));
       repair(correction);
       return true;
@@ -173,6 +179,7 @@ void MappingSession::repair(const PoseCorrection& correction) {
   }
   const bool running = background_ && background_->running();
   if ((stats_.corrections_applied > 0 && correction.correction_id <= stats_.last_correction_id) ||
+      (applied_before_ && correction.correction_id <= *applied_before_) ||
       (running && correction.correction_id <= running_correction_id_)) {
     ++stats_.rejected["correction: not newer than the last one applied"];
     return;
@@ -201,6 +208,14 @@ void MappingSession::repair(const PoseCorrection& correction) {
     }
     try {
       const MapRepairResult started = background_->start(correction);
+      if (started.nothing_moved) {
+        if (!started.unknown_utimes.empty()) {
+          stats_.rejected["correction: utime of no mapped frame"] +=
+              static_cast<int64_t>(started.unknown_utimes.size());
+        }
+        recordRepair(started);
+        return;
+      }
       if (running) ++stats_.corrections_superseded;
       running_correction_id_ = correction.correction_id;
       if (!started.unknown_utimes.empty()) {
@@ -239,6 +254,11 @@ void MappingSession::repair(const PoseCorrection& correction) {
 void MappingSession::recordRepair(const MapRepairResult& result) {
   stats_.repairs.push_back(describe(result));
   if (result.reintegration.completed) {
+    try {
+      options_.frame_store->recordCorrection(result.correction_id);
+    } catch (const Error& e) {
+      ++stats_.rejected[storeFailure(e.what())];
+    }
     ++stats_.corrections_applied;
     stats_.last_correction_id = result.correction_id;
     stats_.frames_reintegrated += static_cast<int64_t>(result.reintegration.frames);

@@ -70,6 +70,18 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
   if (corrected.matched == 0) {
     throw Error(name + ": " + unmatchedCorrectionReason(mapper_->trajectory(), correction, config_.match_tolerance_us));
   }
+  // Nothing to repair, unless a repair under way is to be superseded (it moves the map).
+  if (!running() && negligible(corrected, config_)) {
+    MapRepairResult nothing;
+    nothing.correction_id = correction.correction_id;
+    nothing.matched = corrected.matched;
+    nothing.unknown_utimes = corrected.unknown_utimes;
+    nothing.max_translation_m = corrected.max_translation_m;
+    nothing.max_rotation_rad = corrected.max_rotation_rad;
+    nothing.nothing_moved = true;
+    nothing.reintegration.completed = true;
+    return nothing;
+  }
   if (running()) {
     cancel();
     ++superseded_;

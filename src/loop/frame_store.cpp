@@ -379,6 +379,9 @@ void FrameStore::readIndex(Check check) {
         continue;
       }
       it->second.T_W_C = T;
+    } else if (tokens.size() == 2 && tokens[0] == "correction" && parseInt64(tokens[1], &utime)) {
+      // (utime holds the correction id here.)
+      last_correction_id_ = std::max(last_correction_id_.value_or(utime), utime);
     } else {
       problems_.push_back(where + ": not a frame or pose line, ignored");
     }
@@ -624,6 +627,17 @@ void FrameStore::updatePose(int64_t utime, const Eigen::Isometry3d& T_W_C) {
   if (it == entries_.end()) throw Error(what + " is not stored");
   appendIndexLine(sealed(line));
   it->second.T_W_C = T_W_C;
+}
+
+void FrameStore::recordCorrection(int64_t correction_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  appendIndexLine(sealed("correction " + std::to_string(correction_id)));
+  last_correction_id_ = std::max(last_correction_id_.value_or(correction_id), correction_id);
+}
+
+std::optional<int64_t> FrameStore::lastCorrectionId() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_correction_id_;
 }
 
 StoredFrame FrameStore::load(int64_t utime, Parts parts) const {

@@ -11,6 +11,9 @@ namespace panmap {
 
 void MapRepairConfig::check() const {
   if (match_tolerance_us < 0) throw Error("map repair match_tolerance_us must be >= 0");
+  if (!(min_move_m >= 0.0) || !(min_turn_rad >= 0.0)) {
+    throw Error("map repair min_move_m and min_turn_rad must be >= 0");
+  }
 }
 
 FrameLoader storeLoader(const FrameStore* store) {
@@ -35,6 +38,11 @@ PanopticFrameLoader storePanopticLoader(const FrameStore* store) {
       };
 }
 
+bool negligible(const CorrectedTrajectory& corrected, const MapRepairConfig& config) {
+  return corrected.max_translation_m <= config.min_move_m &&
+         corrected.max_rotation_rad <= config.min_turn_rad;
+}
+
 MapRepairResult repairMap(Mapper* mapper, FrameStore* store, const PoseCorrection& correction,
                           const MapRepairConfig& config, const ReintegrationProgress& progress) {
   config.check();
@@ -54,6 +62,11 @@ MapRepairResult repairMap(Mapper* mapper, FrameStore* store, const PoseCorrectio
   result.max_rotation_rad = corrected.max_rotation_rad;
   if (corrected.matched == 0) {
     throw Error(name + ": " + unmatchedCorrectionReason(mapper->trajectory(), correction, config.match_tolerance_us));
+  }
+  if (negligible(corrected, config)) {
+    result.nothing_moved = true;
+    result.reintegration.completed = true;
+    return result;
   }
   // Association under the old poses may have joined surfaces to the wrong super-points;
   // with the segmentations stored, the frames are associated again. A store that holds some
@@ -83,6 +96,14 @@ std::string describe(const MapRepairResult& r) {
               (r.unknown_utimes.size() > 1 ? ", ..." : "") + ")";
   }
   const int total = r.matched + static_cast<int>(r.unknown_utimes.size());
+  if (r.nothing_moved) {
+    std::snprintf(line, sizeof(line),
+                  "correction %lld: %d of %d poses matched%s, no camera moved (largest move "
+                  "%.5f m / %.4f deg): the map stays as it is",
+                  static_cast<long long>(r.correction_id), r.matched, total, unknown.c_str(),
+                  r.max_translation_m, r.max_rotation_rad * 180.0 / M_PI);
+    return line;
+  }
   if (!r.reintegration.completed) {
     std::snprintf(line, sizeof(line), "correction %lld: %d of %d poses matched%s, abandoned",
                   static_cast<long long>(r.correction_id), r.matched, total, unknown.c_str());

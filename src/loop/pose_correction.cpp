@@ -80,6 +80,22 @@ int nearestFrame(const std::vector<StampedPose>& trajectory, int64_t utime, int6
   return best;
 }
 
+// nearestFrame(), and only when the utime is nearer frame k than halfway to its neighbours: a
+// frame the mapper dropped lies between two mapped ones, and a wide tolerance gave its
+// corrected pose to a neighbour (its pose 200 ms away: a 15 degree turn where 9 were due).
+int frameOf(const std::vector<StampedPose>& trajectory, int64_t utime, int64_t tolerance) {
+  const int k = nearestFrame(trajectory, utime, tolerance);
+  if (k < 0) return -1;
+  const int64_t gap = std::abs(trajectory[k].utime - utime);
+  if (gap == 0) return k;
+  const size_t i = static_cast<size_t>(k);
+  if (i > 0 && 2 * gap >= trajectory[i].utime - trajectory[i - 1].utime) return -1;
+  if (i + 1 < trajectory.size() && 2 * gap >= trajectory[i + 1].utime - trajectory[i].utime) {
+    return -1;
+  }
+  return k;
+}
+
 }  // namespace
 
 CorrectedTrajectory applyCorrection(const std::vector<StampedPose>& trajectory,
@@ -94,16 +110,31 @@ CorrectedTrajectory applyCorrection(const std::vector<StampedPose>& trajectory,
   out.poses = trajectory;
   out.translation_m.assign(trajectory.size(), 0.0);
   out.rotation_rad.assign(trajectory.size(), 0.0);
-  // Matched frames in time order with their world-frame correction.
+  // Matched frames in time order with their world-frame correction. Two utimes near one frame
+  // (poses come in time order, so they are neighbours here): the nearer takes it.
   std::vector<std::pair<int, Eigen::Isometry3d>> anchors;
+  int64_t last_gap = 0;
+  int64_t last_utime = 0;
   for (const StampedPose& p : correction.poses) {
-    const int k = nearestFrame(trajectory, p.utime, std::max<int64_t>(tolerance_us, 0));
-    if (k < 0 || (!anchors.empty() && anchors.back().first == k)) {
+    const int k = frameOf(trajectory, p.utime, std::max<int64_t>(tolerance_us, 0));
+    const int64_t gap = k < 0 ? 0 : std::abs(trajectory[k].utime - p.utime);
+    if (k >= 0 && !anchors.empty() && anchors.back().first == k) {
+      if (gap >= last_gap) {
+        out.unknown_utimes.push_back(p.utime);
+        continue;
+      }
+      out.unknown_utimes.push_back(last_utime);
+      anchors.pop_back();
+    }
+    if (k < 0) {
       out.unknown_utimes.push_back(p.utime);
       continue;
     }
     anchors.emplace_back(k, p.T_W_C * trajectory[k].T_W_C.inverse());
+    last_gap = gap;
+    last_utime = p.utime;
   }
+  std::sort(out.unknown_utimes.begin(), out.unknown_utimes.end());
   out.matched = static_cast<int>(anchors.size());
   if (anchors.empty()) return out;
   size_t next = 0;  // first anchor at or after frame i

@@ -403,6 +403,17 @@ TEST_F(MappingSessionTest, ACorrectionRepairsTheMapFromTheFrameStore) {
   EXPECT_EQ(after.rejected.at("malformed PANMAP_POSE_CORRECTION"), 1);
   EXPECT_EQ(test::mapBytes(mapper), before);
 
+  // The map saved and loaded again with its store (a new session): correction 3 is in it, so
+  // it is stale there too (applied again, an older correction would undo a repair).
+  FrameStore reopened(temp.config());
+  EXPECT_EQ(reopened.lastCorrectionId(), std::optional<int64_t>(3));
+  SessionOptions again_options;
+  again_options.frame_store = &reopened;
+  MappingSession again(again_options, &mapper);
+  feed(&again, {encodeMessage(kChannelPoseCorrection, toMessage(correction))});
+  EXPECT_EQ(again.stats().rejected.at("correction: not newer than the last one applied"), 1);
+  EXPECT_EQ(test::mapBytes(mapper), before);
+
   // Without a frame store the correction is refused and counted.
   Mapper no_store(test::streamMapperConfig());
   MappingSession without(SessionOptions{}, &no_store);
@@ -410,6 +421,41 @@ TEST_F(MappingSessionTest, ACorrectionRepairsTheMapFromTheFrameStore) {
   EXPECT_EQ(without.stats().rejected.at("correction: no frame store (panmap-mapper --frame-store)"),
             1);
   EXPECT_EQ(test::mapBytes(no_store), clean_);
+}
+
+TEST_F(MappingSessionTest, ACorrectionStampedByAnotherClockStopsNoFrame) {
+  // A back-end that stamps its correction with its wall clock (here 10^9 s ahead of the
+  // sensor's): the stream's time stood there, and every later frame was refused as waiting too
+  // long. And one that moves nothing is applied without a repair.
+  const size_t n = stream_.frames.size();
+  std::vector<test::Encoded> messages;
+  const std::vector<test::Encoded> all = stream_.messages();
+  PoseCorrection correction;
+  correction.correction_id = 1;
+  correction.utime = stream_.frames[5].utime + 1000000000000000;
+  correction.poses.push_back(stream_.poses[2]);  // the pose it was mapped with: no move
+  for (size_t k = 0; k < n; ++k) {
+    if (k <= 5) {
+      messages.insert(messages.end(), all.begin() + 3 * k, all.begin() + 3 * k + 3);
+    } else {  // from here on the pose comes after its frame (SLAM latency)
+      messages.insert(messages.end(), {all[3 * k + 2], all[3 * k + 1], all[3 * k]});
+    }
+    if (k == 5) messages.push_back(encodeMessage(kChannelPoseCorrection, toMessage(correction)));
+  }
+  TempStore temp;
+  Mapper mapper(test::streamMapperConfig());
+  MappingSession session(temp.options(), &mapper);
+  feed(&session, messages);
+  const SessionStats stats = session.stats();
+  EXPECT_EQ(stats.frames_integrated, static_cast<int64_t>(n));
+  EXPECT_TRUE(stats.rejected.empty());
+  EXPECT_EQ(stats.corrections_applied, 1);
+  EXPECT_EQ(stats.frames_reintegrated, 0);
+  ASSERT_EQ(stats.repairs.size(), 1u);
+  EXPECT_NE(stats.repairs[0].find("correction 1: 1 of 1 poses matched, no camera moved"),
+            std::string::npos)
+      << stats.repairs[0];
+  EXPECT_EQ(test::mapBytes(mapper), clean_);
 }
 
 // With background repairs (the live process), a correction in the middle of the stream is

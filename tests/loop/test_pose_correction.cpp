@@ -198,5 +198,38 @@ TEST(PoseCorrection, AnUnmatchedCorrectionSaysHowFarOffItsUtimesAre) {
             "none of its 2 utimes is a mapped frame (first 1150000, no frame mapped yet)");
 }
 
+TEST(PoseCorrection, AWideToleranceGivesNoDroppedFramesPoseToItsNeighbour) {
+  // Frames at 1.0, 1.1, 1.3, 1.4 s: the mapper dropped the one at 1.2 s.
+  std::vector<StampedPose> trajectory = walk();
+  trajectory.erase(trajectory.begin() + 2);
+  const Eigen::Isometry3d D = pose(0.3, 0.0, 0.0);
+  PoseCorrection c;
+  StampedPose dropped = corrected(trajectory[1], pose(5.0, 0.0, 0.0));
+  dropped.utime = 1200000;  // 100 ms from both neighbours, within a 150 ms tolerance
+  c.poses = {dropped, corrected(trajectory[2], D)};
+  CorrectedTrajectory out = applyCorrection(trajectory, c, 150000);
+  EXPECT_EQ(out.matched, 1);
+  EXPECT_EQ(out.unknown_utimes, std::vector<int64_t>{1200000});
+  expectPose(out.poses[1].T_W_C, D * trajectory[1].T_W_C);
+  // Two utimes near one frame: the nearer takes it, whichever comes first.
+  StampedPose before = corrected(trajectory[1], pose(5.0, 0.0, 0.0));
+  before.utime -= 3000;
+  StampedPose after = corrected(trajectory[1], D);
+  after.utime += 2000;
+  c.poses = {before, after};
+  out = applyCorrection(trajectory, c, 10000);
+  EXPECT_EQ(out.matched, 1);
+  EXPECT_EQ(out.unknown_utimes, std::vector<int64_t>{before.utime});
+  expectPose(out.poses[1].T_W_C, D * trajectory[1].T_W_C);
+  before.utime = trajectory[1].utime - 1000;
+  after.utime = trajectory[1].utime + 2000;
+  before.T_W_C = D * trajectory[1].T_W_C;
+  after.T_W_C = pose(5.0, 0.0, 0.0) * trajectory[1].T_W_C;
+  c.poses = {before, after};
+  out = applyCorrection(trajectory, c, 10000);
+  EXPECT_EQ(out.unknown_utimes, std::vector<int64_t>{after.utime});
+  expectPose(out.poses[1].T_W_C, D * trajectory[1].T_W_C);
+}
+
 }  // namespace
 }  // namespace panmap

@@ -5,6 +5,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -152,6 +153,8 @@ class MappingSession {
   // Per tracked frame: how far refinement moved the given pose (metres, degrees).
   std::vector<double> refinement_moved_m_, refinement_turned_deg_;
   int64_t newest_utime_ = INT64_MIN;
+  /// The newest correction the frame store holds from an earlier session (--load, --resume).
+  std::optional<int64_t> applied_before_;
   bool done_ = false;
   std::unique_ptr<FrameStoreWriter> writer_;      // with a frame store: writes it off this thread
   bool stored_segmentation_ = false;              // a frame went to the store with its masks

@@ -59,6 +59,8 @@ class BackgroundRepair {
   /// Starts the repair for `correction` from the map as it is now, abandoning a running one
   /// first (counted in superseded()). Throws Error like repairMap(), leaving a running repair
   /// alone, when the correction is invalid or none of its utimes is a mapped frame.
+  /// A correction that moves no camera (negligible()) starts nothing while no repair runs: its
+  /// result comes back at once with nothing_moved set.
   /// @return how the correction matched the map (reintegration is filled by poll())
   MapRepairResult start(const PoseCorrection& correction);
   /// Call after each frame the mapper integrated while running(): the repair takes it too.

@@ -6,6 +6,7 @@
 #include <memory>
 #include <mutex>
 #include <set>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -140,6 +141,12 @@ class FrameStore {
   /// Throws Error naming the utime when it is not stored, or when the pose is not rigid.
   /// @param T_W_C camera-to-world pose (optical frame) of the re-integration
   void updatePose(int64_t utime, const Eigen::Isometry3d& T_W_C);
+  /// Records that the repair of correction `correction_id` is in the map (after its pose
+  /// lines); durable on return. A map loaded or resumed with this store refuses corrections
+  /// no newer than it, as the session that applied it did: an older one would undo the repair.
+  void recordCorrection(int64_t correction_id);
+  /// The newest correction recorded (recordCorrection), or nullopt when none was.
+  std::optional<int64_t> lastCorrectionId() const;
 
   /// What load() reads.
   enum class Parts {
@@ -226,6 +233,7 @@ class FrameStore {
   uint64_t index_bytes_ = 0;
   std::vector<std::string> problems_;
   size_t skipped_ = 0;
+  std::optional<int64_t> last_correction_id_;
 };
 
 }  // namespace panmap

@@ -36,6 +36,11 @@ struct MapRepairConfig {
   /// former repair retired vote for nothing until then. With occupancy_first too, the tree
   /// comes first and this map after it (a second pass over the frames).
   bool reintegrate_first = false;
+  /// A correction that moves no camera farther than these (metres, radians) leaves the map as
+  /// it is, counted as applied: resending the poses the map holds cost a whole repair and
+  /// renumbered objects and super-points.
+  double min_move_m = 1e-4;
+  double min_turn_rad = 1e-4;
   /// Throws Error naming the bad field.
   void check() const;
 };
@@ -69,7 +74,14 @@ struct MapRepairResult {
   /// Super-points that joined another at that swap (ReintegrationStats::superpoints_rejoined).
   size_t map_swapped_rejoined = 0;
   double map_swapped_rejoin_s = 0.0;  ///< and the time that took
+  /// No frame moved more than MapRepairConfig::min_move_m / min_turn_rad: nothing was
+  /// repaired, and reintegration.completed is set (the correction counts as applied).
+  bool nothing_moved = false;
 };
+
+/// True when the corrected trajectory moves no camera beyond config's min_move_m and
+/// min_turn_rad: a correction with nothing to repair.
+bool negligible(const CorrectedTrajectory& corrected, const MapRepairConfig& config);
 
 /// The repair after a loop closure (docs/LOOP_CLOSURE.md): spreads the correction over every
 /// mapped frame (applyCorrection), maps the frames from the store again at their new poses
