@@ -470,8 +470,8 @@ class FolderReader : public DatasetReader {
       if (c[i] - d[i] != shift) return "";
     }
     std::ostringstream out;
-    out << "; WARNING: the colour images are numbered " << static_cast<long long>(c.front())
-        << "-" << static_cast<long long>(c.back()) << " and the depth images "
+    out << "; WARNING: the colour images are numbered " << static_cast<long long>(c.front()) << "-"
+        << static_cast<long long>(c.back()) << " and the depth images "
         << static_cast<long long>(d.front()) << "-" << static_cast<long long>(d.back())
         << ": if they are the same frames counted from another start, renumber one folder "
         << "(paired by number, each frame's colour comes from another frame)";

@@ -68,16 +68,13 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
   CorrectedTrajectory corrected =
       applyCorrection(mapper_->trajectory(), correction, config_.match_tolerance_us);
   if (corrected.matched == 0) {
-    throw Error(name + ": " + unmatchedCorrectionReason(mapper_->trajectory(), correction, config_.match_tolerance_us));
+    throw Error(
+        name + ": " +
+        unmatchedCorrectionReason(mapper_->trajectory(), correction, config_.match_tolerance_us));
   }
   // Nothing to repair, unless a repair under way is to be superseded (it moves the map).
   if (!running() && negligible(corrected, config_)) {
-    MapRepairResult nothing;
-    nothing.correction_id = correction.correction_id;
-    nothing.matched = corrected.matched;
-    nothing.unknown_utimes = corrected.unknown_utimes;
-    nothing.max_translation_m = corrected.max_translation_m;
-    nothing.max_rotation_rad = corrected.max_rotation_rad;
+    MapRepairResult nothing = matchedResult(correction, corrected);
     nothing.nothing_moved = true;
     nothing.reintegration.completed = true;
     return nothing;
@@ -86,12 +83,7 @@ MapRepairResult BackgroundRepair::start(const PoseCorrection& correction) {
     cancel();
     ++superseded_;
   }
-  result_ = MapRepairResult();
-  result_.correction_id = correction.correction_id;
-  result_.matched = corrected.matched;
-  result_.unknown_utimes = corrected.unknown_utimes;
-  result_.max_translation_m = corrected.max_translation_m;
-  result_.max_rotation_rad = corrected.max_rotation_rad;
+  result_ = matchedResult(correction, corrected);
   corrected_ = std::move(corrected);
   started_ = std::chrono::steady_clock::now();
   blocks_before_ = mapper_->map().numBlocks();

@@ -38,6 +38,17 @@ PanopticFrameLoader storePanopticLoader(const FrameStore* store) {
       };
 }
 
+MapRepairResult matchedResult(const PoseCorrection& correction,
+                              const CorrectedTrajectory& corrected) {
+  MapRepairResult result;
+  result.correction_id = correction.correction_id;
+  result.matched = corrected.matched;
+  result.unknown_utimes = corrected.unknown_utimes;
+  result.max_translation_m = corrected.max_translation_m;
+  result.max_rotation_rad = corrected.max_rotation_rad;
+  return result;
+}
+
 bool negligible(const CorrectedTrajectory& corrected, const MapRepairConfig& config) {
   return corrected.max_translation_m <= config.min_move_m &&
          corrected.max_rotation_rad <= config.min_turn_rad;
@@ -54,14 +65,11 @@ MapRepairResult repairMap(Mapper* mapper, FrameStore* store, const PoseCorrectio
   }
   const CorrectedTrajectory corrected =
       applyCorrection(mapper->trajectory(), correction, config.match_tolerance_us);
-  MapRepairResult result;
-  result.correction_id = correction.correction_id;
-  result.matched = corrected.matched;
-  result.unknown_utimes = corrected.unknown_utimes;
-  result.max_translation_m = corrected.max_translation_m;
-  result.max_rotation_rad = corrected.max_rotation_rad;
+  MapRepairResult result = matchedResult(correction, corrected);
   if (corrected.matched == 0) {
-    throw Error(name + ": " + unmatchedCorrectionReason(mapper->trajectory(), correction, config.match_tolerance_us));
+    throw Error(
+        name + ": " +
+        unmatchedCorrectionReason(mapper->trajectory(), correction, config.match_tolerance_us));
   }
   if (negligible(corrected, config)) {
     result.nothing_moved = true;

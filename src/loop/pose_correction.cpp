@@ -166,8 +166,8 @@ CorrectedTrajectory applyCorrection(const std::vector<StampedPose>& trajectory,
 
 std::string unmatchedCorrectionReason(const std::vector<StampedPose>& trajectory,
                                       const PoseCorrection& correction, int64_t tolerance_us) {
-  std::string out = "none of its " + std::to_string(correction.poses.size()) +
-                    " utimes is a mapped frame";
+  std::string out =
+      "none of its " + std::to_string(correction.poses.size()) + " utimes is a mapped frame";
   if (correction.poses.empty()) return out;
   const int64_t first = correction.poses.front().utime;
   out += " (first " + std::to_string(first);

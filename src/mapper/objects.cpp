@@ -1,11 +1,11 @@
 #include "panmap/mapper/objects.h"
 
 #include <algorithm>
-#include <set>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <set>
 #include <utility>
 
 #include <nlohmann/json.hpp>

@@ -87,8 +87,9 @@ TEST(Tum, OnlyTheSequenceFoldersOwnNameNamesItsCamera) {
   writeTumFolder(fr3, 7500);
   const auto reader = openDataset(fr3, DatasetOptions{});
   EXPECT_DOUBLE_EQ(reader->read(0).rgbd.camera.fx, 535.4);
-  EXPECT_NE(joined(reader->notes()).find("intrinsics: TUM's freiburg3 intrinsics (the folder is "
-                                         "named rgbd_dataset_freiburg3_office"),
+  EXPECT_NE(joined(reader->notes())
+                .find("intrinsics: TUM's freiburg3 intrinsics (the folder is "
+                      "named rgbd_dataset_freiburg3_office"),
             std::string::npos)
       << joined(reader->notes());
   // A user's own recording below a folder whose name merely contains "freiburg2...".

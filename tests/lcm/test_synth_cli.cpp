@@ -130,9 +130,8 @@ TEST(SynthCli, BadArgumentsFailClearly) {
   // (it was "cannot open ../shared/data/scannet-meta/...", a path the user never gave).
   const std::string lone = dir.path("scans/scene0001_00");
   std::filesystem::create_directories(lone);
-  const auto no_table = runCommand("cd " + dir.path("scans") + " && " +
-                                   binPath("panmap-synth") + " --scannet " + lone + " --out " +
-                                   dir.path("x"));
+  const auto no_table = runCommand("cd " + dir.path("scans") + " && " + binPath("panmap-synth") +
+                                   " --scannet " + lone + " --out " + dir.path("x"));
   EXPECT_EQ(no_table.exit_code, 1);
   EXPECT_EQ(test::countLines(no_table.output), 1) << no_table.output;
   EXPECT_NE(no_table.output.find("--scannet " + lone +

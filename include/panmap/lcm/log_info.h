@@ -11,10 +11,10 @@ namespace panmap {
 /// Statistics of one channel of an LCM log.
 struct ChannelInfo {
   std::string channel;
-  std::string type;         ///< panmap type name, "" when unknown or mixed
-  size_t count = 0;         ///< events
-  size_t bytes = 0;         ///< payload bytes
-  size_t failures = 0;      ///< events that did not decode as a panmap type
+  std::string type;     ///< panmap type name, "" when unknown or mixed
+  size_t count = 0;     ///< events
+  size_t bytes = 0;     ///< payload bytes
+  size_t failures = 0;  ///< events that did not decode as a panmap type
   /// utime of the first and last message that decoded; when none did, the log's event
   /// timestamps (another clock: when the logger received them).
   int64_t first_utime = 0;

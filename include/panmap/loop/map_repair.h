@@ -79,6 +79,11 @@ struct MapRepairResult {
   bool nothing_moved = false;
 };
 
+/// A repair's result as far as matching goes: the correction's id, the utimes it matched and
+/// did not, and the largest move and turn it makes (the repair's own fields left empty).
+MapRepairResult matchedResult(const PoseCorrection& correction,
+                              const CorrectedTrajectory& corrected);
+
 /// True when the corrected trajectory moves no camera beyond config's min_move_m and
 /// min_turn_rad: a correction with nothing to repair.
 bool negligible(const CorrectedTrajectory& corrected, const MapRepairConfig& config);

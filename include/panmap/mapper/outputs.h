@@ -27,9 +27,9 @@ struct OutputOptions {
 struct OutputSummary {
   size_t mesh_vertices = 0;
   size_t mesh_faces = 0;
-  double mesh_area_m2 = 0.0;       ///< LabelledMesh::surfaceArea()
-  size_t instances_in_mesh = 0;    ///< distinct instance ids > 0 on mesh vertices
-  size_t objects = 0;              ///< entries of objects.json
+  double mesh_area_m2 = 0.0;     ///< LabelledMesh::surfaceArea()
+  size_t instances_in_mesh = 0;  ///< distinct instance ids > 0 on mesh vertices
+  size_t objects = 0;            ///< entries of objects.json
   /// Instances left out of objects.json because no vertex of mesh_instance.ply carries them
   /// (a thin piece whose surface the mesh labels by its neighbour's voxels).
   size_t objects_off_mesh = 0;
