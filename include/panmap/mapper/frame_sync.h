@@ -78,9 +78,9 @@ class FrameSynchronizer {
   /// Throws Error when the config is invalid.
   explicit FrameSynchronizer(const SyncConfig& config);
 
-  /// Queues a frame in utime order (drops the oldest when full). A frame whose utime repeats a
-  /// queued or already handled frame's, or is older than the newest handled frame, is refused
-  /// and counted: the map must not depend on duplicated or late messages.
+  /// Queues a frame in utime order (popReady() sends the oldest on when full). A frame whose utime
+  /// repeats a queued or already handled frame's, or is older than the newest handled frame, is
+  /// refused and counted: the map must not depend on duplicated or late messages.
   void addFrame(RgbdFrame frame);
   /// Adds a pose; poses must be finite (the caller validates). A repeated utime keeps the
   /// first pose (counted).
