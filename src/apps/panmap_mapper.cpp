@@ -10,7 +10,6 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 
 #include <unistd.h>
@@ -26,6 +25,7 @@
 #include "panmap/core/process_memory.h"
 #include "panmap/core/progress.h"
 #include "panmap/graph/optimiser.h"
+#include "panmap/io/atomic_file.h"
 #include "panmap/io/output_path.h"
 #include "panmap/lcm/live_mapper.h"
 #include "panmap/lcm/object_conversions.h"
@@ -188,11 +188,9 @@ std::string autosaveDirOf(const std::string& dir) {
 }
 
 void writeJson(const std::string& path, const nlohmann::json& json) {
-  std::ofstream out(path);
   // Rejection reasons may quote a channel name, which need not be UTF-8.
-  out << json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
-  out.close();  // the last bytes reach the disk here: a full disk shows now, not never
-  if (!out) throw panmap::Error("cannot write " + path);
+  panmap::writeFileAtomically(
+      path, json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 // Frames mapped into no surface at all: wrong depth units, intrinsics or pose units look
@@ -534,18 +532,16 @@ int main(int argc, char** argv) {
     }
     // After the outputs are safely written the snapshots have served their purpose.
     auto finishAutosave = [&]() {
-      if (autosaver) {
-        // The outputs are written by now: snapshots left behind cost disk, not the map.
-        try {
+      // The outputs are written by now: snapshots left behind cost disk, not the map.
+      try {
+        if (autosaver) {
           autosaver->clear();
-        } catch (const std::exception& e) {
-          std::fprintf(stderr, "panmap-mapper: warning: autosave snapshots not removed: %s\n",
-                       e.what());
+        } else if (resumed) {
+          panmap::clearAutosaveFolder(autosaveDirOf(resume_dir));
         }
-      } else if (resumed) {
-        for (const std::string& path : panmap::listResumeCandidates(autosaveDirOf(resume_dir))) {
-          std::remove(path.c_str());
-        }
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "panmap-mapper: warning: autosave snapshots not removed: %s\n",
+                     e.what());
       }
     };
     panmap::OutputOptions output_options;

@@ -78,4 +78,18 @@ void AtomicFileWriter::commit() {
   }
 }
 
+void writeFileAtomically(const std::string& path, const void* data, size_t size) {
+  try {
+    AtomicFileWriter file(path);
+    file.append(static_cast<const uint8_t*>(data), size);
+    file.commit();
+  } catch (const Error& e) {
+    throw Error("cannot write " + path + ": " + e.what());
+  }
+}
+
+void writeFileAtomically(const std::string& path, const std::string& bytes) {
+  writeFileAtomically(path, bytes.data(), bytes.size());
+}
+
 }  // namespace panmap

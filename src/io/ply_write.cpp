@@ -5,12 +5,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "panmap/core/error.h"
+#include "panmap/io/atomic_file.h"
 #include "panmap/io/internal/ply_format.h"
 
 namespace panmap {
@@ -102,89 +102,96 @@ void writePly(const std::string& path, const PlyColumns& columns, PlyFormat form
   header += "element face " + std::to_string(faces.size()) + "\n";
   header += "property list uchar int vertex_indices\nend_header\n";
 
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw Error("cannot write " + path);
-  out.write(header.data(), static_cast<std::streamsize>(header.size()));
-  // Streamed in chunks: a building's mesh is 380 MB of PLY per file.
-  constexpr size_t kChunkBytes = size_t{1} << 20;
-  if (format == PlyFormat::kBinaryLittleEndian) {
-    size_t vertex_bytes = 12 + (colours ? 3 : 0);
-    for (int k = 0; k < 3; ++k) vertex_bytes += labels[k] ? 4 : 0;
-    constexpr size_t kFaceBytes = 13;
-    std::vector<char> buffer(kChunkBytes);
-    const size_t vertices_per_chunk = kChunkBytes / vertex_bytes;
-    for (size_t first = 0; first < n; first += vertices_per_chunk) {
-      const size_t end = std::min(n, first + vertices_per_chunk);
-      LittleEndianWriter w(buffer.data());
-      for (size_t v = first; v < end; ++v) {
-        const Eigen::Vector3f& p = (*columns.vertices)[v];
-        w.put(p.x());
-        w.put(p.y());
-        w.put(p.z());
+  // Through a partial file renamed over PATH at the end: a viewer or planner reading the mesh
+  // while the mapper rewrites it sees the old one or the whole new one, never a cut-off file.
+  try {
+    AtomicFileWriter out(path);
+    auto write = [&out](const char* data, size_t size) {
+      out.append(reinterpret_cast<const uint8_t*>(data), size);
+    };
+    write(header.data(), header.size());
+    // Streamed in chunks: a building's mesh is 380 MB of PLY per file.
+    constexpr size_t kChunkBytes = size_t{1} << 20;
+    if (format == PlyFormat::kBinaryLittleEndian) {
+      size_t vertex_bytes = 12 + (colours ? 3 : 0);
+      for (int k = 0; k < 3; ++k) vertex_bytes += labels[k] ? 4 : 0;
+      constexpr size_t kFaceBytes = 13;
+      std::vector<char> buffer(kChunkBytes);
+      const size_t vertices_per_chunk = kChunkBytes / vertex_bytes;
+      for (size_t first = 0; first < n; first += vertices_per_chunk) {
+        const size_t end = std::min(n, first + vertices_per_chunk);
+        LittleEndianWriter w(buffer.data());
+        for (size_t v = first; v < end; ++v) {
+          const Eigen::Vector3f& p = (*columns.vertices)[v];
+          w.put(p.x());
+          w.put(p.y());
+          w.put(p.z());
+          if (colours) {
+            const Rgb8 c = (*columns.colors)[v];
+            w.put(c.r);
+            w.put(c.g);
+            w.put(c.b);
+          }
+          for (int k = 0; k < 3; ++k) {
+            if (labels[k]) w.put(label(k, v));
+          }
+        }
+        write(buffer.data(), (end - first) * vertex_bytes);
+      }
+      const size_t faces_per_chunk = kChunkBytes / kFaceBytes;
+      for (size_t first = 0; first < faces.size(); first += faces_per_chunk) {
+        const size_t end = std::min(faces.size(), first + faces_per_chunk);
+        LittleEndianWriter w(buffer.data());
+        for (size_t f = first; f < end; ++f) {
+          w.put(static_cast<uint8_t>(3));
+          for (int k = 0; k < 3; ++k) w.put(static_cast<int32_t>(faces[f][k]));
+        }
+        write(buffer.data(), (end - first) * kFaceBytes);
+      }
+    } else {
+      std::string body;
+      body.reserve(kChunkBytes + 256);
+      auto flushIfFull = [&] {
+        if (body.size() < kChunkBytes) return;
+        write(body.data(), body.size());
+        body.clear();
+      };
+      for (size_t v = 0; v < n; ++v) {
+        // to_chars(float) gives the shortest text that reads back to the same float.
+        for (int k = 0; k < 3; ++k) {
+          if (k > 0) body += ' ';
+          appendNumber(&body, (*columns.vertices)[v][k]);
+        }
         if (colours) {
           const Rgb8 c = (*columns.colors)[v];
-          w.put(c.r);
-          w.put(c.g);
-          w.put(c.b);
+          for (const uint8_t channel : {c.r, c.g, c.b}) {
+            body += ' ';
+            appendNumber(&body, static_cast<int>(channel));
+          }
         }
         for (int k = 0; k < 3; ++k) {
-          if (labels[k]) w.put(label(k, v));
-        }
-      }
-      out.write(buffer.data(), static_cast<std::streamsize>((end - first) * vertex_bytes));
-    }
-    const size_t faces_per_chunk = kChunkBytes / kFaceBytes;
-    for (size_t first = 0; first < faces.size(); first += faces_per_chunk) {
-      const size_t end = std::min(faces.size(), first + faces_per_chunk);
-      LittleEndianWriter w(buffer.data());
-      for (size_t f = first; f < end; ++f) {
-        w.put(static_cast<uint8_t>(3));
-        for (int k = 0; k < 3; ++k) w.put(static_cast<int32_t>(faces[f][k]));
-      }
-      out.write(buffer.data(), static_cast<std::streamsize>((end - first) * kFaceBytes));
-    }
-  } else {
-    std::string body;
-    body.reserve(kChunkBytes + 256);
-    auto flushIfFull = [&] {
-      if (body.size() < kChunkBytes) return;
-      out.write(body.data(), static_cast<std::streamsize>(body.size()));
-      body.clear();
-    };
-    for (size_t v = 0; v < n; ++v) {
-      // to_chars(float) gives the shortest text that reads back to the same float.
-      for (int k = 0; k < 3; ++k) {
-        if (k > 0) body += ' ';
-        appendNumber(&body, (*columns.vertices)[v][k]);
-      }
-      if (colours) {
-        const Rgb8 c = (*columns.colors)[v];
-        for (const uint8_t channel : {c.r, c.g, c.b}) {
+          if (!labels[k]) continue;
           body += ' ';
-          appendNumber(&body, static_cast<int>(channel));
+          appendNumber(&body, label(k, v));
         }
+        body += '\n';
+        flushIfFull();
       }
-      for (int k = 0; k < 3; ++k) {
-        if (!labels[k]) continue;
-        body += ' ';
-        appendNumber(&body, label(k, v));
+      for (const Eigen::Vector3i& f : faces) {
+        body += '3';
+        for (int k = 0; k < 3; ++k) {
+          body += ' ';
+          appendNumber(&body, f[k]);
+        }
+        body += '\n';
+        flushIfFull();
       }
-      body += '\n';
-      flushIfFull();
+      write(body.data(), body.size());
     }
-    for (const Eigen::Vector3i& f : faces) {
-      body += '3';
-      for (int k = 0; k < 3; ++k) {
-        body += ' ';
-        appendNumber(&body, f[k]);
-      }
-      body += '\n';
-      flushIfFull();
-    }
-    out.write(body.data(), static_cast<std::streamsize>(body.size()));
+    out.commit();
+  } catch (const Error& e) {
+    throw Error("cannot write " + path + ": " + e.what());
   }
-  out.close();
-  if (!out) throw Error("cannot write " + path + " (disk full?)");
 }
 
 }  // namespace panmap

@@ -2,10 +2,10 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <string>
 
 #include "panmap/core/error.h"
+#include "panmap/io/atomic_file.h"
 #include "panmap/io/text_files.h"
 #include "panmap/io/timestamps.h"
 
@@ -42,19 +42,16 @@ std::vector<StampedPose> readTumTrajectory(const std::string& path) {
 }
 
 void writeTumTrajectory(const std::string& path, const std::vector<StampedPose>& trajectory) {
-  std::ofstream out(path);
-  if (!out) throw Error("cannot write trajectory " + path);
-  out << "# timestamp tx ty tz qx qy qz qw\n";
+  std::string text = "# timestamp tx ty tz qx qy qz qw\n";
   char buffer[256];
   for (const StampedPose& p : trajectory) {
     const Eigen::Quaterniond q(p.T_W_C.linear());
     const Eigen::Vector3d t = p.T_W_C.translation();
     std::snprintf(buffer, sizeof(buffer), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n",
                   p.utime * 1e-6, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
-    out << buffer;
+    text += buffer;
   }
-  out.close();  // the last bytes reach the disk here: a full disk shows now, not never
-  if (!out) throw Error("cannot write trajectory " + path);
+  writeFileAtomically(path, text);
 }
 
 }  // namespace panmap

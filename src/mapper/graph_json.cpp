@@ -1,10 +1,9 @@
 #include "panmap/mapper/graph_json.h"
 
-#include <fstream>
-
 #include <nlohmann/json.hpp>
 
 #include "panmap/core/error.h"
+#include "panmap/io/atomic_file.h"
 
 namespace panmap {
 namespace {
@@ -47,10 +46,7 @@ void writeGraphJson(const std::string& path, const SuperpointGraph& graph,
   }
   const nlohmann::json root = {
       {"voxel_size_m", graph.voxel_size_m}, {"vertices", vertices}, {"edges", edges}};
-  std::ofstream out(path);
-  out << root.dump() << "\n";
-  out.close();  // the last bytes reach the disk here: a full disk shows now, not never
-  if (!out) throw Error(path + ": cannot write");
+  writeFileAtomically(path, root.dump() + "\n");
 }
 
 }  // namespace panmap

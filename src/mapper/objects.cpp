@@ -13,6 +13,7 @@
 #include "panmap/core/classes.h"
 #include "panmap/core/error.h"
 #include "panmap/graph/object_confidence.h"
+#include "panmap/io/atomic_file.h"
 #include "panmap/mapper/final_labels.h"
 #include "panmap/mapper/mapper.h"
 
@@ -279,10 +280,7 @@ void writeObjectsJson(const std::string& path, const std::vector<MappedObject>& 
                       {"class_share", o.evidence.class_share}}}});
   }
   const json root = {{"utime", utime}, {"objects", list}};
-  std::ofstream out(path);
-  out << root.dump(2) << "\n";
-  out.close();  // the last bytes reach the disk here: a full disk shows now, not never
-  if (!out) throw Error(path + ": cannot write");
+  writeFileAtomically(path, root.dump(2) + "\n");
 }
 
 std::vector<MappedObject> readObjectsJson(const std::string& path, int64_t* utime) {

@@ -2,12 +2,12 @@
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <iterator>
 #include <set>
 
 #include "panmap/core/error.h"
+#include "panmap/io/atomic_file.h"
 #include "panmap/io/image_codec.h"
 #include "panmap/io/tum_trajectory.h"
 #include "panmap/mapper/config_file.h"
@@ -38,7 +38,8 @@ void writeSnapshots(const std::string& dir, const LabelledMesh& mesh, OutputSumm
       mesh, {byLabel(mesh, &semanticColor, mesh.semantic), byLabel(mesh, &idColor, mesh.instance),
              byLabel(mesh, &idColor, mesh.superpoint), vertexColours(mesh)});
   for (size_t i = 0; i < names.size(); ++i) {
-    writeFileBytes(dir + "/" + names[i], encodePng(pictures[i]));
+    const std::vector<uint8_t> png = encodePng(pictures[i]);
+    writeFileAtomically(dir + "/" + names[i], png.data(), png.size());
     summary->files.push_back(names[i]);
   }
 }
@@ -135,10 +136,8 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
   step("trajectory.txt");
   // The exact parameters the outputs were made with (a loaded map brings its own).
   attempt({"config.yaml"}, [&] {
-    std::ofstream out(dir + "/config.yaml");
-    out << configToYaml(PanmapConfig{mapper->config(), optimiser, options.sync});
-    out.close();
-    if (!out) throw Error("cannot write " + dir + "/config.yaml");
+    writeFileAtomically(dir + "/config.yaml",
+                        configToYaml(PanmapConfig{mapper->config(), optimiser, options.sync}));
     summary.files.push_back("config.yaml");
   });
   step("config.yaml");

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "panmap/core/error.h"
+#include "panmap/io/atomic_file.h"
 
 namespace panmap {
 namespace {
@@ -153,12 +154,7 @@ std::unique_ptr<octomap::OcTree> treeFromBtBytes(const std::string& bytes,
 }
 
 void writeBtFile(const octomap::OcTree& tree, const std::string& path) {
-  const std::string bytes = toBtBytes(tree);
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw Error(path + ": cannot open for writing");
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  out.close();
-  if (!out) throw Error(path + ": write failed");
+  writeFileAtomically(path, toBtBytes(tree));
 }
 
 std::unique_ptr<octomap::OcTree> readBtFile(const std::string& path) {

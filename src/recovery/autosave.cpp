@@ -1,8 +1,11 @@
 #include "panmap/recovery/autosave.h"
 
+#include <cerrno>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <regex>
 
@@ -167,12 +170,23 @@ void Autosaver::wait() {
 
 void Autosaver::clear() {
   wait();
-  for (const std::string& path : listResumeCandidates(config_.dir)) std::remove(path.c_str());
   if (journal_) std::fclose(journal_);
-  std::error_code ignored;  // the folder may have gone with the output folder it was in
-  std::filesystem::create_directories(config_.dir, ignored);
-  journal_ = std::fopen((config_.dir + "/frames.journal").c_str(), "w");  // emptied
-  if (!journal_) throw Error("cannot reopen " + config_.dir + "/frames.journal");
+  journal_ = nullptr;  // frames after this are not journaled: nothing is left to resume from
+  clearAutosaveFolder(config_.dir);
+}
+
+void clearAutosaveFolder(const std::string& dir) {
+  std::vector<std::string> paths = listResumeCandidates(dir);
+  paths.push_back(dir + "/frames.journal");
+  for (const std::string& path : paths) {
+    if (std::remove(path.c_str()) != 0 && errno != ENOENT) {
+      throw Error("cannot remove " + path + ": " + std::strerror(errno));
+    }
+  }
+  // The folder too, when nothing else is in it: an autosave/ left in a finished output folder
+  // with an empty journal read as a run that had not ended.
+  std::error_code ignored;
+  std::filesystem::remove(dir, ignored);
 }
 
 Autosaver::Stats Autosaver::stats() const {

@@ -86,7 +86,8 @@ TEST_F(CrashRecovery, OfflineKillThenResumeEqualsTheUninterruptedRun) {
   // Lost: what was mapped after the snapshot resumed from, at most one period (frames are 1/30 s
   // apart; a snapshot streamed but not yet renamed counts when its checksum holds).
   EXPECT_LE(report["resumed"]["lost_frame_ids"].size(), static_cast<size_t>(kPeriodS * 30 + 1));
-  EXPECT_TRUE(listAutosaves(out + "/autosave").empty());  // cleared once the outputs are safe
+  // Cleared once the outputs are safe, journal and folder included.
+  EXPECT_FALSE(fs::exists(out + "/autosave"));
 }
 
 TEST_F(CrashRecovery, LiveKillThenResumeMapsOnFromTheSnapshot) {
@@ -149,6 +150,7 @@ TEST_F(CrashRecovery, LiveKillThenResumeMapsOnFromTheSnapshot) {
   EXPECT_GT(before, 0);
   EXPECT_EQ(report["rejected"]["frame: mapped before the resume point"].get<int64_t>(), before);
   EXPECT_LE(report["resumed"]["lost_frame_ids"].size(), static_cast<size_t>(kPeriodS * 30 + 1));
+  EXPECT_FALSE(fs::exists(out + "/autosave"));  // snapshots, journal and folder: all cleared
 
   // The same snapshot continued offline over the log maps the same frames; when UDP delivered
   // every frame of the second replay the two maps are byte-identical.

@@ -207,18 +207,23 @@ TEST_F(BoxScene, AnOutputThatCannotBeWrittenCostsOnlyThatOutput) {
   EXPECT_FALSE(std::filesystem::exists(dir.path("out/snapshot_color.png")));
   EXPECT_EQ(Mapper::load(dir.path("out/map.panmap"))->framesIntegrated(), 3);
 
-  // A full disk shows when the last bytes are flushed, at close: small files (config.yaml,
-  // trajectory.txt, objects.json) were reported written while they stayed empty.
+  // A full disk: small files (config.yaml, trajectory.txt, objects.json) were once reported
+  // written while they stayed empty. Outputs go to NAME.partial first (renamed over NAME when
+  // whole), so that is where the full disk is met.
   if (!std::filesystem::exists("/dev/full")) return;
   std::filesystem::create_directories(dir.path("full"));
   for (const char* name : {"trajectory.txt", "config.yaml"}) {
-    std::filesystem::create_symlink("/dev/full", dir.path("full/") + name);
+    std::filesystem::create_symlink("/dev/full", dir.path("full/") + name + ".partial");
   }
   const OutputSummary full = writeOutputs(dir.path("full"), mapper.get(), &labels, {}, options);
   ASSERT_EQ(full.failed.size(), 2u);
   EXPECT_NE(full.failed[0].find("trajectory.txt"), std::string::npos) << full.failed[0];
   EXPECT_NE(full.failed[1].find("config.yaml"), std::string::npos) << full.failed[1];
   EXPECT_EQ(std::count(full.files.begin(), full.files.end(), "trajectory.txt"), 0);
+  for (const char* name : {"trajectory.txt", "config.yaml"}) {
+    const std::string partial = dir.path("full/") + name + ".partial";
+    EXPECT_FALSE(std::filesystem::exists(std::filesystem::symlink_status(partial))) << partial;
+  }
 }
 
 TEST_F(BoxScene, LiveMeshUpdatesAddUpToTheExportedMesh) {

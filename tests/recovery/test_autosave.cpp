@@ -68,6 +68,9 @@ TEST(Autosaver, SnapshotsEveryPeriodOfStreamTimeAndKeepsTheNewestTwo) {
   EXPECT_EQ(listAutosaves(dir.path())[0], autosavePath(dir.path(), 4));
   again.clear();
   EXPECT_TRUE(listAutosaves(dir.path()).empty());
+  // Nothing is left behind: an empty journal read as a run that had not finished.
+  EXPECT_FALSE(fs::exists(dir.path("frames.journal")));
+  EXPECT_FALSE(fs::exists(dir.path()));
 }
 
 // The loop-closure store is written behind the map on a thread of its own: a snapshot taken

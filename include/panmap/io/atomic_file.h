@@ -36,4 +36,12 @@ class AtomicFileWriter : public ByteSink {
   int fd_ = -1;
 };
 
+/// Writes SIZE bytes to PATH through an AtomicFileWriter, so a reader polling PATH (a planner
+/// reading objects.json or occupancy.bt while the mapper writes them) sees the old file or the
+/// whole new one, never a part. Throws Error "cannot write PATH: why"; PATH is then untouched.
+void writeFileAtomically(const std::string& path, const void* data, size_t size);
+
+/// writeFileAtomically of a string's bytes.
+void writeFileAtomically(const std::string& path, const std::string& bytes);
+
 }  // namespace panmap

@@ -47,8 +47,9 @@ struct PlyColumns {
   const std::vector<int32_t>* superpoint = nullptr;
 };
 
-/// writePly() of the given columns, in the same layout; streamed to the file in chunks of
-/// about 1 MiB, never held whole in memory. Throws Error naming the file when it cannot be
+/// writePly() of the given columns, in the same layout; streamed in chunks of about 1 MiB,
+/// never held whole in memory, to PATH.partial, renamed over PATH when complete (a reader of
+/// PATH sees the old mesh or the whole new one). Throws Error naming the file when it cannot be
 /// written, a column's length differs from the vertices', or a face index is out of range.
 void writePly(const std::string& path, const PlyColumns& columns,
               PlyFormat format = PlyFormat::kBinaryLittleEndian);

@@ -12,7 +12,8 @@ namespace panmap {
 /// malformed line, a non-finite value or a quaternion far from unit length.
 std::vector<StampedPose> readTumTrajectory(const std::string& path);
 
-/// Writes a TUM trajectory file (timestamps in seconds with 6 decimals).
+/// Writes a TUM trajectory file (timestamps in seconds with 6 decimals), replaced whole
+/// (writeFileAtomically).
 void writeTumTrajectory(const std::string& path, const std::vector<StampedPose>& trajectory);
 
 }  // namespace panmap

@@ -100,7 +100,8 @@ size_t keepObjectsOnMesh(const std::vector<int32_t>& mesh_instance,
 /// Writes objects.json: {"utime", "objects": [{"id", "class", "class_name", "confidence",
 /// "num_voxels", "centroid", "aabb_min", "aabb_max", "obb_center", "obb_orientation_wxyz",
 /// "obb_extent", "superpoints"}]} (panmap-eval --confidences reads id and confidence).
-/// Throws Error naming the file when it cannot be written.
+/// Replaces the file whole (writeFileAtomically). Throws Error naming the file when it cannot be
+/// written.
 void writeObjectsJson(const std::string& path, const std::vector<MappedObject>& objects,
                       int64_t utime);
 

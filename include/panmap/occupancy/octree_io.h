@@ -33,7 +33,8 @@ std::string toBtBytes(const octomap::OcTree& tree);
 /// @param what name of the source for messages (a path, "message")
 std::unique_ptr<octomap::OcTree> treeFromBtBytes(const std::string& bytes, const std::string& what);
 
-/// Writes a .bt file. Throws Error naming the path when it cannot be written.
+/// Writes a .bt file, replaced whole (writeFileAtomically). Throws Error naming the path when it
+/// cannot be written.
 void writeBtFile(const octomap::OcTree& tree, const std::string& path);
 
 /// Reads a .bt file. Throws Error naming the path when it is missing or malformed.

@@ -71,8 +71,8 @@ class Autosaver {
   void snapshotNow(const Mapper& mapper);
   /// Blocks until the snapshot in flight is on disk.
   void wait();
-  /// Removes the snapshots, partial ones and the journal (after the final outputs are safely
-  /// written).
+  /// Removes the snapshots, partial ones, the journal and the folder if that leaves it empty
+  /// (after the final outputs are safely written); later frames are not journaled.
   void clear();
   /// Counters so far (thread-safe).
   Stats stats() const;
@@ -105,5 +105,10 @@ std::vector<std::string> listAutosaves(const std::string& dir);
 /// behind. A process killed after streaming a snapshot but before its fsync and rename leaves
 /// a complete .partial (its checksum tells), which costs less than the previous snapshot.
 std::vector<std::string> listResumeCandidates(const std::string& dir);
+
+/// Removes what a finished run no longer needs from an autosave folder: its resume candidates,
+/// its journal and the folder itself when that leaves it empty. Throws Error naming a file that
+/// cannot be removed.
+void clearAutosaveFolder(const std::string& dir);
 
 }  // namespace panmap
