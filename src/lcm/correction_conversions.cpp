@@ -19,8 +19,8 @@ pose_correction_t toMessage(const PoseCorrection& correction) {
 PoseCorrection fromMessage(const pose_correction_t& msg) {
   const std::string what = "pose correction " + std::to_string(msg.correction_id);
   if (msg.num_poses < 0 || msg.poses.size() != static_cast<size_t>(msg.num_poses)) {
-    throw Error(what + ": " + std::to_string(msg.poses.size()) + " poses for num_poses " +
-                std::to_string(msg.num_poses));
+    throw Error(what + ": num_poses disagrees with the poses (" + std::to_string(msg.poses.size()) +
+                " poses for num_poses " + std::to_string(msg.num_poses) + ")");
   }
   PoseCorrection c;
   c.utime = msg.utime;

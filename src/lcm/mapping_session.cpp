@@ -31,10 +31,17 @@ std::string reasonOf(const std::string& what) {
   const auto colon = what.find(':');
   if (colon == std::string::npos) return what;
   // "rgbd frame 12: principal point ... lies outside ...": the head names one message, and
-  // counted by it every frame was a reason of its own and what was wrong was lost.
+  // counted by it every frame was a reason of its own and what was wrong was lost. Heads nest
+  // ("pose correction 7: pose 1100000: non-finite value").
   if (colon > 0 && std::isdigit(static_cast<unsigned char>(what[colon - 1]))) {
     const size_t rest = what.find_first_not_of(' ', colon + 1);
-    if (rest != std::string::npos) return what.substr(rest);
+    if (rest != std::string::npos) {
+      const std::string reason = what.substr(rest);
+      const auto next = reason.find(':');
+      const bool nested = next != std::string::npos && next > 0 &&
+                          std::isdigit(static_cast<unsigned char>(reason[next - 1]));
+      return nested ? reasonOf(reason) : reason;
+    }
   }
   return what.substr(0, colon);
 }
@@ -164,7 +171,11 @@ bool MappingSession::handle(const std::string& channel, const void* data, size_t
       sync_.addPanoptic(std::move(panoptic));
     }
   } catch (const Error& error) {
-    ++stats_.rejected["bad " + channel + ": " + reasonOf(error.what())];
+    std::string reason = reasonOf(error.what());
+    // A correction's checks end with the utimes they tripped on ("pose utimes must increase
+    // (1200000 after 1300000)"): counted by what went wrong, one key however many arrive.
+    if (channel == options_.channel_correction) reason = reason.substr(0, reason.find(" ("));
+    ++stats_.rejected["bad " + channel + ": " + reason];
     return true;
   }
   integrate(sync_.popReady(now_utime >= 0 ? now_utime : newest_utime_));

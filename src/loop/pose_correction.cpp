@@ -48,7 +48,7 @@ void PoseCorrection::check() const {
   for (size_t i = 0; i < poses.size(); ++i) {
     const StampedPose& p = poses[i];
     if (p.utime < -kMaxUtime || p.utime > kMaxUtime) {
-      throw Error(what + ": utime " + std::to_string(p.utime) + " is out of range");
+      throw Error(what + ": utime out of range (" + std::to_string(p.utime) + ")");
     }
     if (i > 0 && p.utime <= poses[i - 1].utime) {
       throw Error(what + ": pose utimes must increase (" + std::to_string(p.utime) + " after " +
@@ -56,7 +56,7 @@ void PoseCorrection::check() const {
     }
     std::string why;
     if (!isRigidTransform(p.T_W_C.matrix(), 1e-6, &why)) {
-      throw Error(what + ": pose at " + std::to_string(p.utime) + " is not rigid (" + why + ")");
+      throw Error(what + ": pose not rigid (at " + std::to_string(p.utime) + ": " + why + ")");
     }
   }
 }

@@ -403,6 +403,28 @@ TEST_F(MappingSessionTest, ACorrectionRepairsTheMapFromTheFrameStore) {
   EXPECT_EQ(after.rejected.at("malformed PANMAP_POSE_CORRECTION"), 1);
   EXPECT_EQ(test::mapBytes(mapper), before);
 
+  // Corrections that fail their checks are counted by what went wrong, not by the utimes they
+  // tripped on: a back-end sending them every second made a counter key each.
+  std::vector<test::Encoded> broken;
+  for (int k = 0; k < 4; ++k) {
+    pose_correction_t msg = toMessage(correction);
+    msg.correction_id = 10 + k;
+    msg.poses.push_back(msg.poses[0]);
+    msg.num_poses = static_cast<int32_t>(msg.poses.size());
+    if (k < 2) msg.poses[1].utime -= 1000 * (k + 1);  // utimes not increasing
+    if (k == 2) msg.poses[1].utime += 1000, msg.poses[1].position[0] = NAN;  // nested head
+    if (k == 3) msg.poses[1].utime = INT64_MAX - k;
+    broken.push_back(encodeMessage(kChannelPoseCorrection, msg));
+  }
+  feed(&session, broken);
+  const SessionStats counted = session.stats();
+  const std::string bad = "bad " + std::string(kChannelPoseCorrection) + ": ";
+  EXPECT_EQ(counted.rejected.at(bad + "pose utimes must increase"), 2);
+  EXPECT_EQ(counted.rejected.at(bad + "non-finite value"), 1);
+  EXPECT_EQ(counted.rejected.at(bad + "pose: utime out of range"), 1);
+  EXPECT_EQ(counted.rejected.size(), after.rejected.size() + 3);
+  EXPECT_EQ(test::mapBytes(mapper), before);
+
   // The map saved and loaded again with its store (a new session): correction 3 is in it, so
   // it is stale there too (applied again, an older correction would undo a repair).
   FrameStore reopened(temp.config());
