@@ -411,7 +411,9 @@ int main(int argc, char** argv) {
     std::unique_ptr<panmap::Mapper> mapper;
     std::optional<panmap::ResumePoint> resumed;
     if (!resume_dir.empty()) {
-      resumed = panmap::resumeFrom(autosaveDirOf(resume_dir));
+      // An export (or a final export cut short) may have written a map newer than the newest
+      // snapshot: the newer of the two is taken.
+      resumed = panmap::resumeFrom(autosaveDirOf(resume_dir), {resume_dir + "/map.panmap"});
       mapper = std::move(resumed->mapper);
       options.resume_after_utime = resumed->last_utime;
     } else if (!load_path.empty()) {
@@ -522,6 +524,18 @@ int main(int argc, char** argv) {
     if (autosave_s > 0.0 && !export_only) {
       panmap::Autosaver::Config autosave_config;
       autosave_config.dir = out_dir + "/autosave";
+      // Snapshots of a run that did not finish are what it mapped: a new run would clear them
+      // with its own at the end, so forgetting --resume once lost hours of map without a word.
+      const std::vector<std::string> leftover = panmap::listResumeCandidates(autosave_config.dir);
+      std::error_code error;
+      const bool resuming_them = resumed && std::filesystem::equivalent(autosaveDirOf(resume_dir),
+                                                                        autosave_config.dir, error);
+      if (!leftover.empty() && !resuming_them) {
+        throw panmap::Error(autosave_config.dir +
+                            " holds snapshots of a run that did not finish (" + leftover.front() +
+                            "): continue it with --resume " + out_dir + ", or remove " +
+                            autosave_config.dir + " to start a new map there");
+      }
       autosave_config.period_s = autosave_s;
       if (frame_store) {
         autosave_config.frame_stored = [store = frame_store.get()](int64_t utime) {
@@ -687,7 +701,10 @@ int main(int argc, char** argv) {
         done = "map saved to " + path;
       } else {
         const std::string dir = argument.empty() ? out_dir : argument;
-        panmap::requireAllWritten(panmap::writeOutputs(dir, m, labels, optimiser, output_options),
+        panmap::OutputOptions export_options = output_options;
+        // Stamped with the newest frame mapped, as the final export and PANMAP_OBJECTS are.
+        export_options.utime = m->trajectory().empty() ? 0 : m->trajectory().back().utime;
+        panmap::requireAllWritten(panmap::writeOutputs(dir, m, labels, optimiser, export_options),
                                   dir);
         done = "outputs written to " + dir;
       }

@@ -143,7 +143,18 @@ void Autosaver::snapshotNow(const Mapper& mapper) {
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<AtomicFileWriter> file;
   try {
-    // Created in here: a folder gone or a full disk fails the snapshot, not the frame.
+    // Created in here: a folder gone or a full disk fails the snapshot, not the frame. A folder
+    // removed under a running mapper (its output folder deleted, then made again by an export)
+    // is made again, journal included: without, every later snapshot failed.
+    std::error_code ignored;
+    if (std::filesystem::create_directories(config_.dir, ignored) && journal_) {
+      std::fclose(journal_);
+      journal_ = std::fopen((config_.dir + "/frames.journal").c_str(), "a");
+      if (journal_) {
+        std::fprintf(journal_, "# folder made again, next snapshot %" PRId64 "\n", next_number_);
+        std::fflush(journal_);
+      }
+    }
     file = std::make_unique<AtomicFileWriter>(autosavePath(config_.dir, next_number_++));
     mapper.serialize(file.get());
   } catch (const std::exception& e) {

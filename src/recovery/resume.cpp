@@ -1,5 +1,7 @@
 #include "panmap/recovery/resume.h"
 
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -34,9 +36,32 @@ std::vector<std::pair<int64_t, int64_t>> journalAfter(const std::string& path, i
 
 }  // namespace
 
-ResumePoint resumeFrom(const std::string& dir) {
-  const std::vector<std::string> snapshots = listResumeCandidates(dir);
-  if (snapshots.empty()) throw Error(dir + ": no autosave-NNNNNN.panmap snapshot to resume from");
+ResumePoint resumeFrom(const std::string& dir, const std::vector<std::string>& also) {
+  std::vector<std::string> snapshots = listResumeCandidates(dir);
+  // A map file written after the newest snapshot holds more: a mapper killed while it wrote
+  // its final outputs had map.panmap whole (written first), and resuming from the snapshot
+  // before it lost every frame since and then overwrote it. Snapshots of one run grow with
+  // time, so the newest file is the fullest; ties keep the snapshots' order.
+  std::vector<std::pair<std::filesystem::file_time_type, std::string>> dated;
+  for (const std::string& path : snapshots) {
+    std::error_code error;
+    dated.emplace_back(std::filesystem::last_write_time(path, error), path);
+  }
+  for (const std::string& path : also) {
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(path, error)) continue;
+    dated.emplace_back(std::filesystem::last_write_time(path, error), path);
+  }
+  std::stable_sort(dated.begin(), dated.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  snapshots.clear();
+  for (const auto& [time, path] : dated) snapshots.push_back(path);
+  if (snapshots.empty()) {
+    throw Error(dir + ": no autosave-NNNNNN.panmap snapshot to resume from" +
+                (also.empty() ? std::string() : " and no " + also.front()) +
+                " (a run stopped before its first snapshot saved nothing: start it without "
+                "--resume)");
+  }
   ResumePoint point;
   for (const std::string& path : snapshots) {
     try {

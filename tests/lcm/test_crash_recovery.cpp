@@ -72,6 +72,19 @@ TEST_F(CrashRecovery, OfflineKillThenResumeEqualsTheUninterruptedRun) {
   ASSERT_TRUE(mapper.wait(10));
   ASSERT_FALSE(fs::exists(out + "/report.json")) << "the run ended before the kill";
 
+  // Run again into the same folder without --resume: refused, the snapshots untouched (a new
+  // run cleared them with its own at its end, and hours of map went without a word).
+  const std::vector<std::string> snapshots = listResumeCandidates(out + "/autosave");
+  const test::CommandResult fresh =
+      test::runCommand(binPath("panmap-mapper") + " -q --no-snapshots --log " + log() + " --out " +
+                       out + " --autosave-s " + std::to_string(kPeriodS));
+  EXPECT_EQ(fresh.exit_code, 1) << fresh.output;
+  EXPECT_NE(fresh.output.find("holds snapshots of a run that did not finish"), std::string::npos)
+      << fresh.output;
+  EXPECT_NE(fresh.output.find("continue it with --resume " + out), std::string::npos)
+      << fresh.output;
+  EXPECT_EQ(listResumeCandidates(out + "/autosave"), snapshots);
+
   const test::CommandResult resumed = test::runCommand(
       binPath("panmap-mapper") + " -q --no-snapshots --resume " + out + " --log " + log());
   ASSERT_EQ(resumed.exit_code, 0) << resumed.output;

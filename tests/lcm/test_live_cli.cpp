@@ -18,6 +18,7 @@
 #include "panmap/io/ply.h"
 #include "panmap/io/tum_trajectory.h"
 #include "panmap/mapper/mapper.h"
+#include "panmap/mapper/objects.h"
 #include "panmap/status_t.hpp"
 #include "test_helpers.h"
 
@@ -133,6 +134,11 @@ TEST_F(LiveCli, LogplayerToMapperAndOptimiserOverUdp) {
             std::string::npos)
       << exported.output;
   EXPECT_TRUE(std::filesystem::is_regular_file(dir_->path("midway/mesh_instance.ply")));
+  // Its objects.json is stamped with the newest frame mapped, as the final one is (an export
+  // wrote utime 0: a planner could not tell which map state it held).
+  int64_t objects_utime = 0;
+  readObjectsJson(dir_->path("midway/objects.json"), &objects_utime);
+  EXPECT_EQ(objects_utime, readTumTrajectory(dir_->path("midway/trajectory.txt")).back().utime);
   // As a user ends a replay: finish returns when the outputs are written.
   const test::CommandResult finish = test::runCommand(command + "finish");
   EXPECT_EQ(finish.exit_code, 0) << finish.output;

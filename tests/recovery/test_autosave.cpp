@@ -2,6 +2,7 @@
 // resuming from the newest snapshot that loads (past a corrupt one) exactly as if never
 // interrupted.
 #include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 
@@ -132,6 +133,23 @@ TEST(Autosaver, TheLastSnapshotsFailureIsKnownUntilOneSucceeds) {
   autosaver.wait();
   EXPECT_FALSE(autosaver.stats().last_failed);
   EXPECT_EQ(autosaver.stats().written, 1);
+  // The folder removed under the running mapper (with the output folder around it): the next
+  // snapshot makes it again, and the journal goes on in it (every later snapshot failed).
+  fs::remove_all(dir.path("auto"));
+  integrate(&mapper, s, 1);
+  autosaver.afterFrame(mapper, s.frames[1].frame_id, s.frames[1].utime);
+  autosaver.snapshotNow(mapper);
+  autosaver.wait();
+  EXPECT_FALSE(autosaver.stats().last_failed);
+  EXPECT_EQ(autosaver.stats().written, 2);
+  EXPECT_EQ(listAutosaves(dir.path("auto")).size(), 1u);
+  integrate(&mapper, s, 2);
+  autosaver.afterFrame(mapper, s.frames[2].frame_id, s.frames[2].utime);
+  const std::string journal = test::fileBytes(dir.path("auto/frames.journal"));
+  EXPECT_NE(
+      journal.find(std::to_string(s.frames[2].frame_id) + " " + std::to_string(s.frames[2].utime)),
+      std::string::npos)
+      << journal;
 }
 
 TEST(Resume, SkipsACorruptSnapshotListsLostFramesAndContinuesExactly) {
@@ -196,6 +214,38 @@ TEST(Resume, TakesACompletePartialSnapshotAndRefusesACutOne) {
   EXPECT_EQ(listAutosaves(dir.path())[0], autosavePath(dir.path(), 4));
   again.clear();
   EXPECT_TRUE(listResumeCandidates(dir.path()).empty());
+}
+
+TEST(Resume, AMapFileNewerThanTheSnapshotsIsTaken) {
+  // A mapper killed while it wrote its final outputs had map.panmap whole (it goes first):
+  // resuming from the snapshot before it lost every frame since, then overwrote it.
+  test::TempDir dir;
+  mapWithAutosave(dir.path("autosave"));
+  const test::SyntheticStream& s = test::syntheticStream();
+  Mapper whole(test::streamMapperConfig());
+  for (size_t k = 0; k < s.frames.size(); ++k) integrate(&whole, s, k);
+  const std::string map = dir.path("map.panmap");
+  whole.save(map);
+  const auto snapshot_time = fs::last_write_time(autosavePath(dir.path("autosave"), 3));
+  fs::last_write_time(map, snapshot_time + std::chrono::seconds(1));
+  ResumePoint point = resumeFrom(dir.path("autosave"), {map});
+  EXPECT_EQ(point.path, map);
+  EXPECT_EQ(point.frames, 12);
+  EXPECT_TRUE(point.lost.empty());  // the journal holds no frame after its newest
+  EXPECT_EQ(test::mapBytes(*point.mapper), test::mapBytes(whole));
+  // An older map file (a finished run's, before this run's snapshots) is not taken.
+  fs::last_write_time(map, snapshot_time - std::chrono::seconds(1));
+  point = resumeFrom(dir.path("autosave"), {map});
+  EXPECT_EQ(point.path, autosavePath(dir.path("autosave"), 3));
+  EXPECT_EQ(point.frames, 10);
+  // Nothing but the map file: it is taken (an export's map, before the first snapshot).
+  for (const std::string& path : listResumeCandidates(dir.path("autosave"))) fs::remove(path);
+  EXPECT_EQ(resumeFrom(dir.path("autosave"), {map}).path, map);
+  // Neither: one error that says what to do.
+  fs::remove(map);
+  test::expectError([&] { resumeFrom(dir.path("autosave"), {map}); },
+                    {"no autosave-NNNNNN.panmap snapshot to resume from and no " + map,
+                     "start it without --resume"});
 }
 
 TEST(Resume, NoLoadableSnapshotIsOneClearError) {

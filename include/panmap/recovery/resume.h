@@ -26,9 +26,11 @@ struct ResumePoint {
 /// Loads the newest snapshot of an autosave folder that reads cleanly, a complete .partial one
 /// included (a corrupt or truncated newer one is refused with its error and the next older
 /// one tried; the checksum tells a complete partial file from a cut one), and reads the frame
-/// journal to list the frames lost since it. Throws Error naming the folder when no snapshot
-/// loads, listing each one's error.
-ResumePoint resumeFrom(const std::string& dir);
+/// journal to list the frames lost since it. `also`: other map files that may be newer (the
+/// output folder's map.panmap, written by an export or a final export cut short after the last
+/// snapshot); those that exist join the snapshots, newest modification time first. Throws Error
+/// naming the folder when nothing loads, listing each one's error.
+ResumePoint resumeFrom(const std::string& dir, const std::vector<std::string>& also = {});
 
 /// One line for users: the snapshot, its frames, and the frames lost ("frames 812-845").
 std::string describeResume(const ResumePoint& point);
