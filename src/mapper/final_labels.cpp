@@ -34,27 +34,27 @@ int32_t largestInitialInstance(const SuperpointGraph& graph) {
 
 GraphLabels fitLabelsToMap(const GraphLabels& labels, int32_t graph_largest_instance,
                            const SuperpointTracker& tracker) {
-  bool clash = false;
+  // The frame-count ids given since the graph was taken move above every id of the answer, by
+  // an offset fixed by the answer alone. Moving the answer's ids above the tracker's instead
+  // renumbered the optimiser's objects at every publish (the tracker keeps giving ids), and the
+  // ids they left were given to other objects: a planner's object changed its identity.
+  int32_t answer_largest = graph_largest_instance;
+  for (const auto& [superpoint, instance] : labels.instance) {
+    answer_largest = std::max(answer_largest, instance);
+  }
+  for (const auto& [id, confidence] : labels.instance_confidence) {
+    answer_largest = std::max(answer_largest, id);
+  }
+  for (const auto& [id, evidence] : labels.instance_evidence) {
+    answer_largest = std::max(answer_largest, id);
+  }
+  const int32_t shift = answer_largest - graph_largest_instance;
+  GraphLabels out = labels;
+  if (shift == 0) return out;
   for (const auto& [superpoint, state] : tracker.states()) {
     if (labels.instance.count(superpoint)) continue;
-    if (state.instance() > graph_largest_instance) {
-      clash = true;
-      break;
-    }
-  }
-  if (!clash) return labels;
-  // Above every id the tracker has given, so no frame-count instance can have it.
-  const int32_t shift = std::max(0, tracker.numInstances() - graph_largest_instance);
-  const auto moved = [&](int32_t id) { return id > graph_largest_instance ? id + shift : id; };
-  GraphLabels out = labels;
-  for (auto& [superpoint, instance] : out.instance) instance = moved(instance);
-  out.instance_confidence.clear();
-  for (const auto& [id, confidence] : labels.instance_confidence) {
-    out.instance_confidence[moved(id)] = confidence;
-  }
-  out.instance_evidence.clear();
-  for (const auto& [id, evidence] : labels.instance_evidence) {
-    out.instance_evidence[moved(id)] = evidence;
+    const int32_t id = state.instance();
+    if (id > graph_largest_instance) out.instance[superpoint] = id + shift;
   }
   return out;
 }

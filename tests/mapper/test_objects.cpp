@@ -206,7 +206,7 @@ TEST(Objects, SquareFootprintGetsItsTightYaw) {
 // makeTracker() gave instances up to 9; the optimiser's graph was taken when the largest was 7,
 // and it made instances 8 and 9 of its own. Super-point 3, made since and not named, counts
 // frame instance 9: reported as they are, it and the optimiser's 9 would be one object.
-TEST(FitLabels, InstancesTheOptimiserMadeMoveAboveEveryFrameCountId) {
+TEST(FitLabels, FrameCountIdsGivenSinceTheGraphMoveAboveTheAnswers) {
   const TsdfMap map = makeMap();
   const SuperpointTracker tracker = makeTracker();
   GraphLabels labels;
@@ -216,21 +216,40 @@ TEST(FitLabels, InstancesTheOptimiserMadeMoveAboveEveryFrameCountId) {
   labels.instance_evidence[9].area_m2 = 2.0f;
   const GraphLabels fitted = fitLabelsToMap(labels, 7, tracker);
   EXPECT_EQ(fitted.semantic, labels.semantic);
-  EXPECT_EQ(fitted.instance, (std::map<int32_t, int32_t>{{1, 10}, {2, 11}}));
-  EXPECT_EQ(fitted.instance_confidence, (std::map<int32_t, float>{{10, 0.25f}, {11, 0.5f}}));
+  // The answer's ids as it gave them; super-point 3's 9 moved by 9 - 7 = 2 (the answer's
+  // largest id less the graph's); super-point 5 has no instance, 4 is part of 1.
+  EXPECT_EQ(fitted.instance, (std::map<int32_t, int32_t>{{1, 8}, {2, 9}, {3, 11}}));
+  EXPECT_EQ(fitted.instance_confidence, labels.instance_confidence);
   ASSERT_EQ(fitted.instance_evidence.size(), 1u);
-  EXPECT_EQ(fitted.instance_evidence.at(11).area_m2, 2.0f);
+  EXPECT_EQ(fitted.instance_evidence.at(9).area_m2, 2.0f);
   std::vector<int32_t> ids;
   for (const MappedObject& o : computeObjects(map, tracker, &fitted)) ids.push_back(o.id);
-  EXPECT_EQ(ids, (std::vector<int32_t>{9, 10, 11}));
+  EXPECT_EQ(ids, (std::vector<int32_t>{8, 9, 11}));
   // Unfitted, super-point 3 joins the optimiser's instance 9.
   ids.clear();
   for (const MappedObject& o : computeObjects(map, tracker, &labels)) ids.push_back(o.id);
   EXPECT_EQ(ids, (std::vector<int32_t>{8, 9}));
 }
 
-// Kept frame-count ids (at most the graph's largest) never move, and without an unnamed
-// super-point above the graph's largest instance nothing does.
+// One answer, published again and again while the tracker gives more ids: every id stays (they
+// moved above the tracker's newest id at each publish, and the ids they left went to other
+// objects).
+TEST(FitLabels, AnAnswersIdsStayWhileTheTrackerGivesMore) {
+  SuperpointTracker tracker = makeTracker();
+  GraphLabels labels;
+  labels.instance = {{1, 8}, {2, 9}};
+  labels.instance_confidence = {{8, 0.25f}, {9, 0.5f}};
+  const GraphLabels first = fitLabelsToMap(labels, 7, tracker);
+  SuperpointTracker::Snapshot later = tracker.snapshot();
+  later.next_instance = 40;
+  tracker.restore(later);
+  const GraphLabels again = fitLabelsToMap(labels, 7, tracker);
+  EXPECT_EQ(again.instance, first.instance);
+  EXPECT_EQ(again.instance_confidence, first.instance_confidence);
+}
+
+// Kept frame-count ids (at most the graph's largest) never move, and when the answer made no id
+// above the graph's, nothing does.
 TEST(FitLabels, WithoutAClashTheLabelsStayAsTheyAre) {
   const SuperpointTracker tracker = makeTracker();
   GraphLabels labels;
@@ -240,10 +259,14 @@ TEST(FitLabels, WithoutAClashTheLabelsStayAsTheyAre) {
   const GraphLabels fitted = fitLabelsToMap(labels, 9, tracker);
   EXPECT_EQ(fitted.instance, labels.instance);
   EXPECT_EQ(fitted.instance_confidence, labels.instance_confidence);
-  // Super-point 3 unnamed, its frame instance 9 above a graph whose largest was 8: 10 moves.
+  // Super-point 3 unnamed, its frame instance 9 above a graph whose largest was 8: it moves
+  // above the answer's 10.
   labels.instance.erase(3);
   EXPECT_EQ(fitLabelsToMap(labels, 8, tracker).instance,
-            (std::map<int32_t, int32_t>{{1, 7}, {2, 11}}));
+            (std::map<int32_t, int32_t>{{1, 7}, {2, 10}, {3, 11}}));
+  labels.instance = {{1, 7}};
+  labels.instance_confidence = {{7, 0.5f}};
+  EXPECT_EQ(fitLabelsToMap(labels, 8, tracker).instance, labels.instance);
 }
 
 TEST(Objects, OptimisedLabelsOverrideFrameCounts) {

@@ -28,9 +28,9 @@ int32_t largestInitialInstance(const SuperpointGraph& graph);
 /// since (new frames, or a loop-closure repair that numbered them anew) are not named and keep
 /// their frame-count labels, whose instance ids may reach above the graph's; an instance the
 /// optimiser made could then share an id with one of them, and the two would be reported as one
-/// object. When some unnamed live super-point has such an id, every instance the optimiser made
-/// moves above all the tracker has given (confidences and evidence with it); otherwise the
-/// labels are returned as they are.
+/// object. So those frame-count ids move above every id of the answer, by an offset the answer
+/// alone fixes (its largest id less the graph's): the optimiser's ids stay as it gave them, and
+/// stay the same at every publish of one answer, however many ids the tracker gives meanwhile.
 GraphLabels fitLabelsToMap(const GraphLabels& labels, int32_t graph_largest_instance,
                            const SuperpointTracker& tracker);
 
