@@ -59,6 +59,7 @@ nlohmann::json sessionJson(const panmap::SessionStats& s) {
           {"geometry_only_frames", s.sync.geometry_only},
           {"geometry_only_queue_full", s.sync.geometry_only_queue_full},
           {"unmatched_panoptic", s.sync.unmatched_panoptic},
+          {"panoptic_of_skipped_frames", s.sync.panoptic_of_skipped_frames},
           {"late_panoptic", s.sync.late_panoptic},
           {"panoptic_time_offset", s.sync.panoptic_time_offset},
           {"timings", timings},

@@ -100,7 +100,17 @@ void LiveMapper::post(Item item) {
         // Newest data is worth more to a robot than a backlog: push the oldest frame out.
         for (auto it = queue_.begin(); it != queue_.end(); ++it) {
           if (it->channel == options_.session.channel_rgbd) {
-            queue_.erase(it);
+            // Its mask is dropped with it, not counted as one that matched no frame (whose
+            // warning blamed the masks' timestamps): the session hears of the drop in order.
+            // The utime is the message's first field, after LCM's 8-byte fingerprint.
+            if (it->bytes.size() >= 16) {
+              uint64_t bits = 0;
+              for (int k = 8; k < 16; ++k) bits = (bits << 8) | it->bytes[k];
+              const int64_t utime = static_cast<int64_t>(bits);
+              *it = Item{"", {}, [this, utime](Mapper*) { session_.skipFrame(utime); }};
+            } else {
+              queue_.erase(it);
+            }
             --queued_frames_;
             ++dropped_frames_;
             break;

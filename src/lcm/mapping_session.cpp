@@ -146,6 +146,7 @@ bool MappingSession::handle(const std::string& channel, const void* data, size_t
         stats_.resume_point_seen =
             stats_.resume_point_seen || frame.utime == options_.resume_after_utime;
         ++stats_.rejected["frame: mapped before the resume point"];
+        sync_.skipFrame(frame.utime);  // its mask is no timing fault
         return true;
       }
       newest_utime_ = std::max(newest_utime_, frame.utime);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <iterator>
 
 #include "panmap/core/error.h"
 
@@ -42,9 +43,46 @@ void FrameSynchronizer::addPose(const StampedPose& pose) {
   if (!poses_.emplace(pose.utime, pose).second) ++stats_.repeated_poses;
 }
 
+void FrameSynchronizer::skipFrame(int64_t utime) {
+  skipped_.insert(utime);
+  // At most the masks a network sends while frames wait: older skips can have no mask to come.
+  constexpr size_t kMaxSkipped = 4096;
+  while (skipped_.size() > kMaxSkipped) skipped_.erase(skipped_.begin());
+  const int64_t tolerance = config_.mask_tolerance_us;
+  for (auto it = panoptics_.lower_bound(utime - tolerance);
+       it != panoptics_.end() && it->first <= utime + tolerance;) {
+    if (ofSkippedFrame(it->first)) {
+      ++stats_.panoptic_of_skipped_frames;
+      it = panoptics_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
+bool FrameSynchronizer::ofSkippedFrame(int64_t utime) const {
+  const int64_t tolerance = config_.mask_tolerance_us;
+  const auto it = skipped_.lower_bound(utime - tolerance);
+  if (it == skipped_.end() || *it > utime + tolerance) return false;
+  // The nearest skipped frame, unless a waiting frame is nearer: that one keeps the mask.
+  int64_t skipped_gap = std::abs(*it - utime);
+  const auto next = std::next(it);
+  if (next != skipped_.end() && *next <= utime + tolerance) {
+    skipped_gap = std::min(skipped_gap, std::abs(*next - utime));
+  }
+  for (const RgbdFrame& f : frames_) {
+    if (std::abs(f.utime - utime) < skipped_gap) return false;
+  }
+  return true;
+}
+
 void FrameSynchronizer::addPanoptic(PanopticFrame panoptic) {
   const int64_t utime = panoptic.utime;
   newest_mask_ = std::max(newest_mask_, utime);
+  if (ofSkippedFrame(utime)) {
+    ++stats_.panoptic_of_skipped_frames;
+    return;
+  }
   // Frames go in utime order: a handled frame at or after utime - tolerance is this mask's
   // frame (or one past it), mapped or refused already.
   if (newest_handled_ >= utime - config_.mask_tolerance_us) {
@@ -154,10 +192,15 @@ std::vector<SyncedFrame> FrameSynchronizer::popReady(int64_t now_utime) {
   for (auto it = panoptics_.begin();
        it != panoptics_.end() &&
        (newest_handled_ >= it->first - tolerance || it->first + tolerance < expired);) {
-    ++stats_.unmatched_panoptic;
-    stats_.last_unmatched_gap_us = nearestFrameGap(it->first);
+    if (ofSkippedFrame(it->first)) {
+      ++stats_.panoptic_of_skipped_frames;
+    } else {
+      ++stats_.unmatched_panoptic;
+      stats_.last_unmatched_gap_us = nearestFrameGap(it->first);
+    }
     it = panoptics_.erase(it);
   }
+
   const int64_t oldest = frames_.empty() ? expired : frames_.front().utime;
   prunePoses(oldest - config_.max_pose_gap_us);
   return ready;

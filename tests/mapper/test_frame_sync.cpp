@@ -162,6 +162,30 @@ TEST(FrameSync, AMaskAfterItsFrameWasMappedIsLate) {
   EXPECT_EQ(sync.stats().late_panoptic, 1);
 }
 
+// Frames the caller drops (a full input queue) or refuses (mapped before a resume point) never
+// reach the synchroniser, their masks do: counted as masks of skipped frames, not as masks that
+// matched no frame (whose warning blamed the masks' timestamps, once per dropped frame).
+TEST(FrameSync, MasksOfSkippedFramesAreNoTimingFault) {
+  FrameSynchronizer sync{SyncConfig{}};
+  sync.addPanoptic(maskAt(100 * kMs + 2 * kMs));  // held before its frame is skipped
+  sync.skipFrame(100 * kMs);
+  sync.skipFrame(200 * kMs);
+  sync.addPanoptic(maskAt(200 * kMs));  // arrives after
+  sync.addPose(poseAt(300 * kMs));
+  sync.addFrame(frameAt(300 * kMs));
+  sync.skipFrame(303 * kMs);  // a waiting frame nearer its mask keeps it
+  sync.addPanoptic(maskAt(301 * kMs, 9));
+  sync.addPanoptic(maskAt(400 * kMs));  // a mask whose frame never came at all
+  std::vector<SyncedFrame> out = sync.popReady(300 * kMs);
+  ASSERT_EQ(out.size(), 1u);
+  ASSERT_TRUE(out[0].panoptic.has_value());
+  EXPECT_EQ(out[0].panoptic->frame_id, 9);
+  EXPECT_EQ(sync.stats().panoptic_of_skipped_frames, 2);
+  sync.flush();
+  EXPECT_EQ(sync.stats().unmatched_panoptic, 1);
+  EXPECT_EQ(sync.stats().panoptic_of_skipped_frames, 2);
+}
+
 TEST(FrameSync, ConfigChecksNameTheField) {
   SyncConfig bad;
   bad.mask_tolerance_us = -1;

@@ -116,6 +116,9 @@ class MappingSession {
   /// Maps what is still waiting at the end of the stream (frames with a pose), rejects the rest,
   /// and waits for a background repair to finish.
   void flush();
+  /// Says the frame at `utime` was dropped before it reached the session (a full input queue):
+  /// its mask is counted with it, not as a mask that matched no frame.
+  void skipFrame(int64_t utime) { sync_.skipFrame(utime); }
   /// Swaps in a background repair that has caught up with the map (also done after every
   /// message; call it when no message comes for a while).
   void poll();

@@ -4,6 +4,7 @@
 #include <deque>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,9 @@ struct SyncStats {
   int64_t late_panoptic = 0;        ///< masks arriving after their frame was mapped or refused
   /// Masks matched to a frame whose utime differs from theirs (within mask_tolerance_us).
   int64_t panoptic_time_offset = 0;
+  /// Masks of frames the caller skipped (skipFrame(): dropped behind, or mapped before a
+  /// resume point): not a timing fault, so not among unmatched_panoptic.
+  int64_t panoptic_of_skipped_frames = 0;
   /// How far the last unmatched mask's utime was from the nearest frame's (-1: no frame yet).
   int64_t last_unmatched_gap_us = -1;
 };
@@ -89,6 +93,10 @@ class FrameSynchronizer {
   /// repeated utime keeps the first, a mask whose frame was already handled is dropped (both
   /// counted).
   void addPanoptic(PanopticFrame panoptic);
+  /// Says the frame at `utime` will not come (the caller dropped or refused it): its mask,
+  /// held or still to come, is dropped and counted as panoptic_of_skipped_frames, not as a mask
+  /// that matched no frame (whose warning blamed the masks' timestamps).
+  void skipFrame(int64_t utime);
 
   /// Frames ready at stream time `now_utime` (the newest utime seen, or the wall clock),
   /// oldest first. Frames that waited too long for a pose are rejected and counted.
@@ -108,11 +116,14 @@ class FrameSynchronizer {
   int64_t nearestFrameGap(int64_t utime) const;
   /// The held mask nearest `utime` within the tolerance, or panoptics_.end().
   std::map<int64_t, PanopticFrame>::iterator maskFor(int64_t utime);
+  /// A skipped frame within the mask tolerance of `utime`.
+  bool ofSkippedFrame(int64_t utime) const;
 
   SyncConfig config_;
   std::deque<RgbdFrame> frames_;
   std::map<int64_t, StampedPose> poses_;
   std::map<int64_t, PanopticFrame> panoptics_;
+  std::set<int64_t> skipped_;           ///< utimes of skipped frames whose masks may still come
   int64_t newest_handled_ = INT64_MIN;  ///< utime of the newest frame mapped or refused
   int64_t newest_mask_ = INT64_MIN;     ///< utime of the newest mask received
   SyncStats stats_;
