@@ -814,7 +814,8 @@ int main(int argc, char** argv) {
       node.publishFinished(false, e.what());
       throw;
     }
-    node.publishFinished(true, "outputs written to " + out_dir);
+    node.publishFinished(true, "outputs written to " + out_dir +
+                                   (labels ? "" : " (unoptimised: frame-count labels)"));
     std::printf(
         "mapped %lld of %lld frames received (%lld dropped behind) in %.1f s: %zu "
         "super-points, %zu instances%s, %zu mesh vertices; outputs in %s\n",

@@ -254,6 +254,7 @@ void LiveMapper::publishFinished(bool ok, const std::string& result) {
 
 void LiveMapper::requestOptimisation() {
   const int64_t request = ++request_id_;
+  unanswered_requests_ = request_id_ - std::max(labels_request_id_, request_base_);
   const std::string graph_channel = options_.channel_graph;
   post(Item{"", {}, [this, request, graph_channel](Mapper* mapper) {
               const SuperpointGraph taken = mapper->graph();
@@ -300,6 +301,7 @@ void LiveMapper::onLabels(const lcm::ReceiveBuffer* buffer, const std::string& c
     }
     labels_ = fromMessage(msg);
     labels_request_id_ = msg.request_id;
+    unanswered_requests_ = request_id_ - labels_request_id_;
   } catch (const std::exception& e) {
     countRejected("bad " + channel);
     std::fprintf(stderr, "panmap-mapper: labels ignored: %s\n", e.what());
@@ -404,6 +406,14 @@ status_t LiveMapper::status(const std::string& state) const {
   msg.depth_pattern_mm = std::isfinite(pattern_m) ? static_cast<float>(1000.0 * pattern_m) : -1.0f;
   if (warning_source_) msg.warnings = warning_source_();
   for (std::string& w : syncWarnings(s, options_.session.sync)) msg.warnings.push_back(w);
+  // One request may be on its way; two or more without an answer mean no optimiser listens.
+  if (const int64_t unanswered = unanswered_requests_; unanswered >= 2) {
+    msg.warnings.push_back("optimiser: no answer to the last " + std::to_string(unanswered) +
+                           " graph requests on " + options_.channel_graph +
+                           " (is panmap-optimizer running on this LCM URL?); labels from frame "
+                           "counts since its last answer");
+  }
+  if (!waiting_for_labels_.empty()) msg.warnings.push_back(waiting_for_labels_);
   msg.num_warnings = static_cast<int32_t>(msg.warnings.size());
   {
     std::lock_guard<std::mutex> lock(command_mutex_);
@@ -482,8 +492,10 @@ std::optional<GraphLabels> LiveMapper::requestLabels(const std::atomic<bool>& st
   const auto seconds = [](double s) {
     return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
   };
-  const auto deadline = Clock::now() + seconds(options_.optimiser_timeout_s);
+  const auto start = Clock::now();
+  const auto deadline = start + seconds(options_.optimiser_timeout_s);
   auto next_send = Clock::now();
+  int sent = 0;
   publishStatus("optimising");
   while (!stop && Clock::now() < deadline) {
     if (Clock::now() >= next_send) {
@@ -492,10 +504,25 @@ std::optional<GraphLabels> LiveMapper::requestLabels(const std::atomic<bool>& st
       lcm_->publish(options_.channel_graph, &graph);
       ++graph_requests_sent_;
       next_send = Clock::now() + seconds(options_.optimiser_retry_s);
+      if (++sent > 1) {
+        // Said on the status channel too: it went silent for the whole timeout.
+        char text[200];
+        std::snprintf(text, sizeof(text),
+                      "optimiser: no answer to the final graph after %.0f s; the outputs get "
+                      "frame-count labels after %.0f s",
+                      std::chrono::duration<double>(Clock::now() - start).count(),
+                      options_.optimiser_timeout_s);
+        waiting_for_labels_ = text;
+        publishStatus("optimising");
+      }
     }
     lcm_->handleTimeout(50);
-    if (labels_ && labels_request_id_ == request) return labels_;
+    if (labels_ && labels_request_id_ == request) {
+      waiting_for_labels_.clear();
+      return labels_;
+    }
   }
+  waiting_for_labels_.clear();
   return std::nullopt;
 }
 

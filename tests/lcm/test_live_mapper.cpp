@@ -466,6 +466,45 @@ TEST(LiveMapper, FramesAfterFinishAreCountedNotLost) {
   EXPECT_EQ(live.status("done").frames_rejected, rejected);
 }
 
+// No optimiser on the bus: the status said nothing while mapping and went silent for the whole
+// wait at the end. Two requests without an answer, and every resend at the end, are named.
+TEST(LiveMapper, AnOptimiserThatDoesNotAnswerIsNamedOnTheStatus) {
+  const test::SyntheticStream& stream = test::syntheticStream();
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  StatusInbox inbox;
+  lcm.subscribe("PANMAP_STATUS", &StatusInbox::onStatus, &inbox);
+  LiveOptions options = testOptions();
+  options.optimiser_retry_s = 0.1;
+  Mapper mapper(test::streamMapperConfig());
+  LiveMapper live(&lcm, options, &mapper);
+  publishAll(&lcm, stream.messages());
+  publishCommand(&lcm, command_t::COMMAND_OPTIMISE);
+  EXPECT_EQ(live.status("mapping").num_warnings, 0);
+  publishCommand(&lcm, command_t::COMMAND_OPTIMISE);
+  publishCommand(&lcm, command_t::COMMAND_FINISH);
+  std::atomic<bool> stop{false};
+  EXPECT_TRUE(live.run(stop));
+  live.drain();
+  const status_t mapping = live.status("mapping");
+  ASSERT_EQ(mapping.num_warnings, 1);
+  EXPECT_NE(mapping.warnings[0].find("optimiser: no answer to the last 2 graph requests on "
+                                     "PANMAP_GRAPH (is panmap-optimizer running"),
+            std::string::npos)
+      << mapping.warnings[0];
+  inbox.received.clear();
+  EXPECT_FALSE(live.requestLabels(stop).has_value());
+  while (lcm.handleTimeout(0) > 0) {
+  }
+  int waiting = 0;
+  for (const status_t& s : inbox.received) {
+    for (const std::string& w : s.warnings) {
+      waiting += w.find("optimiser: no answer to the final graph after") != std::string::npos;
+    }
+  }
+  EXPECT_GE(waiting, 1);  // resent every 0.1 s for 0.5 s: each resend says so
+}
+
 TEST(LiveMapper, TheStatusCarriesTheWarningsOfItsSource) {
   lcm::LCM lcm("memq://");
   Mapper mapper(test::streamMapperConfig());

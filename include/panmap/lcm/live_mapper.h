@@ -232,6 +232,11 @@ class LiveMapper {
   std::optional<GraphLabels> labels_;
   int64_t labels_request_id_ = -1;
   int64_t graph_requests_sent_ = 0;
+  // Graph requests sent since the last answer (set on the LCM thread, read by status()): an
+  // optimiser that is not running was never mentioned while mapping.
+  std::atomic<int64_t> unanswered_requests_{0};
+  // While finish() waits for the final labels (main thread, worker gone): what status() says.
+  std::string waiting_for_labels_;
 };
 
 }  // namespace panmap
