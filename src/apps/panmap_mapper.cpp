@@ -712,25 +712,29 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "panmap-mapper: %s\n", done.c_str());
       return done;
     });
-    node.setPeriodicPublisher(
-        [&live, &optimiser](panmap::Mapper* m, int64_t utime, const panmap::GraphLabels* labels) {
-          std::vector<panmap::OutgoingMessage> out;
-          out.push_back(panmap::encodeMessage(
-              live.channel_objects,
-              panmap::toMessage(panmap::computeObjects(*m, labels, optimiser.objects), utime)));
-          if (m->occupancy()) {
-            panmap::octomap_t tree;
-            tree.utime = utime;
-            tree.resolution_m = m->occupancy()->resolution();
-            tree.tree_type = "OcTree";
-            tree.binary = true;
-            const std::string data = m->occupancy()->toBinaryData();
-            tree.data.assign(data.begin(), data.end());
-            tree.size = static_cast<int32_t>(tree.data.size());
-            out.push_back(panmap::encodeMessage(live.channel_octomap, tree));
-          }
-          return out;
-        });
+    // Objects and occupancy for planners: every publish period, and once more after the final
+    // export with objects.json's own objects (the channels never carried the final map).
+    auto planner_messages = [&live](const panmap::Mapper& m, int64_t utime,
+                                    const std::vector<panmap::MappedObject>& objects) {
+      std::vector<panmap::OutgoingMessage> out;
+      out.push_back(panmap::encodeMessage(live.channel_objects, panmap::toMessage(objects, utime)));
+      if (m.occupancy()) {
+        panmap::octomap_t tree;
+        tree.utime = utime;
+        tree.resolution_m = m.occupancy()->resolution();
+        tree.tree_type = "OcTree";
+        tree.binary = true;
+        const std::string data = m.occupancy()->toBinaryData();
+        tree.data.assign(data.begin(), data.end());
+        tree.size = static_cast<int32_t>(tree.data.size());
+        out.push_back(panmap::encodeMessage(live.channel_octomap, tree));
+      }
+      return out;
+    };
+    node.setPeriodicPublisher([&planner_messages, &optimiser](panmap::Mapper* m, int64_t utime,
+                                                              const panmap::GraphLabels* labels) {
+      return planner_messages(*m, utime, panmap::computeObjects(*m, labels, optimiser.objects));
+    });
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
     std::fprintf(stderr,
@@ -814,6 +818,7 @@ int main(int argc, char** argv) {
       node.publishFinished(false, e.what());
       throw;
     }
+    node.publishNow(planner_messages(*mapper, final_options.utime, outputs.object_list));
     node.publishFinished(true, "outputs written to " + out_dir +
                                    (labels ? "" : " (unoptimised: frame-count labels)"));
     std::printf(

@@ -354,6 +354,13 @@ void LiveMapper::refreshScanIfIdle() {
   }
 }
 
+void LiveMapper::publishNow(const std::vector<OutgoingMessage>& messages) {
+  if (worker_.joinable()) throw Error("publishNow: drain() first");
+  for (const OutgoingMessage& m : messages) {
+    lcm_->publish(m.channel, m.bytes.data(), static_cast<unsigned int>(m.bytes.size()));
+  }
+}
+
 void LiveMapper::publishOutbox() {
   std::vector<OutgoingMessage> out;
   {

@@ -119,6 +119,7 @@ OutputSummary writeOutputs(const std::string& dir, Mapper* mapper, const GraphLa
     summary.objects_off_mesh = keepObjectsOnMesh(mesh_instances, &objects);
     writeObjectsJson(dir + "/objects.json", objects, options.utime);
     summary.objects = objects.size();
+    summary.object_list = objects;
     summary.files.push_back("objects.json");
   });
   step("objects.json");

@@ -103,6 +103,9 @@ class LiveMapper {
 
   /// Sets what is published every publish_period_s.
   void setPeriodicPublisher(Publisher publisher) { publisher_ = std::move(publisher); }
+  /// Publishes messages at once, on the calling thread; after drain() (the final objects and
+  /// occupancy, so a planner on the channels gets what the output files hold).
+  void publishNow(const std::vector<OutgoingMessage>& messages);
   /// Sets what the status's warnings are (called with each status, on the worker thread):
   /// problems mapping survives that an operator must hear of, e.g. autosaves that fail.
   void setWarningSource(std::function<std::vector<std::string>()> source) {

@@ -8,6 +8,7 @@
 #include "panmap/graph/optimiser.h"
 #include "panmap/mapper/frame_sync.h"
 #include "panmap/mapper/mapper.h"
+#include "panmap/mapper/objects.h"
 
 namespace panmap {
 
@@ -30,6 +31,8 @@ struct OutputSummary {
   double mesh_area_m2 = 0.0;     ///< LabelledMesh::surfaceArea()
   size_t instances_in_mesh = 0;  ///< distinct instance ids > 0 on mesh vertices
   size_t objects = 0;            ///< entries of objects.json
+  /// objects.json's objects: a live mapper publishes them once more after its final export.
+  std::vector<MappedObject> object_list;
   /// Instances left out of objects.json because no vertex of mesh_instance.ply carries them
   /// (a thin piece whose surface the mesh labels by its neighbour's voxels).
   size_t objects_off_mesh = 0;
