@@ -748,6 +748,24 @@ int main(int argc, char** argv) {
                  by_command ? "finish command" : "signal");
     node.drain();
     const double wall_s = msSince(start) / 1000.0;
+    // Empty outputs and exit 0 would pass a wrong URL or channel name off as a map, as offline.
+    if (mapper->framesIntegrated() == 0) {
+      const panmap::SessionStats nothing = node.stats();
+      std::string why =
+          std::to_string(node.framesReceived()) + " frames received on " + options.channel_rgbd;
+      for (const auto& [reason, count] : nothing.rejected) {
+        why += "; " + reason + " (" + std::to_string(count) + ")";
+      }
+      for (const std::string& w : panmap::syncWarnings(nothing, options.sync)) {
+        std::fprintf(stderr, "panmap-mapper: warning: %s\n", w.c_str());
+      }
+      const std::string error = "no frame mapped (" + why + "): is the camera publishing on " +
+                                (lcm_url.empty() ? std::string("LCM's default URL") : lcm_url) +
+                                "? nothing written";
+      node.publishFinished(false, error);
+      finishAutosave();  // its journal holds no frame: nothing to resume
+      throw panmap::Error(error);
+    }
     g_stop = false;  // a second Ctrl-C cuts the wait for labels short
     std::fprintf(stderr,
                  "panmap-mapper: waiting up to %.0f s for panmap-optimizer's labels (Ctrl-C "

@@ -270,5 +270,34 @@ TEST_F(LiveCli, AFinishThatCannotWriteKeepsTheMap) {
   EXPECT_EQ(Mapper::load(out + "/map.panmap")->framesIntegrated(), rescued->framesIntegrated());
 }
 
+// A live mapper that never got a frame (a wrong URL, or started after the camera stopped)
+// wrote an empty map and exited 0 after waiting for labels of an empty graph; as offline, it
+// now ends with exit 1 and one line saying why, and writes nothing.
+TEST_F(LiveCli, AFinishWithoutAFrameMappedFailsAndSaysWhy) {
+  const std::string url = "udpm://239.255.76.67:7687?ttl=0&recv_buf_size=16777216";
+  if (!test::multicastWorks(url)) GTEST_SKIP() << test::kNoMulticast;
+  const std::string out = dir_->path("empty");
+  test::ChildProcess mapper(
+      {test::binPath("panmap-mapper"), "--lcm-url", url, "--out", out, "--voxel-size", "0.04"},
+      dir_->path("empty.log"));
+  lcm::LCM lcm(url);
+  test::StatusWatch watch;
+  lcm.subscribe("PANMAP_STATUS", &test::StatusWatch::onStatus, &watch);
+  for (int i = 0; i < 100 && watch.received == 0; ++i) lcm.handleTimeout(100);
+  ASSERT_GT(watch.received, 0) << test::fileBytes(dir_->path("empty.log"));
+  const std::string command = test::binPath("panmap-command") + " -q --lcm-url '" + url + "' ";
+  const test::CommandResult finish = test::runCommand(command + "finish");
+  EXPECT_EQ(finish.exit_code, 1) << finish.output;
+  EXPECT_NE(finish.output.find("no frame mapped (0 frames received on CAMERA_RGBD)"),
+            std::string::npos)
+      << finish.output;
+  ASSERT_TRUE(mapper.wait(30)) << test::fileBytes(dir_->path("empty.log"));
+  EXPECT_EQ(mapper.exitCode(), 1);
+  const std::string log_text = test::fileBytes(dir_->path("empty.log"));
+  EXPECT_EQ(log_text.find("waiting up to"), std::string::npos) << log_text;  // no labels asked
+  EXPECT_FALSE(std::filesystem::exists(out + "/map.panmap"));
+  EXPECT_FALSE(std::filesystem::exists(out + "/autosave"));
+}
+
 }  // namespace
 }  // namespace panmap
