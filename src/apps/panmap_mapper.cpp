@@ -531,6 +531,7 @@ int main(int argc, char** argv) {
       std::error_code error;
       const bool resuming_them = resumed && std::filesystem::equivalent(autosaveDirOf(resume_dir),
                                                                         autosave_config.dir, error);
+      if (resuming_them) autosave_config.resumed_from = resumed->path;
       if (!leftover.empty() && !resuming_them) {
         throw panmap::Error(autosave_config.dir +
                             " holds snapshots of a run that did not finish (" + leftover.front() +

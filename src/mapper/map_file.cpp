@@ -588,6 +588,13 @@ uint64_t readHeader(BinaryReader* header, size_t total_bytes, const std::string&
   }
   const uint64_t size = header->get<uint64_t>();
   const size_t after = total_bytes - kHeaderBytes;
+  if (size == 0 && after > sizeof(uint32_t)) {
+    // serialize() fills the size in last: a writer stopped part way (a snapshot's .partial
+    // file after a kill) left it 0, which read as an "overlong" file announcing 24 bytes.
+    throw Error(path + ": unfinished map file (" + std::to_string(total_bytes) +
+                " bytes; its writer stopped before the end, the header's size was never filled "
+                "in)");
+  }
   if (size > after || after - size != sizeof(uint32_t)) {
     throw Error(path + ": " + (size + sizeof(uint32_t) > after ? "truncated" : "overlong") +
                 " map file (" + std::to_string(total_bytes) +

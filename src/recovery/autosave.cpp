@@ -76,6 +76,14 @@ Autosaver::Autosaver(const Config& config) : config_(config) {
   if (ec) throw Error("cannot create autosave folder " + config_.dir + ": " + ec.message());
   const auto existing = numberedAutosaves(config_.dir, true);
   if (!existing.empty()) next_number_ = existing.front().first + 1;
+  if (!config_.resumed_from.empty()) {
+    for (const auto& [number, path] : existing) {
+      const bool partial = path.size() > 8 && path.compare(path.size() - 8, 8, ".partial") == 0;
+      std::error_code error;  // spelt differently, the resumed file must still be kept
+      const bool resumed = std::filesystem::equivalent(path, config_.resumed_from, error);
+      if (partial && !error && !resumed) std::remove(path.c_str());
+    }
+  }
   const std::string journal = config_.dir + "/frames.journal";
   journal_ = std::fopen(journal.c_str(), "a");
   if (!journal_) throw Error("cannot open " + journal);

@@ -205,10 +205,17 @@ TEST(Resume, TakesACompletePartialSnapshotAndRefusesACutOne) {
   EXPECT_EQ(point.path, autosavePath(dir.path(), 2));
   ASSERT_EQ(point.refused.size(), 1u);
   EXPECT_NE(point.refused[0].find(".partial: truncated map file"), std::string::npos);
-  // A new run numbers its snapshots after the leftover, and clears it at the end.
+  // A new run numbers its snapshots after the leftover, and clears it at the end. Resumed, it
+  // removes the partial files of earlier crashes but the one it resumed from.
+  const std::string older_partial = autosavePath(dir.path(), 1) + ".partial";
+  fs::copy_file(autosavePath(dir.path(), 2), older_partial);
   Autosaver::Config config;
   config.dir = dir.path();
+  config.resumed_from = point.path;
   Autosaver again(config);
+  EXPECT_FALSE(fs::exists(newest + ".partial"));  // the cut one
+  EXPECT_FALSE(fs::exists(older_partial));
+  EXPECT_TRUE(fs::exists(point.path));
   again.snapshotNow(*point.mapper);
   again.wait();
   EXPECT_EQ(listAutosaves(dir.path())[0], autosavePath(dir.path(), 4));
@@ -284,6 +291,13 @@ TEST(MapFile, CorruptionIsNamedWithFileAndOffset) {
   EXPECT_EQ(error(bytes), "m.panmap: checksum mismatch over bytes 20-" + std::to_string(size - 4) +
                               " (corrupt map file)");
   EXPECT_NE(error({'P', 'A', 'N'}).find("m.panmap: truncated"), std::string::npos);
+  // Cut while it was written (a snapshot's .partial after a kill): the size, filled in last, is
+  // still 0. It read as "overlong ... announces 24".
+  std::vector<uint8_t> unfinished(bytes.begin(), bytes.begin() + static_cast<long>(size / 2));
+  for (size_t k = 12; k < 20; ++k) unfinished[k] = 0;
+  EXPECT_EQ(error(unfinished), "m.panmap: unfinished map file (" + std::to_string(size / 2) +
+                                   " bytes; its writer stopped before the end, the header's size "
+                                   "was never filled in)");
 }
 
 // load() streams the file (parsing as it reads, the checksum compared at the end) instead of

@@ -35,6 +35,10 @@ class Autosaver {
     std::function<bool(int64_t utime)> frame_stored;
     /// How long a snapshot waits for the store before it is taken anyway (counted).
     double store_wait_s = 30.0;
+    /// The file a resumed run loaded (ResumePoint::path), or empty. The other .partial files of
+    /// the folder, left by earlier crashes, are removed at the start: they piled up, crash
+    /// after crash, until a run finished (85 MB after three).
+    std::string resumed_from;
     /// Throws Error naming the bad field.
     void check() const;
   };
