@@ -1,5 +1,6 @@
 #include "panmap/lcm/live_mapper.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -398,7 +399,15 @@ status_t LiveMapper::status(const std::string& state) const {
   msg.num_blocks = static_cast<int64_t>(mapper_->map().numBlocks());
   msg.num_voxels = msg.num_blocks * kBlockVoxels;
   msg.num_superpoints = static_cast<int32_t>(mapper_->superpoints().states().size());
-  msg.num_instances = mapper_->superpoints().numInstances();
+  // Instances some live super-point holds (the tracker's numInstances() is the largest id it
+  // has given, 451 where a room had 27-44 objects).
+  std::vector<int32_t> instances;
+  for (const auto& [superpoint, state] : mapper_->superpoints().states()) {
+    if (state.instance() > 0) instances.push_back(state.instance());
+  }
+  std::sort(instances.begin(), instances.end());
+  msg.num_instances =
+      static_cast<int32_t>(std::unique(instances.begin(), instances.end()) - instances.begin());
   msg.vote_evictions = static_cast<int64_t>(mapper_->voteEvictions());
   msg.corrections_applied = s.corrections_applied;
   msg.last_correction_id = s.last_correction_id;

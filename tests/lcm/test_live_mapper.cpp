@@ -5,6 +5,7 @@
 
 #include <fstream>
 #include <iterator>
+#include <set>
 
 #include "panmap/command_t.hpp"
 #include "panmap/graph/optimiser.h"
@@ -130,6 +131,11 @@ TEST(LiveMapper, MapsLikeTheSessionAndAnswersStatus) {
   ASSERT_EQ(last.num_reject_reasons, 1);
   EXPECT_EQ(last.reject_reasons[0], "malformed CAMERA_POSE");
   EXPECT_EQ(last.num_superpoints, static_cast<int32_t>(mapper.superpoints().states().size()));
+  std::set<int32_t> instances;  // distinct instances held, not the largest id given
+  for (const auto& [superpoint, state] : mapper.superpoints().states()) {
+    if (state.instance() > 0) instances.insert(state.instance());
+  }
+  EXPECT_EQ(last.num_instances, static_cast<int32_t>(instances.size()));
   EXPECT_GT(last.num_blocks, 0);
   EXPECT_GT(last.memory_bytes, 0);
   EXPECT_GE(last.num_stages, 5);
