@@ -6,10 +6,35 @@
 #include "panmap/core/error.h"
 #include "panmap/io/dataset_reader.h"
 #include "panmap/io/image_codec.h"
+#include "panmap/io/timestamps.h"
+#include "panmap/io/tum_trajectory.h"
 #include "test_helpers.h"
 
 namespace panmap {
 namespace {
+
+// Times counted from the start of a recording in us or ns are small numbers that read as
+// seconds by magnitude: frames 33,333 s apart, and nothing matched. The step between rows
+// tells their unit.
+TEST(Timestamps, RelativeTimesInFinerUnitsAreJudgedByTheirStep) {
+  EXPECT_STREQ(timestampUnitOf({0, 33333333, 66666667, 100000000}).name, "nanoseconds");
+  EXPECT_STREQ(timestampUnitOf({0, 33333, 66667, 100000}).name, "microseconds");
+  EXPECT_STREQ(timestampUnitOf({0, 500, 1000, 1500}).name, "milliseconds");  // 2 Hz keyframes
+  EXPECT_STREQ(timestampUnitOf({0, 33, 67, 100}).name, "seconds");  // ms at 30 Hz: not told
+  EXPECT_STREQ(timestampUnitOf({0, 3, 6, 9}).name, "seconds");      // frame numbers
+  EXPECT_STREQ(timestampUnitOf({1305031102.175, 1305031102.211}).name, "seconds");
+  EXPECT_STREQ(timestampUnitOf({1305031102175.0, 1305031102211.0}).name, "milliseconds");
+  EXPECT_STREQ(timestampUnitOf({}).name, "seconds");
+  EXPECT_STREQ(timestampUnitOf({5.0, 5.0, 5.0}).name, "seconds");  // no step at all
+  test::TempDir dir;
+  std::ofstream(dir.path("t.txt")) << "0 0 0 0 0 0 0 1\n"
+                                      "33333333 0.1 0 0 0 0 0 1\n"
+                                      "66666667 0.2 0 0 0 0 0 1\n";
+  const std::vector<StampedPose> poses = readTumTrajectory(dir.path("t.txt"));
+  ASSERT_EQ(poses.size(), 3u);
+  EXPECT_EQ(poses[1].utime, 33333);
+  EXPECT_EQ(poses[2].utime, 66667);
+}
 
 TEST(Tum, AssociatesByNearestTimestamp) {
   const auto reader = openDataset(test::fixtureDir("tum_tiny"), DatasetOptions{});

@@ -8,7 +8,9 @@ namespace panmap {
 
 /// The unit of a column of timestamps, judged by its largest magnitude: Unix times in seconds
 /// stay below 1e11 (the year 5138), so a larger one is in ms, us or ns (ROS bags, EuRoC CSVs
-/// and phone exports write those as integers).
+/// and phone exports write those as integers). Below that, by the median step between rows:
+/// more than 100 s between a camera's frames is a finer unit (times counted from the start of a
+/// recording in us or ns; in ms at 30 Hz the step, 33, still reads as seconds).
 struct TimestampUnit {
   double seconds_per_unit = 1.0;
   const char* name = "seconds";
