@@ -252,7 +252,7 @@ int main(int argc, char** argv) {
                  done.result.c_str());
     return 1;
   }
-  std::printf("panmap-command: %s: %s; panmap-mapper is %s, %lld frames integrated\n",
+  std::printf("panmap-command: %s: %s; panmap-mapper is %s, %lld frames integrated by this run\n",
               command.c_str(), done.result.c_str(), done.mapper_state.c_str(),
               static_cast<long long>(done.frames_integrated));
   return 0;
