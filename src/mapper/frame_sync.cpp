@@ -200,7 +200,6 @@ std::vector<SyncedFrame> FrameSynchronizer::popReady(int64_t now_utime) {
     }
     it = panoptics_.erase(it);
   }
-
   const int64_t oldest = frames_.empty() ? expired : frames_.front().utime;
   prunePoses(oldest - config_.max_pose_gap_us);
   return ready;
