@@ -1,5 +1,7 @@
 #include "panmap/lcm/live_mapper.h"
 
+#include <lcm/lcm_coretypes.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -103,11 +105,11 @@ void LiveMapper::post(Item item) {
           if (it->channel == options_.session.channel_rgbd) {
             // Its mask is dropped with it, not counted as one that matched no frame (whose
             // warning blamed the masks' timestamps): the session hears of the drop in order.
-            // The utime is the message's first field, after LCM's 8-byte fingerprint.
-            if (it->bytes.size() >= 16) {
-              uint64_t bits = 0;
-              for (int k = 8; k < 16; ++k) bits = (bits << 8) | it->bytes[k];
-              const int64_t utime = static_cast<int64_t>(bits);
+            // The utime is the message's first field, after LCM's 8-byte fingerprint: LCM's
+            // own decoder reads it without decoding the images.
+            int64_t utime = 0;
+            if (__int64_t_decode_array(it->bytes.data(), 8, static_cast<int>(it->bytes.size()),
+                                       &utime, 1) > 0) {
               *it = Item{"", {}, [this, utime](Mapper*) { session_.skipFrame(utime); }};
             } else {
               queue_.erase(it);

@@ -350,6 +350,10 @@ TEST(LiveMapper, FullQueueDropsTheOldestFramesAndCountsThem) {
   EXPECT_EQ(live.framesReceived(), n);
   EXPECT_EQ(stats.frames_integrated + live.framesDropped(), n);
   EXPECT_GE(stats.frames_integrated, 1);
+  // The dropped frames' masks go with them, not among masks that matched no frame.
+  EXPECT_GT(live.framesDropped(), 0);
+  EXPECT_EQ(stats.sync.panoptic_of_skipped_frames, live.framesDropped());
+  EXPECT_EQ(stats.sync.unmatched_panoptic, 0);
 }
 
 TEST(LiveMapper, OptimiserAnswersAndItsAbsenceTimesOut) {
