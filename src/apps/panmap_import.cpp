@@ -88,6 +88,19 @@ int main(int argc, char** argv) {
   app.add_option("--poses", options.dataset.poses_path,
                  "folder and tum layouts: camera-to-world poses, a TUM file, a matrix per line "
                  "(12 or 16 numbers), stacked 4x4 matrices, or a folder of per-frame 4x4 files");
+  std::string pose_convention = "auto", quaternion_order = "auto", pose_unit = "auto";
+  app.add_option("--pose-convention", pose_convention,
+                 "how the pose file is written: camera-to-world, world-to-camera, or auto (told "
+                 "from the depth of frame pairs, for pose files of the folder layout or --poses)")
+      ->check(CLI::IsMember({"auto", "camera-to-world", "world-to-camera"}))
+      ->capture_default_str();
+  app.add_option("--quaternion-order", quaternion_order,
+                 "a TUM-style pose file's quaternion: xyzw (TUM's 'qx qy qz qw'), wxyz, or auto")
+      ->check(CLI::IsMember({"auto", "xyzw", "wxyz"}))
+      ->capture_default_str();
+  app.add_option("--pose-unit", pose_unit, "the pose file's translations: m, cm, mm, or auto")
+      ->check(CLI::IsMember({"auto", "m", "cm", "mm"}))
+      ->capture_default_str();
   app.add_option("--depth-scale", depth_scale,
                  "metres per depth unit (e.g. 0.001 for mm); default: the layout's convention, "
                  "for the folder layout detected from the values (mm or 1/5000 m)")
@@ -148,6 +161,15 @@ int main(int argc, char** argv) {
       if (!options.dataset.intrinsics) options.dataset.intrinsics_file = intrinsics;
     }
     if (depth_scale > 0.0) options.dataset.depth_scale_m = depth_scale;
+    if (pose_convention != "auto") {
+      options.pose_convention.inverted = pose_convention == "world-to-camera";
+    }
+    if (quaternion_order != "auto") options.pose_convention.wxyz = quaternion_order == "wxyz";
+    if (pose_unit != "auto") {
+      options.pose_convention.translation_scale = pose_unit == "m"    ? 1.0
+                                                  : pose_unit == "cm" ? 0.01
+                                                                      : 0.001;
+    }
     options.dataset.pairing = pairing == "name"   ? panmap::FramePairing::kName
                               : pairing == "time" ? panmap::FramePairing::kTime
                                                   : panmap::FramePairing::kAuto;

@@ -195,15 +195,17 @@ void writeJson(const std::string& path, const nlohmann::json& json) {
 }
 
 // Frames mapped into no surface at all: wrong depth units, intrinsics or pose units look
-// exactly like this, and an exit 0 with an empty map would hide them.
-void warnIfNoSurface(const panmap::Mapper& mapper, size_t mesh_vertices) {
-  if (mesh_vertices > 0 || mapper.framesIntegrated() == 0) return;
+// exactly like this. An exit 0 with an empty map would pass a script's check, so it is a
+// failure (the outputs stay written, for a look). Returns the exit code.
+int failIfNoSurface(const panmap::Mapper& mapper, size_t mesh_vertices) {
+  if (mesh_vertices > 0 || mapper.framesIntegrated() == 0) return 0;
   const panmap::IntegratorConfig& c = mapper.config().integrator;
   std::fprintf(stderr,
-               "panmap-mapper: warning: %lld frames mapped but no surface came of them: no depth "
+               "panmap-mapper: error: %lld frames mapped but no surface came of them: no depth "
                "within %.2f-%.2f m, or frames that do not overlap (check the depth scale, the "
                "intrinsics and the poses' units)\n",
                static_cast<long long>(mapper.framesIntegrated()), c.min_depth_m, c.max_depth_m);
+  return 1;
 }
 
 // report.json last: a failure to write it is one more failed output, named with the others.
@@ -248,8 +250,8 @@ int main(int argc, char** argv) {
       "panmap mapping process. Live (default): maps CAMERA_RGBD + CAMERA_POSE + PANOPTIC from "
       "LCM until PANMAP_COMMAND finish or Ctrl-C, then asks panmap-optimizer for the final "
       "labels. Offline (--log): maps a log as fast as it can, optimising in-process. Both write "
-      "mesh_{semantic,instance,superpoint}.ply, map.panmap, report.json, config.yaml and "
-      "snapshot PNGs into --out."};
+      "mesh_{semantic,instance,superpoint}.ply, objects.json, occupancy.bt, trajectory.txt, "
+      "map.panmap, report.json, config.yaml and snapshot PNGs into --out (README, panmap-mapper)."};
   std::string log_path, out_dir, load_path, config_path, lcm_url;
   panmap::MapperConfig config;
   panmap::LiveOptions live;
@@ -668,8 +670,7 @@ int main(int argc, char** argv) {
       }
       printRefinement(report.refinement);
       printDepthCheck(*mapper);
-      warnIfNoSurface(*mapper, outputs.mesh_vertices);
-      return 0;
+      return failIfNoSurface(*mapper, outputs.mesh_vertices);
     }
 
     // Live: LCM in, LCM out. Repairs run beside the mapping: frames keep coming meanwhile.
@@ -853,8 +854,7 @@ int main(int argc, char** argv) {
     }
     printRefinement(stats.refinement);
     printDepthCheck(*mapper);
-    warnIfNoSurface(*mapper, outputs.mesh_vertices);
-    return 0;
+    return failIfNoSurface(*mapper, outputs.mesh_vertices);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-mapper: error: %s\n", e.what());
     return 1;

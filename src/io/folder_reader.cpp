@@ -176,6 +176,9 @@ class FolderReader : public DatasetReader {
            ")";
   }
   std::vector<std::string> notes() const override { return notes_; }
+  bool posesAreQuaternions() const override {
+    return !pose_folder_ && list_.format == PoseList::Format::kTum;
+  }
 
   DatasetFrame read(size_t index) const override {
     const Frame& f = frames_.at(index);

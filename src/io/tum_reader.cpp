@@ -143,6 +143,7 @@ class TumReader : public DatasetReader {
 
   std::string layoutName() const override { return "tum"; }
   std::vector<std::string> notes() const override { return notes_; }
+  bool posesAreQuaternions() const override { return true; }
   size_t size() const override { return pairs_.size(); }
   size_t unmatchedFrames() const override { return unmatched_; }
 

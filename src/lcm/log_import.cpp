@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -48,6 +49,44 @@ bool fitMaskToColour(LabelImage* mask, const DatasetFrame& frame, bool resize,
   return true;
 }
 
+// How the user's pose file is written, from the depth of frame pairs: 8 frames spread over the
+// import, each with partners 3, 10 and 30 frames later (0.1 to 1 s at 30 Hz), so that some
+// pairs see the camera move while still overlapping. Frames that cannot be read or have no
+// pose are left out here; the import itself reports them.
+PoseConventionVerdict checkPoseConvention(const DatasetReader& reader, size_t total,
+                                          const PoseConventionChoice& fixed) {
+  constexpr size_t kBases = 8;
+  constexpr size_t kGaps[] = {3, 10, 30};
+  std::map<size_t, int> sample_of;
+  std::vector<PoseSample> samples;
+  auto sampleOf = [&](size_t index) {
+    const auto found = sample_of.find(index);
+    if (found != sample_of.end()) return found->second;
+    int sample = -1;
+    try {
+      DatasetFrame frame = reader.read(index);
+      if (frame.T_W_C) {
+        frame.rgbd.color = ColorImage();
+        samples.push_back(PoseSample{std::move(frame.rgbd), *frame.T_W_C});
+        sample = static_cast<int>(samples.size()) - 1;
+      }
+    } catch (const Error&) {
+    }
+    sample_of.emplace(index, sample);
+    return sample;
+  };
+  std::vector<std::pair<int, int>> pairs;
+  for (size_t b = 0; b < kBases; ++b) {
+    const size_t base = b * total / kBases;
+    for (const size_t gap : kGaps) {
+      if (base + gap >= total) continue;
+      const int first = sampleOf(base), second = sampleOf(base + gap);
+      if (first >= 0 && second >= 0) pairs.emplace_back(first, second);
+    }
+  }
+  return detectPoseConvention(samples, pairs, reader.posesAreQuaternions(), fixed);
+}
+
 }  // namespace
 
 ImportStats importDataset(const std::string& dataset_dir, const std::string& log_path,
@@ -81,6 +120,21 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
   stats.notes = reader->notes();
   const size_t total =
       options.max_frames ? std::min(options.max_frames, reader->size()) : reader->size();
+  // Pose files the user brings are checked against depth; a dataset's own follow its documented
+  // convention unless the user says otherwise.
+  const PoseConventionChoice& fixed = options.pose_convention;
+  const bool user_poses = options.dataset.layout == DatasetLayout::kFolder ||
+                          stats.layout == "folder" || !options.dataset.poses_path.empty();
+  PoseConvention convention;
+  if (user_poses) {
+    stats.pose_convention = checkPoseConvention(*reader, total, fixed);
+    convention = stats.pose_convention->convention;
+    stats.notes.push_back(stats.pose_convention->note);
+  } else {
+    convention.translation_scale = fixed.translation_scale.value_or(1.0);
+    convention.wxyz = fixed.wxyz.value_or(false);
+    convention.inverted = fixed.inverted.value_or(false);
+  }
 
   // Write beside the target and rename at the end: a failed import leaves no partial log.
   const std::string partial = log_path + ".partial";
@@ -111,8 +165,7 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
       if (!frame.T_W_C) {
         if (!skip_invalid) {
           throw Error(frame.pose_problem +
-                      " (to leave such frames out: ImportOptions::InvalidPose::kSkip, "
-                      "panmap-import --invalid-poses skip)");
+                      " (to leave such frames out: panmap-import --invalid-poses skip)");
         }
         if (stats.first_skip_reason.empty()) stats.first_skip_reason = frame.pose_problem;
         ++stats.skipped_invalid_pose;
@@ -134,7 +187,7 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
       StampedPose pose;
       pose.utime = utime;
       pose.frame_id = frame.rgbd.frame_id;
-      pose.T_W_C = *frame.T_W_C;
+      pose.T_W_C = convention.isIdentity() ? *frame.T_W_C : convention.apply(*frame.T_W_C);
       pose.source = options.pose_source;
       stats.recorded_poses.push_back(pose);
       if (options.pose_filter) pose.T_W_C = options.pose_filter(pose.T_W_C);

@@ -66,7 +66,7 @@ TEST(Cli, OptimizerRefusesChannelsThatCannotWork) {
 TEST(Cli, MapperChecksTheOutputFolderFirst) {
   test::TempDir dir;
   std::ofstream(dir.path("file")) << "x";
-  for (const std::string out : {dir.path("file"), dir.path("file/map")}) {
+  for (const std::string& out : {dir.path("file"), dir.path("file/map")}) {
     const auto r = runCommand(binPath("panmap-mapper") + " --log " + dir.path("absent.lcmlog") +
                               " --out " + out);
     EXPECT_EQ(r.exit_code, 1);
@@ -180,8 +180,9 @@ TEST(Cli, ALoadedMapSkipsItsFramesAndKeepsItsSettings) {
 }
 
 // Depth in the wrong units (here read as metres per unit: every point kilometres away) mapped
-// into an empty map with exit 0 and no word; it says so now.
-TEST(Cli, MapperWarnsWhenFramesGiveNoSurface) {
+// into an empty map with exit 0 and no word; it says so now, and exits 1 (a script checking
+// the exit code took the empty map for a success).
+TEST(Cli, MapperFailsWhenFramesGiveNoSurface) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   test::TempDir dir;
   const auto imp =
@@ -191,11 +192,12 @@ TEST(Cli, MapperWarnsWhenFramesGiveNoSurface) {
   const auto mapped =
       runCommand(binPath("panmap-mapper") + " -q --voxel-size 0.05 " + "--no-snapshots --log " +
                  dir.path("s.lcmlog") + " --out " + dir.path("a"));
-  EXPECT_EQ(mapped.exit_code, 0) << mapped.output;
-  EXPECT_NE(mapped.output.find("warning: 2 frames mapped but no surface came of them"),
+  EXPECT_EQ(mapped.exit_code, 1) << mapped.output;
+  EXPECT_NE(mapped.output.find("error: 2 frames mapped but no surface came of them"),
             std::string::npos)
       << mapped.output;
-  importSevenScenes(dir, 2);  // the right units: no warning
+  EXPECT_TRUE(std::filesystem::exists(dir.path("a/report.json")));  // written, for a look
+  importSevenScenes(dir, 2);                                        // the right units: no warning
   const auto good = runCommand(binPath("panmap-mapper") + " -q --voxel-size 0.05 " +
                                "--no-snapshots --grid-shift 0.01,0,0 --log " +
                                dir.path("s.lcmlog") + " --out " + dir.path("b"));

@@ -1,5 +1,6 @@
 // panmap-import on the generic RGB-D folder built from real 7-Scenes frames: no flags needed,
 // a corrupt file stops the import with its name, --skip-bad imports the rest and lists it.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -22,24 +23,35 @@ using test::runCommand;
 
 constexpr int kFrames = 10;
 
+// How a user's pose file may be written other than TUM's camera-to-world, x y z w, metres.
+enum class PoseMistake { kNone, kWorldToCamera, kWxyz, kMillimetres };
+
 // rgb/*.png (re-encoded from the JPEGs), depth/*.png (mm, the recorded files), intrinsic.txt
-// (4x4) and gt_pose.txt (TUM, frame numbers as timestamps).
-void makeFolder(const test::TempDir& dir) {
+// (4x4) and gt_pose.txt (TUM, frame numbers as timestamps), its poses written with `mistake`.
+void makeFolder(const test::TempDir& dir, PoseMistake mistake = PoseMistake::kNone,
+                int frames = kFrames) {
   fs::create_directory(dir.path("rgb"));
   fs::create_directory(dir.path("depth"));
   std::ofstream poses(dir.path("gt_pose.txt"));
   poses.precision(17);
-  for (int i = 0; i < kFrames; ++i) {
+  for (int i = 0; i < frames; ++i) {
     char src[64], dst[32];
     std::snprintf(src, sizeof(src), "7scenes-200/frame-%06d", 3 * i);
     std::snprintf(dst, sizeof(dst), "%06d.png", i);
     const std::string stem = test::dataDir(src);
     fs::create_symlink(stem + ".depth.png", dir.path("depth/") + dst);
     writeFileBytes(dir.path("rgb/") + dst, encodePng(readColorFile(stem + ".color.jpg")));
-    const Eigen::Matrix4d T = readMatrixFile(stem + ".pose.txt", 4, 4);
-    const Eigen::Quaterniond q(nearestIsometry(T).linear());
-    poses << i << " " << T(0, 3) << " " << T(1, 3) << " " << T(2, 3) << " " << q.x() << " " << q.y()
-          << " " << q.z() << " " << q.w() << "\n";
+    Eigen::Isometry3d T = nearestIsometry(readMatrixFile(stem + ".pose.txt", 4, 4));
+    if (mistake == PoseMistake::kWorldToCamera) T = T.inverse();
+    if (mistake == PoseMistake::kMillimetres) T.translation() *= 1000.0;
+    const Eigen::Quaterniond q(T.linear());
+    const Eigen::Vector3d t = T.translation();
+    poses << i << " " << t.x() << " " << t.y() << " " << t.z() << " ";
+    if (mistake == PoseMistake::kWxyz) {
+      poses << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << "\n";
+    } else {
+      poses << q.x() << " " << q.y() << " " << q.z() << " " << q.w() << "\n";
+    }
   }
   std::ofstream(dir.path("intrinsic.txt")) << "585 0 320 0\n0 585 240 0\n0 0 1 0\n0 0 0 1\n";
 }
@@ -70,6 +82,65 @@ TEST(ImportFolder, CommonExportImportsWithNoFlags) {
         << i;
     EXPECT_EQ(s.recorded_poses[i].frame_id, i);
   }
+}
+
+// The recorded 7-Scenes pose of folder frame i.
+Eigen::Isometry3d truePose(int i) {
+  char src[64];
+  std::snprintf(src, sizeof(src), "7scenes-200/frame-%06d.pose.txt", 3 * i);
+  return nearestIsometry(readMatrixFile(test::dataDir(src), 4, 4));
+}
+
+TEST(ImportFolder, PosesWrittenAnotherWayAreReadTheWayTheDepthAgreesWith) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  constexpr int kLonger = 40;  // 4 s of the recording: pairs 0.3 and 1 s apart
+  const std::pair<PoseMistake, std::string> cases[] = {
+      {PoseMistake::kNone, "read as camera-to-world, quaternion x y z w, metres: the depth"},
+      {PoseMistake::kWorldToCamera, "read as world-to-camera, quaternion x y z w, metres:"},
+      {PoseMistake::kWxyz, "read as camera-to-world, quaternion w x y z, metres:"},
+      {PoseMistake::kMillimetres, "read as camera-to-world, quaternion x y z w, millimetres:"}};
+  for (const auto& [mistake, note] : cases) {
+    SCOPED_TRACE(note);
+    test::TempDir dir;
+    makeFolder(dir, mistake, kLonger);
+    const ImportStats s = importDataset(dir.path(), dir.path("out.lcmlog"), ImportOptions());
+    ASSERT_TRUE(s.pose_convention);
+    EXPECT_EQ(s.pose_convention->note.rfind("poses: " + note, 0), 0u) << s.pose_convention->note;
+    // panmap-import prints the notes.
+    EXPECT_NE(std::find(s.notes.begin(), s.notes.end(), s.pose_convention->note), s.notes.end());
+    EXPECT_EQ(s.pose_convention->changed, mistake != PoseMistake::kNone);
+    EXPECT_GT(s.pose_convention->agreement_chosen, 0.5);
+    ASSERT_EQ(s.recorded_poses.size(), static_cast<size_t>(kLonger));
+    for (int i = 0; i < kLonger; ++i) {
+      // Back to the recorded pose up to rounding (the file keeps 17 digits).
+      EXPECT_LT((s.recorded_poses[i].T_W_C.matrix() - truePose(i).matrix()).cwiseAbs().maxCoeff(),
+                1e-6)
+          << i;
+    }
+  }
+}
+
+TEST(ImportFolder, APoseConventionTheUserGivesIsKeptAndDoubtedAloud) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  makeFolder(dir, PoseMistake::kWorldToCamera, 40);
+  const auto r =
+      runCommand(binPath("panmap-import") + " --quiet --pose-convention camera-to-world " +
+                 dir.path() + " " + dir.path("out.lcmlog"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("poses: read as camera-to-world, quaternion x y z w, metres, but the "
+                          "depth of 16 frame pairs agrees on only"),
+            std::string::npos)
+      << r.output;
+  ImportOptions options;
+  options.pose_convention.inverted = false;
+  const ImportStats s = importDataset(dir.path(), dir.path("again.lcmlog"), options);
+  ASSERT_TRUE(s.pose_convention);
+  EXPECT_FALSE(s.pose_convention->changed);
+  // Kept as written: world-to-camera.
+  EXPECT_LT(
+      (s.recorded_poses[5].T_W_C.matrix() - truePose(5).inverse().matrix()).cwiseAbs().maxCoeff(),
+      1e-6);
 }
 
 TEST(ImportFolder, ACorruptFileStopsTheImportUnlessSkipBad) {

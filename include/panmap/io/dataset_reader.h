@@ -87,6 +87,8 @@ class DatasetReader {
   /// True when invalid poses are a documented property of the layout (ScanNet writes -inf
   /// rows for frames its reconstruction lost), so skipping them is the default.
   virtual bool invalidPosesExpected() const { return false; }
+  /// True when the poses come from quaternions (a TUM-style file): their order may be w x y z.
+  virtual bool posesAreQuaternions() const { return false; }
   /// Frames the reader dropped while indexing (e.g. TUM depth without a matching colour).
   virtual size_t unmatchedFrames() const { return 0; }
   /// What the unmatchedFrames() were, for "dropped N <what>".

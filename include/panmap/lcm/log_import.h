@@ -2,11 +2,13 @@
 
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 
+#include "panmap/convention/pose_convention.h"
 #include "panmap/core/pose.h"
 #include "panmap/io/dataset_reader.h"
 #include "panmap/lcm/conversions.h"
@@ -37,6 +39,10 @@ struct ImportOptions {
   /// stopping; each is listed in ImportStats::skipped_bad.
   bool skip_bad = false;
   size_t max_frames = 0;  ///< 0 = all
+  /// How the pose file is written, where the user said (panmap-import --pose-convention,
+  /// --quaternion-order, --pose-unit); the rest is told from the depth of frame pairs for
+  /// pose files the user brings (folder layout, or --poses), see detectPoseConvention.
+  PoseConventionChoice pose_convention;
   /// Applied to each recorded pose, in frame order, before it is written (e.g. injected
   /// drift, panmap-import --drift); empty = written as recorded.
   std::function<Eigen::Isometry3d(const Eigen::Isometry3d&)> pose_filter;
@@ -60,8 +66,10 @@ struct ImportStats {
   std::string unmatched_what;   ///< what those were (DatasetReader::unmatchedWhat)
   size_t bytes_written = 0;
   std::string first_skip_reason;
-  std::vector<std::string> skipped_bad;     ///< with skip_bad: each skipped frame's error
-  std::vector<std::string> notes;           ///< what the reader detected (DatasetReader::notes)
+  std::vector<std::string> skipped_bad;  ///< with skip_bad: each skipped frame's error
+  std::vector<std::string> notes;        ///< what the reader detected (DatasetReader::notes)
+  /// How the poses were read, when checked against depth (empty when not checked).
+  std::optional<PoseConventionVerdict> pose_convention;
   std::vector<StampedPose> recorded_poses;  ///< every written frame's pose as recorded
   std::vector<StampedPose> written_poses;   ///< as written (differs with a pose_filter)
 };
