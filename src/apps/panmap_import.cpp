@@ -254,6 +254,9 @@ int main(int argc, char** argv) {
           "%zu frames without a mask; %zu segments of categories unknown to the label "
           "table (class 0)\n",
           s.frames_without_mask, s.unknown_category_segments);
+      if (s.unlisted_mask_pixels > 0) {
+        std::printf("warning: %s\n", panmap::unlistedMaskPixels(s).c_str());
+      }
       if (s.masks_resized > 0) {
         std::printf("%zu masks scaled to their colour image\n", s.masks_resized);
       }

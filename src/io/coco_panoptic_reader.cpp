@@ -134,12 +134,28 @@ PanopticFrame CocoPanopticReader::read(const std::string& color_stem) {
   }
   const auto bytes = readFileBytes(entry.png_path);
   frame.segment_ids = decodeLabelPng(bytes.data(), bytes.size(), entry.png_path);
-  // Pixels of ids without a segments_info entry are unsegmented (COCO: id 0 is void).
+  // Pixels of ids without a segments_info entry are unsegmented (COCO: id 0 is void). They are
+  // counted, and so are those a swap of R and B would have matched: cv2.imwrite of an RGB
+  // array writes BGR, and left every pixel unlisted with nothing said.
   std::set<int32_t> known;
   for (const auto& s : frame.segments) known.insert(s.id);
+  int32_t last_id = 0;
+  bool last_known = true, last_bgr = false;
   for (size_t i = 0; i < frame.segment_ids.size(); ++i) {
     int32_t& id = frame.segment_ids.data()[i];
-    if (id != 0 && !known.count(id)) id = 0;
+    if (id == 0) continue;
+    ++stats_.labelled_pixels;
+    if (id != last_id) {
+      last_id = id;
+      last_known = known.count(id) > 0;
+      const int32_t swapped = (id >> 16 & 0xFF) | (id & 0xFF00) | (id & 0xFF) << 16;
+      last_bgr = !last_known && known.count(swapped) > 0;
+    }
+    if (!last_known) {
+      ++stats_.unlisted_pixels;
+      stats_.unlisted_bgr_pixels += last_bgr ? 1 : 0;
+      id = 0;
+    }
   }
   ++stats_.frames_with_masks;
   stats_.segments += frame.segments.size();

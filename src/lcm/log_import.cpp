@@ -89,6 +89,24 @@ PoseConventionVerdict checkPoseConvention(const DatasetReader& reader, size_t to
 
 }  // namespace
 
+std::string unlistedMaskPixels(const ImportStats& stats) {
+  const auto percent = [](size_t part, size_t whole) {
+    char text[16];
+    std::snprintf(text, sizeof(text), "%.1f %%", whole ? 100.0 * part / whole : 0.0);
+    return std::string(text);
+  };
+  std::string text = "masks: " + percent(stats.unlisted_mask_pixels, stats.mask_pixels) +
+                     " of the pixels with a segment id carry an id their segments_info does "
+                     "not list (left unlabelled)";
+  if (2 * stats.unlisted_bgr_mask_pixels > stats.unlisted_mask_pixels) {
+    text += "; with R and B swapped " +
+            percent(stats.unlisted_bgr_mask_pixels, stats.unlisted_mask_pixels) +
+            " of them would match: the PNGs look written as BGR (cv2.imwrite of an RGB array; "
+            "cv2.cvtColor(ids_rgb, cv2.COLOR_RGB2BGR) before writing)";
+  }
+  return text;
+}
+
 ImportStats importDataset(const std::string& dataset_dir, const std::string& log_path,
                           const ImportOptions& options,
                           const std::function<void(size_t, size_t)>& progress) {
@@ -211,6 +229,17 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
       throw Error("no mask in " + options.mask_dir + " matches a frame: a mask is found by its " +
                   "colour image's name (the first frame's is '" + first_color_stem +
                   "', its mask '" + first_color_stem + ".png')");
+    }
+    if (masks) {
+      const MaskReaderStats& m = masks->stats();
+      stats.mask_pixels = m.labelled_pixels;
+      stats.unlisted_mask_pixels = m.unlisted_pixels;
+      stats.unlisted_bgr_mask_pixels = m.unlisted_bgr_pixels;
+      // Masks most of whose pixels name no segment would map as void: refused, with the
+      // likeliest cause.
+      if (2 * m.unlisted_pixels > m.labelled_pixels) {
+        throw Error(unlistedMaskPixels(stats) + "; not imported");
+      }
     }
     if (stats.frames_written == 0 && stats.skipped_invalid_pose > 0) {
       throw Error("no frame has a valid pose: all " + std::to_string(stats.skipped_invalid_pose) +

@@ -293,6 +293,54 @@ TEST(Import, PanopticMasksBecomeMessages) {
   ASSERT_EQ(p.segments.size(), 2u);
   EXPECT_EQ(p.segments[1], (PanopticSegment{300, 5, 62, true, 0.9f}));
   EXPECT_TRUE(inspectLog(dir.path("m.lcmlog"), true).allDecoded());
+  EXPECT_EQ(s.mask_pixels, 320u * 480u + 100u * 100u);
+  EXPECT_EQ(s.unlisted_mask_pixels, 0u);
+}
+
+// Id 300 (R 44, G 1) written by cv2.imwrite from an RGB array: B 44, G 1, read back as
+// 1 * 256 + 44 * 65536.
+constexpr int32_t kId300AsBgr = 256 + 44 * 65536;
+
+// Pixels whose id segments_info does not list were left void with nothing said: a network's
+// PNG saved as BGR gave an empty map and exit 0. A few are counted and named; most refuse the
+// import, naming the swap when it would have matched them.
+TEST(Import, MaskPixelsOfUnlistedIdsAreCountedAndMostlyUnlistedMasksRefused) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  const std::string json =
+      R"({"segments_info": [{"id": 1, "category_id": 1}, {"id": 300, "category_id": 62}]})";
+  LabelImage mask(640, 480, 0);
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 320; ++u) mask(u, v) = 1;
+  }
+  for (int v = 100; v < 200; ++v) {
+    for (int u = 400; u < 500; ++u) mask(u, v) = kId300AsBgr;
+  }
+  {
+    test::TempDir dir;
+    const ImportStats s =
+        importWithFirstMask(dir, mask, json, test::fixtureDir("coco_tiny/labels.tsv"), 1);
+    EXPECT_EQ(s.mask_pixels, 320u * 480u + 100u * 100u);
+    EXPECT_EQ(s.unlisted_mask_pixels, 100u * 100u);
+    EXPECT_EQ(s.unlisted_bgr_mask_pixels, 100u * 100u);
+    EXPECT_EQ(unlistedMaskPixels(s),
+              "masks: 6.1 % of the pixels with a segment id carry an id their segments_info does "
+              "not list (left unlabelled); with R and B swapped 100.0 % of them would match: the "
+              "PNGs look written as BGR (cv2.imwrite of an RGB array; "
+              "cv2.cvtColor(ids_rgb, cv2.COLOR_RGB2BGR) before writing)");
+    const PanopticFrame p =
+        fromMessage(decodeEvent<panoptic_t>(readEvents(dir.path("m.lcmlog"))[2]));
+    EXPECT_EQ(p.segment_ids(450, 150), 0);  // void, as COCO reads it
+    EXPECT_EQ(p.segment_ids(10, 10), 1);
+  }
+  // The whole mask written as BGR: id 1 reads as 65536.
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 320; ++u) mask(u, v) = 65536;
+  }
+  test::TempDir dir;
+  test::expectError(
+      [&] { importWithFirstMask(dir, mask, json, test::fixtureDir("coco_tiny/labels.tsv"), 1); },
+      {"masks: 100.0 % of the pixels", "the PNGs look written as BGR", "not imported"});
+  EXPECT_FALSE(fs::exists(dir.path("m.lcmlog")));
 }
 
 // Masks that match no frame by name are an error, not a map without classes: the message

@@ -12,6 +12,11 @@ struct MaskReaderStats {
   size_t frames_with_masks = 0;
   size_t segments = 0;
   size_t unknown_category_segments = 0;  ///< category absent from the label table
+  size_t labelled_pixels = 0;            ///< pixels with a segment id other than 0 (void), as read
+  /// Of those, pixels whose id no segment lists (left unsegmented: COCO treats them as void).
+  size_t unlisted_pixels = 0;
+  /// Of the unlisted, pixels whose id with R and B swapped is listed: a PNG written as BGR.
+  size_t unlisted_bgr_pixels = 0;
 };
 
 /// A segmentation network's masks of a dataset's colour images, one per image, found by the

@@ -61,6 +61,11 @@ struct ImportStats {
   size_t skipped_invalid_pose = 0;
   size_t frames_without_mask = 0;
   size_t unknown_category_segments = 0;
+  /// Mask pixels with an id other than 0, and those of them whose id the segments do not list
+  /// (left unlabelled; MaskReaderStats), of which a swap of R and B would have matched.
+  size_t mask_pixels = 0;
+  size_t unlisted_mask_pixels = 0;
+  size_t unlisted_bgr_mask_pixels = 0;
   size_t masks_resized = 0;     ///< with resize_masks: masks scaled to their colour image
   size_t unmatched_frames = 0;  ///< e.g. TUM depth without colour in time
   std::string unmatched_what;   ///< what those were (DatasetReader::unmatchedWhat)
@@ -73,6 +78,10 @@ struct ImportStats {
   std::vector<StampedPose> recorded_poses;  ///< every written frame's pose as recorded
   std::vector<StampedPose> written_poses;   ///< as written (differs with a pose_filter)
 };
+
+/// One line on the mask pixels whose segment id no segments_info entry lists, naming a BGR
+/// PNG when swapping R and B would match most of them.
+std::string unlistedMaskPixels(const ImportStats& stats);
 
 /// Reads a dataset folder and writes an LCM log with CAMERA_RGBD, CAMERA_POSE and (with
 /// masks) PANOPTIC events, all stamped with the frame's utime. Throws Error naming the file
