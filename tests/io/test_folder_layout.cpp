@@ -146,6 +146,32 @@ TEST(FolderLayout, PairsByPositionAndReadsPoseFolders) {
   EXPECT_NE(g.pose_problem.find("no pose file for depth image 1.png"), std::string::npos);
 }
 
+// A TUM file paired by order keeps its clock: frames of a 10 Hz recording were stamped at
+// --rate's 30 Hz, and a trajectory judged against the file matched a third of them.
+TEST(FolderLayout, PosesPairedByOrderGiveTheFramesTheirTimes) {
+  test::TempDir dir;
+  makeIssueFolder(dir, 3);
+  std::ofstream(dir.path("gt_pose.txt"))
+      << "1700000000.0 0 0 1 0 0 0 1\n1700000000.1 0.1 0 1 0 0 0 1\n"
+      << "1700000000.25 0.2 0 1 0 0 0 1\n";
+  auto reader = openDataset(dir.path(), DatasetOptions{});
+  EXPECT_EQ(reader->read(0).rgbd.utime, 1700000000000000);
+  EXPECT_EQ(reader->read(1).rgbd.utime, 1700000000100000);
+  EXPECT_EQ(reader->read(2).rgbd.utime, 1700000000250000);
+  EXPECT_NE(reader->notes()[2].find("by order (one pose per frame), frame times from its time "
+                                    "column"),
+            std::string::npos)
+      << reader->notes()[2];
+  // Times that do not increase say nothing of the frames: --rate's clock.
+  std::ofstream(dir.path("gt_pose.txt")) << "5.0 0 0 1 0 0 0 1\n5.0 0.1 0 1 0 0 0 1\n"
+                                         << "4.0 0.2 0 1 0 0 0 1\n";
+  DatasetOptions at_10_hz;
+  at_10_hz.frame_rate_hz = 10.0;
+  reader = openDataset(dir.path(), at_10_hz);
+  EXPECT_EQ(reader->read(2).rgbd.utime, 200000);
+  EXPECT_EQ(reader->notes()[2].find("frame times"), std::string::npos) << reader->notes()[2];
+}
+
 TEST(FolderLayout, ColourNumberedFromAnotherStartIsNamed) {
   // Colour 1..4, depth 0..3: paired by number, each colour image would come from the next
   // frame. The import says so, and a pose count that no longer fits names the left-out frame.
