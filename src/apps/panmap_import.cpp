@@ -254,6 +254,10 @@ int main(int argc, char** argv) {
           "%zu frames without a mask; %zu segments of categories unknown to the label "
           "table (class 0)\n",
           s.frames_without_mask, s.unknown_category_segments);
+      if (s.masks_unused > 0) {
+        std::printf("%zu of %zu masks matched no imported frame (first: %s)\n", s.masks_unused,
+                    s.masks_found, s.first_unused_mask.c_str());
+      }
       if (s.unlisted_mask_pixels > 0) {
         std::printf("warning: %s\n", panmap::unlistedMaskPixels(s).c_str());
       }

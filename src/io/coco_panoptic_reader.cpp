@@ -47,8 +47,18 @@ std::vector<PanopticSegment> parseSegments(const json& info, const LabelTable& t
       seg.category = 0;
       ++*unknown;
     }
-    if (s.contains("isthing")) seg.is_thing = s["isthing"].get<int>() != 0;
+    if (s.contains("isthing")) {
+      const json& isthing = s["isthing"];
+      if (!isthing.is_boolean() && !isthing.is_number_integer()) {
+        throw Error(what + ": isthing of segment " + std::to_string(seg.id) +
+                    " is not 0/1 or true/false");
+      }
+      seg.is_thing = isthing.is_boolean() ? isthing.get<bool>() : isthing.get<long long>() != 0;
+    }
     if (s.contains("score")) {
+      if (!s["score"].is_number()) {
+        throw Error(what + ": score of segment " + std::to_string(seg.id) + " is not a number");
+      }
       const double score = s["score"].get<double>();
       if (!(score >= 0.0 && score <= 1.0)) {
         throw Error(what + ": score of segment " + std::to_string(seg.id) + " not in [0, 1]");
@@ -71,11 +81,24 @@ CocoPanopticReader::CocoPanopticReader(const std::string& mask_dir, const std::s
     if (!root.is_object() || !root.contains("annotations") || !root["annotations"].is_array()) {
       throw Error(json_path + ": not a COCO panoptic file (no annotations list)");
     }
-    std::map<long long, std::string> image_names;  // image_id -> image file stem
+    // image_id -> image file stem; ids are integers in COCO, strings in Cityscapes' panoptic
+    // files, so both are keyed by their text.
+    std::map<std::string, std::string> image_names;
+    auto idText = [&](const json& id, const std::string& where) {
+      if (id.is_number_integer()) return std::to_string(id.get<long long>());
+      if (id.is_string()) return id.get<std::string>();
+      throw Error(json_path + ": " + where + " is neither an integer nor a string");
+    };
+    auto fileName = [&](const json& entry, const std::string& where) {
+      if (!entry["file_name"].is_string()) {
+        throw Error(json_path + ": " + where + "'s file_name is not a string");
+      }
+      return entry["file_name"].get<std::string>();
+    };
     if (root.contains("images") && root["images"].is_array()) {
       for (const json& im : root["images"]) {
-        if (im.contains("id") && im.contains("file_name")) {
-          image_names[im["id"].get<long long>()] = stemOf(im["file_name"].get<std::string>());
+        if (im.is_object() && im.contains("id") && im.contains("file_name")) {
+          image_names[idText(im["id"], "an image's id")] = stemOf(fileName(im, "an image"));
         }
       }
     }
@@ -84,14 +107,14 @@ CocoPanopticReader::CocoPanopticReader(const std::string& mask_dir, const std::s
       if (!a.contains("file_name") || !a.contains("segments_info")) {
         throw Error(json_path + ": an annotation lacks file_name or segments_info");
       }
-      const std::string png = a["file_name"].get<std::string>();
+      const std::string png = fileName(a, "an annotation");
       Entry entry;
       entry.png_path = mask_dir + "/" + png;
       entry.segments =
           parseSegments(a["segments_info"], table_, json_path + " (" + png + ")", &unknown);
       std::string key = stemOf(png);
-      if (a.contains("image_id") && a["image_id"].is_number_integer()) {
-        const auto it = image_names.find(a["image_id"].get<long long>());
+      if (a.contains("image_id")) {
+        const auto it = image_names.find(idText(a["image_id"], "an annotation's image_id"));
         if (it != image_names.end()) key = it->second;
       }
       entries_[key] = entry;

@@ -5,6 +5,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <utility>
 
@@ -159,6 +160,7 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
   try {
     LogWriter writer(partial);
     int64_t last_utime = INT64_MIN;
+    std::set<std::string> used_masks;  // colour stems whose mask a frame took
     std::string first_color_stem;
     for (size_t i = 0; i < total; ++i) {
       // Everything that reads a file comes first, so a bad frame is skipped whole.
@@ -168,6 +170,7 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
         frame = reader->read(i);
         if (frame.T_W_C && masks && masks->has(frame.color_stem)) {
           panoptic = masks->read(frame.color_stem);
+          used_masks.insert(frame.color_stem);
           const std::string what = "mask of " + frame.color_stem;
           if (fitMaskToColour(&panoptic->segment_ids, frame, options.resize_masks, what)) {
             ++stats.masks_resized;
@@ -231,6 +234,11 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
                   "', its mask '" + first_color_stem + ".png')");
     }
     if (masks) {
+      for (const std::string& stem : masks->stems()) {
+        ++stats.masks_found;
+        if (used_masks.count(stem)) continue;
+        if (stats.masks_unused++ == 0) stats.first_unused_mask = stem;
+      }
       const MaskReaderStats& m = masks->stats();
       stats.mask_pixels = m.labelled_pixels;
       stats.unlisted_mask_pixels = m.unlisted_pixels;

@@ -1,4 +1,9 @@
+#include <algorithm>
 #include <fstream>
+#include <iterator>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -37,6 +42,58 @@ TEST(CocoPanoptic, PerFrameJson) {
   CocoPanopticReader reader(test::fixtureDir("coco_tiny/perframe"), "",
                             LabelTable::load(test::fixtureDir("coco_tiny/labels.tsv")));
   expectFixtureFrame(reader.read("frame-000000.color"));
+}
+
+// Cityscapes' panoptic files number images by strings: they match as COCO's integers do. The
+// reader lists what it found, for the import to name the masks no frame took.
+TEST(CocoPanoptic, StringImageIdsMatchAndTheMasksFoundAreListed) {
+  test::TempDir dir;
+  std::ifstream in(test::fixtureDir("coco_tiny/panoptic.json"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const std::string from : {"\"id\": 5,", "\"image_id\": 5,"}) {
+    const size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, from.size(), from.substr(0, from.size() - 2) + "\"frankfurt_5\",");
+  }
+  std::ofstream(dir.path("strings.json")) << text;
+  CocoPanopticReader reader(test::fixtureDir("coco_tiny/panoptic"), dir.path("strings.json"),
+                            LabelTable::load(test::fixtureDir("coco_tiny/labels.tsv")));
+  EXPECT_EQ(reader.stems(), std::vector<std::string>{"frame-000000.color"});
+  const PanopticFrame f = reader.read("frame-000000.color");
+  expectFixtureFrame(f);
+  // Every one of the 8 x 6 pixels has an id; those of id 7 are listed nowhere: counted, void.
+  EXPECT_EQ(reader.stats().labelled_pixels, 48u);
+  EXPECT_EQ(reader.stats().unlisted_pixels, 4u);
+  EXPECT_EQ(reader.stats().unlisted_bgr_pixels, 0u);
+  EXPECT_EQ(std::count(f.segment_ids.data(), f.segment_ids.data() + f.segment_ids.size(), 0), 4);
+}
+
+// Fields of the wrong JSON type were nlohmann's own message ("type must be number, but is
+// string"), naming neither the file nor the field.
+TEST(CocoPanoptic, FieldsOfTheWrongTypeAreNamedWithTheirFile) {
+  test::TempDir dir;
+  const std::pair<std::string, std::string> cases[] = {
+      {R"([{"id": 1, "category_id": 1, "isthing": "yes"}])", "isthing of segment 1 is not 0/1"},
+      {R"([{"id": 1, "category_id": 1, "score": "high"}])", "score of segment 1 is not a number"},
+      {R"([{"id": "1", "category_id": 1}])", "lacks integer id/category_id"}};
+  for (const auto& [segments, message] : cases) {
+    std::ofstream(dir.path("frame.json")) << segments;
+    std::ifstream png(test::fixtureDir("coco_tiny/perframe/frame-000000.color.png"),
+                      std::ios::binary);
+    std::ofstream(dir.path("frame.png"), std::ios::binary) << png.rdbuf();
+    CocoPanopticReader reader(dir.path(), "", LabelTable::nyu40Identity());
+    test::expectError([&] { reader.read("frame"); }, {dir.path("frame.json"), message});
+  }
+  std::ofstream(dir.path("coco.json"))
+      << R"({"images": [{"id": [5], "file_name": "a.jpg"}], "annotations": []})";
+  test::expectError(
+      [&] { CocoPanopticReader(dir.path(), dir.path("coco.json"), LabelTable::nyu40Identity()); },
+      {dir.path("coco.json"), "an image's id is neither an integer nor a string"});
+  std::ofstream(dir.path("coco.json"))
+      << R"({"annotations": [{"file_name": 3, "segments_info": []}]})";
+  test::expectError(
+      [&] { CocoPanopticReader(dir.path(), dir.path("coco.json"), LabelTable::nyu40Identity()); },
+      {dir.path("coco.json"), "an annotation's file_name is not a string"});
 }
 
 TEST(CocoPanoptic, BadInputNamesTheFile) {

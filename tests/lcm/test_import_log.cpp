@@ -343,6 +343,27 @@ TEST(Import, MaskPixelsOfUnlistedIdsAreCountedAndMostlyUnlistedMasksRefused) {
   EXPECT_FALSE(fs::exists(dir.path("m.lcmlog")));
 }
 
+// Mask files no frame took (numbered otherwise than the images, say) were never mentioned:
+// counted, the first named.
+TEST(Import, MasksNoFrameTookAreCountedAndTheFirstNamed) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  fs::create_directory(dir.path("masks"));
+  for (const std::string stem : {"frame-000000.color", "frame-000999.color"}) {
+    writeFileBytes(dir.path("masks/" + stem + ".png"), encodeLabelPng(LabelImage(640, 480, 1)));
+    std::ofstream(dir.path("masks/" + stem + ".json"))
+        << R"({"segments_info": [{"id": 1, "category_id": 1}]})";
+  }
+  ImportOptions options;
+  options.max_frames = 2;
+  options.mask_dir = dir.path("masks");
+  const ImportStats s = importDataset(test::dataDir("7scenes-200"), dir.path("m.lcmlog"), options);
+  EXPECT_EQ(s.panoptic_written, 1u);
+  EXPECT_EQ(s.masks_found, 2u);
+  EXPECT_EQ(s.masks_unused, 1u);
+  EXPECT_EQ(s.first_unused_mask, "frame-000999.color");
+}
+
 // Masks that match no frame by name are an error, not a map without classes: the message
 // names the file name the first frame's mask would have. No log is left behind.
 TEST(Import, MasksMatchingNoFrameAreNamed) {

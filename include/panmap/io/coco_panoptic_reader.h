@@ -25,6 +25,12 @@ class CocoPanopticReader : public MaskReader {
 
   /// True when a mask exists for the colour image with this file stem.
   bool has(const std::string& color_stem) const override;
+  /// The colour-image stems of every mask found, in sorted order.
+  std::vector<std::string> stems() const override {
+    std::vector<std::string> out;
+    for (const auto& entry : entries_) out.push_back(entry.first);
+    return out;
+  }
 
   /// Reads the mask of a colour image (segment ids) and its segments with panmap classes.
   /// Throws Error naming the file on bad input.

@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "panmap/core/frame.h"
 
@@ -31,6 +32,9 @@ class MaskReader {
   /// Reads the mask of a colour image (segment ids at the mask file's resolution) and its
   /// segments with panmap classes. Throws Error naming the file on bad input.
   virtual PanopticFrame read(const std::string& color_stem) = 0;
+
+  /// The colour-image stems of every mask found, in sorted order.
+  virtual std::vector<std::string> stems() const = 0;
 
   /// What has been read so far.
   const MaskReaderStats& stats() const { return stats_; }

@@ -36,6 +36,12 @@ class SemanticMaskReader : public MaskReader {
 
   /// True when a mask exists for the colour image with this file stem.
   bool has(const std::string& color_stem) const override;
+  /// The colour-image stems of every mask found, in sorted order.
+  std::vector<std::string> stems() const override {
+    std::vector<std::string> out;
+    for (const auto& entry : files_) out.push_back(entry.first);
+    return out;
+  }
 
   /// Reads a mask and splits it into segments. Throws Error naming the file when it is not a
   /// greyscale PNG.

@@ -66,9 +66,13 @@ struct ImportStats {
   size_t mask_pixels = 0;
   size_t unlisted_mask_pixels = 0;
   size_t unlisted_bgr_mask_pixels = 0;
-  size_t masks_resized = 0;     ///< with resize_masks: masks scaled to their colour image
-  size_t unmatched_frames = 0;  ///< e.g. TUM depth without colour in time
-  std::string unmatched_what;   ///< what those were (DatasetReader::unmatchedWhat)
+  size_t masks_found = 0;  ///< mask files in the mask folder (or its COCO JSON)
+  /// Masks no imported frame took (their images absent, skipped, or beyond max_frames).
+  size_t masks_unused = 0;
+  std::string first_unused_mask;  ///< the first of those, by its colour-image stem
+  size_t masks_resized = 0;       ///< with resize_masks: masks scaled to their colour image
+  size_t unmatched_frames = 0;    ///< e.g. TUM depth without colour in time
+  std::string unmatched_what;     ///< what those were (DatasetReader::unmatchedWhat)
   size_t bytes_written = 0;
   std::string first_skip_reason;
   std::vector<std::string> skipped_bad;  ///< with skip_bad: each skipped frame's error
