@@ -33,8 +33,23 @@ void applyScanNetInstanceIds(const std::vector<int32_t>& ids, const std::string&
                   std::to_string(ids[v]));
     }
     if (ids[v] == 0) continue;
+    if (ids[v] / 1000 > kMaxNyu40Class) {
+      throw Error(ids_source + ": line " + std::to_string(v + 1) + ": id " +
+                  std::to_string(ids[v]) + " names class " + std::to_string(ids[v] / 1000) +
+                  ", not an NYU40 id (1..40; a ScanNet label id maps to one through "
+                  "scannetv2-labels.combined.tsv)");
+    }
     mesh->semantic[v] = ids[v] / 1000;
     mesh->instance[v] = ids[v];
+  }
+  // Class ids alone (ScanNet's semantic benchmark format) leave every vertex without a class
+  // here, and every score of the instance evaluation empty with exit 0.
+  const bool any_id = std::any_of(ids.begin(), ids.end(), [](int32_t id) { return id != 0; });
+  const bool any_class = std::any_of(ids.begin(), ids.end(), [](int32_t id) { return id >= 1000; });
+  if (any_id && !any_class) {
+    throw Error(ids_source +
+                ": every id is below 1000, so no vertex has a class: the file holds class * "
+                "1000 + instance per vertex (ScanNet's instance format), not class ids alone");
   }
 }
 

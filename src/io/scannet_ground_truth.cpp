@@ -270,10 +270,20 @@ std::vector<int32_t> readScanNetInstanceFile(const std::string& path) {
   if (!in) throw Error("cannot read " + path);
   std::vector<int32_t> values;
   std::string line;
-  int line_number = 0;
+  int line_number = 0, blank_lines = 0;
   while (std::getline(in, line)) {
     ++line_number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    // Blank lines at the end (np.savetxt and editors leave one) are no vertex; a blank line
+    // followed by more ids would shift every later vertex, so it stays an error.
+    if (line.find_first_not_of(" \t") == std::string::npos) {
+      ++blank_lines;
+      continue;
+    }
+    if (blank_lines > 0) {
+      throw Error(path + ": line " + std::to_string(line_number - blank_lines) +
+                  ": a blank line among the ids");
+    }
     int32_t value = 0;
     if (!parseInt(line, &value)) {
       throw Error(path + ": line " + std::to_string(line_number) + ": '" + line +

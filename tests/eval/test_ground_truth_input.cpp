@@ -33,6 +33,18 @@ TEST(GroundTruthInput, BenchmarkIdsReplaceTheMeshLabels) {
         applyScanNetInstanceIds({0, -4}, "ids.txt", "mesh.ply", &bare);
       },
       {"ids.txt", "line 2", "-4"});
+  // Class ids alone (the semantic benchmark's files) scored nothing and exited 0.
+  expectError(
+      [&] {
+        applyScanNetInstanceIds({0, 5}, "ids.txt", "mesh.ply", &bare);
+      },
+      {"ids.txt: every id is below 1000", "class * 1000 + instance"});
+  // A class beyond NYU40 (a ScanNet label id) counted its objects under no class.
+  expectError(
+      [&] {
+        applyScanNetInstanceIds({0, 45001}, "ids.txt", "mesh.ply", &bare);
+      },
+      {"ids.txt: line 2: id 45001 names class 45", "NYU40"});
 }
 
 TEST(GroundTruthInput, ClassLists) {

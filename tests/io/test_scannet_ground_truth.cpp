@@ -125,6 +125,12 @@ TEST(ScanNetGroundTruth, InstanceFileLineByLine) {
   std::ofstream(dir.path("bad.txt")) << "5001\n3oo2\n";
   expectError([&] { readScanNetInstanceFile(dir.path("bad.txt")); },
               {"bad.txt", "line 2", "'3oo2'"});
+  // Blank lines at the end are no vertex; one among the ids would shift the rest.
+  std::ofstream(dir.path("trailing.txt")) << "5001\n3002\n\n \n";
+  EXPECT_EQ(readScanNetInstanceFile(dir.path("trailing.txt")), (std::vector<int32_t>{5001, 3002}));
+  std::ofstream(dir.path("gap.txt")) << "5001\n\n3002\n";
+  expectError([&] { readScanNetInstanceFile(dir.path("gap.txt")); },
+              {"gap.txt", "line 2: a blank line among the ids"});
 }
 
 TEST(ScanNetGroundTruth, SegsLengthMismatchNamesBothFiles) {
