@@ -609,6 +609,11 @@ int main(int argc, char** argv) {
                        log_path.c_str(), resumed ? "resumed" : "loaded",
                        static_cast<long long>(options.resume_after_utime));
         }
+        const std::string unread = panmap::describeUnreadChannels(report, options);
+        if (!unread.empty()) {
+          std::fprintf(stderr, "panmap-mapper: warning: log %s: %s\n", log_path.c_str(),
+                       unread.c_str());
+        }
         const std::string damage = panmap::describeLogDamage(report);
         if (!damage.empty()) {
           std::fprintf(stderr,

@@ -71,6 +71,22 @@ std::string describeLogDamage(const OfflineReport& report) {
   return out;
 }
 
+std::string describeUnreadChannels(const OfflineReport& report, const SessionOptions& options) {
+  if (report.channel_events.count(options.channel_panoptic) > 0) return "";
+  std::string unread;
+  for (const auto& [channel, count] : report.channel_events) {
+    if (channel == options.channel_rgbd || channel == options.channel_pose ||
+        channel == options.channel_correction) {
+      continue;
+    }
+    unread += (unread.empty() ? "" : ", ") + channel + " (" + std::to_string(count) + ")";
+  }
+  if (unread.empty()) return "";
+  return "no event on the panoptic channel " + options.channel_panoptic +
+         ", so every frame was mapped without masks; the log also has " + unread +
+         ", which no option names (--channel-panoptic)";
+}
+
 std::string describeNothingMapped(const OfflineReport& report, const SessionOptions& options) {
   if (report.log_bytes == 0) return "the log is empty";
   if (report.events == 0) return "no LCM event in the log (not an LCM log, or corrupt from byte 0)";

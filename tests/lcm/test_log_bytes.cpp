@@ -162,5 +162,21 @@ TEST(OfflineReport, SaysWhyNothingWasMapped) {
             "CAMERA_RGBD (1)");
 }
 
+// Masks logged on a channel the mapper does not read were ignored with exit 0 and no word.
+TEST(OfflineReport, NamesTheChannelsLeftUnreadWhenNoMaskCame) {
+  SessionOptions options;
+  OfflineReport report;
+  report.channel_events = {{"CAMERA_RGBD", 30}, {"CAMERA_POSE", 30}};
+  EXPECT_EQ(describeUnreadChannels(report, options), "");  // a log without masks: nothing unread
+  report.channel_events["PANMAP_POSE_CORRECTION"] = 1;
+  EXPECT_EQ(describeUnreadChannels(report, options), "");
+  report.channel_events["panoptic"] = 30;
+  EXPECT_EQ(describeUnreadChannels(report, options),
+            "no event on the panoptic channel PANOPTIC, so every frame was mapped without masks; "
+            "the log also has panoptic (30), which no option names (--channel-panoptic)");
+  report.channel_events["PANOPTIC"] = 30;  // masks read: the other channel is the user's
+  EXPECT_EQ(describeUnreadChannels(report, options), "");
+}
+
 }  // namespace
 }  // namespace panmap

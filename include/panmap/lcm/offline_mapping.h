@@ -29,6 +29,11 @@ std::string describeLogDamage(const OfflineReport& report);
 /// input channels (naming the channels the log has), or the refusals of every frame received.
 std::string describeNothingMapped(const OfflineReport& report, const SessionOptions& options);
 
+/// A log whose masks went unread, in one line ("" otherwise): no event on the panoptic channel
+/// while the log has channels the mapper does not read (naming them, e.g. masks logged as
+/// "panoptic" for a mapper listening on "PANOPTIC").
+std::string describeUnreadChannels(const OfflineReport& report, const SessionOptions& options);
+
 /// Maps every frame of a log as fast as possible, in log order, through a MappingSession
 /// (stream time = the log's event timestamps). Deterministic.
 /// @param progress called with (bytes read, log size) every few events
