@@ -112,6 +112,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--skip-bad", options.skip_bad,
                "skip frames whose files cannot be read (listed, and counted) instead of stopping");
+  double max_pose_gap_ms = 200.0;
+  app.add_option("--max-pose-gap-ms", max_pose_gap_ms,
+                 "timed poses: a frame between two poses at most this far apart takes their "
+                 "interpolation (a SLAM system's keyframes); otherwise it needs a pose within "
+                 "20 ms")
+      ->check(panmap::cli::nonNegative())
+      ->capture_default_str();
   app.add_option("--rate", options.dataset.frame_rate_hz,
                  "frame rate of datasets without timestamps, Hz")
       ->capture_default_str();
@@ -161,6 +168,7 @@ int main(int argc, char** argv) {
       if (!options.dataset.intrinsics) options.dataset.intrinsics_file = intrinsics;
     }
     if (depth_scale > 0.0) options.dataset.depth_scale_m = depth_scale;
+    options.dataset.max_pose_gap_s = max_pose_gap_ms * 1e-3;
     if (pose_convention != "auto") {
       options.pose_convention.inverted = pose_convention == "world-to-camera";
     }

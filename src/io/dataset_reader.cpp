@@ -19,6 +19,7 @@ void DatasetOptions::check() const {
     throw Error("frame rate must be positive");
   }
   if (!(tum_max_dt_s > 0.0)) throw Error("TUM association tolerance must be positive");
+  if (!(max_pose_gap_s >= 0.0)) throw Error("max_pose_gap_s must be >= 0");
   if (!(pose_tolerance > 0.0)) throw Error("pose tolerance must be positive");
   if (intrinsics &&
       !((*intrinsics)(0) > 0.0 && (*intrinsics)(1) > 0.0 && intrinsics->allFinite())) {
@@ -173,14 +174,16 @@ long nearestIndex(const std::vector<double>& sorted_times, double t, double max_
 }
 
 std::optional<Eigen::Isometry3d> poseAtTime(const std::vector<StampedPose>& sorted, double t_s,
-                                            double max_dt_s, const std::string& source,
-                                            std::string* problem) {
+                                            double max_dt_s, double max_gap_s,
+                                            const std::string& source, std::string* problem) {
   auto time = [](const StampedPose& p) { return static_cast<double>(p.utime) * 1e-6; };
   auto it = std::lower_bound(sorted.begin(), sorted.end(), t_s,
                              [&](const StampedPose& e, double value) { return time(e) < value; });
   if (it != sorted.end() && it != sorted.begin()) {
     const double tb = time(*it), ta = time(*(it - 1));
-    if (tb - ta <= 2.0 * max_dt_s + 1e-9) {
+    // The gap from the integer utimes: seconds near 1.7e9 differ from 0.2 in the 8th digit.
+    const double gap_s = static_cast<double>(it->utime - (it - 1)->utime) * 1e-6;
+    if (gap_s <= std::max(max_gap_s, 2.0 * max_dt_s) + 1e-9) {
       const double s = (tb > ta) ? (t_s - ta) / (tb - ta) : 0.0;
       return interpolatePose((it - 1)->T_W_C, it->T_W_C, s);
     }
@@ -192,7 +195,9 @@ std::optional<Eigen::Isometry3d> poseAtTime(const std::vector<StampedPose>& sort
   if (best >= 0) return sorted[static_cast<size_t>(best)].T_W_C;
   std::ostringstream msg;
   msg.precision(6);
-  msg << std::fixed << source << ": no pose within " << max_dt_s << " s of depth time " << t_s;
+  msg << std::fixed << source << ": no pose within " << max_dt_s << " s of depth time " << t_s
+      << ", nor two at most " << std::max(max_gap_s, 2.0 * max_dt_s)
+      << " s apart around it (--max-pose-gap-ms)";
   *problem = msg.str();
   return std::nullopt;
 }

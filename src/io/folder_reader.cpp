@@ -514,7 +514,8 @@ class FolderReader : public DatasetReader {
       return readPoseFile(poses_from_ + "/" + it->second, options_.pose_tolerance, problem);
     }
     if (timestamps_ && list_.format == PoseList::Format::kTum) {
-      return poseAtTime(timed_, f.depth.number, options_.tum_max_dt_s, poses_from_, problem);
+      return poseAtTime(timed_, f.depth.number, options_.tum_max_dt_s, options_.max_pose_gap_s,
+                        poses_from_, problem);
     }
     const size_t i = by_frame_.at(index);
     if (!list_.poses[i]) *problem = list_.problems[i];

@@ -159,8 +159,8 @@ class TumReader : public DatasetReader {
     frame.rgbd.camera_name = "tum";
     frame.rgbd.camera = camera_;
     frame.rgbd.depth_scale_m = depth_scale_m_;
-    frame.T_W_C = poseAtTime(ground_truth_, p.depth.t, options_.tum_max_dt_s, poses_path_,
-                             &frame.pose_problem);
+    frame.T_W_C = poseAtTime(ground_truth_, p.depth.t, options_.tum_max_dt_s,
+                             options_.max_pose_gap_s, poses_path_, &frame.pose_problem);
     return frame;
   }
 

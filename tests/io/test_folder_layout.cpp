@@ -115,6 +115,20 @@ TEST(FolderLayout, PairsTimestampNamesByTimeAndInterpolatesPoses) {
   ASSERT_TRUE(f.T_W_C.has_value());
   EXPECT_NEAR(f.T_W_C->translation().x(), 0.6, 1e-9);  // halfway between 100.03 and 100.07
   EXPECT_NE(reader->notes()[0].find("by timestamp"), std::string::npos);
+
+  // Keyframe poses 200 ms apart (a SLAM system's, Unix times): the frames between take their
+  // interpolation; it needed poses 40 ms apart, and every such frame was refused.
+  writeText(dir.path("groundtruth.txt"),
+            "99.9 0 0 0 0 0 0 1\n100.1 0.4 0 0 0 0 0 1\n100.3 0.8 0 0 0 0 0 1\n");
+  const DatasetFrame g = openDataset(dir.path(), DatasetOptions{})->read(1);
+  ASSERT_TRUE(g.T_W_C.has_value()) << g.pose_problem;
+  EXPECT_NEAR(g.T_W_C->translation().x(), 0.3, 1e-9);  // 100.05: three quarters of the way
+  DatasetOptions strict;
+  strict.max_pose_gap_s = 0.1;
+  const DatasetFrame h = openDataset(dir.path(), strict)->read(1);
+  EXPECT_FALSE(h.T_W_C.has_value());
+  EXPECT_NE(h.pose_problem.find("nor two at most 0.100000 s apart around it"), std::string::npos)
+      << h.pose_problem;
 }
 
 TEST(FolderLayout, PairsByPositionAndReadsPoseFolders) {

@@ -56,6 +56,9 @@ struct DatasetOptions {
   double frame_rate_hz = 30.0;  ///< time base for datasets without timestamps
   ColorRegistration registration = ColorRegistration::kReproject;
   double tum_max_dt_s = 0.02;  ///< TUM: max |t_rgb - t_depth| and |t_pose - t_depth|
+  /// Timed poses: a frame between two poses at most this far apart takes their interpolation
+  /// (a SLAM system's keyframes; the mapper's sync.max_pose_gap_ms is the same 200 ms).
+  double max_pose_gap_s = 0.2;
   /// Largest |R^T R - I| entry accepted in a pose file (datasets store rounded matrices).
   double pose_tolerance = 1e-3;
   /// Metres per depth unit, replacing the layout's convention (7-Scenes and ScanNet mm, TUM

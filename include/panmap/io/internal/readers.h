@@ -35,11 +35,11 @@ void resizeColorMap(int depth_width, int depth_height, int color_width, int colo
 long nearestIndex(const std::vector<double>& sorted_times, double t, double max_dt);
 
 /// Pose at time t_s from time-sorted samples: interpolated between the bracketing samples
-/// when they are at most 2 max_dt_s apart, else the nearest within max_dt_s. Sets `problem`
-/// (naming `source`) and returns nothing when no sample is close enough.
+/// when they are at most max(max_gap_s, 2 max_dt_s) apart, else the nearest within max_dt_s.
+/// Sets `problem` (naming `source`) and returns nothing when no sample is close enough.
 std::optional<Eigen::Isometry3d> poseAtTime(const std::vector<StampedPose>& sorted, double t_s,
-                                            double max_dt_s, const std::string& source,
-                                            std::string* problem);
+                                            double max_dt_s, double max_gap_s,
+                                            const std::string& source, std::string* problem);
 
 /// Reads a 4x4 camera-to-world pose file. Sets `problem` (file and reason) and returns
 /// nothing when the file is missing or the matrix is not a rigid transform.
