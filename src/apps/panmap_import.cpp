@@ -254,6 +254,10 @@ int main(int argc, char** argv) {
         std::printf("  ... and %zu more\n", s.skipped_bad.size() - kShown);
       }
     }
+    if (s.frames_without_depth) {
+      std::printf("%zu frames have no valid depth (every pixel 0): they map nothing\n",
+                  s.frames_without_depth);
+    }
     if (s.unmatched_frames) {
       std::printf("dropped %zu %s\n", s.unmatched_frames, s.unmatched_what.c_str());
     }

@@ -335,6 +335,16 @@ class FolderReader : public DatasetReader {
          << color_width_ << "x" << color_height_;
     if (color_width_ != camera_.width || color_height_ != camera_.height) {
       note << " (resized to the depth size)";
+      // Resizing another shape stretches colour and masks over the depth: fine for a camera
+      // whose two images share a field of view, wrong for a 16:9 colour over 4:3 depth.
+      const double stretch = (static_cast<double>(color_width_) / color_height_) /
+                             (static_cast<double>(camera_.width) / camera_.height);
+      if (std::abs(stretch - 1.0) > 0.01) {
+        note << "; warning: colour and depth differ in shape (" << color_width_ << ":"
+             << color_height_ << " against " << camera_.width << ":" << camera_.height
+             << "), so colour and masks are stretched onto the depth, which is right only if "
+                "both images see the same field of view";
+      }
     }
     if (!hasCentredPrincipalPoint(camera_, camera_.width, camera_.height)) {
       // One intrinsics file for two image sizes is often the colour camera's: its principal

@@ -30,7 +30,15 @@ std::vector<NumberLine> readNumberLines(const std::string& path) {
       errno = 0;
       const double value = std::strtod(token.c_str(), &end);
       if (end == token.c_str() || *end != '\0') {
-        throw Error(path + ":" + std::to_string(number) + ": '" + token + "' is not a number");
+        // The two ways a spreadsheet or pandas export fails here, named.
+        std::string hint;
+        if (token.find(',') != std::string::npos) {
+          hint = " (values separated by commas: panmap reads them separated by spaces or tabs)";
+        } else if (out.empty() && line.values.empty()) {
+          hint = " (a header line? start it with '#')";
+        }
+        throw Error(path + ":" + std::to_string(number) + ": '" + token + "' is not a number" +
+                    hint);
       }
       line.values.push_back(value);
     }

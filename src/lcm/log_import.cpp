@@ -1,5 +1,6 @@
 #include "panmap/lcm/log_import.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -201,6 +202,11 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
       last_utime = frame.rgbd.utime;
       const int64_t utime = frame.rgbd.utime;
 
+      const DepthImage& depth = frame.rgbd.depth;
+      if (std::all_of(depth.data(), depth.data() + depth.size(),
+                      [](uint16_t d) { return d == 0; })) {
+        ++stats.frames_without_depth;
+      }
       writer.write(options.channel_rgbd, utime,
                    toMessage(frame.rgbd, options.encoding, &frame.color_jpeg, &frame.depth_png));
       ++stats.frames_written;

@@ -186,6 +186,24 @@ TEST(FolderLayout, PosesPairedByOrderGiveTheFramesTheirTimes) {
   EXPECT_EQ(reader->notes()[2].find("frame times"), std::string::npos) << reader->notes()[2];
 }
 
+// A 16:9 colour image resized onto 4:3 depth was stretched without a word.
+TEST(FolderLayout, ColourOfAnotherShapeIsResizedWithAWarning) {
+  test::TempDir dir;
+  fs::create_directory(dir.path("rgb"));
+  fs::create_directory(dir.path("depth"));
+  writeFrame(dir.path("rgb/0.png"), dir.path("depth/0.png"), 0, 1000, 16, 9);
+  writeText(dir.path("K.txt"), "5 0 4\n0 6 3\n0 0 1\n");
+  writeText(dir.path("poses.txt"), "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n");
+  const auto reader = openDataset(dir.path(), DatasetOptions{});
+  std::string notes;
+  for (const std::string& note : reader->notes()) notes += note + "\n";
+  EXPECT_NE(notes.find("colour 16x9 (resized to the depth size); warning: colour and depth differ "
+                       "in shape (16:9 against 8:6)"),
+            std::string::npos)
+      << notes;
+  EXPECT_EQ(reader->read(0).rgbd.color.width(), 8);
+}
+
 TEST(FolderLayout, ColourNumberedFromAnotherStartIsNamed) {
   // Colour 1..4, depth 0..3: paired by number, each colour image would come from the next
   // frame. The import says so, and a pose count that no longer fits names the left-out frame.

@@ -143,6 +143,18 @@ TEST(ImportFolder, APoseConventionTheUserGivesIsKeptAndDoubtedAloud) {
       1e-6);
 }
 
+// A frame whose depth is all zero maps nothing; it went by without a count.
+TEST(ImportFolder, FramesWithoutDepthAreCounted) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  makeFolder(dir);
+  fs::remove(dir.path("depth/000004.png"));
+  writeFileBytes(dir.path("depth/000004.png"), encodeDepthPng(DepthImage(640, 480, 0)));
+  const ImportStats s = importDataset(dir.path(), dir.path("out.lcmlog"), ImportOptions());
+  EXPECT_EQ(s.frames_written, static_cast<size_t>(kFrames));
+  EXPECT_EQ(s.frames_without_depth, 1u);
+}
+
 TEST(ImportFolder, ACorruptFileStopsTheImportUnlessSkipBad) {
   PANMAP_REQUIRE_DATA("7scenes-200");
   test::TempDir dir;

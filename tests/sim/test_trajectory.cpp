@@ -314,6 +314,13 @@ TEST(Survey, TumReaderNamesTheBadLine) {
   EXPECT_EQ(message("0.5 1 2 3 0 0 1\n"), path + ":1: expected 't tx ty tz qx qy qz qw'");
   EXPECT_EQ(message("0.5 1 2 3 0 0 0 2\n"), path + ":1: quaternion is not unit length");
   EXPECT_EQ(message("0.5 1 2 x 0 0 0 1\n"), path + ":1: 'x' is not a number");
+  // A spreadsheet's export and a header line without '#' are named as such.
+  EXPECT_EQ(message("0.5,1,2,3,0,0,0,1\n"),
+            path +
+                ":1: '0.5,1,2,3,0,0,0,1' is not a number (values separated by commas: panmap reads "
+                "them separated by spaces or tabs)");
+  EXPECT_EQ(message("timestamp tx ty tz qx qy qz qw\n0.5 1 2 3 0 0 0 1\n"),
+            path + ":1: 'timestamp' is not a number (a header line? start it with '#')");
   EXPECT_EQ(message("# only a comment\n"), "trajectory " + path + " has no poses");
   EXPECT_EQ(message("0.5 1 2 3 0 0 0 1\n"), "no error");
   EXPECT_EQ(readTumTrajectory(path)[0].utime, 500000);

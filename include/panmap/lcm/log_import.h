@@ -66,6 +66,8 @@ struct ImportStats {
   size_t mask_pixels = 0;
   size_t unlisted_mask_pixels = 0;
   size_t unlisted_bgr_mask_pixels = 0;
+  /// Frames written whose depth image has no valid pixel (they map nothing).
+  size_t frames_without_depth = 0;
   size_t masks_found = 0;  ///< mask files in the mask folder (or its COCO JSON)
   /// Masks no imported frame took (their images absent, skipped, or beyond max_frames).
   size_t masks_unused = 0;
