@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -10,6 +11,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "panmap/core/classes.h"
 #include "panmap/core/error.h"
 
 namespace panmap {
@@ -173,6 +175,31 @@ const char* weightingName(OptimiserConfig::Weighting weighting) {
 
 }  // namespace
 
+std::string asConfigKeys(const std::string& message) {
+  // The components' checks name their fields as the code does; a config's user knows the keys.
+  static const std::pair<const char*, const char*> kNames[] = {
+      {"OptimiserConfig.objects.", "objects."},
+      {"OptimiserConfig.default_thresholds.", "optimiser."},
+      {"OptimiserConfig.class_thresholds[", "optimiser.classes[class "},
+      {"OptimiserConfig.", "optimiser."},
+      {"SurfaceFusionConfig.", "fusion."},
+      {"surface fusion ", "fusion."},
+      {"superpoint ", "superpoints."},
+      {"mapper num_threads", "threads"},
+      {"integrator ", "integrator."},
+      {"tracking ", "tracking."},
+      {"occupancy ", "occupancy."},
+      {"graph ", "graph."},
+      {"sync ", "sync."}};
+  for (const auto& [code, key] : kNames) {
+    const std::string prefix = code;
+    if (message.compare(0, prefix.size(), prefix) == 0) {
+      return key + message.substr(prefix.size());
+    }
+  }
+  return message;
+}
+
 PanmapConfig loadConfig(const std::string& path) { return loadConfig(path, PanmapConfig{}); }
 
 PanmapConfig loadConfig(const std::string& path, const PanmapConfig& base) {
@@ -189,11 +216,13 @@ PanmapConfig loadConfig(const std::string& path, const PanmapConfig& base) {
   // OpenCV reads YAML only after a "%YAML" directive on the first line, which plain YAML
   // leaves out: such a file was refused as "Input file is invalid". The directive is added
   // when the file has none; one below the first line is an error in YAML too.
+  int added_lines = 0;
   if (text.compare(0, 5, "%YAML") != 0) {
     if (text.find("\n%YAML") != std::string::npos) {
       throw Error(path + ": the %YAML directive must be the first line");
     }
     text = "%YAML:1.0\n" + text;
+    added_lines = 1;
   }
   cv::FileStorage fs;
   try {
@@ -202,6 +231,13 @@ PanmapConfig loadConfig(const std::string& path, const PanmapConfig& base) {
       throw Error("cannot read config " + path);
     }
   } catch (const cv::Exception& e) {
+    // OpenCV's parser puts the line and the reason where the function's name would be,
+    // "(3): Incorrect indentation", and its own function in err.
+    std::smatch where;
+    if (std::regex_match(e.func, where, std::regex(R"(\((\d+)\): (.*))"))) {
+      const int line = std::stoi(where[1]) - added_lines;
+      throw Error(path + ":" + std::to_string(line) + ": not a YAML config: " + where[2].str());
+    }
     throw Error(path + ": not a YAML config (" + std::string(e.err) + ")");
   }
   PanmapConfig c = base;
@@ -435,8 +471,14 @@ PanmapConfig loadConfig(const std::string& path, const PanmapConfig& base) {
         entry.read("theta_O", &t.theta_O);
         entry.read("theta_L", &t.theta_L);
         entry.finish();
-        if (cls <= 0) entry.fail("optimiser.classes[] needs a positive class");
-        o.class_thresholds[cls] = t;
+        if (cls <= 0 || cls > kMaxNyu40Class) {
+          entry.fail("optimiser.classes[] needs a class of 1..40 (NYU40), not " +
+                     std::to_string(cls));
+        }
+        // A class given twice kept the later entry silently.
+        if (!o.class_thresholds.emplace(cls, t).second) {
+          entry.fail("optimiser.classes[] lists class " + std::to_string(cls) + " twice");
+        }
       }
     }
     s.finish();
@@ -483,7 +525,7 @@ PanmapConfig loadConfig(const std::string& path, const PanmapConfig& base) {
     c.optimiser.check();  // first: a bad max_void_share is named by its own key
     c.mapper.check();
   } catch (const Error& e) {
-    throw Error(path + ": " + e.what());
+    throw Error(path + ": " + asConfigKeys(e.what()));
   }
   return c;
 }

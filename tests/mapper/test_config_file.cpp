@@ -174,6 +174,29 @@ TEST(ConfigFile, BadKeysAndValuesNameTheKey) {
             std::string::npos);
   EXPECT_NE(error("%YAML:1.0\n---\noptimiser:\n   weighting: \"voxels\"\n").find("not \"voxels\""),
             std::string::npos);
+  // A key that lost its indent was "not a YAML config (skipSpaces)": now its line and why.
+  EXPECT_EQ(error("map:\nvoxel_size_m: 0.02\n"),
+            dir.path("config.yaml") + ":2: not a YAML config: Incorrect indentation");
+  // A component's check names the key the file holds, not the code's field.
+  EXPECT_NE(error("objects:\n   min_area_m2: -1\n").find(": objects.min_area_m2"),
+            std::string::npos)
+      << error("objects:\n   min_area_m2: -1\n");
+  EXPECT_NE(error("threads: 0\n").find(": threads must be"), std::string::npos)
+      << error("threads: 0\n");
+  EXPECT_NE(error("fusion:\n   stuff_confidence: 4\n").find(": fusion.stuff_confidence"),
+            std::string::npos)
+      << error("fusion:\n   stuff_confidence: 4\n");
+  EXPECT_EQ(asConfigKeys("superpoint significant_overlap must be in (0, 1]"),
+            "superpoints.significant_overlap must be in (0, 1]");
+  EXPECT_EQ(asConfigKeys("cannot read x"), "cannot read x");
+  // A class listed twice kept the later entry in silence; one beyond NYU40 was taken.
+  EXPECT_NE(error("%YAML:1.0\n---\noptimiser:\n   classes:\n      - { class: 5, theta_D: 0.1 }\n"
+                  "      - { class: 5, theta_D: 0.2 }\n")
+                .find("optimiser.classes[] lists class 5 twice"),
+            std::string::npos);
+  EXPECT_NE(error("%YAML:1.0\n---\noptimiser:\n   classes:\n      - { class: 99, theta_D: 0.1 }\n")
+                .find("needs a class of 1..40 (NYU40), not 99"),
+            std::string::npos);
   EXPECT_THROW(loadConfig(dir.path("missing.yaml")), Error);
   EXPECT_FLOAT_EQ(loadConfig(write(dir, "")).mapper.map.voxel_size_m, 0.01f);  // all defaults
   test::expectError([&] { loadConfig(dir.path()); }, {"config " + dir.path() + " is a folder"});
@@ -211,7 +234,7 @@ TEST(ConfigFile, LinkScaleRoundTripsAndABadValueIsNamed) {
   // A bad value is named by the key the file holds, not by the setting derived from it.
   test::expectError(
       [&] { loadConfig(write(dir, "%YAML:1.0\n---\noptimiser:\n   max_void_share: 1.5\n")); },
-      {"OptimiserConfig.max_void_share"});
+      {"optimiser.max_void_share"});
   EXPECT_EQ(loadConfig(write(dir, configToYaml(smaller))).optimiser.link_scale,
             OptimiserConfig::LinkScale::kSmaller);
   try {

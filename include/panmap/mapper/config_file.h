@@ -17,6 +17,10 @@ struct PanmapConfig {
   SyncConfig sync;
 };
 
+/// A component's check message with the component's field names put as the config's keys
+/// ("OptimiserConfig.objects.min_area_m2 ..." -> "objects.min_area_m2 ..."); others unchanged.
+std::string asConfigKeys(const std::string& message);
+
 /// Reads a YAML config (OpenCV FileStorage dialect, `%YAML:1.0` header): sections map,
 /// integrator, depth_segmentation, fusion, superpoints, graph, optimiser, sync, each optional, each
 /// key optional (missing keys keep their defaults). Unknown sections or keys, wrong types and
