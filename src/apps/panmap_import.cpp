@@ -276,10 +276,26 @@ int main(int argc, char** argv) {
       if (s.masks_resized > 0) {
         std::printf("%zu masks scaled to their colour image\n", s.masks_resized);
       }
-      if (s.unknown_category_segments > 0 && !options.contiguous_ids) {
-        std::printf(
-            "  if the masks number categories from 0 as a network's raw output does, import "
-            "again with --contiguous-ids\n");
+      if (!s.unknown_category_ids.empty()) {
+        std::string list;
+        size_t shown = 0;
+        bool all_row_indices = true;  // every unknown id could be a row counted from 0
+        for (const auto& [id, segments] : s.unknown_category_ids) {
+          all_row_indices =
+              all_row_indices && id >= 0 && static_cast<size_t>(id) < s.label_table_rows;
+          if (shown++ < 8) {
+            list += (list.empty() ? "" : ", ") + std::to_string(id) + " (" +
+                    std::to_string(segments) + ")";
+          }
+        }
+        if (s.unknown_category_ids.size() > 8) list += ", ...";
+        std::printf("  unknown categories (segments): %s\n", list.c_str());
+        // Raw network output counts classes from 0: then every unknown id is a row index.
+        if (all_row_indices && !options.contiguous_ids) {
+          std::printf(
+              "  if the masks number categories from 0 as a network's raw output does, import "
+              "again with --contiguous-ids\n");
+        }
       }
     }
   } catch (const std::exception& e) {

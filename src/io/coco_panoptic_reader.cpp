@@ -155,6 +155,9 @@ PanopticFrame CocoPanopticReader::read(const std::string& color_stem) {
     frame.segments = entry.segments;
     for (const auto& s : frame.segments) unknown += table_.lookup(s.source_category) ? 0 : 1;
   }
+  for (const auto& s : frame.segments) {
+    if (!table_.lookup(s.source_category)) ++stats_.unknown_category_ids[s.source_category];
+  }
   const auto bytes = readFileBytes(entry.png_path);
   frame.segment_ids = decodeLabelPng(bytes.data(), bytes.size(), entry.png_path);
   // Pixels of ids without a segments_info entry are unsegmented (COCO: id 0 is void). They are

@@ -23,7 +23,7 @@ constexpr size_t kPngColourTypeByte = 25;
 }  // namespace
 
 PanopticFrame panopticFromClasses(const LabelImage& classes, const LabelTable& table,
-                                  size_t* unknown_ids) {
+                                  size_t* unknown_ids, std::map<int32_t, size_t>* unknown_by_id) {
   std::set<int32_t> present;
   const int32_t* pixel = classes.data();
   for (size_t i = 0; i < classes.size(); ++i) {
@@ -38,6 +38,7 @@ PanopticFrame panopticFromClasses(const LabelImage& classes, const LabelTable& t
     const auto entry = table.lookup(source);
     if (!entry) {
       ++*unknown_ids;
+      if (unknown_by_id) ++(*unknown_by_id)[source];
       continue;
     }
     region = class_mat == source;
@@ -107,7 +108,8 @@ PanopticFrame SemanticMaskReader::read(const std::string& color_stem) {
   }
   const LabelImage classes = decodeLabelPng(bytes.data(), bytes.size(), path);
   size_t unknown = 0;
-  PanopticFrame frame = panopticFromClasses(classes, table_, &unknown);
+  PanopticFrame frame =
+      panopticFromClasses(classes, table_, &unknown, &stats_.unknown_category_ids);
   ++stats_.frames_with_masks;
   stats_.segments += frame.segments.size();
   stats_.unknown_category_segments += unknown;

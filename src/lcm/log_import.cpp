@@ -114,10 +114,12 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
                           const std::function<void(size_t, size_t)>& progress) {
   const std::unique_ptr<DatasetReader> reader = openDataset(dataset_dir, options.dataset);
   std::unique_ptr<MaskReader> masks;
+  size_t stats_table_rows = 0;
   if (!options.mask_dir.empty()) {
     LabelTable table = options.label_table.empty() ? LabelTable::nyu40Identity()
                                                    : LabelTable::load(options.label_table);
     if (options.contiguous_ids) table = table.contiguous();
+    stats_table_rows = table.size();
     if (options.mask_format == ImportOptions::MaskFormat::kSemantic) {
       if (!options.mask_json.empty()) {
         throw Error("semantic masks have no JSON (" + options.mask_json + ")");
@@ -133,6 +135,7 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
   if (options.invalid_pose == ImportOptions::InvalidPose::kError) skip_invalid = false;
 
   ImportStats stats;
+  stats.label_table_rows = stats_table_rows;
   stats.layout = reader->layoutName();
   stats.frames_found = reader->size();
   stats.unmatched_frames = reader->unmatchedFrames();
@@ -264,7 +267,10 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
     std::remove(partial.c_str());
     throw;
   }
-  if (masks) stats.unknown_category_segments = masks->stats().unknown_category_segments;
+  if (masks) {
+    stats.unknown_category_segments = masks->stats().unknown_category_segments;
+    stats.unknown_category_ids = masks->stats().unknown_category_ids;
+  }
   if (std::rename(partial.c_str(), log_path.c_str()) != 0) {
     std::remove(partial.c_str());
     throw Error("cannot write log " + log_path);

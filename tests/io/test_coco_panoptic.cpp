@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -35,6 +36,7 @@ TEST(CocoPanoptic, SingleJsonFile) {
   EXPECT_FALSE(reader.has("frame-000003.color"));
   expectFixtureFrame(reader.read("frame-000000.color"));
   EXPECT_EQ(reader.stats().unknown_category_segments, 1u);
+  EXPECT_EQ(reader.stats().unknown_category_ids, (std::map<int32_t, size_t>{{999, 1}}));
   EXPECT_THROW(reader.read("frame-000003.color"), Error);
 }
 

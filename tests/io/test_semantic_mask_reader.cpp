@@ -1,3 +1,4 @@
+#include <map>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,7 @@ TEST(SemanticMasks, StuffIsOneSegmentAndThingsSplitWhereTheyDoNotTouch) {
     }
     // Ids 0 and 7 are not in the table: counted once each.
     EXPECT_EQ(reader.stats().unknown_category_segments, 2u);
+    EXPECT_EQ(reader.stats().unknown_category_ids, (std::map<int32_t, size_t>{{0, 1}, {7, 1}}));
     EXPECT_EQ(reader.stats().segments, 5u);
   }
 }

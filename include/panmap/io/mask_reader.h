@@ -1,6 +1,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -12,8 +14,9 @@ namespace panmap {
 struct MaskReaderStats {
   size_t frames_with_masks = 0;
   size_t segments = 0;
-  size_t unknown_category_segments = 0;  ///< category absent from the label table
-  size_t labelled_pixels = 0;            ///< pixels with a segment id other than 0 (void), as read
+  size_t unknown_category_segments = 0;            ///< category absent from the label table
+  std::map<int32_t, size_t> unknown_category_ids;  ///< those categories, with their segments
+  size_t labelled_pixels = 0;  ///< pixels with a segment id other than 0 (void), as read
   /// Of those, pixels whose id no segment lists (left unsegmented: COCO treats them as void).
   size_t unlisted_pixels = 0;
   /// Of the unlisted, pixels whose id with R and B swapped is listed: a PNG written as BGR.

@@ -13,7 +13,8 @@ namespace panmap {
 /// numbered from 1 in order of class id, then of the region's first pixel in raster order.
 /// Pixels of ids `table` lacks are 0; their number of distinct ids is added to `unknown_ids`.
 PanopticFrame panopticFromClasses(const LabelImage& classes, const LabelTable& table,
-                                  size_t* unknown_ids);
+                                  size_t* unknown_ids,
+                                  std::map<int32_t, size_t>* unknown_by_id = nullptr);
 
 /// The masks a semantic network would have given for a panoptic frame: each pixel keeps its
 /// segment's class (NYU40 id, looked up in `table` as a source id) and loses its instance,
