@@ -195,8 +195,12 @@ std::string findScanNetLabelTable(const std::string& scene_dir) {
   if (ec) return "";
   if (!dir.has_filename()) dir = dir.parent_path();  // "scene0000_00/"
   for (int up = 0; up < 3 && !dir.empty(); ++up) {
-    const fs::path table = dir / "scannetv2-labels.combined.tsv";
-    if (fs::is_regular_file(table, ec)) return table.string();
+    // In the folder itself (ScanNet's download), or in a scannet-meta/ folder beside it (the
+    // shared data's layout: scannet-gt/<scene> and scannet-meta/ side by side).
+    for (const fs::path& table : {dir / "scannetv2-labels.combined.tsv",
+                                  dir / "scannet-meta" / "scannetv2-labels.combined.tsv"}) {
+      if (fs::is_regular_file(table, ec)) return table.string();
+    }
     if (dir == dir.parent_path()) break;
     dir = dir.parent_path();
   }

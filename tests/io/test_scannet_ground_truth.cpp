@@ -196,7 +196,7 @@ TEST(ScanNetGroundTruth, FindsTheScanNetFilesOfAFolder) {
 }
 
 // ScanNet's download puts the label table above scans/<scene>/: it is found there, in the
-// scene folder first, and nowhere else.
+// scene folder first, or in a scannet-meta/ folder at those levels, and nowhere else.
 TEST(ScanNetGroundTruth, FindsTheLabelTableAboveTheScene) {
   test::TempDir dir;
   fs::create_directories(dir.path("scans/scene0000_00"));
@@ -207,6 +207,13 @@ TEST(ScanNetGroundTruth, FindsTheLabelTableAboveTheScene) {
   EXPECT_EQ(findScanNetLabelTable(scene + "/"), dir.path("scannetv2-labels.combined.tsv"));
   std::ofstream(scene + "/scannetv2-labels.combined.tsv") << "id\n";
   EXPECT_EQ(findScanNetLabelTable(scene), scene + "/scannetv2-labels.combined.tsv");
+  // The shared data's layout: scannet-gt/<scene> beside scannet-meta/ (found from any folder;
+  // panmap-eval --gt-scannet did not find it where panmap-synth's cwd-relative default did).
+  fs::create_directories(dir.path("data/scannet-gt/scene0470_00"));
+  fs::create_directories(dir.path("data/scannet-meta"));
+  std::ofstream(dir.path("data/scannet-meta/scannetv2-labels.combined.tsv")) << "id\n";
+  EXPECT_EQ(findScanNetLabelTable(dir.path("data/scannet-gt/scene0470_00")),
+            dir.path("data/scannet-meta/scannetv2-labels.combined.tsv"));
   // Three levels up is too far.
   fs::create_directories(dir.path("a/b/c/d"));
   EXPECT_EQ(findScanNetLabelTable(dir.path("a/b/c/d")), "");

@@ -70,7 +70,7 @@ ScanNetSceneFiles findScanNetSceneFiles(const std::string& scene_dir);
 
 /// ScanNet's label table for a scene when none is given: scannetv2-labels.combined.tsv in
 /// `scene_dir`, its parent or its grandparent (ScanNet's download script puts it above
-/// scans/<scene>/). "" when none of them has it.
+/// scans/<scene>/), or in a scannet-meta/ folder in one of them. "" when none has it.
 std::string findScanNetLabelTable(const std::string& scene_dir);
 
 /// Per-vertex NYU40 ids of ScanNet's *_vh_clean_2.labels.ply: its `label` property (ScanNet
