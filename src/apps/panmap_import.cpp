@@ -172,7 +172,9 @@ int main(int argc, char** argv) {
     if (pose_convention != "auto") {
       options.pose_convention.inverted = pose_convention == "world-to-camera";
     }
-    if (quaternion_order != "auto") options.pose_convention.wxyz = quaternion_order == "wxyz";
+    if (quaternion_order != "auto") {
+      options.pose_convention.scalar_moved = quaternion_order == "wxyz";
+    }
     if (pose_unit != "auto") {
       options.pose_convention.translation_scale = pose_unit == "m"    ? 1.0
                                                   : pose_unit == "cm" ? 0.01

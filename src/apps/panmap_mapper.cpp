@@ -102,6 +102,11 @@ nlohmann::json depthCheckJson(const panmap::Mapper& mapper) {
 
 // When the depth check found the sensor uncalibrated (the only way poses are kept as given):
 // why, and what to do about it.
+void printPoseConvention(const panmap::Mapper& mapper) {
+  const std::string warning = mapper.poseConventionWarning();
+  if (!warning.empty()) std::fprintf(stderr, "panmap-mapper: warning: %s\n", warning.c_str());
+}
+
 void printDepthCheck(const panmap::Mapper& mapper) {
   const panmap::DepthPatternMonitor& check = mapper.depthCheck();
   if (check.verdict() != panmap::DepthPatternMonitor::Verdict::kUncalibrated) return;
@@ -140,6 +145,7 @@ nlohmann::json mapJson(const panmap::Mapper& mapper, const panmap::OutputSummary
           {"vote_evictions", mapper.voteEvictions()},
           {"tracking", trackingJson(mapper)},
           {"depth_check", depthCheckJson(mapper)},
+          {"pose_convention_warning", mapper.poseConventionWarning()},
           {"mesh",
            {{"vertices", outputs.mesh_vertices},
             {"faces", outputs.mesh_faces},
@@ -675,6 +681,7 @@ int main(int argc, char** argv) {
       }
       printRefinement(report.refinement);
       printDepthCheck(*mapper);
+      printPoseConvention(*mapper);
       return failIfNoSurface(*mapper, outputs.mesh_vertices);
     }
 
@@ -859,6 +866,7 @@ int main(int argc, char** argv) {
     }
     printRefinement(stats.refinement);
     printDepthCheck(*mapper);
+    printPoseConvention(*mapper);
     return failIfNoSurface(*mapper, outputs.mesh_vertices);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "panmap-mapper: error: %s\n", e.what());

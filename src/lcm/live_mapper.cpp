@@ -432,6 +432,9 @@ status_t LiveMapper::status(const std::string& state) const {
                            "counts since its last answer");
   }
   if (!waiting_for_labels_.empty()) msg.warnings.push_back(waiting_for_labels_);
+  if (std::string poses = mapper_->poseConventionWarning(); !poses.empty()) {
+    msg.warnings.push_back(std::move(poses));
+  }
   msg.num_warnings = static_cast<int32_t>(msg.warnings.size());
   {
     std::lock_guard<std::mutex> lock(command_mutex_);

@@ -53,8 +53,8 @@ bool fitMaskToColour(LabelImage* mask, const DatasetFrame& frame, bool resize,
 
 // How the user's pose file is written, from the depth of frame pairs: 8 frames spread over the
 // import, each with partners 3, 10 and 30 frames later (0.1 to 1 s at 30 Hz), so that some
-// pairs see the camera move while still overlapping. Frames that cannot be read or have no
-// pose are left out here; the import itself reports them.
+// pairs see the camera move while still overlapping. Frames
+// that cannot be read or have no pose are left out here; the import itself reports them.
 PoseConventionVerdict checkPoseConvention(const DatasetReader& reader, size_t total,
                                           const PoseConventionChoice& fixed) {
   constexpr size_t kBases = 8;
@@ -86,7 +86,9 @@ PoseConventionVerdict checkPoseConvention(const DatasetReader& reader, size_t to
       if (first >= 0 && second >= 0) pairs.emplace_back(first, second);
     }
   }
-  return detectPoseConvention(samples, pairs, reader.posesAreQuaternions(), fixed);
+  return detectPoseConvention(
+      samples, pairs,
+      reader.posesAreQuaternions() ? QuaternionInput::kScalarLast : QuaternionInput::kNone, fixed);
 }
 
 }  // namespace
@@ -155,8 +157,9 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
     stats.notes.push_back(stats.pose_convention->note);
   } else {
     convention.translation_scale = fixed.translation_scale.value_or(1.0);
-    convention.wxyz = fixed.wxyz.value_or(false);
+    convention.scalar_moved = fixed.scalar_moved.value_or(false);
     convention.inverted = fixed.inverted.value_or(false);
+    if (reader->posesAreQuaternions()) convention.quaternions = QuaternionInput::kScalarLast;
   }
 
   // Write beside the target and rename at the end: a failed import leaves no partial log.

@@ -232,6 +232,7 @@ FrameStats Mapper::integrate(const RgbdFrame& raw_frame, const Eigen::Isometry3d
   const bool calibrated = config_.hasDepthCalibration();
   if (calibrated) config_.depth_calibration->apply(raw_frame, &calibrated_frame_, pool_.get());
   const RgbdFrame& frame = calibrated ? calibrated_frame_ : raw_frame;
+  pose_convention_watch_.add(frame, T_W_C_given);
   FrameStats stats;
   const auto t_start = Clock::now();
   // Refine the pose against the map first: every later stage then sees the refined pose.

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "panmap/convention/pose_convention.h"
+#include "panmap/convention/pose_convention_watch.h"
 #include "panmap/core/error.h"
 #include "panmap/render/renderer.h"
 #include "panmap/sim/depth_noise.h"
@@ -39,26 +40,40 @@ TEST(PoseConvention, EachReadingUndoesItsMistakeExactly) {
   const Eigen::Isometry3d T = somePose();
   EXPECT_LT(difference(PoseConvention{}.apply(T), T), 1e-12);
   EXPECT_LT(difference(PoseConvention{1.0, false, true}.apply(T.inverse()), T), 1e-12);
-  EXPECT_LT(difference(PoseConvention{1.0, true, false}.apply(readWithScalarFirst(T)), T), 1e-12);
+  constexpr QuaternionInput kTum = QuaternionInput::kScalarLast;
+  EXPECT_LT(difference(PoseConvention{1.0, true, false, kTum}.apply(readWithScalarFirst(T)), T),
+            1e-12);
+  // A pose_t filled from Eigen's coeffs() (x y z w) read as w x y z.
+  const Eigen::Quaterniond q(T.linear());
+  Eigen::Isometry3d coeffs = T;
+  coeffs.linear() = Eigen::Quaterniond(q.x(), q.y(), q.z(), q.w()).normalized().matrix();
+  EXPECT_LT(
+      difference(PoseConvention{1.0, true, false, QuaternionInput::kScalarFirst}.apply(coeffs), T),
+      1e-12);
   Eigen::Isometry3d mm = T;
   mm.translation() *= 1000.0;
   EXPECT_LT(difference(PoseConvention{0.001, false, false}.apply(mm), T), 1e-12);
   // All three at once: millimetres of T_C_W with the scalar first.
   Eigen::Isometry3d all = T.inverse();
   all.translation() *= 1000.0;
-  EXPECT_LT(difference(PoseConvention{0.001, true, true}.apply(readWithScalarFirst(all)), T),
+  EXPECT_LT(difference(PoseConvention{0.001, true, true, kTum}.apply(readWithScalarFirst(all)), T),
             1e-12);
   EXPECT_TRUE(PoseConvention{}.isIdentity());
   EXPECT_FALSE((PoseConvention{1.0, false, true}.isIdentity()));
-  EXPECT_EQ(PoseConvention{}.describe(true), "camera-to-world, quaternion x y z w, metres");
-  EXPECT_EQ((PoseConvention{0.001, false, true}.describe(false)), "world-to-camera, millimetres");
+  EXPECT_EQ((PoseConvention{1.0, false, false, kTum}.describe()),
+            "camera-to-world, quaternion x y z w, metres");
+  EXPECT_EQ((PoseConvention{1.0, true, false, kTum}.describe()),
+            "camera-to-world, quaternion w x y z, metres");
+  EXPECT_EQ((PoseConvention{1.0, true, false, QuaternionInput::kScalarFirst}.describe()),
+            "camera-to-world, quaternion x y z w, metres");
+  EXPECT_EQ((PoseConvention{0.001, false, true}.describe()), "world-to-camera, millimetres");
 }
 
-// Frames of procedural room 1's survey (5 Hz), exact depth.
+// Frames of procedural room 1's survey (30 Hz, 10 s), exact depth.
 struct Survey {
   Survey() : room(generateRoom(1)), renderer(room.mesh) {
     SurveyConfig config;
-    config.num_frames = 120;
+    config.num_frames = 300;
     trajectory = planSurvey(room.mesh, config, 1);
     for (int k = 20; k < 60; k += 2) {
       RgbdFrame frame;
@@ -70,11 +85,21 @@ struct Survey {
       frames.push_back(frame);
       poses.push_back(trajectory[k].T_W_C);
     }
-    // Frames 2 and 6 survey frames apart (0.4 and 1.2 s).
+    // Frames 2 and 6 survey frames apart (67 and 200 ms).
     for (int i = 0; i + 3 < static_cast<int>(frames.size()); i += 3) {
       pairs.emplace_back(i, i + 1);
       pairs.emplace_back(i, i + 3);
     }
+  }
+  // Survey frame k, rendered.
+  RgbdFrame frameAt(int k) const {
+    RgbdFrame frame;
+    frame.camera = test::kinectCamera();
+    frame.utime = trajectory[k].utime;
+    DepthNoiseConfig noise;
+    noise.enabled = false;
+    frame.depth = simulateDepth(renderer.render(frame.camera, trajectory[k].T_W_C), noise, 0);
+    return frame;
   }
   // The frames with their poses as `mistake` wrote them.
   std::vector<PoseSample> samples(
@@ -119,7 +144,7 @@ TEST(DetectPoseConvention, FindsEachWayAFileCanBeWrittenOnARenderedSurvey) {
       {"world-to-camera", [](Eigen::Isometry3d T) { return Eigen::Isometry3d(T.inverse()); },
        PoseConvention{1.0, false, true}},
       {"scalar first", [](Eigen::Isometry3d T) { return readWithScalarFirst(T); },
-       PoseConvention{1.0, true, false}},
+       PoseConvention{1.0, true, false, QuaternionInput::kScalarLast}},
       {"millimetres",
        [](Eigen::Isometry3d T) {
          T.translation() *= 1000.0;
@@ -135,15 +160,17 @@ TEST(DetectPoseConvention, FindsEachWayAFileCanBeWrittenOnARenderedSurvey) {
        PoseConvention{0.01, false, true}}};
   for (const Case& c : cases) {
     SCOPED_TRACE(c.what);
-    const PoseConventionVerdict v =
-        detectPoseConvention(s.samples(c.mistake), s.pairs, true, PoseConventionChoice());
+    const PoseConventionVerdict v = detectPoseConvention(
+        s.samples(c.mistake), s.pairs, QuaternionInput::kScalarLast, PoseConventionChoice());
     EXPECT_EQ(v.convention.translation_scale, c.expected.translation_scale);
-    EXPECT_EQ(v.convention.wxyz, c.expected.wxyz);
+    EXPECT_EQ(v.convention.scalar_moved, c.expected.scalar_moved);
     EXPECT_EQ(v.convention.inverted, c.expected.inverted);
     EXPECT_EQ(v.changed, !c.expected.isIdentity()) << v.note;
     EXPECT_EQ(v.pairs, static_cast<int>(s.pairs.size()));
     EXPECT_GT(v.agreement_chosen, 0.6) << v.note;
-    if (v.changed) EXPECT_GE(v.agreement_chosen - v.agreement_as_read, 0.15) << v.note;
+    if (v.changed) {
+      EXPECT_GE(v.agreement_chosen - v.agreement_as_read, 0.15) << v.note;
+    }
   }
 }
 
@@ -152,16 +179,16 @@ TEST(DetectPoseConvention, WhatTheUserFixedIsNotSearchedAndALowAgreementIsSaid) 
   PoseConventionChoice fixed;
   fixed.inverted = false;
   const PoseConventionVerdict v = detectPoseConvention(
-      s.samples([](Eigen::Isometry3d T) { return Eigen::Isometry3d(T.inverse()); }), s.pairs, true,
-      fixed);
+      s.samples([](Eigen::Isometry3d T) { return Eigen::Isometry3d(T.inverse()); }), s.pairs,
+      QuaternionInput::kScalarLast, fixed);
   EXPECT_FALSE(v.convention.inverted);
   EXPECT_FALSE(v.changed);
   EXPECT_NE(v.note.find("agrees on only"), std::string::npos) << v.note;
   // Quaternions not tried for a matrix file: scalar-first stays as read.
   const PoseConventionVerdict matrices =
       detectPoseConvention(s.samples([](Eigen::Isometry3d T) { return readWithScalarFirst(T); }),
-                           s.pairs, false, PoseConventionChoice());
-  EXPECT_FALSE(matrices.convention.wxyz);
+                           s.pairs, QuaternionInput::kNone, PoseConventionChoice());
+  EXPECT_FALSE(matrices.convention.scalar_moved);
 }
 
 TEST(DetectPoseConvention, ACameraThatDoesNotMoveDecidesNothing) {
@@ -175,11 +202,13 @@ TEST(DetectPoseConvention, ACameraThatDoesNotMoveDecidesNothing) {
     if (inverted) {
       for (PoseSample& p : samples) p.T_as_read = p.T_as_read.inverse();
     }
-    const PoseConventionVerdict v = detectPoseConvention(samples, pairs, true, {});
+    const PoseConventionVerdict v =
+        detectPoseConvention(samples, pairs, QuaternionInput::kScalarLast, {});
     EXPECT_FALSE(v.changed);
     EXPECT_DOUBLE_EQ(v.agreement_as_read, 1.0);
   }
-  const PoseConventionVerdict none = detectPoseConvention(still, {}, true, {});
+  const PoseConventionVerdict none =
+      detectPoseConvention(still, {}, QuaternionInput::kScalarLast, {});
   EXPECT_FALSE(none.changed);
   EXPECT_NE(none.note.find("no two frames"), std::string::npos);
 }
@@ -188,8 +217,8 @@ TEST(DetectPoseConvention, BadArgumentsAreNamed) {
   const Survey& s = survey();
   test::expectError(
       [&] {
-        detectPoseConvention(s.samples([](Eigen::Isometry3d T) { return T; }), {{0, 999}}, true,
-                             {});
+        detectPoseConvention(s.samples([](Eigen::Isometry3d T) { return T; }), {{0, 999}},
+                             QuaternionInput::kScalarLast, {});
       },
       {"pair names a frame"});
   PoseConventionConfig config;
@@ -198,6 +227,66 @@ TEST(DetectPoseConvention, BadArgumentsAreNamed) {
   config = PoseConventionConfig();
   config.min_gain = 1.0;
   test::expectError([&] { config.check(); }, {"min_gain"});
+}
+
+// Live poses are checked by the mapper as they come: a pose_t filled world-to-camera (what
+// ORB-SLAM3's TrackRGBD returns) or from Eigen's coeffs() (x y z w into the w x y z field).
+TEST(PoseConventionWatch, NamesASendersConventionFromAWindowThatMoves) {
+  const Survey& s = survey();
+  using Sent = std::function<Eigen::Isometry3d(Eigen::Isometry3d)>;
+  // Survey frames first .. last (30 Hz), each pose as `sent` makes it, with utimes shifted by
+  // `shift`.
+  auto feed = [&](PoseConventionWatch* watch, int first, int last, const Sent& sent,
+                  int64_t shift = 0) {
+    for (int k = first; k <= last; ++k) {
+      RgbdFrame frame = s.frameAt(k);
+      frame.utime += shift;
+      watch->add(frame, sent(s.trajectory[k].T_W_C));
+    }
+  };
+  const Sent as_is = [](Eigen::Isometry3d T) { return T; };
+  const Sent inverted = [](Eigen::Isometry3d T) { return Eigen::Isometry3d(T.inverse()); };
+  const Sent coeffs = [](Eigen::Isometry3d T) {
+    const Eigen::Quaterniond q(T.linear());
+    T.linear() = Eigen::Quaterniond(q.x(), q.y(), q.z(), q.w()).normalized().matrix();
+    return T;
+  };
+  PoseConventionWatch right;
+  feed(&right, 60, 90, as_is);
+  EXPECT_FALSE(right.finding());
+  EXPECT_EQ(right.warning(), "");
+
+  PoseConventionWatch inverse;
+  feed(&inverse, 60, 90, inverted);
+  ASSERT_TRUE(inverse.finding());
+  EXPECT_TRUE(inverse.finding()->convention.inverted);
+  EXPECT_NE(inverse.warning().find("read as world-to-camera, quaternion w x y z, metres: check "
+                                   "the sender's convention"),
+            std::string::npos)
+      << inverse.warning();
+
+  PoseConventionWatch scalar_last;
+  feed(&scalar_last, 60, 90, coeffs);
+  ASSERT_TRUE(scalar_last.finding());
+  EXPECT_TRUE(scalar_last.finding()->convention.scalar_moved);
+  EXPECT_NE(scalar_last.warning().find("quaternion x y z w"), std::string::npos)
+      << scalar_last.warning();
+
+  // A camera standing still through the first window decides nothing; the next window, once
+  // it moves, does.
+  PoseConventionWatchConfig config;
+  config.window_every_s = 10.0;
+  PoseConventionWatch later(config);
+  RgbdFrame still = s.frameAt(30);
+  for (int i = 0; i < 30; ++i) {
+    still.utime = s.trajectory[30].utime + i * 200000;
+    later.add(still, inverted(s.trajectory[30].T_W_C));
+  }
+  EXPECT_FALSE(later.finding());
+  feed(&later, 60, 90, inverted, 10000000);
+  EXPECT_TRUE(later.finding());
+  config.window_every_s = 1.0;
+  test::expectError([&] { PoseConventionWatch bad(config); }, {"window_every_s"});
 }
 
 }  // namespace

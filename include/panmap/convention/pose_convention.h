@@ -10,30 +10,40 @@
 
 namespace panmap {
 
-/// How a pose file's numbers become camera-to-world poses in metres. A user's own trajectory
-/// can be written world-to-camera, with its quaternion scalar first, or in millimetres; each
-/// gives a map of doubled walls with nothing said (issue found by a newcomer probe).
-struct PoseConvention {
-  /// Scale of the translation, metres per file unit (1, 0.01 for cm, 0.001 for mm).
-  double translation_scale = 1.0;
-  /// The quaternion was written w x y z and read as x y z w (TUM's order).
-  bool wxyz = false;
-  /// The file holds T_C_W (world-to-camera), not T_W_C.
-  bool inverted = false;
+/// Where the reader of the poses expects a quaternion's scalar.
+enum class QuaternionInput {
+  kNone,         ///< the rotations were matrices
+  kScalarLast,   ///< TUM files: qx qy qz qw
+  kScalarFirst,  ///< pose_t's orientation: w x y z
+};
 
-  /// T_W_C from a pose as the reader parsed it (TUM's quaternion order, camera-to-world, the
-  /// file's units).
+/// How a pose source's numbers become camera-to-world poses in metres. A user's own trajectory
+/// can be written world-to-camera, with its quaternion's scalar at the other end, or in
+/// millimetres; each gives a map of doubled walls with nothing said (found by a newcomer probe).
+struct PoseConvention {
+  /// Scale of the translation, metres per unit (1, 0.01 for cm, 0.001 for mm).
+  double translation_scale = 1.0;
+  /// The quaternion's scalar sat at the other end from where the reader expects it (w x y z
+  /// in a TUM file, x y z w in a pose_t, as Eigen's coeffs() gives them).
+  bool scalar_moved = false;
+  /// The source holds T_C_W (world-to-camera), not T_W_C.
+  bool inverted = false;
+  /// How the reader read the quaternion (scalar_moved needs it; kNone: no quaternions).
+  QuaternionInput quaternions = QuaternionInput::kNone;
+
+  /// T_W_C from a pose as the reader parsed it (its quaternion order, camera-to-world, the
+  /// source's units).
   Eigen::Isometry3d apply(const Eigen::Isometry3d& T_as_read) const;
   /// "camera-to-world, quaternion x y z w, metres" and the like.
-  std::string describe(bool quaternions) const;
+  std::string describe() const;
   /// True when apply() returns its input.
-  bool isIdentity() const { return translation_scale == 1.0 && !wxyz && !inverted; }
+  bool isIdentity() const { return translation_scale == 1.0 && !scalar_moved && !inverted; }
 };
 
 /// What the user fixed; unset fields are chosen from the depth images.
 struct PoseConventionChoice {
   std::optional<double> translation_scale;
-  std::optional<bool> wxyz;
+  std::optional<bool> scalar_moved;
   std::optional<bool> inverted;
 };
 
@@ -62,9 +72,9 @@ struct PoseConventionVerdict {
   PoseConvention convention;       ///< what to apply
   double agreement_as_read = 0.0;  ///< share of sampled points two frames agree on, as read
   double agreement_chosen = 0.0;   ///< the same under `convention`
-  int pairs = 0;                   ///< frame pairs compared
-  bool changed = false;            ///< `convention` differs from the file as read
-  std::string note;                ///< one line for the user
+  int pairs = 0;         ///< frame pairs compared that some reading carries across (share a view)
+  bool changed = false;  ///< `convention` differs from the file as read
+  std::string note;      ///< one line for the user
 };
 
 /// Which of the candidate conventions makes the depth of frame pairs agree: for each pair
@@ -72,10 +82,11 @@ struct PoseConventionVerdict {
 /// the second by the candidate's poses and agrees when the second frame's depth there is the
 /// same within the tolerance. The file as read is kept unless another candidate agrees clearly
 /// more (min_agreement, min_gain): a camera that barely moves cannot tell.
-/// @param quaternions whether the file's rotations were quaternions (else wxyz is not tried)
+/// @param quaternions how the reader read the rotations (kNone: scalar_moved is not tried)
 PoseConventionVerdict detectPoseConvention(const std::vector<PoseSample>& samples,
                                            const std::vector<std::pair<int, int>>& pairs,
-                                           bool quaternions, const PoseConventionChoice& fixed,
+                                           QuaternionInput quaternions,
+                                           const PoseConventionChoice& fixed,
                                            const PoseConventionConfig& config = {});
 
 /// Share of `first`'s sampled depth points that land on `second`'s depth within the tolerance

@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include "panmap/calibration/depth_calibration.h"
+#include "panmap/convention/pose_convention_watch.h"
 #include "panmap/core/byte_sink.h"
 #include "panmap/core/frame.h"
 #include "panmap/core/pose.h"
@@ -257,6 +258,10 @@ class Mapper {
   }
   /// Whether this mapper's depth may correct poses (MapperConfig::depth_check).
   const DepthPatternMonitor& depthCheck() const { return depth_check_; }
+  /// A warning when the poses given agree clearly better with the depth read another way
+  /// (world-to-camera, the quaternion's scalar at the other end, cm or mm): the sender's
+  /// convention is wrong. "" otherwise. The poses are used as given either way.
+  std::string poseConventionWarning() const { return pose_convention_watch_.warning(); }
   /// Frames that tracking would have refined but that are integrated at their given pose
   /// because the depth check found the depth uncalibrated (FrameStats::pose_kept, and the
   /// frames refined before the verdict and integrated again as given).
@@ -418,6 +423,7 @@ class Mapper {
   DriftFilter drift_;
   std::array<int64_t, kAlignmentStatusCount> tracking_counts_{};
   DepthPatternMonitor depth_check_;
+  PoseConventionWatch pose_convention_watch_;  // the given poses against the depth
   /// While the depth check is pending: every frame integrated so far, its given pose and the
   /// super-point label each pixel voted for, to integrate them again at their given poses.
   struct ProbationFrame {
