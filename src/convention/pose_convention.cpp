@@ -54,14 +54,15 @@ double medianSpeed(const std::vector<PoseSample>& samples,
 void PoseConventionConfig::check() const {
   if (pixel_step < 1) throw Error("pose convention pixel_step must be >= 1");
   if (!(tolerance_m > 0.0) || !(tolerance_per_m >= 0.0)) {
-    throw Error("pose convention tolerances must be > 0");
+    throw Error("pose convention tolerance_m must be > 0 and tolerance_per_m >= 0");
   }
   if (!(min_agreement > 0.0 && min_agreement <= 1.0)) {
     throw Error("pose convention min_agreement must be in (0, 1]");
   }
   if (!(max_speed_m_per_s > 0.0)) throw Error("pose convention max_speed_m_per_s must be > 0");
-  if (!(min_gain >= 0.0 && min_gain < 1.0))
+  if (!(min_gain >= 0.0 && min_gain < 1.0)) {
     throw Error("pose convention min_gain must be in [0, 1)");
+  }
 }
 
 Eigen::Isometry3d PoseConvention::apply(const Eigen::Isometry3d& T_as_read) const {

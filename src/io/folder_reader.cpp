@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <iterator>
 #include <map>
 #include <regex>
@@ -446,7 +445,10 @@ class FolderReader : public DatasetReader {
         // The time column is the recording's clock: frames take it rather than --rate's, or a
         // trajectory written with these times matched a third of the frames at a 10 Hz
         // recording and its ATE judged a perfect map 41 cm off.
-        if (std::is_sorted(list.times_s.begin(), list.times_s.end(), std::less_equal<double>())) {
+        const bool increasing =
+            std::adjacent_find(list.times_s.begin(), list.times_s.end(),
+                               [](double a, double b) { return b <= a; }) == list.times_s.end();
+        if (increasing) {
           for (const double t : list.times_s) {
             utime_by_frame_.push_back(utimeOfSeconds(t, poses_from_));
           }

@@ -53,8 +53,8 @@ bool fitMaskToColour(LabelImage* mask, const DatasetFrame& frame, bool resize,
 
 // How the user's pose file is written, from the depth of frame pairs: 8 frames spread over the
 // import, each with partners 3, 10 and 30 frames later (0.1 to 1 s at 30 Hz), so that some
-// pairs see the camera move while still overlapping. Frames
-// that cannot be read or have no pose are left out here; the import itself reports them.
+// pairs see the camera move while still overlapping. Frames that cannot be read or have no pose
+// are left out here; the import itself reports them.
 PoseConventionVerdict checkPoseConvention(const DatasetReader& reader, size_t total,
                                           const PoseConventionChoice& fixed) {
   constexpr size_t kBases = 8;
@@ -148,8 +148,7 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
   // Pose files the user brings are checked against depth; a dataset's own follow its documented
   // convention unless the user says otherwise.
   const PoseConventionChoice& fixed = options.pose_convention;
-  const bool user_poses = options.dataset.layout == DatasetLayout::kFolder ||
-                          stats.layout == "folder" || !options.dataset.poses_path.empty();
+  const bool user_poses = stats.layout == "folder" || !options.dataset.poses_path.empty();
   PoseConvention convention;
   if (user_poses) {
     stats.pose_convention = checkPoseConvention(*reader, total, fixed);
