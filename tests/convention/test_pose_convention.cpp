@@ -76,13 +76,7 @@ struct Survey {
     config.num_frames = 300;
     trajectory = planSurvey(room.mesh, config, 1);
     for (int k = 20; k < 60; k += 2) {
-      RgbdFrame frame;
-      frame.camera = test::kinectCamera();
-      frame.utime = trajectory[k].utime;
-      DepthNoiseConfig noise;
-      noise.enabled = false;
-      frame.depth = simulateDepth(renderer.render(frame.camera, trajectory[k].T_W_C), noise, 0);
-      frames.push_back(frame);
+      frames.push_back(frameAt(k));
       poses.push_back(trajectory[k].T_W_C);
     }
     // Frames 2 and 6 survey frames apart (67 and 200 ms).
