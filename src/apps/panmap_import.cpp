@@ -101,6 +101,12 @@ int main(int argc, char** argv) {
   app.add_option("--pose-unit", pose_unit, "the pose file's translations: m, cm, mm, or auto")
       ->check(CLI::IsMember({"auto", "m", "cm", "mm"}))
       ->capture_default_str();
+  std::string camera_frame = "auto";
+  app.add_option("--camera-frame", camera_frame,
+                 "the frame the poses are of: optical (x right, y down, z forward), body (ROS's "
+                 "camera_link: x forward, y left, z up), or auto")
+      ->check(CLI::IsMember({"auto", "optical", "body"}))
+      ->capture_default_str();
   app.add_option("--depth-scale", depth_scale,
                  "metres per depth unit (e.g. 0.001 for mm); default: the layout's convention, "
                  "for the folder layout detected from the values (mm or 1/5000 m)")
@@ -175,6 +181,7 @@ int main(int argc, char** argv) {
     if (quaternion_order != "auto") {
       options.pose_convention.scalar_moved = quaternion_order == "wxyz";
     }
+    if (camera_frame != "auto") options.pose_convention.body_frame = camera_frame == "body";
     if (pose_unit != "auto") {
       options.pose_convention.translation_scale = pose_unit == "m"    ? 1.0
                                                   : pose_unit == "cm" ? 0.01

@@ -78,7 +78,15 @@ Eigen::Isometry3d PoseConvention::apply(const Eigen::Isometry3d& T_as_read) cons
   }
   T.linear() = q.normalized().toRotationMatrix();
   T.translation() = T_as_read.translation() * translation_scale;
-  return inverted ? T.inverse() : T;
+  if (inverted) T = T.inverse();
+  if (body_frame) {
+    // T_W_optical = T_W_body T_body_optical: optical z (forward) is body x, optical x (right)
+    // body -y, optical y (down) body -z.
+    Eigen::Isometry3d T_body_optical = Eigen::Isometry3d::Identity();
+    T_body_optical.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+    T = T * T_body_optical;
+  }
+  return T;
 }
 
 std::string PoseConvention::describe() const {
@@ -87,7 +95,8 @@ std::string PoseConvention::describe() const {
     const bool scalar_first = (quaternions == QuaternionInput::kScalarFirst) != scalar_moved;
     text += scalar_first ? ", quaternion w x y z" : ", quaternion x y z w";
   }
-  return text + ", " + unitName(translation_scale);
+  text += ", " + unitName(translation_scale);
+  return body_frame ? text + ", camera x forward, z up (a ROS body frame)" : text;
 }
 
 double depthAgreement(const RgbdFrame& first, const Eigen::Isometry3d& T_W_C1,
@@ -148,6 +157,8 @@ PoseConventionVerdict detectPoseConvention(const std::vector<PoseSample>& sample
   }
   std::vector<bool> inversions = {false, true};
   if (fixed.inverted) inversions = {*fixed.inverted};
+  std::vector<bool> frames = {false, true};
+  if (fixed.body_frame) frames = {*fixed.body_frame};
 
   // The file as read, with what the user fixed.
   PoseConvention as_read;
@@ -155,17 +166,21 @@ PoseConventionVerdict detectPoseConvention(const std::vector<PoseSample>& sample
   as_read.scalar_moved = fixed.scalar_moved.value_or(false);
   as_read.inverted = fixed.inverted.value_or(false);
   as_read.quaternions = quaternions;
+  as_read.body_frame = fixed.body_frame.value_or(false);
 
   // Every candidate, the file as read first, then in a fixed order, the plainest first, so
   // ties keep the simpler reading.
   std::vector<PoseConvention> candidates = {as_read};
-  for (const bool inverted : inversions) {
-    for (const bool moved : orders) {
-      for (const double scale : scales) {
-        const PoseConvention c{scale, moved, inverted, quaternions};
-        if (c.translation_scale != as_read.translation_scale ||
-            c.scalar_moved != as_read.scalar_moved || c.inverted != as_read.inverted) {
-          candidates.push_back(c);
+  for (const bool body : frames) {
+    for (const bool inverted : inversions) {
+      for (const bool moved : orders) {
+        for (const double scale : scales) {
+          const PoseConvention c{scale, moved, inverted, quaternions, body};
+          if (c.translation_scale != as_read.translation_scale ||
+              c.scalar_moved != as_read.scalar_moved || c.inverted != as_read.inverted ||
+              c.body_frame != as_read.body_frame) {
+            candidates.push_back(c);
+          }
         }
       }
     }
@@ -212,8 +227,8 @@ PoseConventionVerdict detectPoseConvention(const std::vector<PoseSample>& sample
     verdict.note = "poses: read as " + best.describe() + ": the depth of " +
                    std::to_string(compared) + " frame pairs agrees on " + percent(best_agreement) +
                    " of points that way and on " + percent(a0) + " as " + written +
-                   " (--pose-convention, --quaternion-order and --pose-unit "
-                   "fix the reading)";
+                   " (--pose-convention, --quaternion-order, --pose-unit and "
+                   "--camera-frame fix the reading)";
   } else if (a0 < config.min_agreement) {
     verdict.note = "poses: read as " + written + ", but the depth of " + std::to_string(compared) +
                    " frame pairs agrees on only " + percent(a0) + " of points (" + best.describe() +
@@ -223,8 +238,8 @@ PoseConventionVerdict detectPoseConvention(const std::vector<PoseSample>& sample
     verdict.note = "poses: read as " + written + ": the depth of " + std::to_string(compared) +
                    " frame pairs agrees on " + percent(a0) + " of points, and on " +
                    percent(best_agreement) + " read as " + best.describe() +
-                   ", not clearly enough to change it (--pose-convention, --quaternion-order and "
-                   "--pose-unit fix the reading)";
+                   ", not clearly enough to change it (--pose-convention, --quaternion-order, "
+                   "--pose-unit and --camera-frame fix the reading)";
   } else {
     verdict.note = "poses: read as " + written + ": the depth of " + std::to_string(compared) +
                    " frame pairs agrees on " + percent(a0) + " of points";

@@ -59,8 +59,8 @@ std::string PoseConventionWatch::warning() const {
          " % of points at the poses as sent, and on " +
          std::to_string(static_cast<int>(100.0 * finding_->agreement_chosen + 0.5)) +
          " % read as " + finding_->convention.describe() +
-         ": check the sender's convention (CAMERA_POSE carries T_W_C, camera to world, metres, "
-         "quaternion w x y z)";
+         ": check the sender's convention (CAMERA_POSE carries T_W_C of the optical frame, camera "
+         "to world, metres, quaternion w x y z)";
 }
 
 }  // namespace panmap

@@ -158,6 +158,7 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
     convention.translation_scale = fixed.translation_scale.value_or(1.0);
     convention.scalar_moved = fixed.scalar_moved.value_or(false);
     convention.inverted = fixed.inverted.value_or(false);
+    convention.body_frame = fixed.body_frame.value_or(false);
     if (reader->posesAreQuaternions()) convention.quaternions = QuaternionInput::kScalarLast;
   }
 

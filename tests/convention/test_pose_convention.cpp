@@ -67,6 +67,15 @@ TEST(PoseConvention, EachReadingUndoesItsMistakeExactly) {
   EXPECT_EQ((PoseConvention{1.0, true, false, QuaternionInput::kScalarFirst}.describe()),
             "camera-to-world, quaternion x y z w, metres");
   EXPECT_EQ((PoseConvention{0.001, false, true}.describe()), "world-to-camera, millimetres");
+  EXPECT_EQ((PoseConvention{1.0, false, false, QuaternionInput::kNone, true}.describe()),
+            "camera-to-world, metres, camera x forward, z up (a ROS body frame)");
+  // A body frame's pose, T_W_body = T_W_optical T_optical_body, back to the optical frame's.
+  Eigen::Isometry3d T_optical_body = Eigen::Isometry3d::Identity();
+  T_optical_body.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  EXPECT_LT(difference(PoseConvention{1.0, false, false, QuaternionInput::kNone, true}.apply(
+                           T * T_optical_body),
+                       T),
+            1e-12);
 }
 
 // Frames of procedural room 1's survey (30 Hz, 10 s), exact depth.
@@ -145,6 +154,13 @@ TEST(DetectPoseConvention, FindsEachWayAFileCanBeWrittenOnARenderedSurvey) {
          return T;
        },
        PoseConvention{0.001, false, false}},
+      {"a ROS camera_link (x forward, z up) for the optical frame",
+       [](Eigen::Isometry3d T) {
+         Eigen::Isometry3d T_optical_body = Eigen::Isometry3d::Identity();
+         T_optical_body.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+         return Eigen::Isometry3d(T * T_optical_body);
+       },
+       PoseConvention{1.0, false, false, QuaternionInput::kScalarLast, true}},
       {"centimetres, world-to-camera",
        [](Eigen::Isometry3d T) {
          Eigen::Isometry3d inverse = T.inverse();
@@ -159,6 +175,7 @@ TEST(DetectPoseConvention, FindsEachWayAFileCanBeWrittenOnARenderedSurvey) {
     EXPECT_EQ(v.convention.translation_scale, c.expected.translation_scale);
     EXPECT_EQ(v.convention.scalar_moved, c.expected.scalar_moved);
     EXPECT_EQ(v.convention.inverted, c.expected.inverted);
+    EXPECT_EQ(v.convention.body_frame, c.expected.body_frame);
     EXPECT_EQ(v.changed, !c.expected.isIdentity()) << v.note;
     EXPECT_EQ(v.pairs, static_cast<int>(s.pairs.size()));
     EXPECT_GT(v.agreement_chosen, 0.6) << v.note;

@@ -30,6 +30,9 @@ struct PoseConvention {
   bool inverted = false;
   /// How the reader read the quaternion (scalar_moved needs it; kNone: no quaternions).
   QuaternionInput quaternions = QuaternionInput::kNone;
+  /// The pose is of a camera body frame as ROS names it (x forward, y left, z up: a
+  /// camera_link, not its optical frame x right, y down, z forward).
+  bool body_frame = false;
 
   /// T_W_C from a pose as the reader parsed it (its quaternion order, camera-to-world, the
   /// source's units).
@@ -37,7 +40,9 @@ struct PoseConvention {
   /// "camera-to-world, quaternion x y z w, metres" and the like.
   std::string describe() const;
   /// True when apply() returns its input.
-  bool isIdentity() const { return translation_scale == 1.0 && !scalar_moved && !inverted; }
+  bool isIdentity() const {
+    return translation_scale == 1.0 && !scalar_moved && !inverted && !body_frame;
+  }
 };
 
 /// What the user fixed; unset fields are chosen from the depth images.
@@ -45,6 +50,7 @@ struct PoseConventionChoice {
   std::optional<double> translation_scale;
   std::optional<bool> scalar_moved;
   std::optional<bool> inverted;
+  std::optional<bool> body_frame;
 };
 
 /// Parameters of the check.
