@@ -2,6 +2,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -17,9 +18,10 @@ enum class QuaternionInput {
   kScalarFirst,  ///< pose_t's orientation: w x y z
 };
 
-/// How a pose source's numbers become camera-to-world poses in metres. A user's own trajectory
-/// can be written world-to-camera, with its quaternion's scalar at the other end, or in
-/// millimetres; each gives a map of doubled walls with nothing said (found by a newcomer probe).
+/// How a pose source's numbers become camera-to-world poses of the optical frame in metres. A
+/// user's own trajectory can be written world-to-camera, with its quaternion's scalar at the
+/// other end, in millimetres, or of a ROS camera_link; each gives a map of doubled walls with
+/// nothing said (found by a newcomer probe).
 struct PoseConvention {
   /// Scale of the translation, metres per unit (1, 0.01 for cm, 0.001 for mm).
   double translation_scale = 1.0;
@@ -78,9 +80,9 @@ struct PoseConventionVerdict {
   PoseConvention convention;       ///< what to apply
   double agreement_as_read = 0.0;  ///< share of sampled points two frames agree on, as read
   double agreement_chosen = 0.0;   ///< the same under `convention`
-  int pairs = 0;         ///< frame pairs compared that some reading carries across (share a view)
-  bool changed = false;  ///< `convention` differs from the file as read
-  std::string note;      ///< one line for the user
+  int pairs = 0;                   ///< frame pairs compared
+  bool changed = false;            ///< `convention` differs from the file as read
+  std::string note;                ///< one line for the user
 };
 
 /// Which of the candidate conventions makes the depth of frame pairs agree: for each pair
