@@ -23,7 +23,7 @@ std::string stemOf(const std::string& file_name) {
 
 // segments_info entries -> segments with panmap classes. Unknown categories keep class 0.
 std::vector<PanopticSegment> parseSegments(const json& info, const LabelTable& table,
-                                           const std::string& what, size_t* unknown) {
+                                           const std::string& what) {
   if (!info.is_array()) throw Error(what + ": segments_info must be a list");
   std::vector<PanopticSegment> segments;
   std::set<int32_t> ids;
@@ -44,8 +44,7 @@ std::vector<PanopticSegment> parseSegments(const json& info, const LabelTable& t
       seg.category = entry->panmap_class;
       seg.is_thing = entry->is_thing;
     } else {
-      seg.category = 0;
-      ++*unknown;
+      seg.category = 0;  // counted by the reader, with its category
     }
     if (s.contains("isthing")) {
       const json& isthing = s["isthing"];
@@ -102,7 +101,6 @@ CocoPanopticReader::CocoPanopticReader(const std::string& mask_dir, const std::s
         }
       }
     }
-    size_t unknown = 0;
     for (const json& a : root["annotations"]) {
       if (!a.contains("file_name") || !a.contains("segments_info")) {
         throw Error(json_path + ": an annotation lacks file_name or segments_info");
@@ -110,8 +108,7 @@ CocoPanopticReader::CocoPanopticReader(const std::string& mask_dir, const std::s
       const std::string png = fileName(a, "an annotation");
       Entry entry;
       entry.png_path = mask_dir + "/" + png;
-      entry.segments =
-          parseSegments(a["segments_info"], table_, json_path + " (" + png + ")", &unknown);
+      entry.segments = parseSegments(a["segments_info"], table_, json_path + " (" + png + ")");
       std::string key = stemOf(png);
       if (a.contains("image_id")) {
         const auto it = image_names.find(idText(a["image_id"], "an annotation's image_id"));
@@ -145,18 +142,18 @@ PanopticFrame CocoPanopticReader::read(const std::string& color_stem) {
   if (it == entries_.end()) throw Error("no panoptic mask for colour image " + color_stem);
   const Entry& entry = it->second;
   PanopticFrame frame;
-  size_t unknown = 0;
   if (!entry.json_path.empty()) {
     const json root = internal::readJsonFile(entry.json_path);
     const json& info =
         root.is_object() && root.contains("segments_info") ? root["segments_info"] : root;
-    frame.segments = parseSegments(info, table_, entry.json_path, &unknown);
+    frame.segments = parseSegments(info, table_, entry.json_path);
   } else {
     frame.segments = entry.segments;
-    for (const auto& s : frame.segments) unknown += table_.lookup(s.source_category) ? 0 : 1;
   }
   for (const auto& s : frame.segments) {
-    if (!table_.lookup(s.source_category)) ++stats_.unknown_category_ids[s.source_category];
+    if (table_.lookup(s.source_category)) continue;
+    ++stats_.unknown_category_segments;
+    ++stats_.unknown_category_ids[s.source_category];
   }
   const auto bytes = readFileBytes(entry.png_path);
   frame.segment_ids = decodeLabelPng(bytes.data(), bytes.size(), entry.png_path);
@@ -185,7 +182,6 @@ PanopticFrame CocoPanopticReader::read(const std::string& color_stem) {
   }
   ++stats_.frames_with_masks;
   stats_.segments += frame.segments.size();
-  stats_.unknown_category_segments += unknown;
   return frame;
 }
 
