@@ -193,9 +193,14 @@ std::string asConfigKeys(const std::string& message) {
       {"sync ", "sync."}};
   for (const auto& [code, key] : kNames) {
     const std::string prefix = code;
-    if (message.compare(0, prefix.size(), prefix) == 0) {
-      return key + message.substr(prefix.size());
+    if (message.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string rest = message.substr(prefix.size());
+    // "integrator needs 0 <= min_depth_m ..." names no key: only a field name (with an
+    // underscore) after "component " is one.
+    if (prefix.back() == ' ' && rest.substr(0, rest.find(' ')).find('_') == std::string::npos) {
+      return message;
     }
+    return key + rest;
   }
   return message;
 }

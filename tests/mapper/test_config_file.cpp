@@ -189,6 +189,8 @@ TEST(ConfigFile, BadKeysAndValuesNameTheKey) {
   EXPECT_EQ(asConfigKeys("superpoint significant_overlap must be in (0, 1]"),
             "superpoints.significant_overlap must be in (0, 1]");
   EXPECT_EQ(asConfigKeys("cannot read x"), "cannot read x");
+  EXPECT_EQ(asConfigKeys("integrator needs 0 <= min_depth_m < max_depth_m"),
+            "integrator needs 0 <= min_depth_m < max_depth_m");
   // A class listed twice kept the later entry in silence; one beyond NYU40 was taken.
   EXPECT_NE(error("%YAML:1.0\n---\noptimiser:\n   classes:\n      - { class: 5, theta_D: 0.1 }\n"
                   "      - { class: 5, theta_D: 0.2 }\n")
