@@ -169,9 +169,15 @@ int main(int argc, char** argv) {
                                        "scene folder, its parent or its grandparent, else " +
                                            shipped_labels);
   app.add_option("--trajectory", trajectory_file, "TUM trajectory to follow instead of a survey");
-  app.add_option("--frames", frames, "frames to render")
+  app.add_option("--frames", frames,
+                 "frames to render (the survey ends where they do: see --cover-walk)")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
+  bool cover_walk = false;
+  app.add_flag("--cover-walk", cover_walk,
+               "render as many frames as walking the whole survey takes (every lap, at its "
+               "0.35 m/s), --frames being the least: a scene larger than --frames can walk is "
+               "then seen whole (a real scene's size is not known in advance)");
   double rate_hz = 30.0;
   app.add_option("--rate-hz", rate_hz,
                  "frame rate of the survey (a lower rate covers more of the room per frame)")
@@ -347,6 +353,31 @@ int main(int argc, char** argv) {
       survey.rate_hz = rate_hz;
     }
     survey.laps = laps;
+    panmap::SurveyPath walk;
+    if (trajectory_file.empty()) {
+      walk = building_stops.empty() ? panmap::planSurveyPath(mesh, survey, seed)
+                                    : panmap::planSurveyPathThrough(mesh, survey, building_stops);
+      if (walk.clearance_m < survey.clearance_m) {
+        std::cerr << "panmap-synth: the survey walks " << walk.clearance_m
+                  << " m from surfaces, not " << survey.clearance_m
+                  << " m: the room is small or the way to a stop narrow\n";
+      }
+      const int needed = panmap::framesToWalk(walk, survey);
+      if (cover_walk) {
+        survey.num_frames = std::max(survey.num_frames, needed);
+      } else if (survey.num_frames > 0 && survey.num_frames < needed) {
+        // The walk is cut where the frames end: what lies beyond its end is never seen, and a
+        // score over the whole scene then measures the survey, not the mapping.
+        std::cerr << "panmap-synth: " << survey.num_frames << " frames walk "
+                  << std::lround(100.0 * survey.num_frames / needed) << " % of the survey's "
+                  << std::lround(walk.length_m) << " m (" << needed
+                  << " frames at this rate walk all of it: --cover-walk or --frames " << needed
+                  << ")\n";
+      }
+    } else if (cover_walk) {
+      std::cerr << "panmap-synth: --cover-walk is ignored with --trajectory (its poses are the "
+                << "frames)\n";
+    }
     if (!building_stops.empty() && trajectory_file.empty()) {
       trajectory = panmap::planSurveyThrough(mesh, survey, building_stops, seed);
     } else if (!trajectory_file.empty()) {
@@ -368,16 +399,6 @@ int main(int argc, char** argv) {
         trajectory.resize(static_cast<size_t>(frames));
     } else {
       trajectory = panmap::planSurvey(mesh, survey, seed);
-    }
-    panmap::SurveyPath walk;
-    if (trajectory_file.empty()) {
-      walk = building_stops.empty() ? panmap::planSurveyPath(mesh, survey, seed)
-                                    : panmap::planSurveyPathThrough(mesh, survey, building_stops);
-      if (walk.clearance_m < survey.clearance_m) {
-        std::cerr << "panmap-synth: the survey walks " << walk.clearance_m
-                  << " m from surfaces, not " << survey.clearance_m
-                  << " m: the room is small or the way to a stop narrow\n";
-      }
     }
 
     fs::create_directories(out_dir + "/gt");
@@ -460,6 +481,11 @@ int main(int argc, char** argv) {
          {{"source", trajectory_file.empty() ? "survey" : trajectory_file},
           {"laps", trajectory_file.empty() ? laps : 0},
           {"walk_length_m", walk.length_m},
+          // Share of the walk the frames reach (1 when they walk all of it or more).
+          {"walk_covered", trajectory_file.empty()
+                               ? std::min(1.0, static_cast<double>(synth.size()) /
+                                                   panmap::framesToWalk(walk, survey))
+                               : 0.0},
           {"planned_clearance_m", walk.clearance_m},
           {"min_clearance_m", panmap::minClearance(synth.groundTruthTrajectory(), mesh)}}},
         {"masks", masksJson(config.masks)},

@@ -590,10 +590,7 @@ std::vector<StampedPose> planSurveyThrough(const LabelledMesh& mesh, SurveyConfi
   Rng rng(hashSeed(seed, 0x5u));
   FreeSpace fs;
   const SurveyPath path = walkThrough(mesh, config, stops, &fs);
-  if (once) {
-    config.num_frames =
-        std::max(2, static_cast<int>(std::ceil(path.length_m / config.speed_mps * config.rate_hz)));
-  }
+  if (once) config.num_frames = framesToWalk(path, config);
   return posesAlong(mesh, fs, path.points, config, &rng);
 }
 
@@ -612,6 +609,13 @@ SurveyPath planSurveyPath(const LabelledMesh& mesh, const SurveyConfig& config, 
   Rng rng(hashSeed(seed, 0x5u));
   const FreeSpace fs = buildFreeSpace(mesh, config);
   return planWalk(fs, chooseWaypoints(fs, config.num_waypoints, &rng), config.laps);
+}
+
+int framesToWalk(const SurveyPath& path, const SurveyConfig& config) {
+  const double frames = std::ceil(path.length_m / config.speed_mps * config.rate_hz);
+  // A walk too long for an int of frames is no survey anyone renders.
+  if (!(frames < 1e9)) throw Error("survey: the walk is too long to render");
+  return std::max(2, static_cast<int>(frames));
 }
 
 double minClearance(const std::vector<StampedPose>& trajectory, const LabelledMesh& mesh) {

@@ -9,6 +9,7 @@
 #include "panmap/io/ply.h"
 #include "panmap/io/scannet_ground_truth.h"
 #include "panmap/lcm/log_info.h"
+#include "panmap/sim/procedural_room.h"
 #include "panmap/sim/trajectory.h"
 #include "test_helpers.h"
 
@@ -159,6 +160,40 @@ TEST(SynthCli, BadArgumentsFailClearly) {
   EXPECT_NE(repeat.output.find("repeat.txt: pose 3's timestamp is not after the one before"),
             std::string::npos)
       << repeat.output;
+}
+
+// A survey cut short by --frames left what lay beyond its end unseen, and said nothing: a
+// 150 m2 floor rendered for 600 frames at 5 Hz was walked to 40 % and scored as if mapped.
+TEST(SynthCli, ASurveyCutShortIsNamedAndCoverWalkWalksAllOfIt) {
+  test::TempDir dir;
+  const std::string synth =
+      binPath("panmap-synth") + " --quiet --room 3 --rate-hz 0.5 --masks clean --poses gt ";
+  SurveyConfig config;
+  config.rate_hz = 0.5;
+  const int needed = framesToWalk(planSurveyPath(generateRoom(3).mesh, config, 1), config);
+  ASSERT_GT(needed, 3);
+  const auto cut = runCommand(synth + "--frames 3 --out " + dir.path("cut"));
+  ASSERT_EQ(cut.exit_code, 0) << cut.output;
+  EXPECT_NE(cut.output.find("panmap-synth: 3 frames walk " +
+                            std::to_string(std::lround(300.0 / needed)) + " % of the survey's "),
+            std::string::npos)
+      << cut.output;
+  EXPECT_NE(cut.output.find("--cover-walk or --frames " + std::to_string(needed)),
+            std::string::npos)
+      << cut.output;
+  EXPECT_NEAR(readJson(dir.path("cut/info.json"))["trajectory"]["walk_covered"].get<double>(),
+              3.0 / needed, 1e-12);
+  const auto whole = runCommand(synth + "--frames 3 --cover-walk --out " + dir.path("whole"));
+  ASSERT_EQ(whole.exit_code, 0) << whole.output;
+  EXPECT_EQ(whole.output.find("% of the survey"), std::string::npos) << whole.output;
+  const auto info = readJson(dir.path("whole/info.json"));
+  EXPECT_EQ(info["frames"].get<int>(), needed);
+  EXPECT_EQ(info["trajectory"]["walk_covered"].get<double>(), 1.0);
+  // --frames stays the least: a walk shorter than it is walked again.
+  const auto more = runCommand(synth + "--frames " + std::to_string(needed + 2) +
+                               " --cover-walk --out " + dir.path("more"));
+  ASSERT_EQ(more.exit_code, 0) << more.output;
+  EXPECT_EQ(readJson(dir.path("more/info.json"))["frames"].get<int>(), needed + 2);
 }
 
 // Previews of an earlier run into the same folder were left beside the new run's.

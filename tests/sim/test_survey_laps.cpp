@@ -64,6 +64,34 @@ TEST(SurveyLaps, LapsOutsideOneToTwentyAreRefused) {
   }
 }
 
+// The frame count that walks a survey's whole walk ends it back at its start, one step short.
+TEST(SurveyLaps, FramesToWalkEndTheSurveyBackAtItsStart) {
+  const ProceduralRoom room = generateRoom(3, RoomConfig::scanNetLike());
+  SurveyConfig config;
+  config.rate_hz = 5.0;
+  config.laps = 2;
+  const SurveyPath path = planSurveyPath(room.mesh, config, 4);
+  const double step_m = config.speed_mps / config.rate_hz;
+  const int frames = framesToWalk(path, config);
+  EXPECT_EQ(frames, static_cast<int>(std::ceil(path.length_m / step_m)));
+  // Frame frames - 1 is the last one before the walk's end; frame `frames` would start over.
+  EXPECT_LT((frames - 1) * step_m, path.length_m);
+  EXPECT_GE(frames * step_m, path.length_m);
+  config.num_frames = frames;
+  const std::vector<StampedPose> survey = planSurvey(room.mesh, config, 4);
+  ASSERT_EQ(survey.size(), static_cast<size_t>(frames));
+  const Eigen::Vector2d first = survey.front().T_W_C.translation().head<2>();
+  const Eigen::Vector2d last = survey.back().T_W_C.translation().head<2>();
+  EXPECT_LE((last - first).norm(), step_m + 1e-9);
+  EXPECT_GT(path.length_m, 10 * step_m);  // the check above means something
+  // More frames than that start the walk over; the first `frames` are the same poses.
+  config.num_frames = frames + 20;
+  const std::vector<StampedPose> longer = planSurvey(room.mesh, config, 4);
+  for (int k = 0; k < frames; k += 7) {
+    EXPECT_TRUE(longer[k].T_W_C.isApprox(survey[k].T_W_C, 1e-12)) << k;
+  }
+}
+
 class SurveyLapsInRoom : public ::testing::TestWithParam<int> {
  protected:
   /// Box rooms for positive parameters, ScanNet-like rooms for negative ones.

@@ -79,6 +79,11 @@ SurveyPath planSurveyPathThrough(const LabelledMesh& mesh, const SurveyConfig& c
 /// The walk planSurvey follows for the same mesh, config and seed (to tell its laps apart).
 SurveyPath planSurveyPath(const LabelledMesh& mesh, const SurveyConfig& config, uint64_t seed);
 
+/// Frames a survey takes to walk the whole of `path` (every lap, back to its start) at
+/// config.speed_mps and config.rate_hz: num_frames for a survey that leaves no lap out. At
+/// least 2.
+int framesToWalk(const SurveyPath& path, const SurveyConfig& config);
+
 /// Smallest distance from any trajectory position to the mesh's vertices, metres (the mesh
 /// is dense, so this bounds the distance to its surfaces within half an edge length).
 double minClearance(const std::vector<StampedPose>& trajectory, const LabelledMesh& mesh);
