@@ -170,7 +170,8 @@ int main(int argc, char** argv) {
                                            shipped_labels);
   app.add_option("--trajectory", trajectory_file, "TUM trajectory to follow instead of a survey");
   app.add_option("--frames", frames,
-                 "frames to render (the survey ends where they do: see --cover-walk)")
+                 "frames to render (the survey ends where they do: see --cover-walk; with "
+                 "--trajectory, every pose unless given)")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
   bool cover_walk = false;
@@ -395,8 +396,13 @@ int main(int argc, char** argv) {
                     << "timestamps are the frames)\n";
         }
       }
-      if (static_cast<int>(trajectory.size()) > frames)
+      // A recorded trajectory (ScanNet's poses: thousands at 30 Hz) is rendered whole unless
+      // --frames asks for less; the default 300 cut such files to 10 s in silence.
+      if (app.count("--frames") && static_cast<int>(trajectory.size()) > frames) {
+        std::cerr << "panmap-synth: rendering the first " << frames << " of the trajectory's "
+                  << trajectory.size() << " poses (--frames " << frames << ")\n";
         trajectory.resize(static_cast<size_t>(frames));
+      }
     } else {
       trajectory = panmap::planSurvey(mesh, survey, seed);
     }

@@ -98,6 +98,26 @@ TEST(SynthCli, ScanNetGroundTruthWithAGivenTrajectory) {
   const auto parts = readJson(dir.path("j/info.json"))["source"]["joined_parts"];
   EXPECT_TRUE(parts.is_array());
   EXPECT_TRUE(parts.empty());
+  // A recorded trajectory is rendered whole without --frames (300 by default cut ScanNet's
+  // thousands of poses to the first 10 s in silence), and a cut asked for is named.
+  {
+    std::ofstream long_traj(dir.path("long.txt"));
+    for (int k = 0; k < 305; ++k) long_traj << k / 30.0 << " 0 0 3 0 0 0 1\n";
+  }
+  const std::string whole = binPath("panmap-synth") + " --quiet --image-scale 0.25 --scannet " +
+                            test::fixtureDir("scannet_gt_tiny") + " --scannet-labels " +
+                            test::dataDir("scannet-meta/scannetv2-labels.combined.tsv") +
+                            " --poses gt --trajectory " + dir.path("long.txt");
+  const auto all = runCommand(whole + " --out " + dir.path("all"));
+  ASSERT_EQ(all.exit_code, 0) << all.output;
+  EXPECT_EQ(readJson(dir.path("all/info.json"))["frames"].get<int>(), 305);
+  EXPECT_EQ(all.output.find("rendering the first"), std::string::npos) << all.output;
+  const auto cut = runCommand(whole + " --frames 7 --out " + dir.path("cut"));
+  ASSERT_EQ(cut.exit_code, 0) << cut.output;
+  EXPECT_EQ(readJson(dir.path("cut/info.json"))["frames"].get<int>(), 7);
+  EXPECT_NE(cut.output.find("panmap-synth: rendering the first 7 of the trajectory's 305 poses"),
+            std::string::npos)
+      << cut.output;
 }
 
 TEST(SynthCli, BadArgumentsFailClearly) {
