@@ -493,6 +493,8 @@ int main(int argc, char** argv) {
                                                    panmap::framesToWalk(walk, survey))
                                : 0.0},
           {"planned_clearance_m", walk.clearance_m},
+          {"stops", walk.stops.size()},
+          {"free_area_m2", walk.free_area_m2},
           {"min_clearance_m", panmap::minClearance(synth.groundTruthTrajectory(), mesh)}}},
         {"masks", masksJson(config.masks)},
         {"semantic_masks", semantic_masks},

@@ -30,6 +30,7 @@ void SurveyConfig::check() const {
   if (!(max_yaw_rate_dps > 0 && max_pitch_rate_dps > 0)) throw Error("survey rates must be > 0");
   if (!(grid_m > 0)) throw Error("survey grid_m must be > 0");
   if (num_waypoints < 2) throw Error("survey num_waypoints must be >= 2");
+  if (!(area_per_stop_m2 >= 0)) throw Error("survey area_per_stop_m2 must be >= 0");
   if (!(view_max_m > view_min_m)) throw Error("survey view_max_m must exceed view_min_m");
   if (laps < 1 || laps > 20) throw Error("survey laps must be in [1, 20]");
 }
@@ -219,6 +220,16 @@ std::vector<Cell> shortestPath(const FreeSpace& fs, Cell from, Cell to) {
   return path;
 }
 
+// Stops to spread over the free space: num_waypoints, and on a larger floor one per
+// area_per_stop_m2 of it. With 10 over any floor, a 152 m^2 floor of four rooms was walked past
+// 10 places: 61 of its 222 things were seen from 3 viewpoints (155 with 51 stops).
+int stopCount(const FreeSpace& fs, const SurveyConfig& config) {
+  if (config.area_per_stop_m2 <= 0.0) return config.num_waypoints;
+  const double by_area = std::ceil(fs.area_m2 / config.area_per_stop_m2);
+  return std::max(config.num_waypoints,
+                  static_cast<int>(std::min<double>(by_area, kMaxSurveyStops)));
+}
+
 // Tour stops spread over the free space by farthest-point sampling.
 std::vector<Cell> chooseWaypoints(const FreeSpace& fs, int count, Rng* rng) {
   std::vector<Cell> cells;
@@ -327,6 +338,7 @@ SurveyPath planWalk(const FreeSpace& fs, const std::vector<Cell>& stops, int lap
   }
   path.length_m = arc.back();
   path.clearance_m = fs.keep_m;
+  for (const Cell& stop : stops) path.stops.push_back(fs.centre(stop.first, stop.second));
   for (size_t begin : lap_begin) {
     const size_t k = std::lower_bound(origin.begin(), origin.end(), begin) - origin.begin();
     path.lap_start_m.push_back(arc[k]);
@@ -577,7 +589,7 @@ std::vector<StampedPose> planSurvey(const LabelledMesh& mesh, const SurveyConfig
   Rng rng(hashSeed(seed, 0x5u));
   const FreeSpace fs = buildFreeSpace(mesh, config);
   const std::vector<Eigen::Vector2d> loop =
-      planWalk(fs, chooseWaypoints(fs, config.num_waypoints, &rng), config.laps).points;
+      planWalk(fs, chooseWaypoints(fs, stopCount(fs, config), &rng), config.laps).points;
   return posesAlong(mesh, fs, loop, config, &rng);
 }
 
@@ -608,7 +620,9 @@ SurveyPath planSurveyPath(const LabelledMesh& mesh, const SurveyConfig& config, 
   // The same stream as planSurvey's: its first draws choose the stops.
   Rng rng(hashSeed(seed, 0x5u));
   const FreeSpace fs = buildFreeSpace(mesh, config);
-  return planWalk(fs, chooseWaypoints(fs, config.num_waypoints, &rng), config.laps);
+  SurveyPath path = planWalk(fs, chooseWaypoints(fs, stopCount(fs, config), &rng), config.laps);
+  path.free_area_m2 = fs.area_m2;
+  return path;
 }
 
 int framesToWalk(const SurveyPath& path, const SurveyConfig& config) {

@@ -237,6 +237,56 @@ TEST(Survey, ASmallRoomIsWalkedCloserToItsWalls) {
   }
 }
 
+// Ten stops over any floor walked a 150 m^2 floor of four rooms past 10 places, and most of
+// its things were never seen from three viewpoints: a large floor gets one stop per
+// area_per_stop_m2, rooms the size the defaults were set on keep their 10.
+TEST(Survey, ALargeFloorGetsStopsAsDenseAsARoom) {
+  SurveyConfig config;
+  config.rate_hz = 5.0;
+  const LabelledMesh hall = bathroom(12.0f, 10.0f);
+  const SurveyPath dense = planSurveyPath(hall, config, 3);
+  ASSERT_GT(dense.free_area_m2, 90.0);
+  EXPECT_EQ(dense.stops.size(),
+            static_cast<size_t>(std::ceil(dense.free_area_m2 / config.area_per_stop_m2)));
+  SurveyConfig fixed = config;
+  fixed.area_per_stop_m2 = 0.0;
+  const SurveyPath sparse = planSurveyPath(hall, fixed, 3);
+  EXPECT_EQ(sparse.stops.size(), 10u);
+  EXPECT_EQ(sparse.free_area_m2, dense.free_area_m2);
+  // The farthest point of the free floor from every stop: how far the walk may pass from
+  // what stands there (the hall's floor inside 0.4 m of its walls, on a 0.25 m grid).
+  auto reach = [](const SurveyPath& path) {
+    double worst = 0.0;
+    for (double x = 0.4; x <= 11.6; x += 0.25) {
+      for (double y = 0.4; y <= 9.6; y += 0.25) {
+        if (x > 11.2 && y > 9.2) continue;  // the cabinet's corner
+        double nearest = 1e9;
+        for (const Eigen::Vector2d& s : path.stops) {
+          nearest = std::min(nearest, (s - Eigen::Vector2d(x, y)).norm());
+        }
+        worst = std::max(worst, nearest);
+      }
+    }
+    return worst;
+  };
+  EXPECT_LT(reach(dense), 2.3);
+  EXPECT_GT(reach(sparse), 2.8);
+  // The planned survey walks those stops.
+  config.num_frames = framesToWalk(dense, config);
+  const std::vector<StampedPose> poses = planSurvey(hall, config, 3);
+  for (const Eigen::Vector2d& s : dense.stops) {
+    double nearest = 1e9;
+    for (const StampedPose& p : poses) {
+      nearest = std::min(nearest, (p.T_W_C.translation().head<2>() - s).norm());
+    }
+    EXPECT_LT(nearest, 0.6) << s.transpose();  // smoothing rounds a stop off
+  }
+  // A room of the size the defaults were set on keeps num_waypoints.
+  EXPECT_EQ(planSurveyPath(bathroom(8.0f, 7.0f), config, 3).stops.size(), 10u);
+  config.area_per_stop_m2 = -1.0;
+  EXPECT_THROW(config.check(), Error);
+}
+
 TEST(Survey, ANarrowWayToAStopIsWalkedCloserToItsSides) {
   // Two 3 x 3 m rooms joined by a 0.6 m gap in the wall between them at x = 3: at 0.3 m from
   // every surface the gap is shut (0.3 m and a cell on each side).

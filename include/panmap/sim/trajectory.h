@@ -26,8 +26,13 @@ struct SurveyConfig {
   double max_yaw_rate_dps = 45.0;    ///< head-like turning rate limit, degrees per second
   double max_pitch_rate_dps = 20.0;  ///< degrees per second
   double grid_m = 0.05;              ///< free-space grid cell, metres
-  int num_waypoints = 10;            ///< tour stops spread over the free space
-  double view_min_m = 0.8;           ///< preferred distance to the object being looked at
+  int num_waypoints = 10;            ///< tour stops spread over the free space, at least
+  /// Free floor per stop: a floor larger than num_waypoints times this gets one stop per this
+  /// much of it (at most kMaxSurveyStops), so a large scene is walked at least as densely as
+  /// the sparsest room the defaults were set on (box room 1, the demo's: 10 stops over 52 m^2
+  /// of free floor; every room of the suites keeps its 10). 0: num_waypoints alone.
+  double area_per_stop_m2 = 6.0;
+  double view_min_m = 0.8;  ///< preferred distance to the object being looked at
   double view_max_m = 3.5;
   double min_look_s = 1.5;  ///< keep looking at a target at least this long, seconds
   /// Times the walk passes every area, 1..20, as a handheld scan revisits: the loop through the
@@ -43,6 +48,9 @@ struct SurveyConfig {
   void check() const;
 };
 
+/// Most stops a survey spreads (SurveyConfig::area_per_stop_m2), whatever the floor.
+constexpr int kMaxSurveyStops = 400;
+
 /// The walk of a survey: `laps` rounds of one loop through the stops, one after the other.
 struct SurveyPath {
   /// World x, y of the walk, metres; closed: the last point leads back to the first.
@@ -52,6 +60,10 @@ struct SurveyPath {
   /// Distance the walk keeps from every surface, metres: SurveyConfig::clearance_m, less in a
   /// room too small to walk at it.
   double clearance_m = 0.0;
+  /// Floor of the free region the walk keeps to, m^2 (0 for a walk through given stops).
+  double free_area_m2 = 0.0;
+  /// World x, y of the stops in visiting order (the walk's own or the given ones).
+  std::vector<Eigen::Vector2d> stops;
 };
 
 /// Plans a smooth survey of a labelled mesh (z up): a loop through free space at least
