@@ -282,6 +282,12 @@ int main(int argc, char** argv) {
       if (s.unlisted_mask_pixels > 0) {
         std::printf("warning: %s\n", panmap::unlistedMaskPixels(s).c_str());
       }
+      if (!s.mask_void_ids.empty()) {
+        std::string ids;
+        for (int32_t id : s.mask_void_ids) ids += (ids.empty() ? "" : ", ") + std::to_string(id);
+        std::printf("mask pixels of id %s (not in the label table) read as no class\n",
+                    ids.c_str());
+      }
       if (s.masks_resized > 0) {
         std::printf("%zu masks scaled to their colour image\n", s.masks_resized);
       }

@@ -22,8 +22,13 @@ constexpr size_t kPngColourTypeByte = 25;
 
 }  // namespace
 
+bool isSemanticVoid(int32_t id, const LabelTable& table) {
+  return (id == 0 || id == 255 || id == 65535) && !table.lookup(id);
+}
+
 PanopticFrame panopticFromClasses(const LabelImage& classes, const LabelTable& table,
-                                  size_t* unknown_ids, std::map<int32_t, size_t>* unknown_by_id) {
+                                  size_t* unknown_ids, std::map<int32_t, size_t>* unknown_by_id,
+                                  std::set<int32_t>* void_ids) {
   std::set<int32_t> present;
   const int32_t* pixel = classes.data();
   for (size_t i = 0; i < classes.size(); ++i) {
@@ -36,6 +41,12 @@ PanopticFrame panopticFromClasses(const LabelImage& classes, const LabelTable& t
   int32_t next_id = 1;
   for (const int32_t source : present) {
     const auto entry = table.lookup(source);
+    // Void counted as an unknown category made the import suggest --contiguous-ids, which
+    // would have given 0's pixels the class of the table's first row.
+    if (isSemanticVoid(source, table)) {
+      if (void_ids) void_ids->insert(source);
+      continue;
+    }
     if (!entry) {
       ++*unknown_ids;
       if (unknown_by_id) ++(*unknown_by_id)[source];
@@ -108,8 +119,8 @@ PanopticFrame SemanticMaskReader::read(const std::string& color_stem) {
   }
   const LabelImage classes = decodeLabelPng(bytes.data(), bytes.size(), path);
   size_t unknown = 0;
-  PanopticFrame frame =
-      panopticFromClasses(classes, table_, &unknown, &stats_.unknown_category_ids);
+  PanopticFrame frame = panopticFromClasses(classes, table_, &unknown, &stats_.unknown_category_ids,
+                                            &stats_.void_ids);
   ++stats_.frames_with_masks;
   stats_.segments += frame.segments.size();
   stats_.unknown_category_segments += unknown;

@@ -273,6 +273,7 @@ ImportStats importDataset(const std::string& dataset_dir, const std::string& log
   if (masks) {
     stats.unknown_category_segments = masks->stats().unknown_category_segments;
     stats.unknown_category_ids = masks->stats().unknown_category_ids;
+    stats.mask_void_ids = masks->stats().void_ids;
   }
   if (std::rename(partial.c_str(), log_path.c_str()) != 0) {
     std::remove(partial.c_str());

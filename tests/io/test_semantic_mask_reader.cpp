@@ -1,4 +1,5 @@
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -67,11 +68,41 @@ TEST(SemanticMasks, StuffIsOneSegmentAndThingsSplitWhereTheyDoNotTouch) {
     for (int v = 0; v < 6; ++v) {
       for (int u = 0; u < 8; ++u) EXPECT_EQ(f.segment_ids(u, v), expected[v][u]) << u << "," << v;
     }
-    // Ids 0 and 7 are not in the table: counted once each.
-    EXPECT_EQ(reader.stats().unknown_category_segments, 2u);
-    EXPECT_EQ(reader.stats().unknown_category_ids, (std::map<int32_t, size_t>{{0, 1}, {7, 1}}));
+    // Id 7 is not in the table: an unknown category, counted once. 0, not in it either, is
+    // the PNG's "no class" (counted as unknown, it made the import suggest --contiguous-ids).
+    EXPECT_EQ(reader.stats().unknown_category_segments, 1u);
+    EXPECT_EQ(reader.stats().unknown_category_ids, (std::map<int32_t, size_t>{{7, 1}}));
+    EXPECT_EQ(reader.stats().void_ids, (std::set<int32_t>{0}));
     EXPECT_EQ(reader.stats().segments, 5u);
   }
+}
+
+// 0, 255 and 65535 are void only where the table does not list them as classes: a
+// network's classes counted from 0 make 0 a class (ADE20K's wall after --contiguous-ids).
+TEST(SemanticMasks, VoidValuesAreNoClassUnlessTheTableListsThem) {
+  LabelTable table = tinyTable();
+  for (int32_t id : {0, 255, 65535}) EXPECT_TRUE(isSemanticVoid(id, table)) << id;
+  for (int32_t id : {1, 7, 254, 256}) EXPECT_FALSE(isSemanticVoid(id, table)) << id;
+  LabelImage classes(3, 1, 0);
+  classes(1, 0) = 255;
+  classes(2, 0) = 1;
+  size_t unknown = 0;
+  std::set<int32_t> void_ids;
+  PanopticFrame f = panopticFromClasses(classes, table, &unknown, nullptr, &void_ids);
+  EXPECT_EQ(unknown, 0u);
+  EXPECT_EQ(void_ids, (std::set<int32_t>{0, 255}));
+  ASSERT_EQ(f.segments.size(), 1u);
+  EXPECT_EQ(f.segment_ids(0, 0), 0);
+  EXPECT_EQ(f.segment_ids(1, 0), 0);
+  EXPECT_EQ(f.segment_ids(2, 0), 1);
+  table.set(0, {1, false, "wall"});
+  EXPECT_FALSE(isSemanticVoid(0, table));
+  void_ids.clear();
+  f = panopticFromClasses(classes, table, &unknown, nullptr, &void_ids);
+  EXPECT_EQ(void_ids, (std::set<int32_t>{255}));
+  ASSERT_EQ(f.segments.size(), 2u);
+  EXPECT_EQ(f.segments[0].source_category, 0);
+  EXPECT_EQ(f.segment_ids(0, 0), 1);
 }
 
 TEST(SemanticMasks, ColourImagesAndMissingFoldersAreNamed) {

@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
@@ -331,6 +332,7 @@ TEST(Import, MaskPixelsOfUnlistedIdsAreCountedAndMostlyUnlistedMasksRefused) {
         fromMessage(decodeEvent<panoptic_t>(readEvents(dir.path("m.lcmlog"))[2]));
     EXPECT_EQ(p.segment_ids(450, 150), 0);  // void, as COCO reads it
     EXPECT_EQ(p.segment_ids(10, 10), 1);
+  EXPECT_EQ(p.segment_ids(620, 450), 0);
   }
   // The whole mask written as BGR: id 1 reads as 65536.
   for (int v = 0; v < 480; ++v) {
@@ -444,6 +446,7 @@ TEST(Import, ContiguousIdsOfANetworksRawOutputTakeTheSameClasses) {
   test::TempDir dir;
   const ImportStats s = importWithFirstMask(dir, mask, segments, table, 1, true);
   EXPECT_EQ(s.unknown_category_segments, 0u);
+  EXPECT_EQ(s.mask_void_ids, (std::set<int32_t>{255}));
   const PanopticFrame p = onlyPanoptic(dir.path("m.lcmlog"));
   ASSERT_EQ(p.segments.size(), 5u);
   const int32_t classes[] = {1, 2, 5, 3, 0};  // wall, floor, chair, cabinet, void
@@ -506,6 +509,7 @@ TEST(Import, SemanticMasksBecomePanopticMessages) {
   ids(cv::Rect(0, 0, 320, 480)).setTo(0);
   ids(cv::Rect(360, 100, 80, 80)).setTo(19);
   ids(cv::Rect(500, 100, 80, 80)).setTo(19);
+  ids(cv::Rect(600, 400, 40, 80)).setTo(255);  // the network's "ignore": no class
   test::TempDir dir;
   fs::create_directory(dir.path("masks"));
   ASSERT_TRUE(cv::imwrite(dir.path("masks/frame-000000.color.png"), ids));

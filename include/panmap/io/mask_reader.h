@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,9 @@ struct MaskReaderStats {
   size_t segments = 0;
   size_t unknown_category_segments = 0;            ///< category absent from the label table
   std::map<int32_t, size_t> unknown_category_ids;  ///< those categories, with their segments
+  /// Ids read as "no class" rather than as unknown categories (semantic PNGs' 0 and 255 when
+  /// the label table lacks them: isSemanticVoid).
+  std::set<int32_t> void_ids;
   size_t labelled_pixels = 0;  ///< pixels with a segment id other than 0 (void), as read
   /// Of those, pixels whose id no segment lists (left unsegmented: COCO treats them as void).
   size_t unlisted_pixels = 0;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <map>
+#include <set>
 #include <string>
 
 #include "panmap/core/label_table.h"
@@ -11,10 +12,18 @@ namespace panmap {
 /// Splits an image of class ids into panoptic segments, as SemanticMaskReader describes: each
 /// stuff class one segment, each connected region (8-neighbourhood) of a thing class one,
 /// numbered from 1 in order of class id, then of the region's first pixel in raster order.
-/// Pixels of ids `table` lacks are 0; their number of distinct ids is added to `unknown_ids`.
+/// Pixels of ids `table` lacks are 0; their number of distinct ids is added to `unknown_ids`,
+/// except for the void values of semantic PNGs (isSemanticVoid), which are only added to
+/// `void_ids` when given.
 PanopticFrame panopticFromClasses(const LabelImage& classes, const LabelTable& table,
                                   size_t* unknown_ids,
-                                  std::map<int32_t, size_t>* unknown_by_id = nullptr);
+                                  std::map<int32_t, size_t>* unknown_by_id = nullptr,
+                                  std::set<int32_t>* void_ids = nullptr);
+
+/// True for the ids semantic segmentation PNGs use for "no class" when `table` does not list
+/// them as a class: 0 (unlabelled in ADE20K's and NYU's numbering), 255 (the ignore value of
+/// 8-bit masks of networks that count classes from 0) and 65535 (its 16-bit form).
+bool isSemanticVoid(int32_t id, const LabelTable& table);
 
 /// The masks a semantic network would have given for a panoptic frame: each pixel keeps its
 /// segment's class (NYU40 id, looked up in `table` as a source id) and loses its instance,
@@ -28,7 +37,7 @@ PanopticFrame withoutInstances(const PanopticFrame& panoptic, const LabelTable& 
 /// a thing class becomes one segment: a guess at its instances that keeps apart the objects of
 /// a class that do not touch in the image and joins those that do. Pixels of ids the label
 /// table lacks stay unsegmented (0); each such id counts once per frame as an unknown
-/// segment.
+/// segment, but for the void values (isSemanticVoid), which MaskReaderStats::void_ids lists.
 class SemanticMaskReader : public MaskReader {
  public:
   /// @param mask_dir folder with the PNGs

@@ -4,6 +4,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -63,7 +64,8 @@ struct ImportStats {
   size_t frames_without_mask = 0;
   size_t unknown_category_segments = 0;
   std::map<int32_t, size_t> unknown_category_ids;  ///< those categories, with their segments
-  size_t label_table_rows = 0;                     ///< rows of the label table the masks used
+  std::set<int32_t> mask_void_ids;  ///< ids read as no class (MaskReaderStats::void_ids)
+  size_t label_table_rows = 0;      ///< rows of the label table the masks used
   /// Mask pixels with an id other than 0, and those of them whose id the segments do not list
   /// (left unlabelled; MaskReaderStats), of which a swap of R and B would have matched.
   size_t mask_pixels = 0;
