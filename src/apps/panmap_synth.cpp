@@ -179,6 +179,12 @@ int main(int argc, char** argv) {
                "render as many frames as walking the whole survey takes (every lap, at its "
                "0.35 m/s), --frames being the least: a scene larger than --frames can walk is "
                "then seen whole (a real scene's size is not known in advance)");
+  double area_per_stop_m2 = panmap::SurveyConfig().area_per_stop_m2;
+  app.add_option("--area-per-stop", area_per_stop_m2,
+                 "a survey spreads one stop per this much free floor, m^2, where that gives more "
+                 "than 10 (0: always 10; docs/SIMULATION.md)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
   double rate_hz = 30.0;
   app.add_option("--rate-hz", rate_hz,
                  "frame rate of the survey (a lower rate covers more of the room per frame)")
@@ -354,6 +360,7 @@ int main(int argc, char** argv) {
       survey.rate_hz = rate_hz;
     }
     survey.laps = laps;
+    survey.area_per_stop_m2 = area_per_stop_m2;
     panmap::SurveyPath walk;
     if (trajectory_file.empty()) {
       walk = building_stops.empty() ? panmap::planSurveyPath(mesh, survey, seed)

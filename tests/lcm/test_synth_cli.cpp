@@ -1,4 +1,5 @@
 // panmap-synth as a user runs it: outputs, determinism, decodable logs, clear errors.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -209,6 +210,14 @@ TEST(SynthCli, ASurveyCutShortIsNamedAndCoverWalkWalksAllOfIt) {
   const auto info = readJson(dir.path("whole/info.json"));
   EXPECT_EQ(info["frames"].get<int>(), needed);
   EXPECT_EQ(info["trajectory"]["walk_covered"].get<double>(), 1.0);
+  // A room of 28 m^2 of free floor keeps 10 stops; --area-per-stop 2 spreads one per 2 m^2.
+  EXPECT_EQ(info["trajectory"]["stops"].get<int>(), 10);
+  const double free_m2 = info["trajectory"]["free_area_m2"].get<double>();
+  EXPECT_GT(free_m2, 20.0);
+  const auto dense = runCommand(synth + "--frames 2 --area-per-stop 2 --out " + dir.path("dense"));
+  ASSERT_EQ(dense.exit_code, 0) << dense.output;
+  EXPECT_EQ(readJson(dir.path("dense/info.json"))["trajectory"]["stops"].get<int>(),
+            static_cast<int>(std::ceil(free_m2 / 2.0)));
   // --frames stays the least: a walk shorter than it is walked again.
   const auto more = runCommand(synth + "--frames " + std::to_string(needed + 2) +
                                " --cover-walk --out " + dir.path("more"));
