@@ -5,11 +5,12 @@ floor (`panmap-synth --building`) written as a ScanNet scene folder of the curre
 a downloaded scene (m2f masks, ground-truth poses, 5 Hz, the whole survey walked:
 --cover-walk), mapped with every method variant at 2 cm and scored as the suite scores
 (suite.py). Once with the default survey stops (one per 6 m2 of free floor beyond 10) and once
-with 10 stops whatever the floor (`--area-per-stop 0`), the rule before 2026-12-06.
-Writes docs/LARGE_FLOOR.md; about 35 minutes on 2 cores with the defaults.
+with 10 stops whatever the floor (`--area-per-stop 0`, the rule before 2026-12-06) and
+once with one per 3 m2.
+Writes docs/LARGE_FLOOR.md; about 25 minutes on 2 cores with the defaults.
 
   scripts/bench/large_floor.py [--building 7] [--rooms 4] [--area 150] [--seed 1]
-                               [--stops-area 6,0] [--annotations annotated,empty]
+                               [--stops-area 6,3,0] [--annotations annotated,empty]
                                [--work build/large_floor] [--jobs 2] [--out docs/LARGE_FLOOR.md]
                                [--report-only]
 """
@@ -151,7 +152,7 @@ def main():
     parser.add_argument("--rooms", type=int, default=4)
     parser.add_argument("--area", type=float, default=150.0, help="floor area, m2, at least")
     parser.add_argument("--seed", type=int, default=1, help="survey, noise and mask seed")
-    parser.add_argument("--stops-area", default="6,0",
+    parser.add_argument("--stops-area", default="6,3,0",
                         help="panmap-synth --area-per-stop values, comma-separated")
     parser.add_argument("--annotations", default="annotated,empty",
                         help="annotated, painted, empty (25 %% unannotated), comma-separated")
