@@ -39,8 +39,10 @@ ProjectiveIntegrator::ProjectiveIntegrator(const IntegratorConfig& config, Threa
 
 namespace {
 
-// Image rows a thread takes at a time when finding votes.
-constexpr size_t kVoteRowsPerChunk = 16;
+// Image rows whose votes are found and summed together: a voxel wider than a pixel gets a run
+// of votes from each of the rows that cross it, and one sum per band replaces them all. A
+// fixed band, not a thread's share of rows, so that the sums are the same whatever the threads.
+constexpr size_t kVoteBandRows = 16;
 // Runs ahead whose vote slot is prefetched while votes are applied.
 constexpr size_t kAhead = 16;
 
@@ -61,14 +63,47 @@ uint32_t voteOwner(const Block* block, size_t owners) {
 
 }  // namespace
 
+namespace internal {
+
+size_t sumVoteRuns(VoteRun* runs, size_t n, VoteSumTable* table) {
+  ++table->band;
+  if (table->band == 0) {  // the stamp wrapped: no entry may look current
+    std::fill(std::begin(table->stamp), std::end(table->stamp), 0u);
+    table->band = 1;
+  }
+  size_t m = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const VoteRun& run = runs[i];
+    const uint64_t key = (reinterpret_cast<uintptr_t>(run.block) >> 6) ^
+                         (static_cast<uint64_t>(run.voxel) << 40) ^
+                         (static_cast<uint64_t>(static_cast<uint32_t>(run.label)) << 20);
+    const size_t h = static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - kVoteSumBits));
+    if (table->stamp[h] == table->band) {
+      VoteRun& sum = runs[table->index[h]];
+      if (sum.block == run.block && sum.voxel == run.voxel && sum.label == run.label) {
+        sum.count += run.count;
+        continue;
+      }
+    }
+    // New, or its slot taken by another voxel or label: a run of its own (it then adds up
+    // after the other, which the counts do not mind).
+    table->stamp[h] = table->band;
+    table->index[h] = static_cast<uint32_t>(m);
+    runs[m++] = run;
+  }
+  return m;
+}
+
+}  // namespace internal
+
 // Pi_V (Eq. 2's counts): every labelled pixel votes for its label in the voxel its measured
 // point falls in, as in the paper (a vote per point, not per projected voxel: projective
 // distances stretch at grazing angles and would miss the surface voxels there).
 // Two passes so both can run on every thread and still give the single-threaded result: first
-// each pixel's voxel is looked up (rows split between threads, the map is only read), and each
-// row's runs of votes are grouped by the thread that owns their voxel's block; then every
-// thread applies its own runs row by row, so each voxel sees its votes in pixel order whatever
-// the thread count.
+// each pixel's voxel is looked up (bands of rows split between threads, the map is only read),
+// each band's votes summed per voxel and label (sumVoteRuns) and grouped by the thread that
+// owns their voxel's block; then every thread applies its own sums band by band, so each voxel
+// sees its votes in the same order whatever the thread count.
 void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isometry3f& T_W_C,
                                       const LabelImage& labels, TsdfMap* map,
                                       IntegrationStats* stats) {
@@ -76,32 +111,41 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
   const RowCamera row_cam = RowCamera::of(cam);
   const int stride = voteStride(config_, map->voxelSize(), cam.fx);
   const size_t cols = (cam.width + stride - 1) / stride, rows = (cam.height + stride - 1) / stride;
+  const size_t bands = (rows + kVoteBandRows - 1) / kVoteBandRows;
+  const size_t band_capacity = cols * kVoteBandRows;
   const size_t owners = static_cast<size_t>(pool_->size());
-  vote_runs_.resize(cols * rows);
-  owner_begin_.resize(rows * (owners + 1));
+  if (vote_runs_.size() < bands * band_capacity) vote_runs_.resize(bands * band_capacity);
+  owner_begin_.resize(bands * (owners + 1));
   row_scratch_.resize(owners);
-  // Rows differ a lot in cost (invalid depth, blocks missed by the cache): whichever thread is
-  // free takes the next few; each row's runs land in its own slot.
-  pool_->parallelForDynamic(rows, kVoteRowsPerChunk, [&](size_t r0, size_t r1, int thread) {
+  // Bands differ a lot in cost (invalid depth, blocks missed by the cache): whichever thread is
+  // free takes the next; each band's sums land in its own slot.
+  pool_->parallelForDynamic(bands, 1, [&](size_t b0, size_t b1, int thread) {
     MutableVoxelLookup lookup(*map);
     RowScratch& scratch = row_scratch_[thread];
-    scratch.runs.resize(cols);
-    scratch.owner.resize(cols);
+    if (owners > 1 && scratch.runs.size() < band_capacity) {
+      scratch.runs.resize(band_capacity);
+      scratch.owner.resize(band_capacity);
+    }
     scratch.next.resize(owners);
-    for (size_t r = r0; r < r1; ++r) {
-      size_t* begin = &owner_begin_[r * (owners + 1)];
-      VoteRun* slot = &vote_runs_[r * cols];
+    for (size_t b = b0; b < b1; ++b) {
+      size_t* begin = &owner_begin_[b * (owners + 1)];
+      VoteRun* slot = &vote_runs_[b * band_capacity];
+      // One owner: the band's slot is where its runs are found and summed.
+      VoteRun* found = owners == 1 ? slot : scratch.runs.data();
+      size_t n = 0;
+      const size_t r_end = std::min(rows, (b + 1) * kVoteBandRows);
+      for (size_t r = b * kVoteBandRows; r < r_end; ++r) {
+        n += internal::findRowVotes(depth_m_, labels, static_cast<int>(r) * stride, stride, T_W_C,
+                                    row_cam, &lookup, found + n);
+      }
+      n = internal::sumVoteRuns(found, n, &scratch.sums);
       if (owners == 1) {
         begin[0] = 0;
-        begin[1] = internal::findRowVotes(depth_m_, labels, static_cast<int>(r) * stride, stride,
-                                          T_W_C, row_cam, &lookup, slot);
+        begin[1] = n;
         continue;
       }
-      VoteRun* found = scratch.runs.data();
+      // Stable counting sort by owner: each owner's sums stay in the order found.
       uint32_t* owner = scratch.owner.data();
-      const size_t n = internal::findRowVotes(depth_m_, labels, static_cast<int>(r) * stride,
-                                              stride, T_W_C, row_cam, &lookup, found);
-      // Stable counting sort by owner: each owner's runs stay in pixel order.
       std::fill(begin, begin + owners + 1, size_t{0});
       for (size_t i = 0; i < n; ++i) {
         owner[i] = voteOwner(found[i].block, owners);
@@ -116,9 +160,9 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
   pool_->parallelFor(owners, [&](size_t t0, size_t t1, int) {
     size_t my_added = 0, my_evicted = 0;
     for (size_t t = t0; t < t1; ++t) {
-      for (size_t r = 0; r < rows; ++r) {
-        const VoteRun* runs = &vote_runs_[r * cols];
-        const size_t* begin = &owner_begin_[r * (owners + 1)];
+      for (size_t b = 0; b < bands; ++b) {
+        const VoteRun* runs = &vote_runs_[b * band_capacity];
+        const size_t* begin = &owner_begin_[b * (owners + 1)];
         const size_t end = begin[t + 1];
         for (size_t i = begin[t]; i < end; ++i) {
           // A vote set is reached through its voxel's slot: both mostly miss the cache, so

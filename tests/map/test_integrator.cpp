@@ -241,6 +241,57 @@ TEST(Integrator, AutomaticVoteStrideAtCoarseVoxelsLabelsTheSameVoxels) {
   EXPECT_GE(kept, voted * 95 / 100) << kept << " of " << voted;
 }
 
+// At 10 cm voxels a voxel of the wall gets its votes from about 15 rows of each band of 16;
+// summed per band, every voxel still ends with one vote per pixel whose point falls in it, as
+// the votes of each row applied pixel by pixel give it (two labels: nothing is evicted).
+TEST(Integrator, VotesSummedPerBandOfRowsEqualAVoteAPixel) {
+  const LabelledWall wall;
+  const Eigen::Isometry3f T_W_C = wall.T_W_C.cast<float>();
+  for (int threads : {1, 2}) {
+    TsdfMap map(TsdfMap::Config{0.1f});
+    ThreadPool pool(threads);
+    ProjectiveIntegrator integrator(IntegratorConfig{}, &pool);
+    const IntegrationStats stats = integrator.integrate(wall.frame, wall.T_W_C, &wall.labels, &map);
+    EXPECT_EQ(stats.votes_added, 640u * 480u);
+    // The reference: the same rows' votes applied one row at a time, into a copy of the map's
+    // blocks without votes.
+    TsdfMap reference(TsdfMap::Config{0.1f});
+    for (const auto& block : map.blocks()) reference.allocateBlock(block->index);
+    Image<float> depth_m(640, 480, 0.0f);
+    for (int v = 0; v < 480; ++v) {
+      for (int u = 0; u < 640; ++u) {
+        const float d = wall.frame.depth(u, v) * static_cast<float>(wall.frame.depth_scale_m);
+        depth_m(u, v) = d >= 0.1f && d <= 3.5f ? d : 0.0f;  // IntegratorConfig's range
+      }
+    }
+    MutableVoxelLookup lookup(reference);
+    std::vector<VoteRun> runs(640);
+    for (int v = 0; v < 480; ++v) {
+      const size_t n =
+          internal::findRowVotesScalar(depth_m, wall.labels, v, 1, T_W_C,
+                                       RowCamera::of(wall.frame.camera), &lookup, runs.data());
+      for (size_t i = 0; i < n; ++i) {
+        addVotes(runs[i].block->votesToWrite(runs[i].voxel), runs[i].label, runs[i].count);
+      }
+    }
+    size_t voted = 0;
+    for (size_t b = 0; b < map.numBlocks(); ++b) {
+      const Block& got = *map.blocks()[b];
+      const Block* want = reference.findBlock(got.index);
+      ASSERT_NE(want, nullptr);
+      for (int i = 0; i < kBlockVoxels; ++i) {
+        const VoxelVotes* g = got.votes(i);
+        const VoxelVotes* w = want->votes(i);
+        ASSERT_EQ(g == nullptr, w == nullptr) << "block " << b << " voxel " << i;
+        if (!g) continue;
+        ++voted;
+        EXPECT_EQ(std::memcmp(g, w, sizeof(VoxelVotes)), 0) << "block " << b << " voxel " << i;
+      }
+    }
+    EXPECT_GT(voted, 100u) << threads << " threads";
+  }
+}
+
 // A block keeps vote sets only for voxels that got a vote; the others have none (null), and
 // giving one voxel its set leaves every other voxel's alone.
 TEST(Votes, ABlockKeepsVoteSetsOnlyForVotedVoxels) {

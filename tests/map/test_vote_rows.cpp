@@ -1,6 +1,8 @@
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -180,6 +182,77 @@ TEST(VoteRows, AddVotesEqualsRepeatedAddVote) {
 }
 
 // The lookups' floor must agree with std::floor everywhere a voxel index can be.
+// A band's runs summed by hand: each voxel and label once, at the place of its first run.
+TEST(VoteSums, EachVoxelAndLabelOnceWhereFirstSeen) {
+  TsdfMap map(voxelSize(0.1f));
+  Block* a = map.allocateBlock(BlockIndex(0, 0, 0));
+  Block* b = map.allocateBlock(BlockIndex(1, 0, 0));
+  std::vector<VoteRun> runs = {{a, 5, 7, 2}, {a, 6, 7, 1}, {b, 5, 7, 4}, {a, 5, 9, 1},
+                               {a, 5, 7, 3}, {b, 5, 7, 1}, {a, 6, 7, 10}};
+  VoteSumTable table;
+  const size_t n = sumVoteRuns(runs.data(), runs.size(), &table);
+  ASSERT_EQ(n, 4u);
+  const VoteRun want[] = {{a, 5, 7, 5}, {a, 6, 7, 11}, {b, 5, 7, 5}, {a, 5, 9, 1}};
+  for (size_t i = 0; i < n; ++i) {
+    EXPECT_EQ(runs[i].block, want[i].block) << i;
+    EXPECT_EQ(runs[i].voxel, want[i].voxel) << i;
+    EXPECT_EQ(runs[i].label, want[i].label) << i;
+    EXPECT_EQ(runs[i].count, want[i].count) << i;
+  }
+}
+
+// The table is reused from band to band without clearing: a sum of the band before must not be
+// found again (here it would add the run to itself), also when the band stamp wraps around to
+// the stamp the slot was written with.
+TEST(VoteSums, ABandSeesNoSumOfTheBandBefore) {
+  TsdfMap map(voxelSize(0.1f));
+  Block* a = map.allocateBlock(BlockIndex(0, 0, 0));
+  VoteSumTable table;
+  auto sumOne = [&] {
+    VoteRun run{a, 3, 4, 3};
+    EXPECT_EQ(sumVoteRuns(&run, 1, &table), 1u);
+    return run.count;
+  };
+  for (int band = 0; band < 3; ++band) EXPECT_EQ(sumOne(), 3u) << "band " << band;
+  table.band = 0;
+  EXPECT_EQ(sumOne(), 3u);  // written with stamp 1
+  table.band = 0xFFFFFFFFu;
+  EXPECT_EQ(sumOne(), 3u);  // the stamp wraps to 1 again
+}
+
+// Far more pairs than table slots: pairs that lose their slot keep runs of their own, and still
+// every pair's total is unchanged and the pairs first appear in the order they did.
+TEST(VoteSums, CollidingPairsStillAddUpExactly) {
+  TsdfMap map(voxelSize(0.1f));
+  std::vector<Block*> blocks;
+  for (int x = 0; x < 8; ++x) blocks.push_back(map.allocateBlock(BlockIndex(x, 0, 0)));
+  std::mt19937 rng(5);
+  std::vector<VoteRun> runs;
+  for (int i = 0; i < 20000; ++i) {
+    runs.push_back(VoteRun{blocks[rng() % blocks.size()], static_cast<int32_t>(rng() % 512),
+                           static_cast<int32_t>(1 + rng() % 3), 1 + rng() % 5});
+  }
+  using Pair = std::tuple<Block*, int32_t, int32_t>;
+  auto totals = [](const VoteRun* r, size_t n, std::vector<Pair>* order) {
+    std::map<Pair, uint64_t> sum;
+    for (size_t i = 0; i < n; ++i) {
+      const Pair pair{r[i].block, r[i].voxel, r[i].label};
+      if (sum.count(pair) == 0) order->push_back(pair);
+      sum[pair] += r[i].count;
+    }
+    return sum;
+  };
+  std::vector<Pair> order_before, order_after;
+  const auto before = totals(runs.data(), runs.size(), &order_before);
+  VoteSumTable table;
+  const size_t n = sumVoteRuns(runs.data(), runs.size(), &table);
+  const auto after = totals(runs.data(), n, &order_after);
+  EXPECT_EQ(after, before);
+  EXPECT_EQ(order_after, order_before);
+  EXPECT_LT(n, runs.size());    // most repeats were summed
+  EXPECT_GT(n, before.size());  // some pairs collided (12k pairs, 1,024 slots)
+}
+
 TEST(VoxelLookup, FloorToIntMatchesStdFloor) {
   const float edges[] = {0.0f,        -0.0f,       1.0f,         -1.0f,  0.5f,   -0.5f,
                          -1e-30f,     1e-30f,      -0.99999994f, 2.5f,   -2.5f,  8388607.5f,

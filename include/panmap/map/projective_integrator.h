@@ -76,14 +76,16 @@ class ProjectiveIntegrator {
   std::vector<absl::flat_hash_set<uint64_t>> key_sets_;  // scratch: block keys seen, per thread
   std::vector<uint64_t> keys_;                           // scratch: the same, sorted
   std::vector<Block*> blocks_;                           // scratch: blocks in view
-  std::vector<VoteRun> vote_runs_;  // scratch: each image row's runs of votes, `cols` apart
-  // scratch: where each owner's runs start in each row's slot (owners + 1 entries per row)
+  // scratch: each band of rows' summed votes, `cols * kVoteBandRows` apart
+  std::vector<VoteRun> vote_runs_;
+  // scratch: where each owner's runs start in each band's slot (owners + 1 entries per band)
   std::vector<size_t> owner_begin_;
-  /// Per-thread scratch of the vote lookup: one row's runs before they are grouped by owner.
+  /// Per-thread scratch of the vote lookup: one band's runs before they are grouped by owner.
   struct RowScratch {
     std::vector<VoteRun> runs;
     std::vector<uint32_t> owner;  // of each run
-    std::vector<size_t> next;     // next free place of each owner in the row's slot
+    std::vector<size_t> next;     // next free place of each owner in the band's slot
+    internal::VoteSumTable sums;  // which run holds each voxel and label's sum
   };
   std::vector<RowScratch> row_scratch_;
 };
