@@ -66,29 +66,43 @@ uint32_t voteOwner(const Block* block, size_t owners) {
 namespace internal {
 
 size_t sumVoteRuns(VoteRun* runs, size_t n, VoteSumTable* table) {
+  // At most half full, so a probe ends soon at a free slot.
+  size_t slots = table->stamp.size();
+  if (slots < 2 * n || slots == 0) {
+    slots = 64;
+    while (slots < 2 * n) slots *= 2;
+    table->stamp.assign(slots, 0u);
+    table->index.assign(slots, 0u);
+    table->band = 0;
+  }
   ++table->band;
-  if (table->band == 0) {  // the stamp wrapped: no entry may look current
-    std::fill(std::begin(table->stamp), std::end(table->stamp), 0u);
+  if (table->band == 0) {  // the stamp wrapped: no slot may look current
+    std::fill(table->stamp.begin(), table->stamp.end(), 0u);
     table->band = 1;
   }
+  const size_t mask = slots - 1;
+  const uint32_t band = table->band;
+  uint32_t* stamp = table->stamp.data();
+  uint32_t* index = table->index.data();
   size_t m = 0;
   for (size_t i = 0; i < n; ++i) {
-    const VoteRun& run = runs[i];
+    const VoteRun run = runs[i];
     const uint64_t key = (reinterpret_cast<uintptr_t>(run.block) >> 6) ^
                          (static_cast<uint64_t>(run.voxel) << 40) ^
                          (static_cast<uint64_t>(static_cast<uint32_t>(run.label)) << 20);
-    const size_t h = static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - kVoteSumBits));
-    if (table->stamp[h] == table->band) {
-      VoteRun& sum = runs[table->index[h]];
+    size_t h = static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 32) & mask;
+    bool summed = false;
+    for (; stamp[h] == band; h = (h + 1) & mask) {
+      VoteRun& sum = runs[index[h]];
       if (sum.block == run.block && sum.voxel == run.voxel && sum.label == run.label) {
         sum.count += run.count;
-        continue;
+        summed = true;
+        break;
       }
     }
-    // New, or its slot taken by another voxel or label: a run of its own (it then adds up
-    // after the other, which the counts do not mind).
-    table->stamp[h] = table->band;
-    table->index[h] = static_cast<uint32_t>(m);
+    if (summed) continue;
+    stamp[h] = band;
+    index[h] = static_cast<uint32_t>(m);
     runs[m++] = run;
   }
   return m;

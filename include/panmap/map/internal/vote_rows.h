@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -39,21 +40,19 @@ size_t findRowVotesScalar(const Image<float>& depth_m, const LabelImage& labels,
 /// True when findRowVotes runs the AVX2 path on this CPU.
 bool voteRowsUseAvx2();
 
-/// log2 of the slots of a VoteSumTable.
-constexpr int kVoteSumBits = 10;
-
 /// Scratch of sumVoteRuns: which run holds the sum of each (voxel, label) seen in the current
-/// band, direct-mapped by hash. Reused from band to band without clearing (stamped).
+/// band, an open-addressed table at most half full. Reused from band to band without clearing
+/// (each slot is stamped with the band that wrote it).
 struct VoteSumTable {
-  uint32_t band = 0;                       ///< stamp of the current band
-  uint32_t stamp[1 << kVoteSumBits] = {};  ///< band that wrote each slot
-  uint32_t index[1 << kVoteSumBits] = {};  ///< the run that slot names
+  uint32_t band = 0;            ///< stamp of the current band
+  std::vector<uint32_t> stamp;  ///< band that wrote each slot (a power of two of them)
+  std::vector<uint32_t> index;  ///< the run that slot names
 };
 
 /// Sums the runs of one band of rows in place: each run whose voxel and label an earlier run
-/// of the band already has (as remembered by `table`) adds its count to that run and goes.
-/// The runs kept stay in the order found, so every voxel sees its first vote where it did.
-/// A pair whose table slot another pair took keeps runs of its own (they add up the same).
+/// of the band has adds its count to that run and goes, so every pair is left once, where its
+/// first run was, and the runs stay in the order found (every voxel sees its first vote where
+/// it did). Exact whatever the runs' addresses: the map is the same on every run.
 /// Returns how many runs are left, at the front of `runs`.
 size_t sumVoteRuns(VoteRun* runs, size_t n, VoteSumTable* table);
 
