@@ -63,53 +63,6 @@ uint32_t voteOwner(const Block* block, size_t owners) {
 
 }  // namespace
 
-namespace internal {
-
-size_t sumVoteRuns(VoteRun* runs, size_t n, VoteSumTable* table) {
-  // At most half full, so a probe ends soon at a free slot.
-  size_t slots = table->stamp.size();
-  if (slots < 2 * n || slots == 0) {
-    slots = 64;
-    while (slots < 2 * n) slots *= 2;
-    table->stamp.assign(slots, 0u);
-    table->index.assign(slots, 0u);
-    table->band = 0;
-  }
-  ++table->band;
-  if (table->band == 0) {  // the stamp wrapped: no slot may look current
-    std::fill(table->stamp.begin(), table->stamp.end(), 0u);
-    table->band = 1;
-  }
-  const size_t mask = slots - 1;
-  const uint32_t band = table->band;
-  uint32_t* stamp = table->stamp.data();
-  uint32_t* index = table->index.data();
-  size_t m = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const VoteRun run = runs[i];
-    const uint64_t key = (reinterpret_cast<uintptr_t>(run.block) >> 6) ^
-                         (static_cast<uint64_t>(run.voxel) << 40) ^
-                         (static_cast<uint64_t>(static_cast<uint32_t>(run.label)) << 20);
-    size_t h = static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 32) & mask;
-    bool summed = false;
-    for (; stamp[h] == band; h = (h + 1) & mask) {
-      VoteRun& sum = runs[index[h]];
-      if (sum.block == run.block && sum.voxel == run.voxel && sum.label == run.label) {
-        sum.count += run.count;
-        summed = true;
-        break;
-      }
-    }
-    if (summed) continue;
-    stamp[h] = band;
-    index[h] = static_cast<uint32_t>(m);
-    runs[m++] = run;
-  }
-  return m;
-}
-
-}  // namespace internal
-
 // Pi_V (Eq. 2's counts): every labelled pixel votes for its label in the voxel its measured
 // point falls in, as in the paper (a vote per point, not per projected voxel: projective
 // distances stretch at grazing angles and would miss the surface voxels there).
@@ -130,12 +83,12 @@ void ProjectiveIntegrator::voteLabels(const RgbdFrame& frame, const Eigen::Isome
   const size_t owners = static_cast<size_t>(pool_->size());
   if (vote_runs_.size() < bands * band_capacity) vote_runs_.resize(bands * band_capacity);
   owner_begin_.resize(bands * (owners + 1));
-  row_scratch_.resize(owners);
+  band_scratch_.resize(owners);
   // Bands differ a lot in cost (invalid depth, blocks missed by the cache): whichever thread is
   // free takes the next; each band's sums land in its own slot.
   pool_->parallelForDynamic(bands, 1, [&](size_t b0, size_t b1, int thread) {
     MutableVoxelLookup lookup(*map);
-    RowScratch& scratch = row_scratch_[thread];
+    BandScratch& scratch = band_scratch_[thread];
     if (owners > 1 && scratch.runs.size() < band_capacity) {
       scratch.runs.resize(band_capacity);
       scratch.owner.resize(band_capacity);

@@ -1,5 +1,6 @@
 #include "panmap/map/internal/vote_rows.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "panmap/core/cpu_features.h"
@@ -151,6 +152,51 @@ size_t findRowVotesScalar(const Image<float>& depth_m, const LabelImage& labels,
 }
 
 bool voteRowsUseAvx2() { return cpuHasAvx2(); }
+
+// The block address only spreads the pairs over the table; the sums, found by probing until
+// the pair or a free slot, do not depend on it.
+size_t sumVoteRuns(VoteRun* runs, size_t n, VoteSumTable* table) {
+  // At most half full, so a probe ends soon at a free slot.
+  size_t slots = table->stamp.size();
+  if (slots < 2 * n || slots == 0) {
+    slots = 64;
+    while (slots < 2 * n) slots *= 2;
+    table->stamp.assign(slots, 0u);
+    table->index.assign(slots, 0u);
+    table->band = 0;
+  }
+  ++table->band;
+  if (table->band == 0) {  // the stamp wrapped: no slot may look current
+    std::fill(table->stamp.begin(), table->stamp.end(), 0u);
+    table->band = 1;
+  }
+  const size_t mask = slots - 1;
+  const uint32_t band = table->band;
+  uint32_t* stamp = table->stamp.data();
+  uint32_t* index = table->index.data();
+  size_t m = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const VoteRun run = runs[i];
+    const uint64_t key = (reinterpret_cast<uintptr_t>(run.block) >> 6) ^
+                         (static_cast<uint64_t>(run.voxel) << 40) ^
+                         (static_cast<uint64_t>(static_cast<uint32_t>(run.label)) << 20);
+    size_t h = static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 32) & mask;
+    bool summed = false;
+    for (; stamp[h] == band; h = (h + 1) & mask) {
+      VoteRun& sum = runs[index[h]];
+      if (sum.block == run.block && sum.voxel == run.voxel && sum.label == run.label) {
+        sum.count += run.count;
+        summed = true;
+        break;
+      }
+    }
+    if (summed) continue;
+    stamp[h] = band;
+    index[h] = static_cast<uint32_t>(m);
+    runs[m++] = run;
+  }
+  return m;
+}
 
 size_t findRowVotes(const Image<float>& depth_m, const LabelImage& labels, int v, int stride,
                     const Eigen::Isometry3f& T_W_C, const RowCamera& cam,

@@ -81,13 +81,13 @@ class ProjectiveIntegrator {
   // scratch: where each owner's runs start in each band's slot (owners + 1 entries per band)
   std::vector<size_t> owner_begin_;
   /// Per-thread scratch of the vote lookup: one band's runs before they are grouped by owner.
-  struct RowScratch {
+  struct BandScratch {
     std::vector<VoteRun> runs;
     std::vector<uint32_t> owner;  // of each run
     std::vector<size_t> next;     // next free place of each owner in the band's slot
     internal::VoteSumTable sums;  // which run holds each voxel and label's sum
   };
-  std::vector<RowScratch> row_scratch_;
+  std::vector<BandScratch> band_scratch_;
 };
 
 }  // namespace panmap
