@@ -74,8 +74,14 @@ void IncrementalMesher::clear() {
 
 void IncrementalMesher::remesh(const TsdfMap& map, std::vector<const Block*>* blocks,
                                const BlockMeshedFn& on_meshed) {
-  // Blocks never move, so their addresses identify them.
-  std::sort(blocks->begin(), blocks->end());
+  // In z, y, x order, x fastest: a thread's next block is then often the neighbour across x,
+  // whose voxels meshing this one has just read (the x = 0 layer is a line per row: the whole
+  // block). A block occurs once in the map, so equal indices are equal pointers.
+  std::sort(blocks->begin(), blocks->end(), [](const Block* a, const Block* b) {
+    if (a->index.z() != b->index.z()) return a->index.z() < b->index.z();
+    if (a->index.y() != b->index.y()) return a->index.y() < b->index.y();
+    return a->index.x() < b->index.x();
+  });
   blocks->erase(std::unique(blocks->begin(), blocks->end()), blocks->end());
   // Insert every entry first: no rehash may move a BlockMesh while threads fill them.
   meshes_.reserve(meshes_.size() + blocks->size());
@@ -87,8 +93,17 @@ void IncrementalMesher::remesh(const TsdfMap& map, std::vector<const Block*>* bl
     changed_.insert(key);
   }
   auto work = [&](size_t begin, size_t end, int thread) {
+    if (begin >= end) return;
+    // The next block's voxels load while this one is meshed and labelled: cold, a block took
+    // twice as long to mesh as when its voxels were cached (7-Scenes at 1 cm).
+    BlockGrid next = blockGrid(map, *(*blocks)[begin]);
     for (size_t i = begin; i < end; ++i) {
-      meshBlock(map, *(*blocks)[i], config_, targets[i]);
+      const BlockGrid grid = next;
+      if (i + 1 < end) {
+        next = blockGrid(map, *(*blocks)[i + 1]);
+        prefetchBlockGrid(next);
+      }
+      meshBlock(map, grid, config_, targets[i]);
       if (on_meshed) on_meshed(*targets[i], thread);
     }
   };

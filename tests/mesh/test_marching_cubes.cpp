@@ -350,6 +350,21 @@ TEST(MarchingCubes, RandomFieldGivesAClosedConsistentSurface) {
   expectWatertight(mesh);
 }
 
+TEST(MarchingCubes, BlockGridHoldsTheUpperNeighboursBySlotAndNullWhereNone) {
+  TsdfMap map(TsdfMap::Config{0.01f});
+  const BlockIndex origin(4, -2, 7);
+  Block* block = map.allocateBlock(origin);
+  // Slots 1 (+x), 3 (+x +y) and 6 (+y +z) exist; 2, 4, 5 and 7 do not.
+  const Block* plus_x = map.allocateBlock(origin + BlockIndex(1, 0, 0));
+  const Block* plus_xy = map.allocateBlock(origin + BlockIndex(1, 1, 0));
+  const Block* plus_yz = map.allocateBlock(origin + BlockIndex(0, 1, 1));
+  map.allocateBlock(origin - BlockIndex(1, 0, 0));  // a lower neighbour is not in the grid
+  const BlockGrid grid = blockGrid(map, *block);
+  const Block* expected[8] = {block, plus_x, nullptr, plus_xy, nullptr, nullptr, plus_yz, nullptr};
+  for (int slot = 0; slot < 8; ++slot) EXPECT_EQ(expected[slot], grid.blocks[slot]) << slot;
+  prefetchBlockGrid(grid);  // reads nothing it may not: missing neighbours are skipped
+}
+
 // Every block's own mesh, in blockIndexLess order, those with surface only.
 std::vector<BlockMesh> sortedBlockMeshes(const TsdfMap& map) {
   std::vector<const Block*> blocks;
@@ -360,6 +375,12 @@ std::vector<BlockMesh> sortedBlockMeshes(const TsdfMap& map) {
   for (const Block* block : blocks) {
     BlockMesh mesh;
     meshBlock(map, *block, MarchingCubesConfig(), &mesh);
+    // Meshing from a grid looked up beforehand (as IncrementalMesher does) is the same.
+    BlockMesh from_grid;
+    meshBlock(map, blockGrid(map, *block), MarchingCubesConfig(), &from_grid);
+    EXPECT_EQ(mesh.vertices, from_grid.vertices);
+    EXPECT_EQ(mesh.sources, from_grid.sources);
+    EXPECT_EQ(mesh.faces, from_grid.faces);
     if (!mesh.vertices.empty()) meshes.push_back(std::move(mesh));
   }
   return meshes;
