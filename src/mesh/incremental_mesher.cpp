@@ -93,19 +93,13 @@ void IncrementalMesher::remesh(const TsdfMap& map, std::vector<const Block*>* bl
     changed_.insert(key);
   }
   auto work = [&](size_t begin, size_t end, int thread) {
-    if (begin >= end) return;
-    // The next block's voxels load while this one is meshed and labelled: cold, a block took
-    // twice as long to mesh as when its voxels were cached (7-Scenes at 1 cm).
-    BlockGrid next = blockGrid(map, *(*blocks)[begin]);
-    for (size_t i = begin; i < end; ++i) {
-      const BlockGrid grid = next;
-      if (i + 1 < end) {
-        next = blockGrid(map, *(*blocks)[i + 1]);
-        prefetchBlockGrid(next);
-      }
-      meshBlock(map, grid, config_, targets[i]);
-      if (on_meshed) on_meshed(*targets[i], thread);
-    }
+    // The next block's voxels load while this one is meshed and labelled.
+    BlockMesh* const* out = targets.data() + begin;
+    std::function<void(size_t)> done;
+    if (on_meshed) done = [&on_meshed, out, thread](size_t i) { on_meshed(*out[i], thread); };
+    meshBlocks(
+        map, blocks->data() + begin, end - begin, config_, [out](size_t i) { return out[i]; },
+        done);
   };
   // Handed out a few blocks at a time: a block without a sign change costs a fraction of one
   // with surface, and halves fixed in advance left one thread waiting for the other (the mesh

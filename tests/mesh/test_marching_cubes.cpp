@@ -365,6 +365,40 @@ TEST(MarchingCubes, BlockGridHoldsTheUpperNeighboursBySlotAndNullWhereNone) {
   prefetchBlockGrid(grid);  // reads nothing it may not: missing neighbours are skipped
 }
 
+TEST(MarchingCubes, MeshBlocksMeshesEachIntoItsTargetAndReportsEachInOrder) {
+  TsdfMap map(TsdfMap::Config{0.003f});
+  fillSphere(&map);
+  std::vector<const Block*> blocks;
+  for (const auto& block : map.blocks()) blocks.push_back(block.get());
+  ASSERT_GT(blocks.size(), 100u);
+  std::vector<BlockMesh> meshes(blocks.size());
+  std::vector<size_t> done;
+  meshBlocks(
+      map, blocks.data(), blocks.size(), MarchingCubesConfig(),
+      [&meshes](size_t i) { return &meshes[i]; },
+      [&](size_t i) {
+        // Called right after block i is meshed, before block i + 1.
+        EXPECT_EQ(meshes[i].index, blocks[i]->index);
+        if (i + 1 < meshes.size()) EXPECT_TRUE(meshes[i + 1].vertices.empty());
+        done.push_back(i);
+      });
+  ASSERT_EQ(done.size(), blocks.size());
+  size_t with_surface = 0;
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    EXPECT_EQ(done[i], i);
+    BlockMesh one;
+    meshBlock(map, *blocks[i], MarchingCubesConfig(), &one);
+    EXPECT_EQ(one.vertices, meshes[i].vertices);
+    EXPECT_EQ(one.faces, meshes[i].faces);
+    with_surface += !one.vertices.empty();
+  }
+  EXPECT_GT(with_surface, 100u);
+  meshBlocks(map, blocks.data(), 0, MarchingCubesConfig(), [](size_t) -> BlockMesh* {
+    ADD_FAILURE() << "no block to mesh";
+    return nullptr;
+  });
+}
+
 // Every block's own mesh, in blockIndexLess order, those with surface only.
 std::vector<BlockMesh> sortedBlockMeshes(const TsdfMap& map) {
   std::vector<const Block*> blocks;

@@ -99,6 +99,14 @@ void meshBlock(const TsdfMap& map, const Block& block, const MarchingCubesConfig
 void meshBlock(const TsdfMap& map, const BlockGrid& grid, const MarchingCubesConfig& config,
                BlockMesh* mesh);
 
+/// meshBlock() of blocks[0 .. n) in order, each into `*target(i)`, then `done(i)` (may be
+/// empty): while one block is meshed and `done` runs, the next block's grid is prefetched.
+/// Blocks in z, y, x order (x fastest) gain most: the next block is then often the neighbour
+/// across x whose voxels the block before has just read.
+void meshBlocks(const TsdfMap& map, const Block* const* blocks, size_t n,
+                const MarchingCubesConfig& config, const std::function<BlockMesh*(size_t)>& target,
+                const std::function<void(size_t)>& done = {});
+
 /// Concatenates block meshes into one mesh, welding the vertices they share on block
 /// borders (one vertex per edge of the voxel grid), and labels every vertex through
 /// `labeller` from the map's current voxels (MeshWelder). Blocks must come in blockIndexLess
