@@ -94,7 +94,7 @@ class Recorder {
   // faces.
   void compareWithPrevious(const panmap::MeshUpdate& update) {
     for (size_t i = 0; i < update.blocks.size(); ++i) {
-      const panmap::LabelledMesh& now = update.meshes[i];
+      const panmap::LabelledMesh now = update.mesh(i);
       auto it = previous_.find(update.blocks[i]);
       if (it != previous_.end()) {
         const panmap::LabelledMesh& before = it->second;

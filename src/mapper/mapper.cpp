@@ -89,6 +89,18 @@ LabelledMesh Mapper::extractFinalMesh(const GraphLabels* labels) {
   return marchingCubes(*map_, mesher_->config(), meshLabeller(labels, &cache), pool_.get());
 }
 
+LabelledMesh MeshUpdate::mesh(size_t i) const {
+  const BlockMesh& block = *geometry.at(i);
+  LabelledMesh out;
+  out.vertices = block.vertices;
+  out.colors = block.colors;
+  out.faces = block.faces;
+  out.superpoint = labels.at(i).superpoint;
+  out.semantic = labels.at(i).semantic;
+  out.instance = labels.at(i).instance;
+  return out;
+}
+
 MeshUpdate Mapper::updateMesh(const GraphLabels* labels) {
   // Every thread labels the blocks it has just meshed, while their voxels are in cache, with
   // its own cache of super-point labels; resolve() only reads once the registry is flattened.
@@ -101,12 +113,12 @@ MeshUpdate Mapper::updateMesh(const GraphLabels* labels) {
   for (const MeshLabeller& labeller : labellers) {
     block_labellers.push_back(std::make_unique<BlockMeshLabeller>(*map_, labeller));
   }
-  std::vector<std::vector<std::pair<BlockIndex, LabelledMesh>>> labelled(threads);
+  std::vector<std::vector<std::pair<BlockIndex, BlockLabels>>> labelled(threads);
   mesher_->update(map_.get(), [&](const BlockMesh& mesh, int thread) {
-    labelled[thread].emplace_back(mesh.index, block_labellers[thread]->label(mesh));
+    labelled[thread].emplace_back(mesh.index, block_labellers[thread]->labels(mesh));
   });
-  // Sorted as (block, thread, position) triples, not as the meshes themselves: each mesh is
-  // moved once, into its place.
+  // Sorted as (block, thread, position) triples, not as the labels themselves: each is moved
+  // once, into its place.
   std::vector<std::tuple<BlockIndex, int, size_t>> all;
   for (int t = 0; t < threads; ++t) {
     for (size_t k = 0; k < labelled[t].size(); ++k) all.emplace_back(labelled[t][k].first, t, k);
@@ -116,17 +128,22 @@ MeshUpdate Mapper::updateMesh(const GraphLabels* labels) {
   });
   MeshUpdate update;
   update.blocks = mesher_->takeChangedBlocks();
-  update.meshes.resize(update.blocks.size());
+  update.geometry.resize(update.blocks.size());
+  update.labels.resize(update.blocks.size());
   // Both lists are sorted; blocks re-meshed earlier by extractMesh() are labelled now.
   auto next = all.begin();
   for (size_t i = 0; i < update.blocks.size(); ++i) {
+    update.geometry[i] = mesher_->share(update.blocks[i]);
     if (next != all.end() && std::get<0>(*next) == update.blocks[i]) {
-      update.meshes[i] = std::move(labelled[std::get<1>(*next)][std::get<2>(*next)].second);
+      update.labels[i] = std::move(labelled[std::get<1>(*next)][std::get<2>(*next)].second);
       ++next;
+    } else if (update.geometry[i]) {
+      update.labels[i] = block_labellers[0]->labels(*update.geometry[i]);
     } else {
       // A block dropped by a rebuild and not meshed since has no surface any more.
-      const BlockMesh* mesh = mesher_->find(update.blocks[i]);
-      if (mesh) update.meshes[i] = block_labellers[0]->label(*mesh);
+      auto empty = std::make_shared<BlockMesh>();
+      empty->index = update.blocks[i];
+      update.geometry[i] = std::move(empty);
     }
   }
   return update;

@@ -43,7 +43,7 @@ void IncrementalMesher::rebuild(const TsdfMap& map) {
 std::vector<BlockIndex> IncrementalMesher::takeChangedBlocks() {
   std::vector<BlockIndex> out;
   out.reserve(changed_.size() + dropped_.size());
-  for (uint64_t key : changed_) out.push_back(meshes_.at(key).index);
+  for (uint64_t key : changed_) out.push_back(meshes_.at(key)->index);
   for (const auto& [key, index] : dropped_) {
     if (!changed_.contains(key)) out.push_back(index);
   }
@@ -55,11 +55,16 @@ std::vector<BlockIndex> IncrementalMesher::takeChangedBlocks() {
 
 const BlockMesh* IncrementalMesher::find(const BlockIndex& index) const {
   const auto it = meshes_.find(TsdfMap::key(index));
-  return it == meshes_.end() ? nullptr : &it->second;
+  return it == meshes_.end() ? nullptr : it->second.get();
+}
+
+std::shared_ptr<const BlockMesh> IncrementalMesher::share(const BlockIndex& index) const {
+  const auto it = meshes_.find(TsdfMap::key(index));
+  return it == meshes_.end() ? nullptr : it->second;
 }
 
 void IncrementalMesher::invalidateAll() {
-  for (const auto& [key, mesh] : meshes_) dropped_.emplace(key, mesh.index);
+  for (const auto& [key, mesh] : meshes_) dropped_.emplace(key, mesh->index);
   meshes_.clear();
   changed_.clear();
 }
@@ -83,13 +88,17 @@ void IncrementalMesher::remesh(const TsdfMap& map, std::vector<const Block*>* bl
     return a->index.x() < b->index.x();
   });
   blocks->erase(std::unique(blocks->begin(), blocks->end()), blocks->end());
-  // Insert every entry first: no rehash may move a BlockMesh while threads fill them.
+  // Every target is found or made before the threads start.
   meshes_.reserve(meshes_.size() + blocks->size());
   std::vector<BlockMesh*> targets;
   targets.reserve(blocks->size());
   for (const Block* block : *blocks) {
     const uint64_t key = TsdfMap::key(block->index);
-    targets.push_back(&meshes_.try_emplace(key).first->second);
+    std::shared_ptr<BlockMesh>& mesh = meshes_[key];
+    // A mesh someone else still holds (share()) stays as it was: this block gets a new one.
+    // Only this mesher hands out copies, so a count of 1 cannot grow while it is refilled.
+    if (!mesh || mesh.use_count() > 1) mesh = std::make_shared<BlockMesh>();
+    targets.push_back(mesh.get());
     changed_.insert(key);
   }
   auto work = [&](size_t begin, size_t end, int thread) {
@@ -117,7 +126,7 @@ LabelledMesh IncrementalMesher::assemble(const TsdfMap& map, const MeshLabeller&
   std::vector<const BlockMesh*> sorted;
   sorted.reserve(meshes_.size());
   for (const auto& [key, mesh] : meshes_) {
-    if (!mesh.vertices.empty()) sorted.push_back(&mesh);
+    if (!mesh->vertices.empty()) sorted.push_back(mesh.get());
   }
   std::sort(sorted.begin(), sorted.end(), [](const BlockMesh* a, const BlockMesh* b) {
     return blockIndexLess(a->index, b->index);

@@ -361,23 +361,29 @@ BlockMeshLabeller::BlockMeshLabeller(const TsdfMap& map, const MeshLabeller& lab
 BlockMeshLabeller::~BlockMeshLabeller() = default;
 
 LabelledMesh BlockMeshLabeller::label(const BlockMesh& mesh) {
-  if (vertex_) {
-    // As MeshWelder::add: the vote slots and sets, which marching cubes did not read, are
-    // fetched for the whole block before any label waits on them (here while the copies
-    // below run).
-    vertex_->setBlock(mesh.index);
-    for (uint16_t source : mesh.sources) vertex_->prefetchSlot(source);
-  }
+  BlockLabels labelled = labels(mesh);
   LabelledMesh out;
   out.vertices = mesh.vertices;
   out.colors = mesh.colors;
   out.faces = mesh.faces;
+  out.superpoint = std::move(labelled.superpoint);
+  out.semantic = std::move(labelled.semantic);
+  out.instance = std::move(labelled.instance);
+  return out;
+}
+
+BlockLabels BlockMeshLabeller::labels(const BlockMesh& mesh) {
+  BlockLabels out;
   if (!vertex_) return out;
-  for (uint16_t source : mesh.sources) vertex_->prefetchVotes(source);
+  // As MeshWelder::add: the vote slots and sets, which marching cubes did not read, are
+  // fetched for the whole block before any label waits on them.
+  vertex_->setBlock(mesh.index);
+  for (uint16_t source : mesh.sources) vertex_->prefetchSlot(source);
   const size_t n = mesh.vertices.size();
   out.superpoint.resize(n);
   out.semantic.resize(n);
   out.instance.resize(n);
+  for (uint16_t source : mesh.sources) vertex_->prefetchVotes(source);
   for (size_t i = 0; i < n; ++i) {
     const VertexLabels labels = (*vertex_)(mesh.sources[i]);
     out.superpoint[i] = labels.superpoint;

@@ -231,14 +231,20 @@ TEST_F(BoxScene, LiveMeshUpdatesAddUpToTheExportedMesh) {
   // A viewer: one mesh per block, replaced when an update names the block.
   std::map<std::array<int, 3>, LabelledMesh> view;
   auto apply = [&view](const MeshUpdate& update) {
-    EXPECT_EQ(update.blocks.size(), update.meshes.size());
+    EXPECT_EQ(update.blocks.size(), update.geometry.size());
+    EXPECT_EQ(update.blocks.size(), update.labels.size());
     EXPECT_TRUE(std::is_sorted(update.blocks.begin(), update.blocks.end(), blockIndexLess));
     for (size_t i = 0; i < update.blocks.size(); ++i) {
       const BlockIndex& b = update.blocks[i];
-      view[{b.x(), b.y(), b.z()}] = update.meshes[i];
+      ASSERT_TRUE(update.geometry[i]);
+      EXPECT_EQ(update.geometry[i]->index, b);
+      view[{b.x(), b.y(), b.z()}] = update.mesh(i);
     }
   };
   MeshUpdate last;
+  // An update kept while the mapper goes on: the geometry it shares must not change under it.
+  MeshUpdate kept;
+  std::vector<LabelledMesh> kept_copies;
   for (int k = 0; k < 8; ++k) {
     RgbdFrame frame;
     PanopticFrame panoptic;
@@ -249,8 +255,31 @@ TEST_F(BoxScene, LiveMeshUpdatesAddUpToTheExportedMesh) {
       last = mapper.updateMesh();
       EXPECT_FALSE(last.blocks.empty());
       apply(last);
+      if (k == 1) {
+        kept = last;
+        for (size_t i = 0; i < kept.blocks.size(); ++i) kept_copies.push_back(kept.mesh(i));
+      }
     }
   }
+  size_t kept_vertices = 0;
+  for (size_t i = 0; i < kept.blocks.size(); ++i) {
+    const LabelledMesh now = kept.mesh(i);
+    EXPECT_EQ(now.vertices, kept_copies[i].vertices)
+        << "block " << i << " changed under its holder";
+    EXPECT_EQ(now.faces, kept_copies[i].faces);
+    EXPECT_EQ(now.superpoint, kept_copies[i].superpoint);
+    kept_vertices += now.numVertices();
+  }
+  EXPECT_GT(kept_vertices, 100u);
+  // Blocks the later updates re-meshed hold other geometry now: the kept one was not reused.
+  size_t moved = 0;
+  for (size_t i = 0; i < kept.blocks.size(); ++i) {
+    const auto it = std::find(last.blocks.begin(), last.blocks.end(), kept.blocks[i]);
+    if (it == last.blocks.end()) continue;
+    const BlockMesh& newer = *last.geometry[it - last.blocks.begin()];
+    moved += &newer != kept.geometry[i].get() && newer.vertices != kept_copies[i].vertices;
+  }
+  EXPECT_GT(moved, 0u);
   EXPECT_TRUE(mapper.updateMesh().blocks.empty());  // nothing integrated since
 
   // The blocks the viewer holds give exactly the exported mesh's vertices; those of the last
@@ -275,7 +304,8 @@ TEST_F(BoxScene, LiveMeshUpdatesAddUpToTheExportedMesh) {
   EXPECT_EQ(scratch.vertices, whole.vertices);
   EXPECT_EQ(scratch.faces, whole.faces);
   size_t checked = 0;
-  for (const LabelledMesh& mesh : last.meshes) {
+  for (size_t b = 0; b < last.blocks.size(); ++b) {
+    const LabelledMesh mesh = last.mesh(b);
     for (size_t i = 0; i < mesh.numVertices(); ++i, ++checked) {
       const Eigen::Vector3f& p = mesh.vertices[i];
       ASSERT_EQ(exported.at({p.x(), p.y(), p.z()}),

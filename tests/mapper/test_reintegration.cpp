@@ -226,7 +226,7 @@ TEST_F(Reintegration, TheLiveMeshDropsWhatMovedAway) {
   auto apply = [&view](const MeshUpdate& update) {
     for (size_t i = 0; i < update.blocks.size(); ++i) {
       const BlockIndex& b = update.blocks[i];
-      view[{b.x(), b.y(), b.z()}] = update.meshes[i];
+      view[{b.x(), b.y(), b.z()}] = update.mesh(i);
     }
   };
   apply(mapper->updateMesh());

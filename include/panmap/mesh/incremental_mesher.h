@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include <absl/container/flat_hash_map.h>
@@ -49,6 +50,9 @@ class IncrementalMesher {
   /// The stored mesh of a block, or null when the block was never meshed (or was dropped by
   /// invalidateAll() and not meshed since).
   const BlockMesh* find(const BlockIndex& index) const;
+  /// find() as shared ownership: the mesh stays as it is for as long as the caller holds it,
+  /// since re-meshing a block whose mesh is held elsewhere makes a new one.
+  std::shared_ptr<const BlockMesh> share(const BlockIndex& index) const;
 
   /// Blocks re-meshed by the last update() or rebuild().
   size_t lastRemeshedBlocks() const { return last_remeshed_; }
@@ -74,7 +78,8 @@ class IncrementalMesher {
 
   MarchingCubesConfig config_;
   ThreadPool* pool_;
-  absl::flat_hash_map<uint64_t, BlockMesh> meshes_;    // by TsdfMap::key of the block
+  // By TsdfMap::key of the block; never null. Shared with the callers of share().
+  absl::flat_hash_map<uint64_t, std::shared_ptr<BlockMesh>> meshes_;
   absl::flat_hash_set<uint64_t> changed_;              // re-meshed since takeChangedBlocks()
   absl::flat_hash_map<uint64_t, BlockIndex> dropped_;  // meshed before invalidateAll()
   size_t last_remeshed_ = 0;

@@ -127,6 +127,14 @@ class VertexLabeller;
 /// labelBlockMesh for one block after another, keeping its scratch memory (the labels of the
 /// voxels around a block) between blocks: one per thread. The map must not change while it
 /// is in use.
+/// Per vertex of a BlockMesh: its super-point, class and instance (empty when nothing is
+/// labelled).
+struct BlockLabels {
+  std::vector<int32_t> superpoint;
+  std::vector<int32_t> semantic;
+  std::vector<int32_t> instance;
+};
+
 class BlockMeshLabeller {
  public:
   /// @param map the map whose voxels label the vertices; must outlive this
@@ -138,6 +146,8 @@ class BlockMeshLabeller {
 
   /// The same as labelBlockMesh(map, mesh, labeller).
   LabelledMesh label(const BlockMesh& mesh);
+  /// The labels label() gives the vertices of `mesh`, without a copy of its geometry.
+  BlockLabels labels(const BlockMesh& mesh);
 
  private:
   std::unique_ptr<internal::VertexLabeller> vertex_;  // null when nothing is labelled
