@@ -124,9 +124,6 @@ namespace internal {
 class VertexLabeller;
 }  // namespace internal
 
-/// labelBlockMesh for one block after another, keeping its scratch memory (the labels of the
-/// voxels around a block) between blocks: one per thread. The map must not change while it
-/// is in use.
 /// Per vertex of a BlockMesh: its super-point, class and instance (empty when nothing is
 /// labelled).
 struct BlockLabels {
@@ -135,6 +132,9 @@ struct BlockLabels {
   std::vector<int32_t> instance;
 };
 
+/// labelBlockMesh for one block after another, keeping its scratch memory (the labels of the
+/// voxels around a block) between blocks: one per thread. The map must not change while it
+/// is in use.
 class BlockMeshLabeller {
  public:
   /// @param map the map whose voxels label the vertices; must outlive this
