@@ -6,6 +6,10 @@
 #                             [--rooms 3,4,5] [--jobs N] [--keep-logs] [--report-only]
 set -euo pipefail
 cd "$(dirname "$0")/../.."
+# --help answers before the setup and the build, which take minutes on a fresh machine.
+for arg in "$@"; do
+  case "$arg" in -h|--help) exec python3 scripts/bench/accuracy.py --help ;; esac
+done
 [ -x build/panmap-mapper ] || scripts/setup.sh --skip-network
 cmake --build build -j "$(nproc)" --target panmap-mapper panmap-synth panmap-eval >/dev/null
 exec python3 scripts/bench/accuracy.py "$@"
