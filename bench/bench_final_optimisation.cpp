@@ -61,9 +61,9 @@ int main(int argc, char** argv) {
                "also time the whole labelled mesh from the kept block meshes (welding and "
                "labelling on one thread)");
   CLI11_PARSE(app, argc, argv);
-  // As panmap-mapper: buffers of 4 MiB and more are fresh pages every time, which the final
-  // optimisation's timing has to include.
-  panmap::returnLargeBuffersToTheSystem();
+  // As panmap-mapper: the heap on huge pages where the kernel gives them on request, and buffers
+  // of 4 MiB and more fresh pages every time, which the final optimisation's timing includes.
+  panmap::applyMemoryPolicy(argv);
   try {
     const auto mapper = panmap::Mapper::load(path);
     std::vector<double> graph_ms, solve_ms;

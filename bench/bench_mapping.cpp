@@ -73,6 +73,7 @@ class Recorder {
       const panmap::StageTiming t = panmap::summariseTimes(list);
       out["stages"][stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}};
     }
+    out["heap_huge_pages"] = panmap::heapUsesHugePages();
     out["voxels_updated_median"] = panmap::summariseTimes(voxels_updated_).median_ms;
     out["blocks_in_view_median"] = panmap::summariseTimes(blocks_in_view_).median_ms;
     out["blocks_remeshed_median"] = panmap::summariseTimes(blocks_remeshed_).median_ms;
@@ -137,7 +138,7 @@ class Recorder {
 }  // namespace
 
 int main(int argc, char** argv) {
-  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
+  panmap::applyMemoryPolicy(argv);  // panmap-mapper's allocation policy
   CLI::App app{"Time the mapping pipeline (no network) on every frame of a dataset or log."};
   std::string data = "../shared/data/7scenes-200", json_path, log_path, config_path;
   panmap::MapperConfig config;

@@ -54,7 +54,7 @@ size_t superpointsWithVotes(const panmap::Mapper& mapper) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
+  panmap::applyMemoryPolicy(argv);  // panmap-mapper's allocation policy
   CLI::App app{
       "Map a long synthetic walk through one room and report resident memory against the "
       "map's own size every few hundred frames."};

@@ -93,7 +93,7 @@ struct InputFrame {
 }  // namespace
 
 int main(int argc, char** argv) {
-  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
+  panmap::applyMemoryPolicy(argv);  // panmap-mapper's allocation policy
   CLI::App app{
       "Time a loop-closure repair of N stored frames of a real sequence: blocking, and on its "
       "own thread while frames keep being mapped at a given rate."};

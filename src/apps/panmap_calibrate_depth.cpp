@@ -70,7 +70,7 @@ Round mapOnce(const std::string& log, const panmap::MapperConfig& config, int64_
 }  // namespace
 
 int main(int argc, char** argv) {
-  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
+  panmap::applyMemoryPolicy(argv);  // panmap-mapper's allocation policy
   CLI::App app{
       "Learns a depth sensor's fixed-pattern depth error from an LCM log of its frames and "
       "poses, and writes it for panmap-mapper --depth-calibration. The first round learns "

@@ -18,7 +18,7 @@
 #include "panmap/io/tum_trajectory.h"
 
 int main(int argc, char** argv) {
-  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
+  panmap::applyMemoryPolicy(argv);  // panmap-mapper's allocation policy
   CLI::App app{
       "Photometric consistency of camera trajectories over an RGB-D dataset folder: the median "
       "grey-level difference between each frame's strongly textured pixels and where the "

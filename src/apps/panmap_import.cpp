@@ -37,7 +37,7 @@ std::optional<Eigen::Vector4d> parseIntrinsics(const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
+  panmap::applyMemoryPolicy(argv);  // panmap-mapper's allocation policy
   CLI::App app{
       "Import an RGB-D dataset folder into an LCM log (channels CAMERA_RGBD, CAMERA_POSE and, "
       "with --masks, PANOPTIC).\nLayouts: 7scenes (frame-XXXXXX.{color.jpg,depth.png,pose.txt} "

@@ -52,7 +52,8 @@ nlohmann::json sessionJson(const panmap::SessionStats& s) {
   nlohmann::json timings;
   for (const auto& [stage, t] : s.timings)
     timings[stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}};
-  return {{"messages", s.messages},
+  return {{"heap_huge_pages", panmap::heapUsesHugePages()},
+          {"messages", s.messages},
           {"frames_received", s.frames_received},
           {"frames_integrated", s.frames_integrated},
           {"rejected", s.rejected},
@@ -404,7 +405,7 @@ int main(int argc, char** argv) {
   live_group->add_option("--channel-labels", live.channel_labels)->capture_default_str();
   live_group->add_option("--channel-command", live.channel_command)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
-  panmap::returnLargeBuffersToTheSystem();
+  panmap::applyMemoryPolicy(argv);
 
   try {
     panmap::PanmapConfig file_config;

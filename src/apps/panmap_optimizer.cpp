@@ -31,7 +31,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-regularise", no_regularise, "skip the semantic regularisation (III-C)");
   app.add_flag("--no-refine", no_refine, "skip the instance refinement (III-D)");
   CLI11_PARSE(app, argc, argv);
-  panmap::returnLargeBuffersToTheSystem();
+  panmap::applyMemoryPolicy(argv);
   try {
     if (!config_path.empty()) config.optimiser = panmap::loadConfig(config_path).optimiser;
     if (no_regularise) config.optimiser.regularise = false;

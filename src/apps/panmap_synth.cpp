@@ -109,7 +109,7 @@ void writePreview(const std::string& out_dir, const panmap::SynthFrame& f) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  panmap::returnLargeBuffersToTheSystem();  // panmap-mapper's allocation policy
+  panmap::applyMemoryPolicy(argv);  // panmap-mapper's allocation policy
   CLI::App app{
       "Render a labelled mesh along a camera trajectory into an LCM log (CAMERA_RGBD, "
       "CAMERA_POSE, PANOPTIC) with sensor noise, segmenter errors and SLAM-like pose drift, "

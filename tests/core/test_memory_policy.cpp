@@ -84,5 +84,23 @@ TEST(MemoryPolicy, LargeBuffersStillGoBackToTheSystem) {
 #endif
 }
 
+TEST(MemoryPolicy, BracketedModeIsTheKernelsChoice) {
+  EXPECT_EQ(bracketedMode("always [madvise] never"), "madvise");
+  EXPECT_EQ(bracketedMode("[always] madvise never"), "always");
+  EXPECT_EQ(bracketedMode("always madvise [never]"), "never");
+  EXPECT_EQ(bracketedMode("always madvise never"), "");
+  EXPECT_EQ(bracketedMode(""), "");
+}
+
+// The option joins what the user set; an explicit choice of the option itself stands.
+TEST(MemoryPolicy, TunablesGainTheHugePageOptionUnlessItIsSet) {
+  EXPECT_EQ(tunablesWithHugePages(nullptr), "glibc.malloc.hugetlb=1");
+  EXPECT_EQ(tunablesWithHugePages(""), "glibc.malloc.hugetlb=1");
+  EXPECT_EQ(tunablesWithHugePages("glibc.malloc.tcache_count=0"),
+            "glibc.malloc.tcache_count=0:glibc.malloc.hugetlb=1");
+  EXPECT_EQ(tunablesWithHugePages("glibc.malloc.hugetlb=0"), "");
+  EXPECT_EQ(tunablesWithHugePages("glibc.malloc.check=0:glibc.malloc.hugetlb=2"), "");
+}
+
 }  // namespace
 }  // namespace panmap

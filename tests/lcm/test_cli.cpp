@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "panmap/core/memory_policy.h"
 #include "panmap/io/image_codec.h"
 #include "test_helpers.h"
 
@@ -105,6 +106,39 @@ TEST(Cli, MapperWithoutTheOptimisationSaysSo) {
                                    " --out " + dir.path("b"));
   ASSERT_EQ(exported.exit_code, 0) << exported.output;
   EXPECT_TRUE(optimised("b"));
+}
+
+// panmap-mapper runs itself again with its heap on transparent huge pages where the kernel
+// gives them on request and glibc can ask (core/memory_policy.h), says so in report.json, and
+// leaves them off when told to (PANMAP_HUGE_PAGES=0) or when GLIBC_TUNABLES already chose.
+// The output of a run that restarted is the usual one line of a failure, not two.
+TEST(Cli, MapperPutsItsHeapOnHugePagesWhereTheSystemAllows) {
+  PANMAP_REQUIRE_DATA("7scenes-200");
+  test::TempDir dir;
+  importSevenScenes(dir, 2);
+  if (HasFailure()) return;
+  auto hugePages = [&](const std::string& env, const std::string& out) {
+    const auto mapped =
+        runCommand("env -u GLIBC_TUNABLES -u PANMAP_HUGE_PAGES " + env + " " +
+                   binPath("panmap-mapper") + " -q --voxel-size 0.05 --no-snapshots --log " +
+                   dir.path("s.lcmlog") + " --out " + dir.path(out));
+    EXPECT_EQ(mapped.exit_code, 0) << mapped.output;
+    std::ifstream in(dir.path(out + "/report.json"));
+    return nlohmann::json::parse(in)["heap_huge_pages"].get<bool>();
+  };
+  const bool available = cLibraryCanAskForHugePages() && transparentHugePageMode() == "madvise";
+  EXPECT_EQ(hugePages("", "a"), available);
+  EXPECT_FALSE(hugePages("PANMAP_HUGE_PAGES=0", "b"));
+  EXPECT_FALSE(hugePages("GLIBC_TUNABLES=glibc.malloc.hugetlb=0", "c"));
+  // The same frames give the same map, restarted or not.
+  std::ifstream a(dir.path("a/mesh_instance.ply"), std::ios::binary);
+  std::ifstream b(dir.path("b/mesh_instance.ply"), std::ios::binary);
+  EXPECT_TRUE(std::equal(std::istreambuf_iterator<char>(a), std::istreambuf_iterator<char>(),
+                         std::istreambuf_iterator<char>(b), std::istreambuf_iterator<char>()));
+  const auto failed = runCommand(binPath("panmap-mapper") + " -q --log " + dir.path("absent") +
+                                 " --out " + dir.path("d"));
+  EXPECT_EQ(failed.exit_code, 1);
+  EXPECT_EQ(test::countLines(failed.output), 1) << failed.output;
 }
 
 // An output that cannot be written (a folder where objects.json goes) fails the run in one
