@@ -52,8 +52,8 @@ bool heapUsesHugePages();
 /// the heap on 2 MB pages 498 and 266 ms, and the building's per-frame p95 went from 29.8 to
 /// 22.6 ms at the same resident memory (docs/STATUS.md, 2026-12-07). Returns without doing
 /// anything when PANMAP_HUGE_PAGES=0, when GLIBC_TUNABLES already sets the option, in any
-/// other mode or C library, and when the exec fails (the environment as it was). Call first
-/// in main(), before any thread starts or anything is printed: what ran before runs twice.
+/// other mode or C library, and when the exec fails (the environment as it was). Call early
+/// in main(), before any thread starts, file opens or output: what ran before it runs twice.
 void restartWithHugePageHeap(char** argv);
 
 /// The memory policy of panmap-mapper and panmap-optimizer, and of the tools and benchmarks
