@@ -49,9 +49,9 @@ bool heapUsesHugePages();
 /// gives them only to memory that asks ("madvise" mode) and glibc (>= 2.35) can ask. A
 /// page fault costs several microseconds in a virtual machine: on this project's 2-core VM
 /// the building's final optimisation touched 12,197 fresh 4 kB pages and took 416 ms, with
-/// the heap on 2 MB pages 498 and 266 ms, and the building's per-frame p95 went from 29.8 to
-/// 22.6 ms at the same resident memory (docs/STATUS.md, 2026-12-07). Returns without doing
-/// anything when PANMAP_HUGE_PAGES=0, when GLIBC_TUNABLES already sets the option, in any
+/// the heap on 2 MB pages 498 fresh pages and 266 ms, and the building's per-frame p95 went
+/// from 29.8 to 22.6 ms at the same resident memory (docs/STATUS.md, 2026-12-07). Returns without
+/// doing anything when PANMAP_HUGE_PAGES=0, when GLIBC_TUNABLES already sets the option, in any
 /// other mode or C library, and when the exec fails (the environment as it was). Call early
 /// in main(), before any thread starts, file opens or output: what ran before it runs twice.
 void restartWithHugePageHeap(char** argv);
