@@ -10,7 +10,8 @@ namespace fuzz {
 
 /// Files of every dataset layout: TUM, 7-Scenes, the ScanNet export and the generic
 /// rgb/ + depth/ + intrinsics + poses layout, with two frames each so that sequences, time
-/// matching and per-frame size checks are reachable.
+/// matching and per-frame size checks are reachable; and a ScanNet .sens recording (last, so
+/// the indexes of the others stay what the committed seeds were packed with).
 inline const std::vector<std::string>& datasetFileNames() {
   static const std::vector<std::string> names = {
       // TUM: lists, ground truth, intrinsics and images named by time stamp.
@@ -27,7 +28,9 @@ inline const std::vector<std::string>& datasetFileNames() {
       // Generic: rgb/ + depth/ numbered images, intrinsics, TUM or 4x4 poses.
       "rgb/000000.png", "rgb/000000.jpg", "depth/000000.png", "rgb/000001.png", "depth/000001.png",
       "intrinsic.txt", "intrinsics.txt", "gt_pose.txt", "poses.txt", "pose/000000.txt",
-      "pose/000001.txt"};
+      "pose/000001.txt",
+      // ScanNet .sens recording (with scene0000_00.txt above: its metadata).
+      "scene0000_00.sens"};
   return names;
 }
 

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -19,6 +20,7 @@
 #include "panmap/io/image_codec.h"
 #include "panmap/io/plane_codec.h"
 #include "panmap/io/ply.h"
+#include "panmap/io/scannet_sens.h"
 #include "panmap/lcm/conversions.h"
 #include "panmap/lcm/correction_conversions.h"
 #include "panmap/lcm/graph_conversions.h"
@@ -240,6 +242,32 @@ void datasetSeeds() {
                      {"intrinsic/intrinsic_color.txt", text(k4)},
                      {"intrinsic/extrinsic_color.txt", text(kFourByFour)},
                      {"intrinsic/extrinsic_depth.txt", text(kFourByFour)}}));
+  // A .sens recording: two frames, JPEG colour and deflated depth, the second pose lost.
+  {
+    panmap::ScanNetSensHeader h;
+    h.sensor_name = "StructureSensor";
+    h.intrinsic_depth.topLeftCorner<2, 3>() << 10, 0, 3.5, 0, 10, 2.5;
+    h.intrinsic_color = h.intrinsic_depth;
+    const panmap::DepthImage depth =
+        panmap::readDepthFile(g_fixtures + "/tum_tiny/depth/1.005000.png");
+    h.depth_width = static_cast<uint32_t>(depth.width());
+    h.depth_height = static_cast<uint32_t>(depth.height());
+    h.color_width = static_cast<uint32_t>(tinyFrame(0, 0).color.width());
+    h.color_height = static_cast<uint32_t>(tinyFrame(0, 0).color.height());
+    std::vector<panmap::ScanNetSensFrame> frames(2);
+    for (panmap::ScanNetSensFrame& f : frames) {
+      f.color = jpg;
+      f.depth = panmap::compressSensDepth(depth);
+    }
+    frames[1].camera_to_world.setConstant(-std::numeric_limits<float>::infinity());
+    const std::string path = g_out + "/sens.tmp";
+    panmap::writeScanNetSens(path, h, frames);
+    const Bytes sens = panmap::readFileBytes(path);
+    fs::remove(path);
+    seed("dataset", "scannet_sens", container(n, {{"scene0000_00.sens", sens}}));
+    seed("dataset", "scannet_sens_meta",
+         container(n, {{"scene0000_00.sens", sens}, {"scene0000_00.txt", text(meta)}}));
+  }
   // The generic layout: numbered rgb/ and depth/ images, intrinsics, TUM or 4x4 poses.
   seed("dataset", "generic_tum_poses",
        container(n, {{"rgb/000000.png", c0},

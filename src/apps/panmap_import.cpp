@@ -1,5 +1,5 @@
 // panmap-import: a dataset folder (7-Scenes, ScanNet export, TUM RGB-D, a generic rgb/ +
-// depth/ folder) -> an LCM log.
+// depth/ folder) or a ScanNet .sens file -> an LCM log.
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -42,7 +42,9 @@ int main(int argc, char** argv) {
       "Import an RGB-D dataset folder into an LCM log (channels CAMERA_RGBD, CAMERA_POSE and, "
       "with --masks, PANOPTIC).\nLayouts: 7scenes (frame-XXXXXX.{color.jpg,depth.png,pose.txt} "
       "+ camera-intrinsics.txt), scannet (SensReader export: color/, depth/, pose/, "
-      "intrinsic/), tum (rgb.txt, depth.txt, groundtruth.txt), folder (rgb/ or color/ and "
+      "intrinsic/), scannet-sens (a ScanNet .sens file, or a scan's folder holding one, read "
+      "without exporting it), tum (rgb.txt, depth.txt, groundtruth.txt), folder (rgb/ or color/ "
+      "and "
       "depth/ images, an intrinsics file such as intrinsic.txt, a pose file such as "
       "gt_pose.txt or a pose/ folder; README, panmap-import)."};
   std::string dataset_dir, log_path, layout = "auto", intrinsics, registration = "reproject";
@@ -52,9 +54,9 @@ int main(int argc, char** argv) {
   uint64_t drift_seed = 1;
   panmap::ImportOptions options;
   bool raw = false, quiet = false;
-  app.add_option("dataset", dataset_dir, "dataset folder")->required();
+  app.add_option("dataset", dataset_dir, "dataset folder, or a ScanNet .sens file")->required();
   app.add_option("output", log_path, "LCM log to write (.lcmlog)")->required();
-  app.add_option("--layout", layout, "auto, 7scenes, scannet, tum or folder")
+  app.add_option("--layout", layout, "auto, 7scenes, scannet, scannet-sens, tum or folder")
       ->capture_default_str();
   app.add_option("--masks", options.mask_dir,
                  "folder of masks, one PNG per colour image named after it: COCO panoptic "

@@ -40,6 +40,8 @@ const char* datasetLayoutName(DatasetLayout layout) {
       return "tum";
     case DatasetLayout::kFolder:
       return "folder";
+    case DatasetLayout::kScanNetSens:
+      return "scannet-sens";
     default:
       return "auto";
   }
@@ -48,28 +50,46 @@ const char* datasetLayoutName(DatasetLayout layout) {
 DatasetLayout parseDatasetLayout(const std::string& name) {
   for (DatasetLayout layout :
        {DatasetLayout::kAuto, DatasetLayout::kSevenScenes, DatasetLayout::kScanNet,
-        DatasetLayout::kTum, DatasetLayout::kFolder}) {
+        DatasetLayout::kScanNetSens, DatasetLayout::kTum, DatasetLayout::kFolder}) {
     if (name == datasetLayoutName(layout)) return layout;
   }
-  throw Error("unknown dataset layout '" + name + "' (auto, 7scenes, scannet, tum, folder)");
+  throw Error("unknown dataset layout '" + name +
+              "' (auto, 7scenes, scannet, scannet-sens, tum, folder)");
 }
 
 std::unique_ptr<DatasetReader> openDataset(const std::string& directory,
                                            const DatasetOptions& given) {
   given.check();
-  if (!isDirectory(directory)) throw Error("dataset folder " + directory + " does not exist");
   DatasetOptions options = given;
   if (!options.intrinsics && !options.intrinsics_file.empty()) {
     options.intrinsics = readIntrinsicsFile(options.intrinsics_file);
   }
   DatasetLayout layout = options.layout;
+  const bool sens_file = isRegularFile(directory);
+  if (sens_file) {
+    if (layout != DatasetLayout::kAuto && layout != DatasetLayout::kScanNetSens) {
+      throw Error(std::string("the ") + datasetLayoutName(layout) + " layout is a folder, " +
+                  directory + " a file");
+    }
+    if (std::filesystem::path(directory).extension() != ".sens") {
+      throw Error(directory + ": a dataset is a folder or a ScanNet .sens file");
+    }
+    layout = DatasetLayout::kScanNetSens;
+  } else if (!isDirectory(directory)) {
+    throw Error(std::filesystem::path(directory).extension() == ".sens"
+                    ? "ScanNet recording " + directory + " does not exist"
+                    : "dataset folder " + directory + " does not exist");
+  }
+  std::string sens_path = sens_file ? directory : "";
   if (layout == DatasetLayout::kAuto) {
-    // Most specific first: ScanNet exports also have depth/ and color/ folders.
+    // Most specific first: ScanNet exports also have depth/ and color/ folders, and a scan's
+    // folder with its .sens may hold an export of it too (the export is then read).
     const std::pair<DatasetLayout, std::string> tried[] = {
         {DatasetLayout::kTum, internal::missingForTum(directory)},
         {DatasetLayout::kScanNet, internal::missingForScanNet(directory)},
         {DatasetLayout::kSevenScenes, internal::missingForSevenScenes(directory)},
-        {DatasetLayout::kFolder, internal::missingForFolder(directory)}};
+        {DatasetLayout::kFolder, internal::missingForFolder(directory)},
+        {DatasetLayout::kScanNetSens, internal::missingForScanNetSens(directory, &sens_path)}};
     std::string why;
     for (const auto& [candidate, missing] : tried) {
       if (missing.empty()) {
@@ -90,6 +110,13 @@ std::unique_ptr<DatasetReader> openDataset(const std::string& directory,
   switch (layout) {
     case DatasetLayout::kScanNet:
       return internal::makeScanNetReader(directory, options);
+    case DatasetLayout::kScanNetSens: {
+      if (sens_path.empty()) {
+        const std::string missing = internal::missingForScanNetSens(directory, &sens_path);
+        if (!missing.empty()) throw Error(directory + ": " + missing);
+      }
+      return internal::makeScanNetSensReader(sens_path, options);
+    }
     case DatasetLayout::kTum:
       return internal::makeTumReader(directory, options);
     case DatasetLayout::kFolder:

@@ -33,27 +33,6 @@ PinholeCamera readIntrinsics4x4(const std::string& path) {
   return camera;
 }
 
-// Key = value lines of the scene metadata file, if the export has one.
-std::map<std::string, std::string> readSceneMeta(const std::string& dir, std::string* path_out) {
-  std::map<std::string, std::string> meta;
-  std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
-    if (!entry.is_regular_file() || entry.path().extension() != ".txt") continue;
-    std::ifstream in(entry.path());
-    std::string line;
-    std::map<std::string, std::string> candidate;
-    while (std::getline(in, line)) {
-      const auto eq = line.find(" = ");
-      if (eq != std::string::npos) candidate[line.substr(0, eq)] = line.substr(eq + 3);
-    }
-    if (candidate.count("colorWidth") && candidate.count("depthWidth")) {
-      *path_out = entry.path().string();
-      return candidate;
-    }
-  }
-  return meta;
-}
-
 class ScanNetReader : public DatasetReader {
  public:
   ScanNetReader(const std::string& dir, const DatasetOptions& options)
@@ -71,20 +50,9 @@ class ScanNetReader : public DatasetReader {
     }
 
     std::string meta_path;
-    const auto meta = readSceneMeta(dir, &meta_path);
-    T_C_D_.setIdentity();
-    if (meta.count("colorToDepthExtrinsics")) {
-      // p_D = E p_C, so T_C_D = E^-1.
-      std::istringstream values(meta.at("colorToDepthExtrinsics"));
-      Eigen::Matrix4d E;
-      for (int i = 0; i < 16; ++i) {
-        if (!(values >> E(i / 4, i % 4))) throw Error(meta_path + ": bad colorToDepthExtrinsics");
-      }
-      std::string why;
-      if (!isRigidTransform(E, 1e-3, &why)) {
-        throw Error(meta_path + ": colorToDepthExtrinsics " + why);
-      }
-      T_C_D_ = nearestIsometry(E).inverse();
+    const auto meta = readScanNetSceneMeta(dir, &meta_path);
+    if (const auto from_meta = scanNetColorFromDepth(meta, meta_path)) {
+      T_C_D_ = *from_meta;
     } else {
       // Without metadata fall back to the export's extrinsics (poses of each sensor on the rig).
       const std::string ec = dir + "/intrinsic/extrinsic_color.txt";
@@ -132,7 +100,9 @@ class ScanNetReader : public DatasetReader {
     frame.color_stem = fileStem(color_path);
     frame.color_source_width = color.width();
     frame.color_source_height = color.height();
-    buildColorMap(frame.rgbd.depth, &frame.color_map_u, &frame.color_map_v);
+    scanNetColorMap(frame.rgbd.depth, depth_camera_, color_camera_, T_C_D_,
+                    options_.depth_scale_m.value_or(0.001), options_.registration,
+                    &frame.color_map_u, &frame.color_map_v);
     cv::Mat registered;
     cv::remap(asMat(color), registered, asMat(frame.color_map_u), asMat(frame.color_map_v),
               cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0, 0, 0));
@@ -157,38 +127,6 @@ class ScanNetReader : public DatasetReader {
     throw Error(base + ".jpg: colour image missing");
   }
 
-  // Colour-image coordinates seen by every depth pixel.
-  void buildColorMap(const DepthImage& depth, Image<float>* map_u, Image<float>* map_v) const {
-    const PinholeCamera& d = depth_camera_;
-    const PinholeCamera& c = color_camera_;
-    if (options_.registration == ColorRegistration::kResize) {
-      resizeColorMap(d.width, d.height, c.width, c.height, map_u, map_v);
-      return;
-    }
-    *map_u = Image<float>(d.width, d.height);
-    *map_v = Image<float>(d.width, d.height);
-    const Eigen::Matrix3d R = T_C_D_.linear();
-    const Eigen::Vector3d t = T_C_D_.translation();
-    const double scale = options_.depth_scale_m.value_or(0.001);
-    for (int v = 0; v < d.height; ++v) {
-      const uint16_t* z_row = depth.row(v);
-      for (int u = 0; u < d.width; ++u) {
-        const double z = z_row[u] * scale;
-        const Eigen::Vector3d ray((u - d.cx) / d.fx, (v - d.cy) / d.fy, 1.0);
-        // Without depth the point is taken at infinity: only the rotation matters.
-        const Eigen::Vector3d p_C =
-            z > 0.0 ? Eigen::Vector3d(R * (ray * z) + t) : Eigen::Vector3d(R * ray);
-        float cu = -1.0f, cv = -1.0f;
-        if (p_C.z() > 1e-6) {
-          cu = static_cast<float>(c.fx * p_C.x() / p_C.z() + c.cx);
-          cv = static_cast<float>(c.fy * p_C.y() / p_C.z() + c.cy);
-        }
-        (*map_u)(u, v) = cu;
-        (*map_v)(u, v) = cv;
-      }
-    }
-  }
-
   std::string dir_;
   DatasetOptions options_;
   PinholeCamera depth_camera_;
@@ -199,6 +137,71 @@ class ScanNetReader : public DatasetReader {
 };
 
 }  // namespace
+
+std::map<std::string, std::string> readScanNetSceneMeta(const std::string& dir,
+                                                        std::string* path_out) {
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    if (!entry.is_regular_file() || entry.path().extension() != ".txt") continue;
+    std::ifstream in(entry.path());
+    std::string line;
+    std::map<std::string, std::string> candidate;
+    while (std::getline(in, line)) {
+      const auto eq = line.find(" = ");
+      if (eq != std::string::npos) candidate[line.substr(0, eq)] = line.substr(eq + 3);
+    }
+    if (candidate.count("colorWidth") && candidate.count("depthWidth")) {
+      *path_out = entry.path().string();
+      return candidate;
+    }
+  }
+  return {};
+}
+
+std::optional<Eigen::Isometry3d> scanNetColorFromDepth(
+    const std::map<std::string, std::string>& meta, const std::string& meta_path) {
+  const auto it = meta.find("colorToDepthExtrinsics");
+  if (it == meta.end()) return std::nullopt;
+  // p_D = E p_C, so T_C_D = E^-1.
+  std::istringstream values(it->second);
+  Eigen::Matrix4d E;
+  for (int i = 0; i < 16; ++i) {
+    if (!(values >> E(i / 4, i % 4))) throw Error(meta_path + ": bad colorToDepthExtrinsics");
+  }
+  std::string why;
+  if (!isRigidTransform(E, 1e-3, &why)) throw Error(meta_path + ": colorToDepthExtrinsics " + why);
+  return nearestIsometry(E).inverse();
+}
+
+void scanNetColorMap(const DepthImage& depth, const PinholeCamera& d, const PinholeCamera& c,
+                     const Eigen::Isometry3d& T_C_D, double depth_scale_m,
+                     ColorRegistration registration, Image<float>* map_u, Image<float>* map_v) {
+  if (registration == ColorRegistration::kResize) {
+    resizeColorMap(d.width, d.height, c.width, c.height, map_u, map_v);
+    return;
+  }
+  *map_u = Image<float>(d.width, d.height);
+  *map_v = Image<float>(d.width, d.height);
+  const Eigen::Matrix3d R = T_C_D.linear();
+  const Eigen::Vector3d t = T_C_D.translation();
+  for (int v = 0; v < d.height; ++v) {
+    const uint16_t* z_row = depth.row(v);
+    for (int u = 0; u < d.width; ++u) {
+      const double z = z_row[u] * depth_scale_m;
+      const Eigen::Vector3d ray((u - d.cx) / d.fx, (v - d.cy) / d.fy, 1.0);
+      // Without depth the point is taken at infinity: only the rotation matters.
+      const Eigen::Vector3d p_C =
+          z > 0.0 ? Eigen::Vector3d(R * (ray * z) + t) : Eigen::Vector3d(R * ray);
+      float cu = -1.0f, cv = -1.0f;
+      if (p_C.z() > 1e-6) {
+        cu = static_cast<float>(c.fx * p_C.x() / p_C.z() + c.cx);
+        cv = static_cast<float>(c.fy * p_C.y() / p_C.z() + c.cy);
+      }
+      (*map_u)(u, v) = cu;
+      (*map_v)(u, v) = cv;
+    }
+  }
+}
 
 std::unique_ptr<DatasetReader> makeScanNetReader(const std::string& dir,
                                                  const DatasetOptions& options) {

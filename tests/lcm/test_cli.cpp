@@ -7,6 +7,7 @@
 
 #include "panmap/core/memory_policy.h"
 #include "panmap/io/image_codec.h"
+#include "scannet_sens_fixture.h"
 #include "test_helpers.h"
 
 namespace panmap {
@@ -337,6 +338,33 @@ TEST(Cli, ImportNamesTheBadFile) {
   const auto bad_option = runCommand(binPath("panmap-import") + " --layout nope " + dir.path() +
                                      " " + dir.path("x.lcmlog"));
   EXPECT_NE(bad_option.exit_code, 0);
+}
+
+// A ScanNet .sens recording imports as it is, and a cut-off one stops the import in one line
+// naming the file and the frame, leaving no log behind.
+TEST(Cli, ImportReadsAScanNetRecording) {
+  PANMAP_REQUIRE_DATA("scannet-export-3");
+  test::TempDir dir;
+  test::writeScanNetExportAsSens(dir.path("scene0707_00.sens"));
+  const auto r = runCommand(binPath("panmap-import") + " --quiet " + dir.path("scene0707_00.sens") +
+                            " " + dir.path("s.lcmlog"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("(scannet-sens layout): 3 frames, 3 poses"), std::string::npos)
+      << r.output;
+  const auto info = runCommand(binPath("panmap-loginfo") + " --json " + dir.path("s.lcmlog"));
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_EQ(nlohmann::json::parse(info.output)["events"], 6);
+
+  const std::string sens = dir.path("scene0707_00.sens");
+  std::filesystem::resize_file(sens, std::filesystem::file_size(sens) - 1000);
+  const auto cut = runCommand(binPath("panmap-import") + " --quiet " + dir.path() + " " +
+                              dir.path("cut.lcmlog"));
+  EXPECT_EQ(cut.exit_code, 1);
+  EXPECT_EQ(test::countLines(cut.output), 1) << cut.output;
+  EXPECT_NE(cut.output.find("scene0707_00.sens frame 2 of 3: the file ends inside it"),
+            std::string::npos)
+      << cut.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path("cut.lcmlog")));
 }
 
 }  // namespace

@@ -32,8 +32,9 @@ struct DatasetFrame {
 };
 
 /// Which folder layout a dataset has. kFolder is the generic export: rgb/ (or color/) and
-/// depth/ image folders, an intrinsics file and a pose file or folder.
-enum class DatasetLayout { kAuto, kSevenScenes, kScanNet, kTum, kFolder };
+/// depth/ image folders, an intrinsics file and a pose file or folder. kScanNetSens is a
+/// ScanNet .sens recording, read without exporting it.
+enum class DatasetLayout { kAuto, kSevenScenes, kScanNet, kTum, kFolder, kScanNetSens };
 
 /// How the folder layout pairs colour with depth images.
 enum class FramePairing {
@@ -79,7 +80,7 @@ struct DatasetOptions {
 class DatasetReader {
  public:
   virtual ~DatasetReader() = default;
-  /// Short layout name: "7scenes", "scannet", "tum" or "folder".
+  /// Short layout name: "7scenes", "scannet", "scannet-sens", "tum" or "folder".
   virtual std::string layoutName() const = 0;
   /// Number of frames (depth images) found.
   virtual size_t size() const = 0;
@@ -102,9 +103,11 @@ class DatasetReader {
   virtual std::vector<std::string> notes() const { return {}; }
 };
 
-/// Opens a dataset folder. Throws Error naming the folder or file when it is missing or does
-/// not look like the layout; with kAuto and no layout recognised, the error lists every
-/// layout tried and what each one missed.
+/// Opens a dataset folder, or a ScanNet .sens file (a folder holding exactly one, such as a
+/// scan's folder from ScanNet's download script, opens it when no other layout matches).
+/// Throws Error naming the folder or file when it is missing or does not look like the
+/// layout; with kAuto and no layout recognised, the error lists every layout tried and what
+/// each one missed.
 std::unique_ptr<DatasetReader> openDataset(const std::string& directory,
                                            const DatasetOptions& options);
 
@@ -116,7 +119,8 @@ LabelImage registerLabelsToDepth(const LabelImage& labels_color, const DatasetFr
 /// Name of a layout.
 const char* datasetLayoutName(DatasetLayout layout);
 
-/// Parses "auto", "7scenes", "scannet", "tum" or "folder"; throws Error otherwise.
+/// Parses "auto", "7scenes", "scannet", "scannet-sens", "tum" or "folder"; throws Error
+/// otherwise.
 DatasetLayout parseDatasetLayout(const std::string& name);
 
 }  // namespace panmap

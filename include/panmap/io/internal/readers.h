@@ -1,5 +1,6 @@
 #pragma once
 
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -15,6 +16,9 @@ std::unique_ptr<DatasetReader> makeSevenScenesReader(const std::string& dir,
                                                      const DatasetOptions& options);
 std::unique_ptr<DatasetReader> makeScanNetReader(const std::string& dir,
                                                  const DatasetOptions& options);
+/// `path`: a ScanNet .sens file.
+std::unique_ptr<DatasetReader> makeScanNetSensReader(const std::string& path,
+                                                     const DatasetOptions& options);
 std::unique_ptr<DatasetReader> makeTumReader(const std::string& dir, const DatasetOptions& options);
 std::unique_ptr<DatasetReader> makeFolderReader(const std::string& dir,
                                                 const DatasetOptions& options);
@@ -23,8 +27,28 @@ std::unique_ptr<DatasetReader> makeFolderReader(const std::string& dir,
 /// images: the auto-detection and its error message.
 std::string missingForSevenScenes(const std::string& dir);
 std::string missingForScanNet(const std::string& dir);
+/// The one *.sens file in `dir`: its path in *found and "", or why there is none to take.
+std::string missingForScanNetSens(const std::string& dir, std::string* found = nullptr);
 std::string missingForTum(const std::string& dir);
 std::string missingForFolder(const std::string& dir);
+
+/// The key = value lines of a ScanNet scene's metadata file (<scene>.txt, the one .txt in
+/// `dir` with colorWidth and depthWidth; *path_out its path), or none.
+std::map<std::string, std::string> readScanNetSceneMeta(const std::string& dir,
+                                                        std::string* path_out);
+
+/// T_C_D (depth camera to colour camera) from the metadata's colorToDepthExtrinsics, or none
+/// when it has none. Throws Error naming `meta_path` when the value is not a rigid transform.
+std::optional<Eigen::Isometry3d> scanNetColorFromDepth(
+    const std::map<std::string, std::string>& meta, const std::string& meta_path);
+
+/// Colour-image coordinates of every pixel of a ScanNet depth image: kReproject moves each
+/// depth pixel's point (at infinity without depth) into the colour camera by T_C_D and
+/// projects it; kResize scales pixel centres.
+void scanNetColorMap(const DepthImage& depth, const PinholeCamera& depth_camera,
+                     const PinholeCamera& color_camera, const Eigen::Isometry3d& T_C_D,
+                     double depth_scale_m, ColorRegistration registration, Image<float>* map_u,
+                     Image<float>* map_v);
 
 /// Colour-image coordinates of every depth pixel when the colour image is the depth image
 /// resized (pixel centres scaled).
