@@ -16,6 +16,7 @@ refinement markers of docs/RESULTS.md (accuracy.py keeps it when it rewrites the
 import argparse
 import concurrent.futures
 import glob
+import struct
 import json
 import os
 import re
@@ -32,8 +33,10 @@ BEGIN = "<!-- refinement:begin (scripts/bench/refinement.py) -->"
 END = "<!-- refinement:end -->"
 DEFAULT_DATA = "../shared/data"  # as the report names the default --data
 MIN_FRAMES = 30  # shorter folders (format fixtures) have no trajectory to speak of
+MAX_FRAMES = 0  # --max-frames: frames imported and read per sequence, 0 for all
 REFERENCES = {"7scenes": "KinectFusion (7-Scenes' recorded poses)",
               "scannet": "BundleFusion (ScanNet's recorded poses)",
+              "scannet-sens": "BundleFusion (ScanNet's recorded poses)",
               "tum": "motion capture (TUM RGB-D ground truth)"}
 # Why 7-Scenes' recorded poses are a reference, not the truth: published, not our finding.
 SEVEN_SCENES_NOTE = (" 7-Scenes' poses are one choice among several: Brachmann et al. (\"On the "
@@ -42,21 +45,41 @@ SEVEN_SCENES_NOTE = (" 7-Scenes' poses are one choice among several: Brachmann e
                      "and the SfM poses rank re-localisation methods differently.")
 
 
+def sens_frames(path):
+    """Frame count in a ScanNet .sens file's header (SensReader's version 4 layout)."""
+    with open(path, "rb") as f:
+        version, name_bytes = struct.unpack("<IQ", f.read(12))
+        if version != 4:
+            return 0
+        # The name, four 4x4 float matrices, two compression types, four sizes, depth shift.
+        f.seek(12 + name_bytes + 4 * 64 + 8 + 16 + 4)
+        return struct.unpack("<Q", f.read(8))[0]
+
+
 def sequences(data_dir):
-    """Real sequences under data_dir: (name, folder, layout) with >= MIN_FRAMES poses."""
+    """Real sequences under data_dir: (name, path, layout, frames); those with >= MIN_FRAMES
+    poses found, the rest skipped. A ScanNet .sens recording counts as it lies there, or as
+    the one .sens of a scan's folder."""
     found, skipped = [], []
     for folder in sorted(glob.glob(os.path.join(data_dir, "*"))):
-        if not os.path.isdir(folder):
+        sens = glob.glob(os.path.join(folder, "*.sens")) if os.path.isdir(folder) else []
+        if folder.endswith(".sens") and os.path.isfile(folder):
+            layout, frames = "scannet-sens", sens_frames(folder)
+        elif not os.path.isdir(folder):
             continue
-        if glob.glob(os.path.join(folder, "frame-*.pose.txt")):
+        elif glob.glob(os.path.join(folder, "frame-*.pose.txt")):
             layout, frames = "7scenes", len(glob.glob(os.path.join(folder, "frame-*.pose.txt")))
         elif os.path.isdir(os.path.join(folder, "pose")):
             layout, frames = "scannet", len(glob.glob(os.path.join(folder, "pose", "*.txt")))
         elif os.path.isfile(os.path.join(folder, "groundtruth.txt")):
             layout, frames = "tum", sum(1 for _ in open(os.path.join(folder, "depth.txt")))
+        elif len(sens) == 1:
+            layout, frames = "scannet-sens", sens_frames(sens[0])
         else:
             continue
         name = os.path.basename(folder)
+        if name.endswith(".sens"):
+            name = name[:-len(".sens")]
         (found if frames >= MIN_FRAMES else skipped).append((name, folder, layout, frames))
     return found, skipped
 
@@ -120,8 +143,8 @@ def map_run(log, out_dir, voxel, tracking, extra=()):
 def photometric(folder, trajectories):
     """panmap-consistency's median |grey-level residual| of each trajectory, all scored on the
     same pixels."""
-    out = suite.run([suite.tool("panmap-consistency"), "--data", folder] +
-                    [a for t in trajectories for a in ("--traj", t)])
+    out = suite.run([suite.tool("panmap-consistency"), "--data", folder, "--max-frames",
+                     str(MAX_FRAMES)] + [a for t in trajectories for a in ("--traj", t)])
     values = []
     for t in trajectories:
         m = re.search(re.escape(t) + r": median \|residual\| ([0-9.]+)", out)
@@ -228,7 +251,8 @@ def render(rows, skipped, layouts, seconds, data=DEFAULT_DATA):
           "estimates**: %s.%s Corrected / kept: frames integrated at a corrected pose / at the "
           "given or predicted one (after the 5 warm-up frames). ms: median of the tracking "
           "stage per frame, runs two at a time on 2 cores." % (
-              "" if data == DEFAULT_DATA else " --data " + data, seconds / 60.0, data,
+              ("" if data == DEFAULT_DATA else " --data " + data) +
+              (" --max-frames %d" % MAX_FRAMES if MAX_FRAMES else ""), seconds / 60.0, data,
               MIN_FRAMES, limits(rows),
               "; ".join("%s: %s" % (n, REFERENCES.get(l, l)) for n, l in layouts),
               SEVEN_SCENES_NOTE if any(l == "7scenes" for _, l in layouts) else ""), "",
@@ -371,12 +395,16 @@ def independent_files(pairs):
 
 
 def main():
+    global MAX_FRAMES
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--data", default=os.path.join(suite.ROOT, "..", "shared", "data"))
     parser.add_argument("--seeds", default="1,2,3")
     parser.add_argument("--voxels", default="0.01,0.02")
     parser.add_argument("--drifts", default="none,light,heavy")
+    parser.add_argument("--max-frames", type=int, default=0,
+                        help="import at most this many frames of each sequence (0: all; a "
+                             "ScanNet scan has thousands at 30 Hz)")
     parser.add_argument("--corrections", default="auto,per_frame,filter,calibrated")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--work", default=os.path.join(suite.BUILD, "refinement"))
@@ -390,6 +418,7 @@ def main():
     if args.report_only:
         with open(os.path.join(args.work, "results.json")) as f:
             saved = json.load(f)
+        MAX_FRAMES = saved.get("max_frames", 0)
         found, skipped = sequences(args.data)
         add_independent(saved["rows"], args.work, independent_files(args.independent))
         splice(args.out, render(saved["rows"], skipped, [(f[0], f[2]) for f in found],
@@ -402,6 +431,9 @@ def main():
     if not found:
         sys.exit("refinement: no real sequence with >= %d frames under %s" % (MIN_FRAMES,
                                                                            args.data))
+    MAX_FRAMES = args.max_frames
+    if MAX_FRAMES:
+        found = [(n, f, l, min(c, MAX_FRAMES)) for n, f, l, c in found]
     if os.path.isdir(args.work):
         shutil.rmtree(args.work)
     os.makedirs(args.work)
@@ -440,7 +472,7 @@ def main():
     seconds = time.time() - start
     add_independent(rows, args.work, independent_files(args.independent))
     with open(os.path.join(args.work, "results.json"), "w") as f:
-        json.dump({"rows": rows, "seconds": seconds}, f, indent=1)
+        json.dump({"rows": rows, "seconds": seconds, "max_frames": MAX_FRAMES}, f, indent=1)
     section = render(rows, skipped, [(f[0], f[2]) for f in found], seconds, data_label(args.data))
     splice(args.out, section)
     print(section)
@@ -455,7 +487,8 @@ def one_import(work, name, folder, drift, seed, calibrate_from=None):
     # Frames without a recorded pose (TUM's motion capture can start late or drop out) have
     # no place in an ATE against it: left out, as TUM's own tools leave them.
     suite.run([suite.tool("panmap-import"), "-q", folder, log, "--drift",
-               "gt" if drift == "none" else drift, "--seed", str(seed), "--invalid-poses", "skip"])
+               "gt" if drift == "none" else drift, "--seed", str(seed), "--invalid-poses", "skip",
+               "--max-frames", str(MAX_FRAMES)])
     if calibrate_from is not None:
         suite.run([suite.tool("panmap-calibrate-depth"), "-q", "--log", log, "--out",
                    calibration_path(work, tag), "--first", str(calibrate_from), "--threads", "1"],

@@ -2,6 +2,7 @@
 // images. Each frame's depth pixels are carried into later frames by the trajectory's poses
 // and the grey levels compared. Depth-based tracking never looks at colour, so this judges a
 // refined trajectory and a dataset's recorded one without taking either as the truth.
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -29,8 +30,16 @@ int main(int argc, char** argv) {
   std::string data_dir, layout = "auto", json_path;
   std::vector<std::string> trajectories;
   panmap::PhotometricConfig config;
-  app.add_option("--data", data_dir, "dataset folder (as panmap-import reads it)")->required();
-  app.add_option("--layout", layout, "auto, 7scenes, scannet, tum or folder")
+  size_t max_frames = 0;
+  app.add_option("--data", data_dir,
+                 "dataset folder, or a ScanNet .sens file (as panmap-import "
+                 "reads it)")
+      ->required();
+  app.add_option("--layout", layout, "auto, 7scenes, scannet, scannet-sens, tum or folder")
+      ->capture_default_str();
+  app.add_option("--max-frames", max_frames,
+                 "read at most this many frames, from the first (0: all; as panmap-import "
+                 "--max-frames: every frame is held in memory)")
       ->capture_default_str();
   app.add_option("--traj", trajectories, "TUM trajectory to score (repeat for several)")
       ->required();
@@ -51,10 +60,11 @@ int main(int argc, char** argv) {
     panmap::DatasetOptions options;
     options.layout = panmap::parseDatasetLayout(layout);
     const auto reader = panmap::openDataset(data_dir, options);
+    const size_t count = max_frames ? std::min(max_frames, reader->size()) : reader->size();
     std::vector<panmap::PhotometricFrame> frames;
-    frames.reserve(reader->size());
+    frames.reserve(count);
     panmap::ProgressLine progress("read", "frames");
-    for (size_t i = 0; i < reader->size(); ++i) {
+    for (size_t i = 0; i < count; ++i) {
       panmap::DatasetFrame frame = reader->read(i);
       if (frame.rgbd.color.empty()) {
         throw panmap::Error(data_dir + ": frame " + std::to_string(i) + " has no colour image");
@@ -66,7 +76,7 @@ int main(int argc, char** argv) {
       f.depth = std::move(frame.rgbd.depth);
       f.grey = panmap::toGrey(frame.rgbd.color);
       frames.push_back(std::move(f));
-      progress.update(i + 1, reader->size());
+      progress.update(i + 1, count);
     }
     progress.finish();
     const std::vector<panmap::PhotometricResult> results =
