@@ -58,6 +58,16 @@ TEST(ConsistencyCli, AJitteredTrajectoryScoresWorseOnTheSamePixels) {
   EXPECT_EQ(out[0]["frames_posed"].get<int>(), 200);
   EXPECT_GT(out[1]["median_abs"].get<double>(), out[0]["median_abs"].get<double>() + 2.0)
       << run.output;
+
+  // --max-frames reads the first frames only: pairs among them, the rest of the poses unused.
+  const auto first = runCommand(consistency() + " --data " + test::dataDir("7scenes-200") +
+                                " --max-frames 20 --gaps 1 --stride 8 --traj " +
+                                dir.path("recorded.txt") + " --json " + dir.path("first.json"));
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  std::ifstream first_in(dir.path("first.json"));
+  const nlohmann::json first_out = nlohmann::json::parse(first_in);
+  EXPECT_EQ(first_out[0]["pairs"].get<int>(), 19);
+  EXPECT_EQ(first_out[0]["frames_posed"].get<int>(), 20);
 }
 
 // --gaps as the README writes it (1,3) and as CLI11 lists it (1 3) give the same pairs.
