@@ -138,19 +138,25 @@ class ScanNetReader : public DatasetReader {
 
 }  // namespace
 
+std::map<std::string, std::string> readScanNetMetaFile(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::map<std::string, std::string> meta;
+  while (std::getline(in, line)) {
+    const auto eq = line.find(" = ");
+    if (eq != std::string::npos) meta[line.substr(0, eq)] = line.substr(eq + 3);
+  }
+  if (!meta.count("colorWidth") || !meta.count("depthWidth")) return {};
+  return meta;
+}
+
 std::map<std::string, std::string> readScanNetSceneMeta(const std::string& dir,
                                                         std::string* path_out) {
   std::error_code ec;
   for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
     if (!entry.is_regular_file() || entry.path().extension() != ".txt") continue;
-    std::ifstream in(entry.path());
-    std::string line;
-    std::map<std::string, std::string> candidate;
-    while (std::getline(in, line)) {
-      const auto eq = line.find(" = ");
-      if (eq != std::string::npos) candidate[line.substr(0, eq)] = line.substr(eq + 3);
-    }
-    if (candidate.count("colorWidth") && candidate.count("depthWidth")) {
+    std::map<std::string, std::string> candidate = readScanNetMetaFile(entry.path().string());
+    if (!candidate.empty()) {
       *path_out = entry.path().string();
       return candidate;
     }

@@ -51,18 +51,18 @@ class ScanNetSensReader : public DatasetReader {
       depth_camera_.cy = k(3);
     }
     depth_scale_m_ = options.depth_scale_m.value_or(1.0 / h.depth_shift);
-    const std::string dir = std::filesystem::path(path).parent_path().string();
-    std::string meta_path;
-    const auto meta = readScanNetSceneMeta(dir.empty() ? "." : dir, &meta_path);
+    // Its own scene's metadata only (scans/<scene>/<scene>.txt): a folder of several scans'
+    // files must not lend one scan's calibration to another.
+    const std::string meta_path = std::filesystem::path(path).replace_extension(".txt").string();
+    const auto meta = readScanNetMetaFile(meta_path);
     if (const auto from_meta = scanNetColorFromDepth(meta, meta_path)) {
       T_C_D_ = *from_meta;
       registration_note_ = "colour registered through colorToDepthExtrinsics of " + meta_path;
     } else {
       T_C_D_ = rigPose(h.extrinsic_color, path + ": colour extrinsics").inverse() *
                rigPose(h.extrinsic_depth, path + ": depth extrinsics");
-      registration_note_ =
-          "colour registered through the file's rig extrinsics (no scene "
-          "metadata <scene>.txt beside it)";
+      registration_note_ = "colour registered through the file's rig extrinsics (no " + meta_path +
+                           " with colorToDepthExtrinsics)";
     }
   }
 

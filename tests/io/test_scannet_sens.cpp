@@ -105,6 +105,30 @@ TEST(ScanNetSens, ReadsExactValuesOfATinyRecording) {
   EXPECT_EQ(f2.rgbd.color(0, 0), (Rgb8{120, 120, 120}));
 }
 
+// A scan's calibration comes from its own metadata (<name>.txt beside <name>.sens), never from
+// another scan's lying in the same folder.
+TEST(ScanNetSens, ColourIsRegisteredWithItsOwnScansMetadata) {
+  test::TempDir dir;
+  const std::string path = writeTiny(dir);
+  const std::string meta =
+      "colorWidth = 8\ncolorHeight = 6\ndepthWidth = 4\ndepthHeight = 3\n"
+      "colorToDepthExtrinsics = 1 0 0 -0.5 0 1 0 0 0 0 1 0 0 0 0 1\n";
+  std::ofstream(dir.path("another_scan.txt")) << meta;
+  const DatasetFrame rig = openDataset(path, DatasetOptions{})->read(0);
+  EXPECT_FLOAT_EQ(rig.color_map_u(3, 2), 6.0f);
+  std::ofstream(dir.path("scan.txt")) << meta;
+  const auto reader = openDataset(path, DatasetOptions{});
+  EXPECT_NE(reader->notes().back().find("colorToDepthExtrinsics of " + dir.path("scan.txt")),
+            std::string::npos);
+  // p_D = E p_C puts a depth point 0.5 m further along x in the colour camera, so it lands
+  // fx_colour * 0.5 / z pixels further along u: frame 0's pixel (3, 2) holds 1000 + 7 * 11
+  // units, z = 2.154 m at 500 units per metre.
+  const DatasetFrame f = reader->read(0);
+  const double z = (1000 + 7 * 11) / 500.0;
+  EXPECT_NEAR(f.color_map_u(3, 2), 6.0 + 4.0 * 0.5 / z, 1e-4);
+  EXPECT_FLOAT_EQ(f.color_map_v(3, 2), 4.0f);
+}
+
 TEST(ScanNetSens, WriterAndReaderAgreeByteForByte) {
   test::TempDir dir;
   const std::string path = writeTiny(dir);

@@ -32,8 +32,12 @@ std::string missingForScanNetSens(const std::string& dir, std::string* found = n
 std::string missingForTum(const std::string& dir);
 std::string missingForFolder(const std::string& dir);
 
-/// The key = value lines of a ScanNet scene's metadata file (<scene>.txt, the one .txt in
-/// `dir` with colorWidth and depthWidth; *path_out its path), or none.
+/// The key = value lines of a ScanNet scene's metadata file (<scene>.txt), or none when the
+/// file is missing or has no colorWidth and depthWidth.
+std::map<std::string, std::string> readScanNetMetaFile(const std::string& path);
+
+/// The metadata of the first .txt in `dir` that readScanNetMetaFile() takes (*path_out its
+/// path), or none.
 std::map<std::string, std::string> readScanNetSceneMeta(const std::string& dir,
                                                         std::string* path_out);
 
