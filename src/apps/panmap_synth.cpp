@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 
 #include <CLI/CLI.hpp>
 
@@ -18,6 +19,7 @@
 #include "panmap/core/error.h"
 #include "panmap/core/memory_policy.h"
 #include "panmap/core/progress.h"
+#include "panmap/io/dataset_reader.h"
 #include "panmap/io/image_codec.h"
 #include "panmap/io/ply.h"
 #include "panmap/io/scannet_ground_truth.h"
@@ -169,6 +171,18 @@ int main(int argc, char** argv) {
                                        "scene folder, its parent or its grandparent, else " +
                                            shipped_labels);
   app.add_option("--trajectory", trajectory_file, "TUM trajectory to follow instead of a survey");
+  std::string recording;
+  app.add_option("--recording", recording,
+                 "a real recording of the scene instead of rendered frames: a dataset folder or "
+                 "ScanNet .sens file as panmap-import reads it, whose depth, colour and poses (the "
+                 "ground truth) go into the log as recorded, with masks from the mesh rendered "
+                 "at each pose (--scannet with the scan's own reconstruction; "
+                 "docs/SIMULATION.md)");
+  size_t every = 1;
+  app.add_option("--every", every,
+                 "with --recording: take every Nth recorded frame (ScanNet records at 30 Hz: 6 "
+                 "gives the accuracy suite's 5 Hz)")
+      ->check(panmap::cli::positive());
   app.add_option("--frames", frames,
                  "frames to render (the survey ends where they do: see --cover-walk; with "
                  "--trajectory, every pose unless given)")
@@ -267,6 +281,19 @@ int main(int argc, char** argv) {
     if (join_parts && scannet_dir.empty()) {
       throw panmap::Error("--join-parts needs --scannet (procedural rooms have whole objects)");
     }
+    if (!recording.empty()) {
+      // Recorded frames carry their own sensor, trajectory and rate.
+      for (const char* flag : {"--trajectory", "--laps", "--rate-hz", "--cover-walk",
+                               "--no-depth-noise", "--depth-pattern", "--image-scale"}) {
+        if (app.count(flag)) {
+          throw panmap::Error(std::string(flag) +
+                              " does not apply to --recording (its frames "
+                              "are recorded)");
+        }
+      }
+    } else if (app.count("--every")) {
+      throw panmap::Error("--every applies to --recording only");
+    }
     const auto start = std::chrono::steady_clock::now();
     panmap::LabelledMesh mesh;
     json source_json;
@@ -362,7 +389,9 @@ int main(int argc, char** argv) {
     survey.laps = laps;
     survey.area_per_stop_m2 = area_per_stop_m2;
     panmap::SurveyPath walk;
-    if (trajectory_file.empty()) {
+    // A survey is planned unless the poses come from a file or a recording.
+    const bool planned = trajectory_file.empty() && recording.empty();
+    if (planned) {
       walk = building_stops.empty() ? panmap::planSurveyPath(mesh, survey, seed)
                                     : panmap::planSurveyPathThrough(mesh, survey, building_stops);
       if (walk.clearance_m < survey.clearance_m) {
@@ -386,7 +415,32 @@ int main(int argc, char** argv) {
       std::cerr << "panmap-synth: --cover-walk is ignored with --trajectory (its poses are the "
                 << "frames)\n";
     }
-    if (!building_stops.empty() && trajectory_file.empty()) {
+    std::unique_ptr<panmap::DatasetReader> reader;
+    std::vector<size_t> recorded_index;  // per rendered frame, its frame in the recording
+    size_t recorded_without_pose = 0;
+    if (!recording.empty()) {
+      config.depth.enabled = false;  // the recording's own
+      reader = panmap::openDataset(recording, panmap::DatasetOptions{});
+      for (size_t i = 0; i < reader->size(); i += every) {
+        if (app.count("--frames") && trajectory.size() >= static_cast<size_t>(frames)) break;
+        const panmap::DatasetPose p = reader->pose(i);
+        if (!p.T_W_C) {
+          ++recorded_without_pose;  // ScanNet's -inf rows: no ground truth to score against
+          continue;
+        }
+        panmap::StampedPose pose;
+        pose.utime = p.utime;
+        pose.frame_id = p.frame_id;
+        pose.T_W_C = *p.T_W_C;
+        trajectory.push_back(pose);
+        recorded_index.push_back(i);
+      }
+      if (trajectory.empty()) throw panmap::Error(recording + ": no frame with a valid pose");
+      if (recorded_without_pose > 0) {
+        std::cerr << "panmap-synth: left out " << recorded_without_pose
+                  << " recorded frames without a valid pose\n";
+      }
+    } else if (!building_stops.empty() && trajectory_file.empty()) {
       trajectory = panmap::planSurveyThrough(mesh, survey, building_stops, seed);
     } else if (!trajectory_file.empty()) {
       trajectory = panmap::readTumTrajectory(trajectory_file);
@@ -429,8 +483,14 @@ int main(int argc, char** argv) {
         poses == "gt" ? panmap::PoseSource::kGroundTruth : panmap::PoseSource::kSlam;
     panmap::ProgressLine progress("synth", "frames", !quiet);
     const panmap::LabelTable nyu40 = panmap::LabelTable::nyu40Identity();
+    panmap::PinholeCamera camera = config.camera;  // the recording's, with one
+    double depth_scale_m = config.depth_scale_m;
     for (size_t k = 0; k < synth.size(); ++k) {
-      const panmap::SynthFrame f = synth.frame(k);
+      const panmap::SynthFrame f =
+          reader ? synth.frameFromRecording(k, reader->read(recorded_index[k]).rgbd)
+                 : synth.frame(k);
+      camera = f.rgbd.camera;
+      depth_scale_m = f.rgbd.depth_scale_m;
       const int64_t utime = f.rgbd.utime;
       log.write(panmap::kChannelRgbd, utime, panmap::toMessage(f.rgbd, encoding));
       panmap::StampedPose pose;
@@ -477,28 +537,35 @@ int main(int argc, char** argv) {
         {"seed", seed},
         {"source", source_json},
         {"frames", synth.size()},
-        {"rate_hz", trajectory_file.empty() ? rate_hz : 0.0},
+        {"rate_hz", planned ? rate_hz : 0.0},
         {"camera",
-         {{"fx", config.camera.fx},
-          {"fy", config.camera.fy},
-          {"cx", config.camera.cx},
-          {"cy", config.camera.cy},
-          {"width", config.camera.width},
-          {"height", config.camera.height},
-          {"depth_scale_m", config.depth_scale_m}}},
+         {{"fx", camera.fx},
+          {"fy", camera.fy},
+          {"cx", camera.cx},
+          {"cy", camera.cy},
+          {"width", camera.width},
+          {"height", camera.height},
+          {"depth_scale_m", depth_scale_m}}},
+        {"recording",
+         {{"path", recording},
+          {"layout", reader ? reader->layoutName() : ""},
+          {"every", recording.empty() ? 0 : every},
+          {"frames_in_recording", reader ? reader->size() : 0},
+          {"left_out_without_pose", recorded_without_pose}}},
         {"mesh",
          {{"vertices", mesh.numVertices()},
           {"faces", mesh.numFaces()},
           {"instances", synth.instances().size()}}},
         {"trajectory",
-         {{"source", trajectory_file.empty() ? "survey" : trajectory_file},
-          {"laps", trajectory_file.empty() ? laps : 0},
+         {{"source", !recording.empty()        ? recording
+                     : trajectory_file.empty() ? "survey"
+                                               : trajectory_file},
+          {"laps", planned ? laps : 0},
           {"walk_length_m", walk.length_m},
           // Share of the walk the frames reach (1 when they walk all of it or more).
-          {"walk_covered", trajectory_file.empty()
-                               ? std::min(1.0, static_cast<double>(synth.size()) /
-                                                   panmap::framesToWalk(walk, survey))
-                               : 0.0},
+          {"walk_covered", planned ? std::min(1.0, static_cast<double>(synth.size()) /
+                                                       panmap::framesToWalk(walk, survey))
+                                   : 0.0},
           {"planned_clearance_m", walk.clearance_m},
           {"stops", walk.stops.size()},
           {"free_area_m2", walk.free_area_m2},

@@ -126,6 +126,16 @@ std::unique_ptr<DatasetReader> openDataset(const std::string& directory,
   }
 }
 
+DatasetPose DatasetReader::pose(size_t index) const {
+  const DatasetFrame frame = read(index);
+  DatasetPose out;
+  out.utime = frame.rgbd.utime;
+  out.frame_id = frame.rgbd.frame_id;
+  out.T_W_C = frame.T_W_C;
+  out.problem = frame.pose_problem;
+  return out;
+}
+
 LabelImage registerLabelsToDepth(const LabelImage& labels_color, const DatasetFrame& frame,
                                  const std::string& what) {
   const int src_w = frame.color_source_width;

@@ -88,6 +88,16 @@ class ScanNetReader : public DatasetReader {
   }
   bool invalidPosesExpected() const override { return true; }
 
+  DatasetPose pose(size_t index) const override {
+    const long long number = frames_.at(index).first;
+    DatasetPose out;
+    out.utime = frameUtime(number, options_.frame_rate_hz);
+    out.frame_id = number;
+    out.T_W_C = readPoseFile(dir_ + "/pose/" + std::to_string(number) + ".txt",
+                             options_.pose_tolerance, &out.problem);
+    return out;
+  }
+
   DatasetFrame read(size_t index) const override {
     DatasetFrame frame;
     const long long number = frames_.at(index).first;

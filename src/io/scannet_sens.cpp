@@ -158,16 +158,27 @@ ScanNetSensFile ScanNetSensFile::open(const std::string& path) {
   return file;
 }
 
-ScanNetSensFrame ScanNetSensFile::readFrame(size_t index) const {
+std::ifstream ScanNetSensFile::openAt(size_t index) const {
   if (index >= records_.size()) {
     throw Error(frameName(path_, index) + ": the file has " + std::to_string(records_.size()) +
                 " frames");
   }
-  const Record& rec = records_[index];
-  const std::string what = frameName(path_, index);
   std::ifstream in(path_, std::ios::binary);
   if (!in) throw Error("cannot read " + path_);
-  in.seekg(static_cast<std::streamoff>(rec.offset));
+  in.seekg(static_cast<std::streamoff>(records_[index].offset));
+  return in;
+}
+
+Eigen::Matrix4f ScanNetSensFile::readPose(size_t index) const {
+  std::ifstream in = openAt(index);
+  const std::string what = frameName(path_, index);
+  return LittleEndianReader(&in, what).matrix("pose");
+}
+
+ScanNetSensFrame ScanNetSensFile::readFrame(size_t index) const {
+  std::ifstream in = openAt(index);
+  const Record& rec = records_[index];
+  const std::string what = frameName(path_, index);
   LittleEndianReader r(&in, what);
   ScanNetSensFrame frame;
   frame.camera_to_world = r.matrix("pose");

@@ -81,6 +81,14 @@ class ScanNetSensReader : public DatasetReader {
     return {line, registration_note_};
   }
 
+  DatasetPose pose(size_t index) const override {
+    DatasetPose out;
+    out.utime = frameUtime(static_cast<long long>(index), options_.frame_rate_hz);
+    out.frame_id = static_cast<int64_t>(index);
+    out.T_W_C = validPose(file_.readPose(index), index, &out.problem);
+    return out;
+  }
+
   DatasetFrame read(size_t index) const override {
     const ScanNetSensFrame stored = file_.readFrame(index);
     DatasetFrame frame;
@@ -100,19 +108,22 @@ class ScanNetSensReader : public DatasetReader {
     frame.rgbd.camera_name = "scannet";
     frame.rgbd.camera = depth_camera_;
     frame.rgbd.depth_scale_m = depth_scale_m_;
-    // ScanNet writes -inf rows for frames its reconstruction lost.
-    const Eigen::Matrix4d T = stored.camera_to_world.cast<double>();
-    std::string why;
-    if (isRigidTransform(T, options_.pose_tolerance, &why)) {
-      frame.T_W_C = nearestIsometry(T);
-    } else {
-      frame.pose_problem =
-          file_.path() + " frame " + std::to_string(index) + ": invalid pose, " + why;
-    }
+    frame.T_W_C = validPose(stored.camera_to_world, index, &frame.pose_problem);
     return frame;
   }
 
  private:
+  // ScanNet writes -inf rows for frames its reconstruction lost.
+  std::optional<Eigen::Isometry3d> validPose(const Eigen::Matrix4f& T, size_t index,
+                                             std::string* problem) const {
+    std::string why;
+    if (isRigidTransform(T.cast<double>(), options_.pose_tolerance, &why)) {
+      return nearestIsometry(T.cast<double>());
+    }
+    *problem = file_.path() + " frame " + std::to_string(index) + ": invalid pose, " + why;
+    return std::nullopt;
+  }
+
   ScanNetSensFile file_;
   DatasetOptions options_;
   PinholeCamera depth_camera_;

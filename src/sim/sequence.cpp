@@ -124,23 +124,38 @@ SequenceSynthesizer::SequenceSynthesizer(const LabelledMesh& mesh,
 
 SynthFrame SequenceSynthesizer::frame(size_t k) {
   if (k >= gt_.size()) throw Error("synth: frame " + std::to_string(k) + " beyond the trajectory");
-  SynthFrame out;
-  out.gt_pose = gt_[k];
-  out.input_pose = input_[k];
   renderer_.render(config_.camera, gt_[k].T_W_C, &view_);
-  out.rgbd.utime = gt_[k].utime;
-  out.rgbd.frame_id = static_cast<int64_t>(k);
-  out.rgbd.camera_name = "panmap-synth";
-  out.rgbd.camera = config_.camera;
-  out.rgbd.depth_scale_m = config_.depth_scale_m;
-  out.rgbd.depth =
+  RgbdFrame rgbd;
+  rgbd.camera_name = "panmap-synth";
+  rgbd.camera = config_.camera;
+  rgbd.depth_scale_m = config_.depth_scale_m;
+  rgbd.depth =
       simulateDepth(view_, config_.depth, hashSeed(config_.seed, k, 0xDE9u), config_.depth_scale_m);
   if (!config_.depth_pattern.empty()) {
     DepthImage with_pattern;
-    config_.depth_pattern.apply(out.rgbd.depth, config_.depth_scale_m, &with_pattern);
-    out.rgbd.depth = std::move(with_pattern);
+    config_.depth_pattern.apply(rgbd.depth, config_.depth_scale_m, &with_pattern);
+    rgbd.depth = std::move(with_pattern);
   }
-  out.rgbd.color = view_.color;
+  rgbd.color = view_.color;
+  return finishFrame(k, std::move(rgbd));
+}
+
+SynthFrame SequenceSynthesizer::frameFromRecording(size_t k, RgbdFrame recorded) {
+  if (k >= gt_.size()) throw Error("synth: frame " + std::to_string(k) + " beyond the trajectory");
+  if (recorded.depth.empty()) {
+    throw Error("synth: recorded frame " + std::to_string(recorded.frame_id) + " has no depth");
+  }
+  renderer_.render(recorded.camera, gt_[k].T_W_C, &view_);
+  return finishFrame(k, std::move(recorded));
+}
+
+SynthFrame SequenceSynthesizer::finishFrame(size_t k, RgbdFrame rgbd) {
+  SynthFrame out;
+  out.gt_pose = gt_[k];
+  out.input_pose = input_[k];
+  out.rgbd = std::move(rgbd);
+  out.rgbd.utime = gt_[k].utime;
+  out.rgbd.frame_id = static_cast<int64_t>(k);
   out.gt_instance = view_.instance;
   out.panoptic = segmenter_.segment(view_.instance, view_.semantic, static_cast<int>(k), infos_);
   out.panoptic.utime = out.rgbd.utime;

@@ -75,6 +75,23 @@ TEST(ScanNetExport, ResizeRegistrationIsAffine) {
   EXPECT_THROW(registerLabelsToDepth(LabelImage(640, 480), f, "mask"), Error);
 }
 
+TEST(ScanNetExport, PosesReadAloneAreThoseOfTheFrames) {
+  PANMAP_REQUIRE_DATA("scannet-export-3");
+  test::TempDir dir;
+  test::makeScanNetExportWithInfPose(dir);
+  const auto reader = openDataset(dir.path(), DatasetOptions{});
+  for (size_t i = 0; i < reader->size(); ++i) {
+    const DatasetPose p = reader->pose(i);
+    const DatasetFrame f = reader->read(i);
+    EXPECT_EQ(p.utime, f.rgbd.utime);
+    EXPECT_EQ(p.frame_id, f.rgbd.frame_id);
+    ASSERT_EQ(p.T_W_C.has_value(), f.T_W_C.has_value()) << i;
+    if (p.T_W_C) EXPECT_TRUE(p.T_W_C->isApprox(*f.T_W_C, 0.0));
+    EXPECT_EQ(p.problem, f.pose_problem);
+  }
+  EXPECT_FALSE(reader->pose(1).T_W_C.has_value());  // the -inf rows
+}
+
 TEST(ScanNetExport, InfPoseIsReportedNotRead) {
   PANMAP_REQUIRE_DATA("scannet-export-3");
   test::TempDir dir;

@@ -98,6 +98,18 @@ TEST(ScanNetSens, ReadsExactValuesOfATinyRecording) {
       << f1.pose_problem;
   EXPECT_EQ(f1.rgbd.utime, 33333);  // 30 Hz, as the export's frame numbers
 
+  // pose() gives what read() gives, without the images.
+  for (size_t i = 0; i < 3; ++i) {
+    const DatasetPose p = reader->pose(i);
+    const DatasetFrame f = reader->read(i);
+    EXPECT_EQ(p.utime, f.rgbd.utime);
+    EXPECT_EQ(p.frame_id, f.rgbd.frame_id);
+    EXPECT_EQ(p.T_W_C.has_value(), f.T_W_C.has_value());
+    if (p.T_W_C) EXPECT_TRUE(p.T_W_C->isApprox(*f.T_W_C, 0.0));
+    EXPECT_EQ(p.problem, f.pose_problem);
+  }
+  expectError([&] { reader->pose(3); }, {path + " frame 3", "has 3 frames"});
+
   const DatasetFrame f2 = reader->read(2);
   ASSERT_TRUE(f2.T_W_C.has_value());
   EXPECT_DOUBLE_EQ(f2.T_W_C->translation().x(), 0.5);

@@ -31,6 +31,14 @@ struct DatasetFrame {
   Image<float> color_map_v;
 };
 
+/// A frame's time and pose, read without its images (DatasetReader::pose).
+struct DatasetPose {
+  int64_t utime = 0;
+  int64_t frame_id = 0;
+  std::optional<Eigen::Isometry3d> T_W_C;  ///< as DatasetFrame::T_W_C
+  std::string problem;                     ///< as DatasetFrame::pose_problem
+};
+
 /// Which folder layout a dataset has. kFolder is the generic export: rgb/ (or color/) and
 /// depth/ image folders, an intrinsics file and a pose file or folder. kScanNetSens is a
 /// ScanNet .sens recording, read without exporting it.
@@ -86,6 +94,9 @@ class DatasetReader {
   virtual size_t size() const = 0;
   /// Reads frame i (0-based, in time order). Throws Error naming the file at fault.
   virtual DatasetFrame read(size_t index) const = 0;
+  /// Frame i's utime, id and pose as read(i) gives them, without decoding its images where
+  /// the layout allows (ScanNet's); the default reads the frame. Throws Error as read() does.
+  virtual DatasetPose pose(size_t index) const;
   /// Where the dataset's poses come from.
   virtual PoseSource poseSource() const { return PoseSource::kGroundTruth; }
   /// True when invalid poses are a documented property of the layout (ScanNet writes -inf

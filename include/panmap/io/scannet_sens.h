@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,9 @@ class ScanNetSensFile {
   size_t size() const { return records_.size(); }
   /// Frame i's pose, time stamps and image bytes. Throws Error naming the file and frame.
   ScanNetSensFrame readFrame(size_t index) const;
+  /// Frame i's camera-to-world pose alone (-inf where ScanNet lost track). Throws Error like
+  /// readFrame.
+  Eigen::Matrix4f readPose(size_t index) const;
   /// Frame i's depth, decompressed: depth_width x depth_height raw units. Throws Error naming
   /// the file and frame when the bytes do not decompress to exactly that.
   DepthImage decodeDepth(const ScanNetSensFrame& frame, size_t index) const;
@@ -73,6 +77,9 @@ class ScanNetSensFile {
     uint64_t color_bytes = 0;
     uint64_t depth_bytes = 0;
   };
+  /// The file, positioned at frame i's record. Throws Error naming a frame it lacks.
+  std::ifstream openAt(size_t index) const;
+
   std::string path_;
   ScanNetSensHeader header_;
   std::vector<Record> records_;

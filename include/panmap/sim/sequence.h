@@ -82,6 +82,12 @@ class SequenceSynthesizer {
   size_t size() const { return gt_.size(); }
   /// Renders frame k (call with k = 0, 1, 2, ... for the coverage and segmenter statistics).
   SynthFrame frame(size_t k);
+  /// Frame k of a recording instead of a rendering (call in the same order as frame()): the
+  /// recorded depth and colour as they are, no simulated sensor noise; the segmenter's masks
+  /// from the mesh rendered at the ground-truth pose with the recording's camera. The mesh must
+  /// be the recorded scene in the recording's world frame (a ScanNet scan and its
+  /// reconstruction). Throws Error when the recorded frame has no depth image.
+  SynthFrame frameFromRecording(size_t k, RgbdFrame recorded);
   /// Ground-truth trajectory.
   const std::vector<StampedPose>& groundTruthTrajectory() const { return gt_; }
   /// Trajectory as the simulated SLAM system reports it.
@@ -94,6 +100,9 @@ class SequenceSynthesizer {
   const std::map<int32_t, InstanceInfo>& instances() const { return infos_; }
 
  private:
+  /// The segmenter's output and the coverage count of the view just rendered, around `rgbd`.
+  SynthFrame finishFrame(size_t k, RgbdFrame rgbd);
+
   SynthConfig config_;
   MeshRenderer renderer_;
   SegmenterNoise segmenter_;
