@@ -10,6 +10,7 @@ Sequences are cached in the work folder (keyed by their parameters), maps are re
 """
 import argparse
 import datetime
+import glob
 import json
 import os
 import shlex
@@ -39,17 +40,31 @@ JOINED_PARTS_NOTE = (
     "what the simulated network sees.")
 
 
-def real_specs(dirs, seeds, frames, join_parts=False):
+def recording_of(scene_dir):
+    """The one .sens recording in a ScanNet scene folder; exits with a one-line reason when
+    there is none or more than one."""
+    found = sorted(glob.glob(os.path.join(scene_dir, "*.sens")))
+    if len(found) != 1:
+        sys.exit("accuracy: --recordings: %s holds %d .sens files, not one" % (scene_dir,
+                                                                               len(found)))
+    return found[0]
+
+
+def real_specs(dirs, seeds, frames, join_parts=False, recordings=None):
+    """recordings: {scene folder: its .sens}, whose frames replace the surveys (the seeds then
+    draw the masks' errors and the drift only)."""
+    recordings = recordings or {}
     specs = []
     for d in dirs:
+        extra = {"join_parts": join_parts, "recording": recordings.get(d)}
         for annotation, _ in suite.ANNOTATIONS:
             for seed in seeds:
                 specs.append(Spec("scannet", d, seed, "gt", "m2f", annotation, "all", frames,
-                                  join_parts=join_parts))
+                                  **extra))
                 specs.append(Spec("scannet", d, seed, "slam", "m2f", annotation, "tracked",
-                                  frames, join_parts=join_parts))
+                                  frames, **extra))
                 specs.append(Spec("scannet", d, seed, "gt", "clean", annotation, "full", frames,
-                                  join_parts=join_parts))
+                                  **extra))
     return specs
 
 
@@ -64,11 +79,13 @@ def like_specs(rooms, frames):
     return specs
 
 
-def weaker_specs(dirs, seeds, rooms, frames_scannet, frames_like, join_parts=False):
+def weaker_specs(dirs, seeds, rooms, frames_scannet, frames_like, join_parts=False,
+                 recordings=None):
     """A weaker network (`hard` masks), ground-truth poses, every variant: how the method and
     each of its parts hold up when the masks are worse than the reported suite's."""
+    recordings = recordings or {}
     specs = [Spec("scannet", d, seed, "gt", "hard", "annotated", "all", frames_scannet,
-                  join_parts=join_parts)
+                  join_parts=join_parts, recording=recordings.get(d))
              for d in dirs for seed in seeds]
     specs += [Spec("scannetlike", r, r, "gt", "hard", "as generated", "all", frames_like)
               for r in rooms]
@@ -722,6 +739,10 @@ def main():
     parser.add_argument("--join-parts", action="store_true",
                         help="real scenes with their stacked same-class parts joined "
                              "(panmap-synth --join-parts): the scene named SCENE_joined")
+    parser.add_argument("--recordings", action="store_true",
+                        help="map each --scannet scene's own recording (the one .sens in its "
+                             "folder, every 6th frame: 5 Hz) with masks simulated from its "
+                             "annotation (panmap-synth --recording) instead of rendered surveys")
     parser.add_argument("--keep-logs", action="store_true",
                         help="keep the rendered logs (150 MB each) for reruns")
     parser.add_argument("--report-only", action="store_true",
@@ -735,11 +756,12 @@ def main():
     if args.config:
         args.config = os.path.abspath(args.config)
     start = time.time()
-    real = real_specs(dirs, seeds, args.frames_scannet, args.join_parts)
+    recordings = {d: recording_of(d) for d in dirs} if args.recordings else {}
+    real = real_specs(dirs, seeds, args.frames_scannet, args.join_parts, recordings)
     likes = like_specs(like, args.frames_like)
     boxes = room_specs(rooms, args.frames_room)
     weaker = weaker_specs(dirs, seeds, like, args.frames_scannet, args.frames_like,
-                          args.join_parts)
+                          args.join_parts, recordings)
     saved = os.path.join(args.work, "results.json")
     if args.report_only:
         try:
@@ -805,13 +827,20 @@ def main():
           "map (doubled surfaces, bent walls) are not removed by it.", ""]
     for title, specs, intro in [
             ("Real ScanNet scene geometry", real,
-             "`panmap-synth --scannet DIR` renders the scene's reconstructed mesh along a "
-             "survey (%d frames at %g Hz, seeds %s): depth noise, `m2f` masks, SLAM drift as "
-             "docs/SIMULATION.md describes. Each scene as annotated, and with 25 %% of its "
+             ("`panmap-synth --scannet DIR --recording SCENE.sens --every 6` maps each scan's "
+              "own recording: its real depth, colour and poses (every 6th frame, 5 Hz), with "
+              "`m2f` masks simulated from the annotated reconstruction rendered at each "
+              "recorded pose (seeds %s draw the masks' errors and the drift; docs/SIMULATION.md, "
+              "\"Recorded frames with simulated masks\")." % ", ".join(map(str, seeds))
+              if recordings else
+              "`panmap-synth --scannet DIR` renders the scene's reconstructed mesh along a "
+              "survey (%d frames at %g Hz, seeds %s): depth noise, `m2f` masks, SLAM drift as "
+              "docs/SIMULATION.md describes." % (args.frames_scannet, args.rate_hz,
+                                                  ", ".join(map(str, seeds)))) +
+             " Each scene as annotated, and with 25 %% of its "
              "vertices left unannotated (`--unannotate 0.25`: whole objects and clutter "
              "patches), the simulated network painting those surfaces (`painted`) or leaving "
              "them without a mask (`empty`).%s" % (
-                 args.frames_scannet, args.rate_hz, ", ".join(map(str, seeds)),
                  JOINED_PARTS_NOTE if args.join_parts else "")),
             ("ScanNet-like procedural rooms", likes,
              "`panmap-synth --room S --room-style scannet --laps 2` (rooms %s, %d frames at "

@@ -101,15 +101,19 @@ class Spec:
     refinement when poses drift), "tracked" (every variant, each with the default tracking:
     drifting poses refined against the map) or "full" (the full method only, default
     tracking). join_parts (scannet): `panmap-synth --join-parts`, the scene named
-    SCENE_joined.
+    SCENE_joined. recording (scannet): the scan's own recording (a .sens file) whose depth,
+    colour and poses replace the survey (`panmap-synth --recording`), every `every`th frame;
+    frames and rate_hz then do not apply.
     """
 
     def __init__(self, kind, source, seed, poses, masks, annotation="annotated", runs="all",
-                 frames=450, rate_hz=5.0, join_parts=False):
+                 frames=450, rate_hz=5.0, join_parts=False, recording=None, every=6):
         self.kind, self.source, self.seed = kind, source, seed
         self.poses, self.masks, self.annotation, self.runs = poses, masks, annotation, runs
         self.frames, self.rate_hz = frames, rate_hz
         self.join_parts = join_parts and kind == "scannet"
+        self.recording = recording if kind == "scannet" else None
+        self.every = every
 
     def scene(self):
         if self.kind == "scannet":
@@ -120,13 +124,22 @@ class Spec:
     def name(self):
         ann = {"annotated": "ann", "as generated": "ann", "empty": "empty",
                "25 % unannotated, painted": "u25p", "25 % unannotated, empty": "u25e"}
-        return "%s_s%d_%s_%s_%s_%df" % (self.scene(), self.seed, ann[self.annotation], self.poses,
-                                        self.masks, self.frames)
+        length = "rec%d" % self.every if self.recording else "%df" % self.frames
+        return "%s_s%d_%s_%s_%s_%s" % (self.scene(), self.seed, ann[self.annotation], self.poses,
+                                       self.masks, length)
 
     def synth_args(self):
-        args = ["--seed", str(self.seed), "--frames", str(self.frames), "--rate-hz",
-                str(self.rate_hz), "--masks", self.masks, "--poses", self.poses]
-        if self.kind == "scannet":
+        args = ["--seed", str(self.seed), "--masks", self.masks, "--poses", self.poses]
+        if self.recording:
+            args += ["--recording", self.recording, "--every", str(self.every)]
+        else:
+            args += ["--frames", str(self.frames), "--rate-hz", str(self.rate_hz)]
+        if self.kind == "scannet" and self.recording:
+            args += ["--scannet", self.source, "--scannet-labels", SCANNET_LABELS]
+            args += dict(ANNOTATIONS)[self.annotation]
+            if self.join_parts:
+                args.append("--join-parts")
+        elif self.kind == "scannet":
             # A real scene's size is not known in advance: the survey walks all of it, with
             # `frames` the least (scene0470's walk takes 111 and 129 frames at 5 Hz, so its
             # sequences are as before; a 150 m2 floor of four rooms took 1,504).
