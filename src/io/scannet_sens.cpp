@@ -37,8 +37,8 @@ class LittleEndianReader {
     in_->read(static_cast<char*>(out), static_cast<std::streamsize>(n));
     if (!*in_) throw Error(what_ + ": file ends inside the " + field);
   }
-  uint64_t u64(const char* field) { return value<uint64_t>(8, field); }
-  uint32_t u32(const char* field) { return static_cast<uint32_t>(value<uint64_t>(4, field)); }
+  uint64_t u64(const char* field) { return little(8, field); }
+  uint32_t u32(const char* field) { return static_cast<uint32_t>(little(4, field)); }
   int32_t i32(const char* field) { return static_cast<int32_t>(u32(field)); }
   float f32(const char* field) {
     const uint32_t bits = u32(field);
@@ -53,12 +53,12 @@ class LittleEndianReader {
   }
 
  private:
-  template <typename T>
-  T value(int n, const char* field) {
+  // The next n bytes as a little-endian unsigned number.
+  uint64_t little(int n, const char* field) {
     unsigned char b[8];
     bytes(b, static_cast<size_t>(n), field);
-    T v = 0;
-    for (int i = n - 1; i >= 0; --i) v = static_cast<T>((v << 8) | b[i]);
+    uint64_t v = 0;
+    for (int i = n - 1; i >= 0; --i) v = (v << 8) | b[i];
     return v;
   }
 
@@ -147,6 +147,11 @@ ScanNetSensFile ScanNetSensFile::open(const std::string& path) {
     rec.offset = offset;
     rec.color_bytes = fr.u64("colour byte count");
     rec.depth_bytes = fr.u64("depth byte count");
+    // No image of the largest size decoders accept takes more than 4 bytes a pixel stored.
+    if (rec.color_bytes > 4 * kMaxImagePixels || rec.depth_bytes > 4 * kMaxImagePixels) {
+      throw Error(what + ": images of " + std::to_string(rec.color_bytes) + " and " +
+                  std::to_string(rec.depth_bytes) + " bytes (not a frame record)");
+    }
     const uint64_t left = file_bytes - offset - kFrameRecordBytes;
     if (rec.color_bytes > left || rec.depth_bytes > left - rec.color_bytes) {
       throw Error(what + ": the file ends inside it (" + std::to_string(file_bytes) +

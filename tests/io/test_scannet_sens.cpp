@@ -237,6 +237,10 @@ TEST(ScanNetSens, BrokenFilesAreNamedInOneLine) {
   writeTiny(dir);
   overwrite(path, 4, {0, 0, 0, 0, 0, 0, 0, 1});  // a name of 2^56 bytes
   expectError([&] { ScanNetSensFile::open(path); }, {path, "sensor name of"});
+
+  writeTiny(dir);
+  overwrite(path, kTinyHeaderBytes + 80, {0, 0, 0, 0, 0, 0, 0, 1});  // frame 0's colour: 2^56 B
+  expectError([&] { ScanNetSensFile::open(path); }, {path, "frame 0 of 3", "not a frame record"});
 }
 
 TEST(ScanNetSens, BrokenFramesAreNamedAndTheOthersStillRead) {
