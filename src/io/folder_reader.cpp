@@ -30,9 +30,9 @@ constexpr const char* kColorFolders[] = {"rgb", "color", "colour", "image", "ima
 constexpr const char* kIntrinsicsFiles[] = {
     "intrinsic.txt", "intrinsics.txt", "camera-intrinsics.txt",         "camera_intrinsics.txt",
     "K.txt",         "cam_K.txt",      "intrinsic/intrinsic_depth.txt", "intrinsic_depth.txt"};
-constexpr const char* kPoseFiles[] = {"gt_pose.txt",     "groundtruth.txt", "poses.txt",
-                                      "pose.txt",        "trajectory.txt",  "traj.txt",
-                                      "camera_poses.txt"};
+constexpr const char* kPoseFiles[] = {"gt_pose.txt",      "groundtruth.txt", "poses.txt",
+                                      "pose.txt",         "trajectory.txt",  "traj.txt",
+                                      "camera_poses.txt", "trajectory.log"};
 constexpr const char* kPoseFolders[] = {"pose", "poses"};
 
 // Depth values above these (median, 99th percentile) are implausible in millimetres for an

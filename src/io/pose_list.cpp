@@ -31,6 +31,33 @@ void addMatrix(const Eigen::Matrix4d& T, const std::string& where, double tolera
   }
 }
 
+// Redwood's .log: five lines a frame, the first of three numbers, the others of four.
+PoseList readLogPoses(const std::string& path, const std::vector<Line>& lines, double tolerance) {
+  PoseList list;
+  list.format = PoseList::Format::kLog;
+  if (lines.size() % 5 != 0) {
+    throw Error(path + ": " + std::to_string(lines.size()) +
+                " lines, not a whole number of .log entries (a line of 3 numbers over a 4x4 "
+                "matrix)");
+  }
+  for (size_t k = 0; k < lines.size(); k += 5) {
+    for (size_t r = 0; r < 5; ++r) {
+      const size_t want = r == 0 ? 3 : 4;
+      if (lines[k + r].values.size() != want) {
+        throw Error(path + ":" + std::to_string(lines[k + r].line) + ": " +
+                    std::to_string(lines[k + r].values.size()) + " numbers where a .log entry " +
+                    "has " + std::to_string(want));
+      }
+    }
+    Eigen::Matrix4d T;
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) T(r, c) = lines[k + 1 + r].values[static_cast<size_t>(c)];
+    }
+    addMatrix(T, path + ":" + std::to_string(lines[k + 1].line), tolerance, &list);
+  }
+  return list;
+}
+
 }  // namespace
 
 const char* poseListFormatName(PoseList::Format format) {
@@ -39,6 +66,8 @@ const char* poseListFormatName(PoseList::Format format) {
       return "TUM";
     case PoseList::Format::kMatrixPerLine:
       return "matrix per line";
+    case PoseList::Format::kLog:
+      return ".log";
     default:
       return "stacked 4x4";
   }
@@ -46,6 +75,9 @@ const char* poseListFormatName(PoseList::Format format) {
 
 PoseList readPoseList(const std::string& path, double tolerance) {
   const std::vector<Line> lines = readLines(path);
+  if (lines.front().values.size() == 3 && lines.size() > 1 && lines[1].values.size() == 4) {
+    return readLogPoses(path, lines, tolerance);
+  }
   const size_t width = lines.front().values.size();
   for (const Line& line : lines) {
     if (line.values.size() != width) {

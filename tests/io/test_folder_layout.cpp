@@ -461,5 +461,32 @@ TEST(PoseList, DetectsFormatsAndKeepsBadPosesAsProblems) {
   EXPECT_THROW(readPoseList(path, 1e-3), Error);
 }
 
+// Redwood's .log (also Augmented ICL-NUIM's *-traj.txt and Open3D's trajectories): a line of
+// frame ids and count over each camera-to-world matrix.
+TEST(PoseList, ReadsTheLogFormatOfRedwoodAndOpen3D) {
+  test::TempDir dir;
+  const std::string path = dir.path("livingroom1-traj.txt");
+  writeText(path,
+            "0 0 2\n1 0 0 0.5\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
+            "1 1 2\n0 -1 0 1\n1 0 0 2\n0 0 1 3\n0 0 0 1\n");
+  const PoseList list = readPoseList(path, 1e-3);
+  EXPECT_EQ(list.format, PoseList::Format::kLog);
+  EXPECT_STREQ(poseListFormatName(list.format), ".log");
+  ASSERT_EQ(list.poses.size(), 2u);
+  ASSERT_TRUE(list.poses[0] && list.poses[1]);
+  EXPECT_DOUBLE_EQ(list.poses[0]->translation().x(), 0.5);
+  EXPECT_DOUBLE_EQ(list.poses[1]->translation().z(), 3.0);
+  // The camera's x axis points along world y.
+  EXPECT_TRUE(list.poses[1]->linear().col(0).isApprox(Eigen::Vector3d(0, 1, 0)));
+  EXPECT_TRUE(list.times_s.empty());
+
+  writeText(path, "0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n");
+  test::expectError([&] { readPoseList(path, 1e-3); },
+                    {"4 lines, not a whole number of .log entries"});
+  writeText(path, "0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0 7\n0 0 0 1\n");
+  test::expectError([&] { readPoseList(path, 1e-3); },
+                    {"livingroom1-traj.txt:4: 5 numbers where a .log entry has 4"});
+}
+
 }  // namespace
 }  // namespace panmap

@@ -11,8 +11,10 @@ namespace panmap {
 /// A trajectory file in one of the formats RGB-D exports use, poses camera-to-world.
 struct PoseList {
   /// kTum: "t tx ty tz qx qy qz qw" per line; kMatrixPerLine: 12 (3x4) or 16 (4x4) row-major
-  /// numbers per line, one line per frame; kStacked: a 4x4 matrix over four lines per frame.
-  enum class Format { kTum, kMatrixPerLine, kStacked };
+  /// numbers per line, one line per frame; kStacked: a 4x4 matrix over four lines per frame;
+  /// kLog: the .log trajectory of Redwood, Augmented ICL-NUIM and Open3D, per frame a line of
+  /// three integers (frame ids and count) over a 4x4 camera-to-world matrix on four lines.
+  enum class Format { kTum, kMatrixPerLine, kStacked, kLog };
   Format format = Format::kTum;
   std::vector<double> times_s;  ///< kTum only: each pose's timestamp, seconds
   /// kTum only: the unit the file's time column was in (see timestampUnitOf).
@@ -28,7 +30,7 @@ struct PoseList {
 /// when the file is missing, not numeric, or its lines disagree on the format.
 PoseList readPoseList(const std::string& path, double tolerance);
 
-/// Name of a pose list format ("TUM", "matrix per line", "stacked 4x4").
+/// Name of a pose list format ("TUM", "matrix per line", "stacked 4x4", ".log").
 const char* poseListFormatName(PoseList::Format format);
 
 }  // namespace panmap
