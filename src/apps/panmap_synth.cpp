@@ -508,6 +508,13 @@ int main(int argc, char** argv) {
       progress.update(k + 1, synth.size());
     }
     progress.finish();
+    if (reader && synth.recordingDepthAgreement() < 0.5) {
+      std::cerr << "panmap-synth: only " << std::lround(100.0 * synth.recordingDepthAgreement())
+                << " % of the recorded depth lies within "
+                << std::lround(100.0 * panmap::kRecordingAgreementM)
+                << " cm of the mesh rendered at its poses: is the mesh the recording's scene, in "
+                   "its world frame? (the masks come from it)\n";
+    }
     size_t correction_poses = 0;
     if (correction_every > 0) {
       residual.sigma_m = residual_cm / 100.0;
@@ -551,6 +558,7 @@ int main(int argc, char** argv) {
           {"layout", reader ? reader->layoutName() : ""},
           {"every", recording.empty() ? 0 : every},
           {"frames_in_recording", reader ? reader->size() : 0},
+          {"depth_agreement", synth.recordingDepthAgreement()},
           {"left_out_without_pose", recorded_without_pose}}},
         {"mesh",
          {{"vertices", mesh.numVertices()},

@@ -146,7 +146,20 @@ SynthFrame SequenceSynthesizer::frameFromRecording(size_t k, RgbdFrame recorded)
     throw Error("synth: recorded frame " + std::to_string(recorded.frame_id) + " has no depth");
   }
   renderer_.render(recorded.camera, gt_[k].T_W_C, &view_);
+  const float scale = static_cast<float>(recorded.depth_scale_m);
+  for (size_t i = 0; i < recorded.depth.size(); ++i) {
+    const float rendered = view_.depth_m.data()[i];
+    const float measured = recorded.depth.data()[i] * scale;
+    if (rendered <= 0.0f || measured <= 0.0f) continue;
+    ++recorded_compared_px_;
+    recorded_agreeing_px_ += std::abs(measured - rendered) <= kRecordingAgreementM;
+  }
   return finishFrame(k, std::move(recorded));
+}
+
+double SequenceSynthesizer::recordingDepthAgreement() const {
+  return recorded_compared_px_ ? static_cast<double>(recorded_agreeing_px_) / recorded_compared_px_
+                               : 0.0;
 }
 
 SynthFrame SequenceSynthesizer::finishFrame(size_t k, RgbdFrame rgbd) {

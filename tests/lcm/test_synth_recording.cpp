@@ -99,6 +99,8 @@ TEST(SynthRecording, GivesTheMasksPosesAndDepthOfTheRenderedFrames) {
   EXPECT_EQ(info["recording"]["layout"], "scannet-sens");
   EXPECT_EQ(info["trajectory"]["source"], dir.path("room3.sens"));
   EXPECT_EQ(info["camera"]["fx"], cam.fx);
+  EXPECT_DOUBLE_EQ(info["recording"]["depth_agreement"].get<double>(), 1.0);  // its own mesh
+  EXPECT_EQ(run.output.find("is the mesh the recording's scene"), std::string::npos);
 
   lcm::LogFile log(dir.path("out/sequence.lcmlog"), "r");
   ASSERT_TRUE(log.good());
@@ -141,6 +143,15 @@ TEST(SynthRecording, GivesTheMasksPosesAndDepthOfTheRenderedFrames) {
   const auto gt = readTumTrajectory(dir.path("sparse/gt/trajectory_gt.txt"));
   ASSERT_EQ(gt.size(), 3u);
   EXPECT_EQ(gt[2].utime, trajectory[4].utime);
+
+  // Another room's mesh under room 3's recording: said, since its masks would be nonsense.
+  const auto other =
+      test::runCommand(test::binPath("panmap-synth") + " --room 4 --recording " +
+                       dir.path("room3.sens") + " --quiet --out " + dir.path("other"));
+  ASSERT_EQ(other.exit_code, 0) << other.output;
+  EXPECT_NE(other.output.find("is the mesh the recording's scene, in its world frame?"),
+            std::string::npos)
+      << other.output;
 }
 
 TEST(SynthRecording, OptionsOfRenderedSequencesAreRefusedInOneLine) {

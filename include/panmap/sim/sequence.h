@@ -49,6 +49,10 @@ SynthConfig scaledImage(SynthConfig config, double scale);
 /// negative. For SynthConfig::depth_pattern. Throws Error on a non-finite or negative scale.
 DepthCalibration sensorDepthPattern(const DepthCalibration& calibration, double scale);
 
+/// How far a recorded depth may lie from the mesh rendered at its pose and still agree with it:
+/// a real sensor's noise at a few metres, and a reconstruction's error, stay within it.
+constexpr double kRecordingAgreementM = 0.05;
+
 /// One synthetic frame: what the sensor, the segmenter and the SLAM system deliver, with the
 /// ground truth beside it.
 struct SynthFrame {
@@ -94,6 +98,10 @@ class SequenceSynthesizer {
   const std::vector<StampedPose>& inputTrajectory() const { return input_; }
   /// Coverage over the frames rendered so far.
   CoverageStats coverage() const;
+  /// Of the pixels of the recorded frames so far that have depth where the mesh rendered at
+  /// their pose has a surface, the share within kRecordingAgreementM of it (0 without any):
+  /// well below 1, the mesh is not the recorded scene, or not in the recording's frame.
+  double recordingDepthAgreement() const;
   /// Segmenter error statistics over the frames rendered so far.
   const SegmenterNoiseStats& segmenterStats() const { return segmenter_.stats(); }
   /// Per-instance facts the segmenter uses (class, extent, stuff).
@@ -111,6 +119,8 @@ class SequenceSynthesizer {
   std::map<int32_t, InstanceInfo> infos_;
   std::map<int32_t, Eigen::Vector3d> centroids_;
   std::map<int32_t, std::vector<Eigen::Vector3d>> views_;  // distinct view directions seen
+  size_t recorded_compared_px_ = 0;                        // recorded depth over a rendered surface
+  size_t recorded_agreeing_px_ = 0;                        // of those, within kRecordingAgreementM
   RenderedView view_;
 };
 
