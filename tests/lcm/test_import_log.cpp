@@ -15,6 +15,7 @@
 #include "panmap/lcm/conversions.h"
 #include "panmap/lcm/log_import.h"
 #include "panmap/lcm/log_info.h"
+#include "scannet_sens_fixture.h"
 #include "test_helpers.h"
 
 namespace panmap {
@@ -298,6 +299,46 @@ TEST(Import, PanopticMasksBecomeMessages) {
   EXPECT_EQ(s.unlisted_mask_pixels, 0u);
 }
 
+// A ScanNet recording with a network's mask for one frame, at the colour camera's 1296x968 and
+// named by frame number as SensReader names the colour it exports: the mask arrives registered
+// to the 640x480 depth camera, with its classes, on that frame only.
+TEST(Import, MasksOfAScanNetRecordingAreRegisteredToItsDepth) {
+  PANMAP_REQUIRE_DATA("scannet-export-3");
+  test::TempDir dir;
+  test::writeScanNetExportAsSens(dir.path("scene0707_00.sens"));
+  LabelImage mask(1296, 968, 1);  // wall
+  for (int v = 0; v < 968; ++v) {
+    for (int u = 648; u < 1296; ++u) mask(u, v) = 300;  // the right half: a chair
+  }
+  fs::create_directory(dir.path("masks"));
+  writeFileBytes(dir.path("masks/1.png"), encodeLabelPng(mask));
+  std::ofstream(dir.path("masks/1.json"))
+      << R"({"segments_info": [{"id": 1, "category_id": 1}, {"id": 300, "category_id": 62, )"
+         R"("score": 0.9}]})";
+  ImportOptions options;
+  options.mask_dir = dir.path("masks");
+  options.label_table = test::fixtureDir("coco_tiny/labels.tsv");
+  const ImportStats s = importDataset(dir.path("scene0707_00.sens"), dir.path("s.lcmlog"), options);
+  EXPECT_EQ(s.layout, "scannet-sens");
+  EXPECT_EQ(s.frames_written, 3u);
+  EXPECT_EQ(s.panoptic_written, 1u);
+  EXPECT_EQ(s.frames_without_mask, 2u);
+  size_t found = 0;
+  for (const Event& e : readEvents(dir.path("s.lcmlog"))) {
+    if (e.channel != "PANOPTIC") continue;
+    ++found;
+    const PanopticFrame p = fromMessage(decodeEvent<panoptic_t>(e));
+    EXPECT_EQ(p.frame_id, 1);
+    ASSERT_EQ(p.segment_ids.width(), 640);
+    ASSERT_EQ(p.segment_ids.height(), 480);
+    EXPECT_EQ(p.segment_ids(20, 240), 1);
+    EXPECT_EQ(p.segment_ids(620, 240), 300);
+    ASSERT_EQ(p.segments.size(), 2u);
+    EXPECT_EQ(p.segments[1], (PanopticSegment{300, 5, 62, true, 0.9f}));
+  }
+  EXPECT_EQ(found, 1u);
+}
+
 // Id 300 (R 44, G 1) written by cv2.imwrite from an RGB array: B 44, G 1, read back as
 // 1 * 256 + 44 * 65536.
 constexpr int32_t kId300AsBgr = 256 + 44 * 65536;
@@ -332,7 +373,7 @@ TEST(Import, MaskPixelsOfUnlistedIdsAreCountedAndMostlyUnlistedMasksRefused) {
         fromMessage(decodeEvent<panoptic_t>(readEvents(dir.path("m.lcmlog"))[2]));
     EXPECT_EQ(p.segment_ids(450, 150), 0);  // void, as COCO reads it
     EXPECT_EQ(p.segment_ids(10, 10), 1);
-  EXPECT_EQ(p.segment_ids(620, 450), 0);
+    EXPECT_EQ(p.segment_ids(620, 450), 0);
   }
   // The whole mask written as BGR: id 1 reads as 65536.
   for (int v = 0; v < 480; ++v) {
