@@ -306,6 +306,7 @@ def regularisation_reach(rows, masks="m2f"):
     """What III-C could and did change at IoU 0.5: GT things paired across the full method and
     w/o III-C (same run, same GT instance)."""
     total = wrong = fixed = broken = 0
+    left_scored = left_unscored = 0  # still missed for a wrong class with III-C
     changed = []  # the GT things whose outcome III-C changed, named
     for key in rows.keys:
         names = rows.names.get(key + ("gt", masks), [])
@@ -314,6 +315,12 @@ def regularisation_reach(rows, masks="m2f"):
                                                           variant="w/o III-C"))):
             after = {t["instance_id"]: t for t in full["diagnostics"]["gt_things"]}
             scored = {c["class_id"]: c["name"] for c in full.get("classes", [])}
+            for t in after.values():
+                if t.get("cause") == "wrong class":
+                    if t.get("class_id") in scored:
+                        left_scored += 1
+                    else:
+                        left_unscored += 1
             for t in without["diagnostics"]["gt_things"]:
                 total += 1
                 now_t = after.get(t["instance_id"], {})
@@ -329,10 +336,13 @@ def regularisation_reach(rows, masks="m2f"):
                         was, t.get("best_iou", 0.0), now, now_t.get("best_iou", 0.0)))
     return ("III-C's reach: without it, %d of the %d GT things are missed for a wrong class, "
             "the cause a change of class addresses directly; III-C turned %d missed "
-            "GT things into matches and %d matched ones into misses%s." % (
+            "GT things into matches and %d matched ones into misses%s. With it, %d stay missed "
+            "for a wrong class, %d of them of a class mAP50 scores (the other %d are of classes "
+            "outside the evaluated ones, which no change of class can turn into mAP50)." % (
                 wrong, total, fixed, broken,
                 (" (without -> with III-C, each with its IoU with the object that overlaps it most: %s)"
-                 % "; ".join(changed)) if changed else ""))
+                 % "; ".join(changed)) if changed else "",
+                left_scored + left_unscored, left_scored, left_unscored))
 
 
 def regularisation_effect(rows, work, masks="m2f"):
