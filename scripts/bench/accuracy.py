@@ -336,9 +336,10 @@ def regularisation_reach(rows, masks="m2f"):
                         was, t.get("best_iou", 0.0), now, now_t.get("best_iou", 0.0)))
     return ("III-C's reach: without it, %d of the %d GT things are missed for a wrong class, "
             "the cause a change of class addresses directly; III-C turned %d missed "
-            "GT things into matches and %d matched ones into misses%s. With it, %d stay missed "
-            "for a wrong class, %d of them of a class mAP50 scores (the other %d of classes outside "
-            "the evaluated ones, which no change of class can turn into mAP50)." % (
+            "GT things into matches and %d matched ones into misses%s. With it, %d stay "
+            "missed for a wrong class, %d of them of a class mAP50 scores (the other %d of "
+            "classes outside the evaluated ones, which no change of class can turn into "
+            "mAP50)." % (
                 wrong, total, fixed, broken,
                 (" (without -> with III-C, each with its IoU with the object that overlaps it most: %s)"
                  % "; ".join(changed)) if changed else "",
