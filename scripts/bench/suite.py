@@ -12,6 +12,7 @@ Three kinds of scenes:
 import argparse
 import concurrent.futures
 import glob
+import hashlib
 import json
 import os
 import shutil
@@ -312,11 +313,53 @@ def reexport(work, spec, config=""):
     return {"results": {"full": evaluate(folder, seq_dir, trajectory=trajectory)}}
 
 
+def _file_digest(path):
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def run_key(spec, voxel_m, config, variants):
+    """What a sequence's result depends on: the binaries that render, map and score it (the
+    runs are deterministic), the sequence's parameters and the mapping options. A result saved
+    under the same key is the result a new run would give."""
+    parts = {"spec": spec.name(), "synth_args": spec.synth_args(), "runs": spec.runs,
+             "voxel_m": voxel_m, "variants": sorted(variants) if variants else None,
+             "config": _file_digest(config) if config else None}
+    for name in ("panmap-synth", "panmap-mapper", "panmap-eval"):
+        parts[name] = _file_digest(tool(name))
+    return hashlib.sha256(json.dumps(parts, sort_keys=True).encode()).hexdigest()
+
+
+def saved_result(work, spec, key):
+    """The result an earlier run saved for spec under key (runs/NAME/result.json), or None."""
+    try:
+        with open(os.path.join(work, "runs", spec.name(), "result.json")) as f:
+            saved = json.load(f)
+    except (OSError, ValueError):
+        return None
+    return saved.get("result") if saved.get("key") == key else None
+
+
 def run_all(work, specs, voxel_m, jobs, keep_logs, config="", variants=None, label="suite",
-            reuse_maps=False):
+            reuse_maps=False, resume=False):
     """Renders and maps every spec (jobs at a time). Returns {spec.name(): result}. With
-    reuse_maps, a spec of the full method mapped before is only re-exported (reexport)."""
+    reuse_maps, a spec of the full method mapped before is only re-exported (reexport). Each
+    mapped spec's result is saved beside its runs (runs/NAME/result.json, with run_key); with
+    resume, a spec whose saved result has the same key is not mapped again: a run cut short
+    (a full disk, a killed job) goes on where it stopped."""
     def job(spec):
+        key = run_key(spec, voxel_m, config, variants)
+        if resume:
+            out = saved_result(work, spec, key)
+            if out is not None:
+                full = out["results"].get("full") or out["results"].get(REFINED)
+                print("%s: %s: saved by an earlier run, full mAP50 %.1f" % (
+                    label, spec.name(), 100 * (full["map50"] or 0)), file=sys.stderr,
+                    flush=True)
+                return dict(out, resumed=True)
         out = reexport(work, spec, config) if reuse_maps else None
         if out is not None:
             print("%s: %s: re-exported, full mAP50 %.1f" % (
@@ -328,6 +371,8 @@ def run_all(work, specs, voxel_m, jobs, keep_logs, config="", variants=None, lab
         if not keep_logs:
             os.remove(os.path.join(seq, "sequence.lcmlog"))
             os.rename(os.path.join(seq, "info.json"), os.path.join(seq, "info.json.done"))
+        with open(os.path.join(work, "runs", spec.name(), "result.json"), "w") as f:
+            json.dump({"key": key, "result": out}, f)
         full = out["results"].get("full") or out["results"].get(REFINED)
         print("%s: %s: full mAP50 %.1f" % (label, spec.name(), 100 * (full["map50"] or 0)),
               file=sys.stderr, flush=True)
