@@ -11,6 +11,7 @@ Writes docs/LARGE_FLOOR.md; about 25 minutes on 2 cores with the defaults.
 
   scripts/bench/large_floor.py [--building 7] [--rooms 4] [--area 150] [--seed 1]
                                [--stops-area 6,3,0] [--annotations annotated,empty]
+                               [--masks m2f[,clean]]
                                [--work build/large_floor] [--jobs 2] [--out docs/LARGE_FLOOR.md]
                                [--report-only]
 """
@@ -52,9 +53,10 @@ def make_scene(args):
     return scene
 
 
-def run_one(args, scene, stops_area, annotation):
-    """Renders, maps (every variant) and scores the floor with one stop rule and annotation."""
-    spec = suite.Spec("scannet", scene, args.seed, "gt", "m2f", ANNOTATIONS[annotation], "all",
+def run_one(args, scene, stops_area, annotation, masks):
+    """Renders, maps (every variant) and scores the floor with one stop rule, annotation and
+    mask preset."""
+    spec = suite.Spec("scannet", scene, args.seed, "gt", masks, ANNOTATIONS[annotation], "all",
                       600)
     seq = os.path.join(args.work, "seq", "%s_stops%g" % (spec.name(), stops_area))
     if not os.path.exists(os.path.join(seq, "info.json")):
@@ -63,7 +65,7 @@ def run_one(args, scene, stops_area, annotation):
     suite.map_sequence(args.work, seq, spec, 0.02, variants=VARIANTS)
     os.remove(os.path.join(seq, "sequence.lcmlog"))  # 0.5-1.3 GB each; the scores are kept
     os.rename(os.path.join(seq, "info.json"), os.path.join(seq, "info.json.done"))
-    return row(args, stops_area, annotation)
+    return row(args, stops_area, annotation, masks)
 
 
 # Where map_sequence leaves each variant's scores (runs/SEQUENCE/FOLDER/eval.json).
@@ -71,9 +73,9 @@ FOLDERS = {"full": "A", "w/o III-B": "wo_III-B", "w/o III-C": "wo_III-C",
            "w/o III-D": "wo_III-D", "Voxblox++-like": "V"}
 
 
-def row(args, stops_area, annotation):
+def row(args, stops_area, annotation, masks):
     """One table row from what a run left on disk (None when it has not run)."""
-    spec = suite.Spec("scannet", scene_dir(args), args.seed, "gt", "m2f",
+    spec = suite.Spec("scannet", scene_dir(args), args.seed, "gt", masks,
                       ANNOTATIONS[annotation], "all", 600)
     name = "%s_stops%g" % (spec.name(), stops_area)
     info_path = os.path.join(args.work, "seq", name, "info.json.done")
@@ -86,7 +88,8 @@ def row(args, stops_area, annotation):
         with open(os.path.join(args.work, "runs", name, FOLDERS[v], "eval.json")) as f:
             results[v] = json.load(f)
     full = results["full"]
-    return {"stops_area": stops_area, "annotation": annotation, "frames": info["frames"],
+    return {"stops_area": stops_area, "annotation": annotation, "masks": masks,
+            "frames": info["frames"],
             "stops": info["trajectory"]["stops"],
             "free_area_m2": info["trajectory"]["free_area_m2"],
             "walk_m": info["trajectory"]["walk_length_m"],
@@ -116,24 +119,26 @@ def report(args, rows, meta):
         "scannet`: ScanNet-like rooms off a corridor, doors open) is written as a ScanNet scene "
         "folder (`to_scannet_layout.py`: ScanNet ids in labels.ply, raw categories in the "
         "aggregation) and goes the way a downloaded scene goes in `accuracy.sh --scannet`: "
-        "rendered along a survey of the mesh (seed %d, 5 Hz, `m2f` masks, ground-truth poses, "
+        "rendered along a survey of the mesh (seed %d, 5 Hz, masks of the row's preset, "
+        "ground-truth poses, "
         "every frame the walk needs: `--cover-walk`), mapped at 2 cm with every variant, scored "
         "by panmap-eval. What changes between rows is how many stops the survey spreads over "
         "the free floor (docs/SIMULATION.md, \"Trajectories\")." % (
             args.building, args.rooms, args.area, args.seed), "",
-        "| survey stops | annotation | stops | free floor m2 | walk m | frames | things seen "
+        "| survey stops | annotation | masks | stops | free floor m2 | walk m | frames | things seen "
         "from 3 views | full | w/o III-B | w/o III-C | w/o III-D | Voxblox++-like | full - "
         "Voxblox++-like | PQ50 | mIoU | objects / GT things | GT things missed unobserved / "
         "partly observed / other |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         m = r["misses"]
         other = sum(v for k, v in m.items() if k not in ("matched", "unobserved",
                                                          "partly observed"))
         lines.append(
-            "| %s | %s | %d | %.0f | %.0f | %d | %d of %d | %s | %.1f | %.1f | %.1f | %d / %d | "
-            "%d / %d / %d |" % (
-                rule(r["stops_area"]), ANNOTATIONS[r["annotation"]], r["stops"],
+            "| %s | %s | `%s` | %d | %.0f | %.0f | %d | %d of %d | %s | %.1f | %.1f | %.1f | "
+            "%d / %d | %d / %d / %d |" % (
+                rule(r["stops_area"]), ANNOTATIONS[r["annotation"]], r.get("masks", "m2f"),
+                r["stops"],
                 r["free_area_m2"], r["walk_m"], r["frames"], r["seen3"], r["things"],
                 " | ".join("%.1f" % r["map50"][v] for v in VARIANTS),
                 r["map50"]["full"] - r["map50"]["Voxblox++-like"], r["pq50"], r["miou"],
@@ -142,7 +147,9 @@ def report(args, rows, meta):
     lines += ["", "Columns full to Voxblox++-like: mAP50. A GT thing is **unobserved** when at "
               "most half of its surface found a mapped vertex within 5 cm (docs/RESULTS.md, "
               "\"Why GT objects are missed\"): no labelling can match it, so the rows with "
-              "fewer stops measure the survey more than the mapping.", ""]
+              "fewer stops measure the survey more than the mapping. A row with `clean` masks maps "
+              "the same survey without the network's errors (docs/SIMULATION.md): what the "
+              "method reaches when the masks are right, the ceiling for its `m2f` row.", ""]
     return lines
 
 
@@ -156,6 +163,9 @@ def main():
                         help="panmap-synth --area-per-stop values, comma-separated")
     parser.add_argument("--annotations", default="annotated,empty",
                         help="annotated, painted, empty (25 %% unannotated), comma-separated")
+    parser.add_argument("--masks", default="m2f",
+                        help="mask presets (m2f, clean, hard), comma-separated: clean masks "
+                             "show what the network's errors cost")
     parser.add_argument("--work", default=os.path.join(suite.BUILD, "large_floor"))
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--out", default=os.path.join(suite.ROOT, "docs", "LARGE_FLOOR.md"))
@@ -167,9 +177,14 @@ def main():
         if a not in ANNOTATIONS:
             sys.exit("large_floor: unknown annotation '%s' (annotated, painted, empty)" % a)
     start = time.time()
-    jobs = [(float(s), a) for s in args.stops_area.split(",") for a in annotations]
+    masks = [m for m in args.masks.split(",") if m]
+    for m in masks:
+        if m not in ("m2f", "clean", "hard"):
+            sys.exit("large_floor: unknown mask preset '%s' (m2f, clean, hard)" % m)
+    jobs = [(float(s), a, m) for s in args.stops_area.split(",") for a in annotations
+            for m in masks]
     if args.report_only:
-        rows = [r for r in (row(args, s, a) for s, a in jobs) if r is not None]
+        rows = [r for r in (row(args, s, a, m) for s, a, m in jobs) if r is not None]
         if not rows:
             sys.exit("large_floor: no runs in %s to report" % args.work)
     else:
@@ -177,13 +192,14 @@ def main():
                         "panmap-mapper", "panmap-eval"], check=True, stdout=subprocess.DEVNULL)
         scene = make_scene(args)
         with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-            futures = [pool.submit(run_one, args, scene, s, a) for s, a in jobs]
+            futures = [pool.submit(run_one, args, scene, s, a, m) for s, a, m in jobs]
             rows = []
             for f in futures:
                 rows.append(f.result())
                 r = rows[-1]
-                print("large_floor: %g m2 a stop, %s: %d stops, full mAP50 %.1f, "
-                      "Voxblox++-like %.1f" % (r["stops_area"], r["annotation"], r["stops"],
+                print("large_floor: %g m2 a stop, %s, %s masks: %d stops, full mAP50 %.1f, "
+                      "Voxblox++-like %.1f" % (r["stops_area"], r["annotation"], r["masks"],
+                                               r["stops"],
                                                r["map50"]["full"], r["map50"]["Voxblox++-like"]),
                       file=sys.stderr, flush=True)
     meta_path = os.path.join(args.work, "meta.json")
