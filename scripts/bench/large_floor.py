@@ -125,8 +125,8 @@ def report(args, rows, meta):
         "by panmap-eval. What changes between rows is how many stops the survey spreads over "
         "the free floor (docs/SIMULATION.md, \"Trajectories\")." % (
             args.building, args.rooms, args.area, args.seed), "",
-        "| survey stops | annotation | masks | stops | free floor m2 | walk m | frames | things seen "
-        "from 3 views | full | w/o III-B | w/o III-C | w/o III-D | Voxblox++-like | full - "
+        "| survey stops | annotation | masks | stops | free floor m2 | walk m | frames | things "
+        "seen from 3 views | full | w/o III-B | w/o III-C | w/o III-D | Voxblox++-like | full - "
         "Voxblox++-like | PQ50 | mIoU | objects / GT things | GT things missed unobserved / "
         "partly observed / other |",
         "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
