@@ -4,9 +4,9 @@ floor (`panmap-synth --building`) written as a ScanNet scene folder of the curre
 (to_scannet_layout.py), rendered with `panmap-synth --scannet` as the accuracy suite renders
 a downloaded scene (m2f masks unless --masks adds others, ground-truth poses, 5 Hz, the
 whole survey walked: --cover-walk), mapped with every method variant at 2 cm and scored as
-the suite scores (suite.py). Once with the default survey stops (one per 6 m2 of free floor beyond 10) and once
-with 10 stops whatever the floor (`--area-per-stop 0`, the rule before 2026-12-06) and
-once with one per 3 m2.
+the suite scores (suite.py). Once with the default survey stops (one per 6 m2 of free floor
+beyond 10), once with 10 stops whatever the floor (`--area-per-stop 0`, the rule before
+2026-12-06) and once with one per 3 m2.
 Writes docs/LARGE_FLOOR.md; about 25 minutes on 2 cores with the defaults.
 
   scripts/bench/large_floor.py [--building 7] [--rooms 4] [--area 150] [--seed 1]
