@@ -321,15 +321,19 @@ def _file_digest(path):
     return h.hexdigest()
 
 
-def run_key(spec, voxel_m, config, variants):
-    """What a sequence's result depends on: the binaries that render, map and score it (the
-    runs are deterministic), the sequence's parameters and the mapping options. A result saved
-    under the same key is the result a new run would give."""
+def binary_digests():
+    """The SHA-256 of the binaries that render, map and score a sequence."""
+    return {name: _file_digest(tool(name))
+            for name in ("panmap-synth", "panmap-mapper", "panmap-eval")}
+
+
+def run_key(spec, voxel_m, config, variants, binaries):
+    """What a sequence's result depends on: the binaries that render, map and score it
+    (binary_digests(); the runs are deterministic), the sequence's parameters and the mapping
+    options. A result saved under the same key is the result a new run would give."""
     parts = {"spec": spec.name(), "synth_args": spec.synth_args(), "runs": spec.runs,
              "voxel_m": voxel_m, "variants": sorted(variants) if variants else None,
-             "config": _file_digest(config) if config else None}
-    for name in ("panmap-synth", "panmap-mapper", "panmap-eval"):
-        parts[name] = _file_digest(tool(name))
+             "config": _file_digest(config) if config else None, "binaries": binaries}
     return hashlib.sha256(json.dumps(parts, sort_keys=True).encode()).hexdigest()
 
 
@@ -350,21 +354,24 @@ def run_all(work, specs, voxel_m, jobs, keep_logs, config="", variants=None, lab
     mapped spec's result is saved beside its runs (runs/NAME/result.json, with run_key); with
     resume, a spec whose saved result has the same key is not mapped again: a run cut short
     (a full disk, a killed job) goes on where it stopped."""
+    binaries = binary_digests()  # once: what this run maps with
+
+    def announce(spec, out, how):
+        full = out["results"].get("full") or out["results"].get(REFINED)
+        print("%s: %s: %sfull mAP50 %.1f" % (label, spec.name(), how,
+                                             100 * (full["map50"] or 0)),
+              file=sys.stderr, flush=True)
+
     def job(spec):
-        key = run_key(spec, voxel_m, config, variants)
+        key = run_key(spec, voxel_m, config, variants, binaries)
         if resume:
             out = saved_result(work, spec, key)
             if out is not None:
-                full = out["results"].get("full") or out["results"].get(REFINED)
-                print("%s: %s: saved by an earlier run, full mAP50 %.1f" % (
-                    label, spec.name(), 100 * (full["map50"] or 0)), file=sys.stderr,
-                    flush=True)
+                announce(spec, out, "saved by an earlier run, ")
                 return dict(out, resumed=True)
         out = reexport(work, spec, config) if reuse_maps else None
         if out is not None:
-            print("%s: %s: re-exported, full mAP50 %.1f" % (
-                label, spec.name(), 100 * (out["results"]["full"]["map50"] or 0)),
-                file=sys.stderr, flush=True)
+            announce(spec, out, "re-exported, ")
             return out
         seq = render(work, spec)
         out = map_sequence(work, seq, spec, voxel_m, config, variants)
@@ -373,9 +380,7 @@ def run_all(work, specs, voxel_m, jobs, keep_logs, config="", variants=None, lab
             os.rename(os.path.join(seq, "info.json"), os.path.join(seq, "info.json.done"))
         with open(os.path.join(work, "runs", spec.name(), "result.json"), "w") as f:
             json.dump({"key": key, "result": out}, f)
-        full = out["results"].get("full") or out["results"].get(REFINED)
-        print("%s: %s: full mAP50 %.1f" % (label, spec.name(), 100 * (full["map50"] or 0)),
-              file=sys.stderr, flush=True)
+        announce(spec, out, "")
         return out
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
         futures = {s.name(): pool.submit(job, s) for s in specs}
