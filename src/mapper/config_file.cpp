@@ -304,6 +304,8 @@ PanmapConfig loadConfig(const std::string& path, const PanmapConfig& base) {
     s.read("instance_min_overlap", &m.superpoints.instance_min_overlap);
     s.read("mask_verdicts", &m.superpoints.mask_verdicts);
     s.read("apart_weight", &m.superpoints.apart_weight);
+    s.read("join_mask_pieces", &m.superpoints.join_mask_pieces);
+    s.read("revisit_votes", &m.superpoints.revisit_votes);
     s.finish();
   }
   {
@@ -586,7 +588,11 @@ std::string configToYaml(const PanmapConfig& c) {
     << "   mask_verdicts: " << m.superpoints.mask_verdicts
     << "   # 1: only masks of their class merge or split super-points\n"
     << "   apart_weight: " << m.superpoints.apart_weight
-    << "   # merge only when co-observed in more than this x the frames showing two objects\n";
+    << "   # merge only when co-observed in more than this x the frames showing two objects\n"
+    << "   join_mask_pieces: " << m.superpoints.join_mask_pieces
+    << "   # 1: pieces of one mask share the super-point of its class\n"
+    << "   revisit_votes: " << m.superpoints.revisit_votes
+    << "   # 1: a surface takes back its class's super-point from its voxels' votes\n";
   y << "graph:\n"
     << "   spatial_scale_m: " << m.graph.spatial_scale_m << "   # P_s = 1 / (1 + d / scale)\n"
     << "   sample_stride_px: " << m.graph.sample_stride_px << "\n"

@@ -44,7 +44,9 @@ constexpr char kMagic[8] = {'P', 'A', 'N', 'M', 'A', 'P', '\0', '\0'};
 //     (frames 0), as they were built.
 // 17: fusion's mask-only surfaces (SurfaceFusionConfig::mask_only_surfaces and its depth step);
 //     older files load with them off, as they were built.
-constexpr uint32_t kVersion = 17;
+// 18: III-B's join_mask_pieces and revisit_votes; older files load with both off, as they were
+//     built.
+constexpr uint32_t kVersion = 18;
 
 // Bytes of one voxel's votes in a file: four slots of a 4-byte label and a 2-byte count.
 constexpr size_t kVoteSetBytes = kVoteSlots * 6;
@@ -252,6 +254,8 @@ void putConfig(BinaryWriter* w, const MapperConfig& c) {
   w->put(k.max_pattern_m);
   w->put<uint8_t>(c.fusion.mask_only_surfaces);
   w->put(c.fusion.mask_only_depth_step);
+  w->put<uint8_t>(c.superpoints.join_mask_pieces);
+  w->put<uint8_t>(c.superpoints.revisit_votes);
 }
 
 MapperConfig getConfig(BinaryReader* r, uint32_t version) {
@@ -355,6 +359,8 @@ MapperConfig getConfig(BinaryReader* r, uint32_t version) {
   } else {
     c.fusion.mask_only_surfaces = false;
   }
+  c.superpoints.join_mask_pieces = version >= 18 && r->get<uint8_t>() != 0;
+  c.superpoints.revisit_votes = version >= 18 && r->get<uint8_t>() != 0;
   return c;
 }
 

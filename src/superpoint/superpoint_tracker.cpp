@@ -298,6 +298,12 @@ void SuperpointTracker::associate(const FrameSegmentation& segmentation, const R
     out.surface_labels[s] = label;
     holder[label] = s;
   }
+  if (config_.semantic_consistency && config_.join_mask_pieces) {
+    joinMaskPieces(surfaces, pairs, samples, lost, holder, &out);
+  }
+  if (config_.semantic_consistency && config_.revisit_votes) {
+    revisitVotes(segmentation, frame, T_W_C, map, samples, lost, &holder, &out);
+  }
   out.splits.clear();
   for (size_t s = 0; s < n; ++s) {
     if (out.surface_labels[s] == 0) {
@@ -392,6 +398,87 @@ void SuperpointTracker::associate(const FrameSegmentation& segmentation, const R
   for (size_t i = 0; i < out.pixel_labels.size(); ++i) {
     const int32_t sid = sids[i];
     pixel_labels[i] = sid > 0 && static_cast<size_t>(sid) <= n ? out.surface_labels[sid - 1] : 0;
+  }
+}
+
+void SuperpointTracker::joinMaskPieces(const std::vector<Surface>& surfaces,
+                                       const std::vector<std::tuple<int, size_t, int32_t>>& pairs,
+                                       const std::vector<int>& samples,
+                                       const std::vector<int32_t>& lost,
+                                       const std::map<int32_t, size_t>& holder,
+                                       FrameAssociation* out) const {
+  // Best pairs first, as the association: a surface joins the largest super-point it can.
+  for (const auto& [neg_count, s, label] : pairs) {
+    if (out->surface_labels[s] != 0 || lost[s] != 0) continue;
+    if (-neg_count < config_.association_min_overlap * samples[s]) continue;
+    const auto it = holder.find(label);
+    if (it == holder.end()) continue;
+    const Surface& piece = surfaces[s];
+    const Surface& taker = surfaces[it->second];
+    if (piece.panoptic_segment > 0 && piece.panoptic_segment == taker.panoptic_segment &&
+        piece.category > 0 && piece.category == labelledClassOf(label)) {
+      out->surface_labels[s] = label;
+    }
+  }
+}
+
+void SuperpointTracker::revisitVotes(const FrameSegmentation& segmentation, const RgbdFrame& frame,
+                                     const Eigen::Isometry3d& T_W_C, const TsdfMap& map,
+                                     const std::vector<int>& samples,
+                                     const std::vector<int32_t>& lost,
+                                     std::map<int32_t, size_t>* holder, FrameAssociation* out) {
+  const auto& surfaces = segmentation.surface_list;
+  const size_t n = surfaces.size();
+  // Labelled surfaces about to start a super-point; a split's new one is wanted as it is.
+  std::vector<uint8_t> looking(n + 1, 0);
+  bool any = false;
+  for (size_t s = 0; s < n; ++s) {
+    if (out->surface_labels[s] == 0 && lost[s] == 0 && surfaces[s].category > 0) {
+      looking[s + 1] = 1;
+      any = true;
+    }
+  }
+  if (!any) return;
+  // Per looking surface: its samples whose voxel holds any vote for each super-point (a
+  // super-point counts once per sample however many slots it has there).
+  std::vector<std::map<int32_t, int>> held(n);
+  VoxelLabelSampler sampler(map, T_W_C.cast<float>(), frame.camera,
+                            [this](int32_t l) { return labels_.resolve(l); });
+  const float scale = static_cast<float>(frame.depth_scale_m);
+  const int stride = config_.sample_stride_px;
+  for (int v = 0; v < frame.camera.height; v += stride) {
+    for (int u = 0; u < frame.camera.width; u += stride) {
+      const int32_t sid = segmentation.surfaces(u, v);
+      if (sid <= 0 || static_cast<size_t>(sid) > n || !looking[sid]) continue;
+      const float d = frame.depth(u, v) * scale;
+      if (!(d > 0.0f)) continue;
+      const VoxelVotes* votes = sampler.votes(u, v, d);
+      if (!votes) continue;
+      int32_t seen[kVoteSlots];
+      int k = 0;
+      for (const LabelVote& vote : votes->slots) {
+        if (vote.count == 0) continue;
+        const int32_t root = labels_.resolve(vote.label);
+        if (std::find(seen, seen + k, root) != seen + k) continue;
+        seen[k++] = root;
+        ++held[sid - 1][root];
+      }
+    }
+  }
+  std::vector<std::tuple<int, size_t, int32_t>> pairs;  // (-count, surface, label)
+  for (size_t s = 0; s < n; ++s) {
+    for (const auto& [label, count] : held[s]) {
+      if (count >= config_.association_min_overlap * samples[s] &&
+          labelledClassOf(label) == surfaces[s].category) {
+        pairs.emplace_back(-count, s, label);
+      }
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  for (const auto& [neg_count, s, label] : pairs) {
+    if (out->surface_labels[s] != 0 || holder->count(label)) continue;
+    out->surface_labels[s] = label;
+    (*holder)[label] = s;
   }
 }
 

@@ -438,10 +438,27 @@ constexpr size_t kDepthCheckConfigBytes = 4 * sizeof(int32_t) + sizeof(double);
 // Bytes of fusion's mask-only surfaces in the config (version 17): a flag and a float.
 constexpr size_t kMaskOnlyBytes = 1 + sizeof(float);
 
+// Bytes of III-B's join_mask_pieces and revisit_votes in the config (version 18): two flags.
+constexpr size_t kReuseBytes = 2;
+
+// A file of today's `config` (without a calibration) without what version 18 added after the
+// mask-only surfaces: its layout of version 17.
+std::vector<uint8_t> withoutReuseRules(std::vector<uint8_t> file, const MapperConfig& config) {
+  const size_t at = calibrationFlagAt(config) + 1 + kFillBytes + sizeof(int32_t) +
+                    kDepthCheckConfigBytes + kMaskOnlyBytes;
+  EXPECT_LT(at + kReuseBytes, file.size());
+  EXPECT_EQ(file[at], config.superpoints.join_mask_pieces ? 1 : 0);
+  EXPECT_EQ(file[at + 1], config.superpoints.revisit_votes ? 1 : 0);
+  file.erase(file.begin() + static_cast<std::ptrdiff_t>(at),
+             file.begin() + static_cast<std::ptrdiff_t>(at + kReuseBytes));
+  return file;
+}
+
 // A file of today's `config` (without a calibration) without what version 17 added after the
 // depth check's config: its layout of version 16.
 std::vector<uint8_t> withoutMaskOnlySurfaces(std::vector<uint8_t> file,
                                              const MapperConfig& config) {
+  file = withoutReuseRules(std::move(file), config);
   const size_t at =
       calibrationFlagAt(config) + 1 + kFillBytes + sizeof(int32_t) + kDepthCheckConfigBytes;
   EXPECT_LT(at + kMaskOnlyBytes, file.size());
@@ -533,7 +550,7 @@ std::vector<uint8_t> asVersion(std::vector<uint8_t> file, size_t share_offset, u
   return reseal(std::move(file), version);
 }
 
-TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToSeventeen) {
+TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToEighteen) {
   MapperConfig a;
   a.map.voxel_size_m = 0.05f;
   a.graph.prune_edges = false;
@@ -629,22 +646,36 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToSeventeen) {
   EXPECT_EQ(sixteen->config().depth_check.max_pattern_m, 0.002);
   EXPECT_EQ(sixteen->depthCheck().verdict(), DepthPatternMonitor::Verdict::kPending);
   EXPECT_FALSE(sixteen->config().fusion.mask_only_surfaces);
-  // Version 17 keeps them, on or off, with their depth step.
+  // Version 17 keeps them, on or off, with their depth step, and was built without III-B's
+  // reuse rules.
   EXPECT_TRUE(fill.fusion.mask_only_surfaces);
   fill.fusion.mask_only_depth_step = 0.03f;
-  const auto on = Mapper::deserialize(Mapper(fill).serialize(), "17.panmap");
+  const auto on = Mapper::deserialize(reseal(withoutReuseRules(Mapper(fill).serialize(), fill), 17),
+                                      "17.panmap");
   EXPECT_TRUE(on->config().fusion.mask_only_surfaces);
   EXPECT_EQ(on->config().fusion.mask_only_depth_step, 0.03f);
+  EXPECT_FALSE(on->config().superpoints.join_mask_pieces);
+  EXPECT_FALSE(on->config().superpoints.revisit_votes);
   fill.fusion.mask_only_surfaces = false;
-  EXPECT_FALSE(Mapper::deserialize(Mapper(fill).serialize(), "17.panmap")
+  EXPECT_FALSE(Mapper::deserialize(reseal(withoutReuseRules(Mapper(fill).serialize(), fill), 17),
+                                   "17.panmap")
                    ->config()
                    .fusion.mask_only_surfaces);
+  // Version 18 keeps each rule, on or off.
+  EXPECT_TRUE(fill.superpoints.join_mask_pieces && fill.superpoints.revisit_votes);
+  for (const auto& [join, revisit] : {std::pair{true, false}, std::pair{false, true}}) {
+    fill.superpoints.join_mask_pieces = join;
+    fill.superpoints.revisit_votes = revisit;
+    const auto eighteen = Mapper::deserialize(Mapper(fill).serialize(), "18.panmap");
+    EXPECT_EQ(eighteen->config().superpoints.join_mask_pieces, join);
+    EXPECT_EQ(eighteen->config().superpoints.revisit_votes, revisit);
+  }
 
-  // Versions outside 5-17 are refused by name.
+  // Versions outside 5-18 are refused by name.
   std::vector<uint8_t> future = Mapper(b).serialize();
-  future[8] = 18;
+  future[8] = 19;
   test::expectError([&] { Mapper::deserialize(future, "future.panmap"); },
-                    {"future.panmap", "version 18", "reads 5 to 17"});
+                    {"future.panmap", "version 19", "reads 5 to 18"});
 }
 
 // Bytes before a block's voxels in a map file: its index and its updated flag.
@@ -814,12 +845,12 @@ TEST_F(BoxScene, MapFileVotesRoundTripAndBadVoteListsAreRefused) {
   const size_t second_at = count_at + 2 + 2 + sizeof(VoxelVotes);
   std::vector<uint8_t> repeated = file;  // the second voted voxel's index made the first's
   std::memcpy(&repeated[second_at], &file[count_at + 2], 2);
-  test::expectError([&] { Mapper::deserialize(reseal(repeated, 17), "repeated.panmap"); },
+  test::expectError([&] { Mapper::deserialize(reseal(repeated, 18), "repeated.panmap"); },
                     {"repeated.panmap", "out of order"});
   std::vector<uint8_t> too_many = file;
   const uint16_t n = kBlockVoxels + 1;
   std::memcpy(&too_many[count_at], &n, 2);
-  test::expectError([&] { Mapper::deserialize(reseal(too_many, 17), "many.panmap"); },
+  test::expectError([&] { Mapper::deserialize(reseal(too_many, 18), "many.panmap"); },
                     {"many.panmap", "513 voted voxels"});
 }
 

@@ -1,5 +1,6 @@
 #include <map>
 #include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -378,6 +379,7 @@ TEST_F(WallScene, SuperpointUnderOneMaskSplitsWhenShownAsTwoObjects) {
     TsdfMap map(TsdfMap::Config{0.05f});
     SuperpointConfig config;
     config.mask_verdicts = verdicts;
+    config.revisit_votes = false;  // the rule of RevisitingSurfacesTakeBackTheirSuperpoint
     SuperpointTracker tracker(config);
     const auto one = stripes({{640, 5}});            // one mask over both objects
     const auto two = stripes({{320, 5}, {640, 5}});  // two masks (ids 1 and 2) of class 5
@@ -411,6 +413,82 @@ TEST_F(WallScene, SuperpointUnderOneMaskSplitsWhenShownAsTwoObjects) {
   }
 }
 
+// A mask cut in two by a depth edge: the piece whose super-point the other piece took joins it
+// (join_mask_pieces), instead of starting one that the next frame's piece replaces.
+TEST_F(WallScene, PiecesOfOneMaskShareItsSuperpoint) {
+  for (bool join : {true, false}) {
+    TsdfMap map(TsdfMap::Config{0.05f});
+    SuperpointConfig config;
+    config.join_mask_pieces = join;
+    config.revisit_votes = false;
+    SuperpointTracker tracker(config);
+    for (int k = 0; k < 3; ++k) step(&tracker, &map, columns(640, 5, 5));
+    int created = 0;
+    FrameAssociation last;
+    for (int k = 0; k < 4; ++k) {
+      last = step(&tracker, &map, columns(384, 5, 5, /*same_mask=*/true));
+      created += last.new_labels;
+    }
+    ASSERT_EQ(last.surface_labels.size(), 2u);
+    EXPECT_EQ(last.surface_labels[0], 1);
+    if (join) {
+      EXPECT_EQ(created, 0);
+      EXPECT_EQ(last.surface_labels[1], 1);
+      EXPECT_EQ(tracker.state(1)->class_counts.at(5), 3.0 + 2 * 4);  // both pieces count
+    } else {
+      EXPECT_EQ(created, 4);  // a new one every frame: 2, 3, 4, 5
+      EXPECT_EQ(last.surface_labels[1], 5);
+    }
+    // Two masks of one class are two verdicts, not pieces: the right half splits off.
+    const FrameAssociation two = step(&tracker, &map, columns(384, 5, 5));
+    ASSERT_EQ(two.splits.size(), 1u);
+    EXPECT_EQ(two.splits[0].from, 1);
+  }
+}
+
+// An object on a wall whose voxels the wall's super-point leads (6 frames of votes): the
+// object's surface loses that super-point to the wall's surface each frame. With
+// revisit_votes it takes back the super-point it started, from the voxels' second vote slot,
+// until its own votes lead; without, every frame starts another.
+TEST_F(WallScene, RevisitingSurfacesTakeBackTheirSuperpoint) {
+  for (bool revisit : {true, false}) {
+    TsdfMap map(TsdfMap::Config{0.05f});
+    SuperpointConfig config;
+    config.revisit_votes = revisit;
+    SuperpointTracker tracker(config);
+    for (int k = 0; k < 6; ++k) step(&tracker, &map, columns(640, 1, 1));
+    int created = 0;
+    std::vector<int32_t> object_labels;
+    for (int k = 0; k < 9; ++k) {
+      const FrameAssociation a = step(&tracker, &map, columns(384, 1, 6));
+      created += a.new_labels;
+      object_labels.push_back(a.surface_labels.at(1));
+      EXPECT_EQ(a.surface_labels[0], 1);
+      EXPECT_TRUE(a.splits.empty());  // another class: no split
+    }
+    if (revisit) {
+      EXPECT_EQ(created, 1);
+      EXPECT_EQ(object_labels, std::vector<int32_t>(9, 2));
+      EXPECT_EQ(tracker.state(2)->class_counts.at(6), 9.0);
+    } else {
+      EXPECT_EQ(created, 9);
+      EXPECT_EQ(object_labels.back(), 10);
+      EXPECT_EQ(tracker.state(10)->class_counts.at(6), 1.0);
+    }
+  }
+}
+
+// A surface of another class than the super-points in its voxels' slots starts its own.
+TEST_F(WallScene, RevisitingTakesOnlyASuperpointOfTheSurfacesClass) {
+  TsdfMap map(TsdfMap::Config{0.05f});
+  SuperpointTracker tracker(SuperpointConfig{});
+  for (int k = 0; k < 6; ++k) step(&tracker, &map, columns(640, 1, 1));
+  step(&tracker, &map, columns(384, 1, 6));  // super-point 2, class 6, on the right
+  const FrameAssociation a = step(&tracker, &map, columns(384, 1, 7));
+  EXPECT_EQ(a.new_labels, 1);
+  EXPECT_EQ(a.surface_labels[1], 3);
+}
+
 // Three objects first seen under one mask, then as three masks: two surfaces split from the
 // same super-point in one frame, and each split measures its distance to the surface that
 // kept it (the middle stripe's centroid is nearer to the left one than the right stripe's).
@@ -436,6 +514,9 @@ TEST_F(WallScene, ForeignMaskOverTwoSuperpointsDoesNotMergeThem) {
     TsdfMap map(TsdfMap::Config{0.05f});
     SuperpointConfig config;
     config.mask_verdicts = verdicts;
+    // Revisiting, the floor surface would take back its own super-point, whose votes lead its
+    // voxels from the third spill frame on: the pair would no longer be co-observed there.
+    config.revisit_votes = false;
     SuperpointTracker tracker(config);
     const auto two = stripes({{320, 5}, {640, 5}});
     const auto spill = stripes({{280, 5}, {360, 2}, {640, 0}});  // object, floor, unlabelled

@@ -42,6 +42,12 @@ class VoxelLabelSampler {
     return labelOf(lookup_.findGridVotes(grid.voxel(u, d_m)));
   }
 
+  /// The votes of the voxel that pixel (u, v) at depth d_m (> 0) sees; null when its block is
+  /// not allocated or it has none.
+  const VoxelVotes* votes(int u, int v, float d_m) {
+    return lookup_.findGridVotes(row(v).voxel(u, d_m));
+  }
+
   /// Global integer coordinates of the voxel the last label() call found.
   const Eigen::Vector3i& lastVoxel() const { return lookup_.lastVoxel(); }
 

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <map>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -50,6 +51,20 @@ struct SuperpointConfig {
   /// labelled a few times must not bury a labelled piece of an object (issue 19: half of a
   /// chair went unlabelled in a wall-and-clutter super-point). 1 turns the rule off.
   double unlabelled_void_share = 0.8;
+  /// With semantic_consistency: a surface whose super-point another surface of the same mask
+  /// took this frame joins it too, when the super-point is of the mask's class. One mask is one
+  /// verdict, and a depth edge that cuts it says nothing the super-point does not already hold.
+  /// false: a new super-point, as Voxblox++'s one surface per super-point per frame; its one
+  /// vote a voxel lost to the next frame's, it lasted a frame and took the surface's frame
+  /// counts with it (issue 19: a quarter of a ScanNet-like room's new super-points).
+  bool join_mask_pieces = true;
+  /// With semantic_consistency: a labelled surface that would start a super-point (none free
+  /// among its voxels' leading labels) first takes a free one of its class that any vote slot
+  /// of at least association_min_overlap of its samples holds: the one it started on an
+  /// earlier visit, not yet its voxels' leader (a picture on a wall, a cabinet front under a
+  /// super-point that another surface took). false: every visit starts another, and the
+  /// object's frame and apart counts are spread over super-points gone a few frames later.
+  bool revisit_votes = true;
   /// Pixels between overlap samples (1 = every pixel).
   int sample_stride_px = 2;
   /// A 2D instance joins the global instance covering at least this share of its pixels.
@@ -206,6 +221,18 @@ class SuperpointTracker {
   /// co-observed them in one surface (m): no merge (semantic consistency only).
   bool seenApart(const std::pair<int32_t, int32_t>& key, int m) const;
   void mergeLabels(int32_t a, int32_t b, FrameAssociation* out);  // out: null or counts it
+  /// join_mask_pieces: surfaces without a label take the super-point a surface of their mask
+  /// took. pairs: (-samples, surface, label), best first; holder: label -> surface taking it.
+  void joinMaskPieces(const std::vector<Surface>& surfaces,
+                      const std::vector<std::tuple<int, size_t, int32_t>>& pairs,
+                      const std::vector<int>& samples, const std::vector<int32_t>& lost,
+                      const std::map<int32_t, size_t>& holder, FrameAssociation* out) const;
+  /// revisit_votes: labelled surfaces without a label (and not splitting) take a free
+  /// super-point of their class from their voxels' vote slots; holder gains them.
+  void revisitVotes(const FrameSegmentation& segmentation, const RgbdFrame& frame,
+                    const Eigen::Isometry3d& T_W_C, const TsdfMap& map,
+                    const std::vector<int>& samples, const std::vector<int32_t>& lost,
+                    std::map<int32_t, size_t>* holder, FrameAssociation* out);
   void associateInstances(const FrameSegmentation& segmentation, FrameAssociation* out);
 
   SuperpointConfig config_;
