@@ -649,6 +649,8 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToEighteen) {
   // Version 17 keeps them, on or off, with their depth step, and was built without III-B's
   // reuse rules.
   EXPECT_TRUE(fill.fusion.mask_only_surfaces);
+  fill.superpoints.join_mask_pieces = true;
+  fill.superpoints.revisit_votes = true;
   fill.fusion.mask_only_depth_step = 0.03f;
   const auto on = Mapper::deserialize(reseal(withoutReuseRules(Mapper(fill).serialize(), fill), 17),
                                       "17.panmap");
@@ -662,7 +664,6 @@ TEST(MapFile, KeepsItsSettingsAndReadsVersionsFiveToEighteen) {
                    ->config()
                    .fusion.mask_only_surfaces);
   // Version 18 keeps each rule, on or off.
-  EXPECT_TRUE(fill.superpoints.join_mask_pieces && fill.superpoints.revisit_votes);
   for (const auto& [join, revisit] : {std::pair{true, false}, std::pair{false, true}}) {
     fill.superpoints.join_mask_pieces = join;
     fill.superpoints.revisit_votes = revisit;

@@ -481,7 +481,9 @@ TEST_F(WallScene, RevisitingSurfacesTakeBackTheirSuperpoint) {
 // A surface of another class than the super-points in its voxels' slots starts its own.
 TEST_F(WallScene, RevisitingTakesOnlyASuperpointOfTheSurfacesClass) {
   TsdfMap map(TsdfMap::Config{0.05f});
-  SuperpointTracker tracker(SuperpointConfig{});
+  SuperpointConfig config;
+  config.revisit_votes = true;
+  SuperpointTracker tracker(config);
   for (int k = 0; k < 6; ++k) step(&tracker, &map, columns(640, 1, 1));
   step(&tracker, &map, columns(384, 1, 6));  // super-point 2, class 6, on the right
   const FrameAssociation a = step(&tracker, &map, columns(384, 1, 7));

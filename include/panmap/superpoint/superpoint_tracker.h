@@ -51,20 +51,21 @@ struct SuperpointConfig {
   /// labelled a few times must not bury a labelled piece of an object (issue 19: half of a
   /// chair went unlabelled in a wall-and-clutter super-point). 1 turns the rule off.
   double unlabelled_void_share = 0.8;
+  /// Opt-in (docs/MAPPING.md, step 3: on the accuracy suite a box room lost a match at IoU 0.50).
   /// With semantic_consistency: a surface whose super-point another surface of the same mask
   /// took this frame joins it too, when the super-point is of the mask's class. One mask is one
   /// verdict, and a depth edge that cuts it says nothing the super-point does not already hold.
   /// false: a new super-point, as Voxblox++'s one surface per super-point per frame; its one
   /// vote a voxel lost to the next frame's, it lasted a frame and took the surface's frame
   /// counts with it (issue 19: a quarter of a ScanNet-like room's new super-points).
-  bool join_mask_pieces = true;
+  bool join_mask_pieces = false;
   /// With semantic_consistency: a labelled surface that would start a super-point (none free
   /// among its voxels' leading labels) first takes a free one of its class that any vote slot
   /// of at least association_min_overlap of its samples holds: the one it started on an
   /// earlier visit, not yet its voxels' leader (a picture on a wall, a cabinet front under a
   /// super-point that another surface took). false: every visit starts another, and the
   /// object's frame and apart counts are spread over super-points gone a few frames later.
-  bool revisit_votes = true;
+  bool revisit_votes = false;
   /// Pixels between overlap samples (1 = every pixel).
   int sample_stride_px = 2;
   /// A 2D instance joins the global instance covering at least this share of its pixels.
