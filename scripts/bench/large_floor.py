@@ -11,7 +11,7 @@ Writes docs/LARGE_FLOOR.md; about 25 minutes on 2 cores with the defaults.
 
   scripts/bench/large_floor.py [--building 7] [--rooms 4] [--area 150] [--seed 1]
                                [--stops-area 6,3,0] [--annotations annotated,empty]
-                               [--masks m2f[,clean]]
+                               [--masks m2f[,clean]] [--config FILE]
                                [--work build/large_floor] [--jobs 2] [--out docs/LARGE_FLOOR.md]
                                [--report-only]
 """
@@ -62,7 +62,7 @@ def run_one(args, scene, stops_area, annotation, masks):
     if not os.path.exists(os.path.join(seq, "info.json")):
         suite.run([suite.tool("panmap-synth"), "-q", "--out", seq] + spec.synth_args() +
                   ["--area-per-stop", "%g" % stops_area])
-    suite.map_sequence(args.work, seq, spec, 0.02, variants=VARIANTS)
+    suite.map_sequence(args.work, seq, spec, 0.02, args.config, variants=VARIANTS)
     os.remove(os.path.join(seq, "sequence.lcmlog"))  # 0.5-1.3 GB each; the scores are kept
     os.rename(os.path.join(seq, "info.json"), os.path.join(seq, "info.json.done"))
     return row(args, stops_area, annotation, masks)
@@ -166,12 +166,18 @@ def main():
     parser.add_argument("--masks", default="m2f",
                         help="mask presets (m2f, clean, hard), comma-separated: clean masks "
                              "show what the network's errors cost")
+    parser.add_argument("--config", default="",
+                        help="YAML config for every mapper run (panmap-mapper --config)")
     parser.add_argument("--work", default=os.path.join(suite.BUILD, "large_floor"))
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--out", default=os.path.join(suite.ROOT, "docs", "LARGE_FLOOR.md"))
     parser.add_argument("--report-only", action="store_true",
                         help="write the report from the runs WORK holds, mapping nothing")
     args = parser.parse_args()
+    if args.config:
+        if not os.path.isfile(args.config):
+            sys.exit("large_floor: no config file '%s'" % args.config)
+        args.config = os.path.abspath(args.config)
     annotations = [a for a in args.annotations.split(",") if a]
     for a in annotations:
         if a not in ANNOTATIONS:
