@@ -542,12 +542,22 @@ def bridge_list(rows):
                 else:
                     parts = ", ".join("%s %.0f %%" % (c["name"], 100 * c["share"])
                                       for c in b.get("classes", []))
-                items.append("`%s` super-point %d: %d vertices, %s; reach %.1f cm" % (
-                    name, b["superpoint"], b["vertices"], parts, 100 * b.get("reach_m", 0.0)))
+                item = "`%s` super-point %d: %d vertices, %s; reach %.1f cm" % (
+                    name, b["superpoint"], b["vertices"], parts, 100 * b.get("reach_m", 0.0))
+                to_map = b.get("map_distance_m") or []
+                if len(to_map) == 2 and None not in to_map:
+                    item += "; median distance to the map %.1f / %.1f cm" % (
+                        100 * to_map[0], 100 * to_map[1])
+                items.append(item)
     if not items:
         return ""
     return ("Bridging super-points of the full method, run by run (ground-truth poses, `m2f` "
-            "masks; vertices beyond the band by GT object, or by class): " + "; ".join(items) +
+            "masks; vertices beyond the band by GT object, or by class; the median distance "
+            "from the GT vertices of each of its two classes (the larger first) to the nearest "
+            "mapped vertex: on "
+            "surface the map observed, about half a voxel, farther on surface it never "
+            "resolved, which the 5 cm label transfer labels from the nearest mapped surface): " +
+            "; ".join(items) +
             ". docs/MAPPING.md (III-B) says how such bridges arise: the main suite's of "
             "2026-12-02 (docs/RESULTS.md) traced vote by vote.")
 

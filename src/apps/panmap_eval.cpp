@@ -185,7 +185,9 @@ json toJson(const panmap::SceneDiagnostics& d) {
                        {"vertices", b.vertices},
                        {"classes", classes},
                        {"gt_instances", parts},
-                       {"reach_m", b.reach_m}});
+                       {"reach_m", b.reach_m},
+                       {"map_distance_m",
+                        json::array({number(b.map_distance_m[0]), number(b.map_distance_m[1])})}});
   }
   json things = json::array();
   for (const auto& t : d.gt_things) {

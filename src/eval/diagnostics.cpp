@@ -142,6 +142,9 @@ void measureReach(const LabelledMesh& gt, const TransferredLabels& pred,
     trees[cls] = std::make_unique<NearestPointIndex>(&points);
   }
   std::vector<std::array<double, 2>> farthest(bridges->size(), {0.0, 0.0});
+  // Per bridge and side: its vertices' distances to the map (when the transfer kept them).
+  std::vector<std::array<std::vector<float>, 2>> to_map(bridges->size());
+  const bool distances = pred.distance_m.size() == n;
   for (size_t v = 0; v < n; ++v) {
     if (!away[v]) continue;
     const auto it = bridge_of.find(pred.superpoint[v]);
@@ -149,6 +152,7 @@ void measureReach(const LabelledMesh& gt, const TransferredLabels& pred,
     const auto& mix = (*bridges)[it->second].class_mix;
     const int side = gt.semantic[v] == mix[0].first ? 0 : gt.semantic[v] == mix[1].first ? 1 : -1;
     if (side < 0) continue;
+    if (distances) to_map[it->second][side].push_back(pred.distance_m[v]);
     const auto& other = class_points.at(mix[1 - side].first);
     const int64_t w = trees.at(mix[1 - side].first)->nearest(gt.vertices[v]);
     if (w < 0) continue;
@@ -157,6 +161,14 @@ void measureReach(const LabelledMesh& gt, const TransferredLabels& pred,
   }
   for (size_t b = 0; b < bridges->size(); ++b) {
     (*bridges)[b].reach_m = std::min(farthest[b][0], farthest[b][1]);
+    for (int side = 0; side < 2; ++side) {
+      std::vector<float>& d = to_map[b][side];
+      if (d.empty()) continue;
+      // The lower median: a distance some vertex has.
+      const auto mid = d.begin() + static_cast<std::ptrdiff_t>((d.size() - 1) / 2);
+      std::nth_element(d.begin(), mid, d.end());
+      (*bridges)[b].map_distance_m[side] = *mid;
+    }
   }
 }
 
@@ -170,7 +182,8 @@ SceneDiagnostics diagnose(const LabelledMesh& gt, const TransferredLabels& pred,
     throw Error("diagnose: ground-truth mesh lacks semantic or instance labels");
   }
   if (pred.semantic.size() != n || pred.instance.size() != n || pred.superpoint.size() != n ||
-      (!pred.reached.empty() && pred.reached.size() != n)) {
+      (!pred.reached.empty() && pred.reached.size() != n) ||
+      (!pred.distance_m.empty() && pred.distance_m.size() != n)) {
     throw Error("diagnose: transferred labels do not match the ground-truth vertex count");
   }
   if (num_bins < 1) throw Error("diagnose: num_bins must be >= 1");
@@ -450,12 +463,18 @@ std::string formatDiagnostics(const SceneDiagnostics& d) {
     const auto& bridge = d.bridges[b];
     std::snprintf(line, sizeof(line),
                   "  spanning super-point %d: %lld vertices, %s %.0f %%, %s %.0f %%, reaching "
-                  "%.1f cm past their boundary\n",
+                  "%.1f cm past their boundary",
                   bridge.superpoint, static_cast<long long>(bridge.vertices),
                   nyu40Name(bridge.class_mix[0].first).c_str(), 100 * bridge.class_mix[0].second,
                   nyu40Name(bridge.class_mix[1].first).c_str(), 100 * bridge.class_mix[1].second,
                   100 * bridge.reach_m);
     out += line;
+    if (!std::isnan(bridge.map_distance_m[0]) && !std::isnan(bridge.map_distance_m[1])) {
+      std::snprintf(line, sizeof(line), "; median distance to the map %.1f / %.1f cm",
+                    100 * bridge.map_distance_m[0], 100 * bridge.map_distance_m[1]);
+      out += line;
+    }
+    out += "\n";
   }
   std::string mix;
   for (size_t k = 0; k < d.largest_class_mix.size() && k < 5; ++k) {

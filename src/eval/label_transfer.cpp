@@ -1,6 +1,7 @@
 #include "panmap/eval/label_transfer.h"
 
 #include <cmath>
+#include <limits>
 
 #include "panmap/core/error.h"
 #include "panmap/core/nearest_point.h"
@@ -29,6 +30,7 @@ TransferredLabels transferLabels(const LabelledMesh& predicted,
   out.instance.assign(gt_vertices.size(), 0);
   out.superpoint.assign(gt_vertices.size(), 0);
   out.reached.assign(gt_vertices.size(), 0);
+  out.distance_m.assign(gt_vertices.size(), std::numeric_limits<float>::infinity());
   if (predicted.vertices.empty() || gt_vertices.empty()) return out;
 
   const NearestPointIndex tree(&predicted.vertices);
@@ -39,6 +41,7 @@ TransferredLabels transferLabels(const LabelledMesh& predicted,
     // The radius test in double on the original coordinates, so 4.9 cm / 5.1 cm are exact.
     const double d =
         (predicted.vertices[index].cast<double>() - gt_vertices[g].cast<double>()).norm();
+    out.distance_m[g] = static_cast<float>(d);
     if (d > max_distance_m) continue;
     out.semantic[g] = labelOr0(predicted.semantic, index);
     out.instance[g] = labelOr0(predicted.instance, index);

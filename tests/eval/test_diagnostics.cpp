@@ -280,7 +280,35 @@ TEST(Diagnostics, ASuperPointReachingWellIntoTheWallStillBridges) {
   EXPECT_EQ(d.bridges[0].parts[1].class_id, 11);
   EXPECT_EQ(d.bridges[0].parts[1].instance, 2);
   EXPECT_EQ(d.bridges[0].parts[1].vertices, 324);
+  // Labels built by hand keep no distances to the map: none reported.
+  EXPECT_TRUE(std::isnan(d.bridges[0].map_distance_m[0]));
+  EXPECT_TRUE(std::isnan(d.bridges[0].map_distance_m[1]));
+  EXPECT_EQ(formatDiagnostics(d).find("distance to the map"), std::string::npos);
   EXPECT_THROW(diagnose(wide.gt, wide.pred, {}, 5, -0.01), Error);
+}
+
+TEST(Diagnostics, ABridgeSaysHowFarEachOfItsClassesLiesFromTheMap) {
+  // The wall the super-point takes was never mapped (2.5 cm from the nearest mapped vertex,
+  // as behind an object); the picture was: 72 of its 324 vertices beyond the band at 1 mm, the
+  // other 252 at 4 mm. Medians: 2.5 cm and 4 mm (the mean, 3.3 mm, would not be a median).
+  PictureOnWall wide(5, 35);
+  for (size_t v = 0; v < wide.gt.numVertices(); ++v) {
+    const bool picture = wide.gt.semantic[v] == 11;
+    const bool low_rows = wide.gt.vertices[v].y() < 0.145f;  // rows j = 11..14 of the picture
+    wide.pred.distance_m.push_back(!picture ? 0.025f : low_rows ? 0.001f : 0.004f);
+  }
+  const SceneDiagnostics d = diagnose(wide.gt, wide.pred, {}, 5, 0.015);
+  ASSERT_EQ(d.bridges.size(), 1u);
+  ASSERT_EQ(d.bridges[0].class_mix[0].first, 1);  // wall first
+  EXPECT_NEAR(d.bridges[0].map_distance_m[0], 0.025, 1e-7);
+  EXPECT_NEAR(d.bridges[0].map_distance_m[1], 0.004, 1e-7);
+  EXPECT_NE(formatDiagnostics(d).find("reaching 7.1 cm past their boundary; median distance to "
+                                      "the map 2.5 / 0.4 cm\n"),
+            std::string::npos)
+      << formatDiagnostics(d);
+  // A distance per GT vertex or none: anything else is refused like the other arrays.
+  wide.pred.distance_m.pop_back();
+  EXPECT_THROW(diagnose(wide.gt, wide.pred, {}, 5, 0.015), Error);
 }
 
 TEST(Diagnostics, RefusesMismatchedInput) {

@@ -1,3 +1,5 @@
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "panmap/core/error.h"
@@ -20,6 +22,12 @@ TEST(LabelTransfer, RespectsFiveCentimetreRadius) {
   EXPECT_EQ(t.superpoint, (std::vector<int32_t>{9, 0, 9, 10}));
   EXPECT_EQ(t.reached, (std::vector<uint8_t>{1, 0, 1, 1}));
   EXPECT_EQ(t.num_transferred, 3u);
+  // Distances to the nearest predicted vertex, out of range too.
+  ASSERT_EQ(t.distance_m.size(), 4u);
+  EXPECT_FLOAT_EQ(t.distance_m[0], 0.049f);
+  EXPECT_FLOAT_EQ(t.distance_m[1], 0.051f);
+  EXPECT_EQ(t.distance_m[2], 0.0f);
+  EXPECT_FLOAT_EQ(t.distance_m[3], 0.04f);
 }
 
 TEST(LabelTransfer, MissingArraysReadAsZero) {
@@ -37,6 +45,8 @@ TEST(LabelTransfer, EmptyPredictionLeavesEverythingUnlabelled) {
   EXPECT_EQ(t.semantic, (std::vector<int32_t>{0}));
   EXPECT_EQ(t.reached, (std::vector<uint8_t>{0}));
   EXPECT_EQ(t.num_transferred, 0u);
+  ASSERT_EQ(t.distance_m.size(), 1u);
+  EXPECT_TRUE(std::isinf(t.distance_m[0]));  // nothing to be near
   EXPECT_THROW(transferLabels(LabelledMesh(), {}, -1.0), Error);
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -60,6 +62,14 @@ struct SceneDiagnostics {
       int64_t vertices = 0;  ///< its GT vertices here, beyond the boundary band
     };
     std::vector<Part> parts;  ///< most vertices first, at most kBridgeInstances
+    /// Median distance from its vertices of each of its two largest classes (boundary bands
+    /// left out) to the nearest vertex of the map, metres; NaN when the label transfer kept no
+    /// distances. Vertices on surface the map observed lie within about half a voxel of it;
+    /// a class whose vertices lie farther is surface the map never resolved (hidden behind
+    /// or pressed against an object), which the label transfer labels from the nearest mapped
+    /// surface, whatever super-point that is.
+    std::array<double, 2> map_distance_m = {std::numeric_limits<double>::quiet_NaN(),
+                                            std::numeric_limits<double>::quiet_NaN()};
   };
   static constexpr size_t kBridgeInstances = 4;  ///< GT objects listed per bridge, at most
   std::vector<Bridge> bridges;                   ///< the bridging super-points, largest first

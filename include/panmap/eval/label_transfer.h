@@ -21,6 +21,9 @@ struct TransferredLabels {
   /// 1 where the GT vertex found a predicted vertex in range (the map observed it). Empty:
   /// every vertex did (labels built by hand).
   std::vector<uint8_t> reached;
+  /// Distance from each GT vertex to the nearest predicted vertex, metres, in range or not
+  /// (infinity without a predicted vertex). Empty: not known (labels built by hand).
+  std::vector<float> distance_m;
   size_t num_transferred = 0;  ///< GT vertices that found a predicted vertex in range
 };
 
