@@ -553,11 +553,10 @@ def bridge_list(rows):
         return ""
     return ("Bridging super-points of the full method, run by run (ground-truth poses, `m2f` "
             "masks; vertices beyond the band by GT object, or by class; the median distance "
-            "from the GT vertices of each of its two classes (the larger first) to the nearest "
-            "mapped vertex: on "
-            "surface the map observed, about half a voxel, farther on surface it never "
-            "resolved, which the 5 cm label transfer labels from the nearest mapped surface): " +
-            "; ".join(items) +
+            "from the GT vertices of each of its two classes, the larger first, to the nearest "
+            "mapped vertex: about half a voxel on surface the map observed, more on surface it "
+            "never resolved, which the 5 cm label transfer labels from the nearest mapped "
+            "surface): " + "; ".join(items) +
             ". docs/MAPPING.md (III-B) says how such bridges arise: the main suite's of "
             "2026-12-02 (docs/RESULTS.md) traced vote by vote.")
 

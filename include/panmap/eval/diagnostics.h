@@ -65,9 +65,9 @@ struct SceneDiagnostics {
     /// Median distance from its vertices of each of its two largest classes (boundary bands
     /// left out) to the nearest vertex of the map, metres; NaN when the label transfer kept no
     /// distances. Vertices on surface the map observed lie within about half a voxel of it;
-    /// a class whose vertices lie farther is surface the map never resolved (hidden behind
-    /// or pressed against an object), which the label transfer labels from the nearest mapped
-    /// surface, whatever super-point that is.
+    /// a class whose vertices lie farther is surface the map never resolved (the side of a
+    /// bathtub behind an object standing against it), which the label transfer labels from the
+    /// nearest mapped surface, whatever super-point that is.
     std::array<double, 2> map_distance_m = {std::numeric_limits<double>::quiet_NaN(),
                                             std::numeric_limits<double>::quiet_NaN()};
   };
